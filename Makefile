@@ -1,0 +1,60 @@
+# Modal Deform — build, test and run everything from a fresh Debian machine (as root).
+#   make demo    install what is missing, build, bake and pose Suzanne headless -> out/demo.{blend,png}
+#   make test    install, build, run the C++, Python and Blender tests
+#   make bench   benchmarks (JSON in bench/results/, tables printed and in docs/benchmarks.md)
+
+PYTHON      := /usr/bin/python3
+BLENDER     := blender
+BUILD_DIR   ?= build
+JOBS        ?= $(shell nproc)
+CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
+
+# Debian packages the project needs, with the reason for each in README.md.
+PACKAGES := cmake g++ make pkg-config \
+	libeigen3-dev libspectra-dev libsuitesparse-dev libopenblas0-pthread liblbfgspp-dev zlib1g-dev \
+	pybind11-dev python3-dev python3-numpy python3-scipy python3-pytest \
+	libgtest-dev libbenchmark-dev \
+	blender xvfb xauth python3-matplotlib
+
+BLENDER_TEST := $(BLENDER) -b --factory-startup --python-exit-code 1
+
+.PHONY: all deps build test test-cpp test-python test-blender demo bench addon clean
+
+all: build
+
+# Idempotent: asks dpkg first and only calls apt-get for what is missing.
+deps:
+	@missing=$$(for p in $(PACKAGES); do \
+		dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q '^install ok installed' || echo $$p; done); \
+	if [ -n "$$missing" ]; then \
+		echo "Installing: $$missing"; \
+		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $$missing; \
+	fi
+
+build: deps
+	@cmake -S . -B $(BUILD_DIR) $(CMAKE_FLAGS) -DPython_EXECUTABLE=$(PYTHON) > $(BUILD_DIR).configure.log 2>&1 \
+		|| (cat $(BUILD_DIR).configure.log; exit 1)
+	@cmake --build $(BUILD_DIR) -j $(JOBS)
+
+test: build
+	$(MAKE) --no-print-directory test-cpp test-python test-blender
+
+test-cpp:
+	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
+
+test-python:
+	PYTHONPATH=python_addon $(PYTHON) -m pytest -q tests/python
+
+test-blender:
+	PYTHONPATH=python_addon $(PYTHON) -m pytest -q tests/blender
+
+demo: build
+	@mkdir -p out
+	$(BLENDER_TEST) --python blender_scripts/demo.py -- --output out
+
+bench: build
+	@mkdir -p bench/results
+	$(BUILD_DIR)/bench/modal_deform_bench --benchmark_out=bench/results/native.json --benchmark_out_format=json
+
+clean:
+	rm -rf $(BUILD_DIR) $(BUILD_DIR).configure.log out dist python_addon/modal_deform/_native*.so

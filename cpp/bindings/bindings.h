@@ -1,0 +1,11 @@
+// One bind_xxx per pipeline stage; each only converts arguments and calls the core.
+#pragma once
+
+#include <pybind11/pybind11.h>
+
+namespace modal_deform {
+
+void bind_errors(pybind11::module_& m);
+void bind_mesh(pybind11::module_& m);
+
+}  // namespace modal_deform

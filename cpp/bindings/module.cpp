@@ -1,0 +1,8 @@
+// The compiled extension modal_deform._native. The Python package modal_deform.core wraps it.
+#include "bindings/bindings.h"
+
+PYBIND11_MODULE(_native, m) {
+  m.doc() = "Modal Deform native core (use modal_deform.core)";
+  modal_deform::bind_errors(m);
+  modal_deform::bind_mesh(m);
+}

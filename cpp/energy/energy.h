@@ -1,0 +1,30 @@
+// The interface every deformation energy implements (discrete shells, ARAP).
+//
+// Positions x are flat vectors of length 3n (x0 y0 z0 x1 ...); the rest state x̄ is fixed when
+// the energy is built, and E(x̄) = 0, ∇E(x̄) = 0. The solvers and the bake see only this
+// interface.
+#pragma once
+
+#include "util/types.h"
+
+namespace modal_deform {
+
+class Energy {
+ public:
+  virtual ~Energy() = default;
+
+  virtual int num_vertices() const = 0;
+  // The rest positions x̄ (3n).
+  virtual const Eigen::VectorXd& rest() const = 0;
+
+  // E(x).
+  virtual double value(const VectorRef& x) const = 0;
+  // E(x), with ∇E(x) written into `gradient` (3n).
+  virtual double value_and_gradient(const VectorRef& x, Eigen::Ref<Eigen::VectorXd> gradient) const = 0;
+  // ∇²E(x): symmetric 3n by 3n, both triangles stored.
+  virtual SparseMatrix hessian(const VectorRef& x) const = 0;
+  // ∇³E(x)(u, w) (3n): the Hessian's derivative along u, applied to w.
+  virtual Eigen::VectorXd third(const VectorRef& x, const VectorRef& u, const VectorRef& w) const = 0;
+};
+
+}  // namespace modal_deform

@@ -1,0 +1,74 @@
+#include "mesh/mesh_check.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
+#include <set>
+
+#include "util/errors.h"
+
+namespace modal_deform {
+
+void validate_mesh(const VerticesRef& V, const FacesRef& F) {
+  if (V.rows() == 0) throw InputError("V: the mesh has no vertices");
+  if (F.rows() == 0) throw InputError("F: the mesh has no faces");
+  for (Eigen::Index i = 0; i < V.rows(); ++i)
+    if (!V.row(i).allFinite())
+      throw InputError(message("V[", i, "]: vertex ", i, " has a non-finite coordinate (", V(i, 0), ", ",
+                               V(i, 1), ", ", V(i, 2), ")"));
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k)
+      if (F(f, k) < 0 || F(f, k) >= V.rows())
+        throw InputError(message("F[", f, "]: face ", f, " refers to vertex ", F(f, k), ", outside [0, ",
+                                 V.rows(), ")"));
+}
+
+bool is_degenerate_face(const VerticesRef& V, const FacesRef& F, int f) {
+  const int a = F(f, 0), b = F(f, 1), c = F(f, 2);
+  if (a == b || b == c || c == a) return true;
+  const Eigen::Vector3d ab = (V.row(b) - V.row(a)).transpose();
+  const Eigen::Vector3d bc = (V.row(c) - V.row(b)).transpose();
+  const Eigen::Vector3d ca = (V.row(a) - V.row(c)).transpose();
+  const double longest_squared = std::max({ab.squaredNorm(), bc.squaredNorm(), ca.squaredNorm()});
+  return ab.cross(-ca).norm() <= kDegenerateAreaRatio * longest_squared;
+}
+
+MeshReport check_mesh(const VerticesRef& V, const FacesRef& F) {
+  validate_mesh(V, F);
+  const MeshTopology topology = build_topology(V, F);
+  MeshReport report;
+  report.num_vertices = static_cast<int>(V.rows());
+  report.num_faces = static_cast<int>(F.rows());
+  report.num_edges = static_cast<int>(topology.edges.size());
+  report.num_components = topology.num_components;
+  report.component_sizes.assign(topology.num_components, 0);
+  for (int c : topology.vertex_component)
+    if (c >= 0) ++report.component_sizes[c];
+  std::sort(report.component_sizes.rbegin(), report.component_sizes.rend());
+
+  auto add = [&report](const std::string& name, const std::vector<int>& indices) {
+    MeshReport::Finding finding{name, static_cast<int>(indices.size()), {}};
+    finding.examples.assign(indices.begin(),
+                            indices.begin() + std::min<size_t>(indices.size(), MeshReport::kExamples));
+    report.findings.push_back(std::move(finding));
+  };
+
+  std::vector<int> degenerate, duplicate;
+  std::set<std::array<int, 3>> seen;
+  for (int f = 0; f < F.rows(); ++f) {
+    if (is_degenerate_face(V, F, f)) degenerate.push_back(f);
+    std::array<int, 3> key{F(f, 0), F(f, 1), F(f, 2)};
+    std::sort(key.begin(), key.end());
+    if (!seen.insert(key).second) duplicate.push_back(f);
+  }
+  add("boundary_edges", topology.boundary_edges);
+  add("nonmanifold_edges", topology.nonmanifold_edges);
+  add("nonmanifold_vertices", topology.nonmanifold_vertices);
+  add("unreferenced_vertices", topology.unreferenced_vertices);
+  add("degenerate_faces", degenerate);
+  add("duplicate_faces", duplicate);
+  return report;
+}
+
+}  // namespace modal_deform

@@ -1,0 +1,39 @@
+// Input validation and a report of what is awkward about a mesh.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "mesh/mesh_topology.h"
+#include "util/types.h"
+
+namespace modal_deform {
+
+// Throws InputError naming the first problem that makes (V, F) unusable: no vertices, no faces,
+// a non-finite coordinate (V[i]), or an index outside [0, #V) (F[f]).
+void validate_mesh(const VerticesRef& V, const FacesRef& F);
+
+// Twice the area below which a face counts as degenerate, relative to its longest edge squared.
+constexpr double kDegenerateAreaRatio = 1e-12;
+
+// True when face f has repeated indices or (numerically) zero area.
+bool is_degenerate_face(const VerticesRef& V, const FacesRef& F, int f);
+
+// Counts of each awkward feature with the first few offending indices (at most kExamples).
+struct MeshReport {
+  static constexpr int kExamples = 10;
+  struct Finding {
+    std::string name;          // e.g. "nonmanifold_edges"
+    int count = 0;
+    std::vector<int> examples;  // first offending indices (vertices, faces or edges as named)
+  };
+  int num_vertices = 0, num_faces = 0, num_edges = 0, num_components = 0;
+  std::vector<int> component_sizes;  // vertices per component, largest first
+  std::vector<Finding> findings;     // boundary_edges, nonmanifold_edges, ... in a fixed order
+};
+
+// Validates (V, F) and reports its boundary edges, non-manifold edges and vertices, unreferenced
+// vertices, degenerate faces and duplicate faces, and its connected components.
+MeshReport check_mesh(const VerticesRef& V, const FacesRef& F);
+
+}  // namespace modal_deform

@@ -1,0 +1,20 @@
+// The paper's normalisation: every model is scaled so its longest bounding-box edge is 10 before
+// the energy weights apply, so material weights mean the same on a 0.2-unit scan and a
+// 2-metre character. The bake and both solvers work in this frame.
+#pragma once
+
+#include "util/errors.h"
+#include "util/types.h"
+
+namespace modal_deform {
+
+constexpr double kNormalizedExtent = 10.0;
+
+// The factor that scales V (#V by 3) to a longest bounding-box edge of 10.
+inline double normalizing_scale(const VerticesRef& V) {
+  const double extent = (V.colwise().maxCoeff() - V.colwise().minCoeff()).maxCoeff();
+  if (!(extent > 0)) throw InputError("V: all vertices coincide; the mesh has no extent to scale");
+  return kNormalizedExtent / extent;
+}
+
+}  // namespace modal_deform

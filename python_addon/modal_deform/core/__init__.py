@@ -1,0 +1,10 @@
+"""Modal Deform's Python API, free of bpy: numpy in, numpy out.
+
+    import modal_deform.core as mdc
+
+The pipeline, one module per stage: ``mesh`` (check, mass, test shapes).
+"""
+from .._native import Cancelled
+from .mesh import bar, bumpy_plane, check, cylinder, grid, mass, read_mesh
+
+__all__ = ["Cancelled", "bar", "bumpy_plane", "check", "cylinder", "grid", "mass", "read_mesh"]

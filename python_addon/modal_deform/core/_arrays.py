@@ -1,0 +1,36 @@
+"""Shape and dtype checks at the boundary to the native core.
+
+Each function returns an array the native core takes without a copy (C order, the right dtype)
+and raises ValueError naming the argument when the input cannot be one. Contents (index ranges,
+finiteness) are checked by the native core, which must refuse bad data on its own anyway.
+"""
+import numpy as np
+
+
+def vertices(V, name="V"):
+    """(n, 3) float64, C order."""
+    V = np.ascontiguousarray(V, dtype=np.float64)
+    if V.ndim != 2 or V.shape[1] != 3:
+        raise ValueError(f"{name}: expected an (n, 3) array of positions, got shape {V.shape}")
+    return V
+
+
+def faces(F, name="F"):
+    """(m, 3) int32, C order; larger integer types are narrowed when their values fit."""
+    F = np.asarray(F)
+    if F.ndim != 2 or F.shape[1] != 3:
+        raise ValueError(f"{name}: expected an (m, 3) array of triangle indices, got shape {F.shape}")
+    if F.dtype.kind not in "iu":
+        raise ValueError(f"{name}: expected integer indices, got dtype {F.dtype}")
+    if F.size and (F.max() > np.iinfo(np.int32).max or F.min() < np.iinfo(np.int32).min):
+        raise ValueError(f"{name}: an index does not fit in 32 bits")
+    return np.ascontiguousarray(F, dtype=np.int32)
+
+
+def positions(X, num_vertices, name="X"):
+    """Flat (3n,) float64 view of an (n, 3) or (3n,) array of positions or displacements."""
+    X = np.ascontiguousarray(X, dtype=np.float64)
+    if X.shape not in ((num_vertices, 3), (3 * num_vertices,)):
+        raise ValueError(
+            f"{name}: expected shape ({num_vertices}, 3) or ({3 * num_vertices},), got {X.shape}")
+    return X.reshape(-1)
