@@ -5,4 +5,5 @@ PYBIND11_MODULE(_native, m) {
   m.doc() = "Modal Deform native core (use modal_deform.core)";
   modal_deform::bind_errors(m);
   modal_deform::bind_mesh(m);
+  modal_deform::bind_energy(m);
 }
