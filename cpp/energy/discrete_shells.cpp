@@ -218,6 +218,10 @@ void add_vertex_pairs(const std::vector<Term>& terms, std::vector<std::array<int
 template <typename Term>
 void finish_set(shells::TermSet<Term>& set, const BlockSparsity& sparsity, const VertexPartition& partition) {
   constexpr int K = kVerticesOf<Term>;
+  // In the order of their smallest vertex, so that sweeps move through the outputs in order.
+  std::stable_sort(set.terms.begin(), set.terms.end(), [](const Term& a, const Term& b) {
+    return *std::min_element(a.vertices.begin(), a.vertices.end()) < *std::min_element(b.vertices.begin(), b.vertices.end());
+  });
   set.block_offsets.resize(set.terms.size());
   for (size_t e = 0; e < set.terms.size(); ++e)
     for (int p = 0; p < K; ++p)
@@ -351,11 +355,12 @@ double DiscreteShells::value_and_gradient(const VectorRef& x, Eigen::Ref<Eigen::
 
 SparseMatrix DiscreteShells::hessian(const VectorRef& x) const {
   require_finite_vector(x, rest_.size(), "X");
-  SparseMatrix H = sparsity_.zero_matrix();
+  SparseMatrix H = sparsity_.allocate_matrix();
   double* values = H.valuePtr();
 #pragma omp parallel for schedule(static, 1) if (parallel())
   for (int part = 0; part < partition_.parts(); ++part) {
     const VertexPartition::Range owned = partition_.range(part);
+    sparsity_.zero_columns(H, owned.first, owned.last);
     for_each_term(part, [&](const auto& term, int e) {
       using Term = std::decay_t<decltype(term)>;
       constexpr int K = kVerticesOf<Term>, N = kDofsOf<Term>, M = 3 * K;
@@ -435,7 +440,8 @@ Eigen::MatrixXd DiscreteShells::third_batch(const VectorRef& x, const Eigen::Ref
     const VertexPartition::Range owned = partition_.range(part);
     out.middleRows(3 * owned.first, 3 * (owned.last - owned.first)).setZero();
     // Φ over each element's relative coordinates (slot by slot) and ∇²s times it.
-    std::vector<double> phi(9 * num_used), h_phi(9 * num_used);
+    constexpr int kMaxDofs = kDofsOf<HingeTerm>;
+    std::vector<double> phi(kMaxDofs * num_used), h_phi(kMaxDofs * num_used);
     for_each_term(part, [&](const auto& term, int) {
       using Term = std::decay_t<decltype(term)>;
       constexpr int K = kVerticesOf<Term>, N = kDofsOf<Term>;

@@ -109,7 +109,7 @@ struct DihedralAngle {
   struct Frame {
     Vec3<T> a, b, c, n1, n2;
     T aa, length, n1n1, n2n2;  // ‖a‖², ‖a‖, ‖n1‖², ‖n2‖²
-    T inverse_n1n1_n2n2;       // 1 / (‖n1‖²‖n2‖²)
+    T inverse_product;         // 1 / (‖a‖²‖n1‖²‖n2‖²): the one division a hinge needs
   };
 
   template <typename T>
@@ -125,7 +125,7 @@ struct DihedralAngle {
     f.length = sqrt(f.aa);
     f.n1n1 = dot(f.n1, f.n1);
     f.n2n2 = dot(f.n2, f.n2);
-    f.inverse_n1n1_n2n2 = T(1.0) / (f.n1n1 * f.n2n2);
+    f.inverse_product = T(1.0) / (f.aa * f.n1n1 * f.n2n2);
     return f;
   }
 
@@ -136,8 +136,8 @@ struct DihedralAngle {
   // cos θ = n1·n2 / (‖n1‖‖n2‖), sin θ = (n1 × n2)·a / (‖n1‖‖n2‖‖a‖) = −(n1·c) ‖a‖ / (‖n1‖‖n2‖),
   // since n1 × n2 = −((a × b)·c) a.
   static CosSin measure(const Frame<double>& f) {
-    const double inverse = std::sqrt(f.inverse_n1n1_n2n2);
-    return {dot(f.n1, f.n2) * inverse, -dot(f.n1, f.c) * f.length * inverse};
+    const double inverse = std::sqrt(f.inverse_product);  // 1 / (‖a‖‖n1‖‖n2‖)
+    return {dot(f.n1, f.n2) * f.length * inverse, -dot(f.n1, f.c) * f.aa * inverse};
   }
 
   // The classic hinge gradient (e.g. Wardetzky et al. 2007, "Discrete quadratic curvature
@@ -147,8 +147,9 @@ struct DihedralAngle {
   // ∇_a θ = −(t_b ∇_b θ + t_c ∇_c θ).
   template <typename T>
   static void gradient(const Frame<T>& f, T* g) {
-    const T inverse_aa = T(1.0) / f.aa;
-    const T sb = -(f.length * f.n2n2 * f.inverse_n1n1_n2n2), sc = -(f.length * f.n1n1 * f.inverse_n1n1_n2n2);
+    const T length_aa = f.length * f.aa * f.inverse_product;
+    const T inverse_aa = f.n1n1 * f.n2n2 * f.inverse_product;
+    const T sb = -(length_aa * f.n2n2), sc = -(length_aa * f.n1n1);
     const T tb = dot(f.a, f.b) * inverse_aa, tc = dot(f.a, f.c) * inverse_aa;
     for (int i = 0; i < 3; ++i) {
       const T gb = f.n1[i] * sb, gc = f.n2[i] * sc;

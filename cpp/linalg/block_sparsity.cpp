@@ -49,23 +49,33 @@ int BlockSparsity::offset(int a, int b) const {
 }
 
 SparseMatrix BlockSparsity::zero_matrix() const {
+  SparseMatrix matrix = allocate_matrix();
+  zero_columns(matrix, 0, num_vertices());
+  return matrix;
+}
+
+SparseMatrix BlockSparsity::allocate_matrix() const {
   const int n = num_vertices();
   SparseMatrix matrix(3 * n, 3 * n);
   matrix.resizeNonZeros(num_nonzeros());
   int* outer = matrix.outerIndexPtr();
-  int* inner = matrix.innerIndexPtr();
-  for (int b = 0; b < n; ++b) {
-    const int stride = column_stride(b);
-    for (int j = 0; j < 3; ++j) {
-      int at = 9 * begin_[b] + j * stride;
-      outer[3 * b + j] = at;
-      for (int k = begin_[b]; k < begin_[b + 1]; ++k)
-        for (int i = 0; i < 3; ++i) inner[at++] = 3 * rows_[k] + i;
-    }
-  }
+  for (int b = 0; b < n; ++b)
+    for (int j = 0; j < 3; ++j) outer[3 * b + j] = 9 * begin_[b] + j * column_stride(b);
   outer[3 * n] = num_nonzeros();
-  std::fill(matrix.valuePtr(), matrix.valuePtr() + num_nonzeros(), 0.0);
   return matrix;
+}
+
+void BlockSparsity::zero_columns(SparseMatrix& matrix, int first_vertex, int last_vertex) const {
+  int* inner = matrix.innerIndexPtr();
+  double* values = matrix.valuePtr();
+  int at = 9 * begin_[first_vertex];
+  for (int b = first_vertex; b < last_vertex; ++b)
+    for (int j = 0; j < 3; ++j)
+      for (int k = begin_[b]; k < begin_[b + 1]; ++k)
+        for (int i = 0; i < 3; ++i) {
+          inner[at] = 3 * rows_[k] + i;
+          values[at++] = 0.0;
+        }
 }
 
 }  // namespace modal_deform

@@ -34,6 +34,11 @@ class BlockSparsity {
 
   // The 3n by 3n matrix with this pattern and all values zero.
   SparseMatrix zero_matrix() const;
+  // The same in two steps, so that threads can fill their own columns: a matrix with this
+  // pattern's column starts but unset row indices and values, then the row indices and zero
+  // values of the columns of vertices [first_vertex, last_vertex).
+  SparseMatrix allocate_matrix() const;
+  void zero_columns(SparseMatrix& matrix, int first_vertex, int last_vertex) const;
 
  private:
   std::vector<int> begin_;  // #V + 1: the blocks of vertex column b are rows_[begin_[b] .. begin_[b + 1])
