@@ -15,9 +15,13 @@
 //   ∇E = w f' ∇s,   ∇²E = w (f'' ∇s∇sᵀ + f' ∇²s),
 //   ∇³E(u, v) = w [f''' (∇s·u)(∇s·v) ∇s + f'' ((uᵀ∇²s v) ∇s + (∇s·u) ∇²s v + (∇s·v) ∇²s u)
 //               + f' ∇³s(u, v)],
-// with ∇s written by hand and ∇²s, ∇³s(u, v) from it by dual numbers (dual.h). For the bending
-// terms f = w (1 − cos δ), δ = θ − θ̄, taken from cos θ, sin θ and the same for θ̄: δ lives on the
-// circle, so it is wrapped into (−π, π] by construction and the derivatives agree across ±π.
+// with ∇s written by hand and ∇²s, ∇³s(u, v) from it by dual numbers (dual.h). A bending term,
+// f = ½ w (2 sin(δ/2))² = w (1 − cos δ) with δ = θ − θ̄, needs θ only through cos θ and sin θ,
+// which the same function gives for θ and θ̄ from the unnormalised normals: (2 sin(δ/2))² is the
+// squared chord between (cos θ, sin θ) and (cos θ̄, sin θ̄) on the unit circle, and f', f'', f'''
+// are ±w sin δ, w cos δ. So δ is wrapped into (−π, π] by construction, the derivatives agree
+// across ±π, and no atan2 or sine is evaluated (they would cost as much as all the rest of
+// value and gradient on a small mesh).
 // At rest f' = 0 for every term, so ∇²E(x̄) = Σ w f'' ∇s∇sᵀ is positive semi-definite and
 // ∇³E(x̄) needs only ∇s and ∇²s (what third_batch exploits).
 //
@@ -38,9 +42,10 @@
 //   Every output stays finite.
 //
 // Meshes with at least kParallelElements terms are evaluated in parallel (OpenMP) over vertex
-// ranges (vertex_partition.h); smaller ones, such as the reduced solver's ghost mesh, run on
-// the calling thread without allocating (value, value_and_gradient). All methods are const and
-// safe to call concurrently.
+// ranges (vertex_partition.h), with the same results for any number of threads (but for the
+// order in which value sums); smaller ones, such as the reduced solver's ghost mesh, run on the
+// calling thread without allocating (value, value_and_gradient). All methods are const and safe
+// to call concurrently.
 #pragma once
 
 #include <array>
@@ -71,7 +76,7 @@ struct TriangleTerm {
   double collapsed_norm;  // ‖n‖ = 2A at or below which the triangle counts as collapsed
 };
 
-// f(θ) = w (1 − cos(θ − θ̄)) = ½ w (2 sin((θ − θ̄)/2))², w = 3 α ‖ē‖² / Ā_e.
+// f(θ) = ½ w (2 sin((θ − θ̄)/2))², w = 3 α ‖ē‖² / Ā_e.
 struct HingeTerm {
   using Quantity = DihedralAngle;
   std::array<int, 4> vertices;  // as in Hinge::vertices
@@ -104,9 +109,11 @@ class DiscreteShells final : public Energy {
   int num_vertices() const override { return static_cast<int>(rest_.size() / 3); }
   const Eigen::VectorXd& rest() const override { return rest_; }
 
-  // x: 3n positions. Throws InputError for a wrong length or a non-finite entry (naming it).
+  // x, u, w: 3n. Throws InputError for a wrong length or a non-finite entry (naming it).
   double value(const VectorRef& x) const override;
   double value_and_gradient(const VectorRef& x, Eigen::Ref<Eigen::VectorXd> gradient) const override;
+  // Exactly symmetric; its pattern (vertex blocks of every vertex pair sharing a term, and all
+  // diagonal blocks) is the same at every x.
   SparseMatrix hessian(const VectorRef& x) const override;
   Eigen::VectorXd third(const VectorRef& x, const VectorRef& u, const VectorRef& w) const override;
 
