@@ -169,14 +169,16 @@ void third_of_term(const Response& q, const double* gradient, const double* hu, 
 }
 
 // ∇²(w f(s)) = f'' ∇s∇sᵀ + f' ∇²s over the relative coordinates (N by N), expanded to the
-// 3K by 3K Hessian over the term's vertices (row-major).
+// 3K by 3K Hessian over the term's vertices (row-major). ∇²s is only read when f' ≠ 0.
 template <int K>
 void term_hessian(const Response& q, const double* gradient, const double* hessian, double* full) {
   constexpr int N = 3 * (K - 1), M = 3 * K;
   // Written so that the result is exactly symmetric (the assembled Hessian then is too).
   for (int i = 0; i < N; ++i)
-    for (int j = 0; j < N; ++j)
-      full[(3 + i) * M + 3 + j] = q.d2f * (gradient[i] * gradient[j]) + q.df * hessian[i * N + j];
+    for (int j = 0; j < N; ++j) full[(3 + i) * M + 3 + j] = q.d2f * (gradient[i] * gradient[j]);
+  if (q.df != 0)
+    for (int i = 0; i < N; ++i)
+      for (int j = 0; j < N; ++j) full[(3 + i) * M + 3 + j] += q.df * hessian[i * N + j];
   // The first vertex's columns, then its rows: minus the sums over the other vertices.
   for (int i = 3; i < M; ++i)
     for (int c = 0; c < 3; ++c) {
@@ -365,10 +367,15 @@ SparseMatrix DiscreteShells::hessian(const VectorRef& x) const {
       using Term = std::decay_t<decltype(term)>;
       constexpr int K = kVerticesOf<Term>, N = kDofsOf<Term>, M = 3 * K;
       double r[N];
-      const Response q = respond_at(term, x.data(), r);
+      relative(term, x.data(), r);
+      const auto frame = Term::Quantity::frame(r);
+      const Response q = respond(term, frame);
       if (!q.differentiable) return;
       double g[N], h[N * N], full[M * M];
-      second_derivatives<typename Term::Quantity, N>(r, g, h);
+      if (q.df != 0)
+        second_derivatives<typename Term::Quantity, N>(r, g, h);
+      else  // at rest, for instance: ∇²s is not needed
+        Term::Quantity::gradient(frame, g);
       term_hessian<K>(q, g, h, full);
       const auto& offsets = set_of(term).block_offsets[e];
       for (int b = 0; b < K; ++b) {
