@@ -3,6 +3,7 @@
 #include <pybind11/pybind11.h>
 
 #include "bindings/bindings.h"
+#include "energy/arap.h"
 #include "energy/energy.h"
 #include "util/errors.h"
 
@@ -52,6 +53,9 @@ void bind_energy(py::module_& m) {
           py::arg("x"), py::arg("u"), py::arg("w"), py::call_guard<py::gil_scoped_release>());
 
   // Each energy adds its class here, deriving from Energy.
+
+  py::class_<Arap, Energy>(m, "Arap")
+      .def(py::init<const VerticesRef&, const FacesRef&>(), py::arg("V"), py::arg("F"));
 }
 
 }  // namespace modal_deform

@@ -1,4 +1,5 @@
 """Deformation energies with their derivatives: value, gradient, Hessian, third derivative."""
+from .. import _native
 from . import _arrays
 
 
@@ -30,3 +31,16 @@ class _Energy:
     def third(self, X, U, W):
         """∇³E(X)(U, W): (3n,) float64, the derivative of the Hessian along U applied to W."""
         return self._native.third(self._flat(X, "X"), self._flat(U, "U"), self._flat(W, "W"))
+
+
+class Arap(_Energy):
+    """As-rigid-as-possible energy (Sorkine & Alexa 2007) of the rest mesh (V, F), in length².
+
+    Cotangent weights of the rest mesh, clamped at zero (edges whose opposite angles sum to more
+    than 180 degrees drop out, so the rest state stays the minimum); one best rotation per vertex.
+    ``hessian`` is exact at any X (the rotations' Schur complement); ``third`` raises ValueError:
+    modal derivatives need the shells energy.
+    """
+
+    def __init__(self, V, F):
+        super().__init__(_native.Arap(_arrays.vertices(V), _arrays.faces(F)))
