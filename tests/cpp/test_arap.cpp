@@ -1,12 +1,16 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <limits>
 #include <map>
 #include <optional>
 #include <random>
+#include <string>
+#include <tuple>
+#include <vector>
 
 #include "energy/arap.h"
 #include "mesh/cotangent_weights.h"
@@ -287,12 +291,12 @@ TEST(Arap, ObtuseTrianglesKeepTheRestStateTheMinimum) {
 }
 
 TEST(Arap, DegenerateTrianglesAndLooseVerticesStayFinite) {
-  // A fan around vertex 0, plus a collinear face, a repeated index, a 1e-9 sliver and an
-  // unreferenced vertex (7).
-  RowMatrixX3d V(8, 3);
-  V << 0, 0, 0, 1, 0, 0, 0.3, 1, 0.2, -1, 0.2, 0, 0.5, -1, 0.1, 2, 0, 0, 0.5, 1e-9, 0, 5, 5, 5;
-  RowMatrixX3i F(7, 3);
-  F << 0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1, 0, 1, 5, 2, 2, 3, 0, 6, 1;
+  // A fan around vertex 0, plus a collinear face, a repeated index, a 1e-9 sliver, a face with
+  // two vertices in one place (8 on 1) and an unreferenced vertex (7).
+  RowMatrixX3d V(9, 3);
+  V << 0, 0, 0, 1, 0, 0, 0.3, 1, 0.2, -1, 0.2, 0, 0.5, -1, 0.1, 2, 0, 0, 0.5, 1e-9, 0, 5, 5, 5, 1, 0, 0;
+  RowMatrixX3i F(8, 3);
+  F << 0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1, 0, 1, 5, 2, 2, 3, 0, 6, 1, 1, 8, 2;
   const Arap energy(V, F);
   EXPECT_LT(std::abs(energy.value(energy.rest())), 1e-20);
   const Eigen::VectorXd x = energy.rest() + 0.2 * random_vector(energy.rest().size(), 5);
