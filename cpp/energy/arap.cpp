@@ -13,10 +13,11 @@
 namespace modal_deform {
 namespace {
 
-// Below this many vertices the cells run on the calling thread: the reduced solver evaluates a
-// ghost mesh of about 1k vertices every BFGS iteration, where a thread team costs more than it
-// saves (bench_arap).
-constexpr int kParallelVertices = 4096;
+// Below this many vertices the cells run on the calling thread. The reduced solver evaluates a
+// ghost mesh of 500-5000 vertices (0.6 ms per 1k serially) every BFGS iteration; there a thread
+// team saves at most half of that on idle cores and, measured on a loaded 2-core machine, doubles
+// it when the second thread is descheduled (every call waits for it at the barrier).
+constexpr int kParallelVertices = 8192;
 
 // Eigenvalues of f_ωω below this fraction of its largest are treated as zero (pseudo-inverse):
 // a cell whose edges are collinear can spin about their line at no cost.
