@@ -13,7 +13,8 @@ Ghost ghost_mesh(const VerticesRef& V, const FacesRef& F, const VectorRef& mass,
   Ghost ghost;
   ghost.F = std::move(collapse.F);
   ghost.map = std::move(collapse.cluster);
-  // Vertices no face uses join the nearest cluster; they have no mass to move its centroid.
+  // Vertices without a face join the nearest cluster. Unreferenced ones have no mass; those whose
+  // faces cancelled (double sheets) have a little, and move the centroid by their share of it.
   for (Eigen::Index i = 0; i < ghost.map.size(); ++i)
     if (ghost.map[i] < 0) (collapse.V.rowwise() - V.row(i)).rowwise().squaredNorm().minCoeff(&ghost.map[i]);
   const int num_ghost = static_cast<int>(collapse.V.rows());

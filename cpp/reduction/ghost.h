@@ -19,8 +19,8 @@ struct Ghost {
 
 // Simplifies (V #V by 3, F #F by 3) by edge collapse (see collapse_edges) to about `target`
 // vertices (fewer are not reached when no valid collapse is left; the result says how many).
-// `mass` (#V, length², lumped_mass) weights the means. Vertices no face uses join the nearest
-// ghost vertex. A target of at least #V gives the mesh itself with the identity map. Reports
+// `mass` (#V, length², lumped_mass) weights the means. Vertices left without a face (unreferenced,
+// or only on faces that cancelled) join the nearest ghost vertex. A target of at least #V gives the mesh itself with the identity map. Reports
 // stage "ghost"; throws Cancelled when told to stop, InputError for bad input.
 Ghost ghost_mesh(const VerticesRef& V, const FacesRef& F, const VectorRef& mass, int target,
                  Progress* progress = nullptr);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <map>
 #include <set>
@@ -28,6 +29,13 @@ Eigen::Vector3d face_normal(const RowMatrixX3d& V, const RowMatrixX3i& F, int f)
   return (b - a).cross(c - a);
 }
 
+// 4√3·area / Σ edge²: 1 for an equilateral triangle, 0 for a degenerate one.
+double face_quality(const RowMatrixX3d& V, const RowMatrixX3i& F, int f) {
+  const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+  return 2 * std::sqrt(3.0) * (b - a).cross(c - a).norm() /
+         ((b - a).squaredNorm() + (c - b).squaredNorm() + (a - c).squaredNorm());
+}
+
 std::array<int, 3> sorted_triple(int a, int b, int c) {
   std::array<int, 3> t{a, b, c};
   std::sort(t.begin(), t.end());
@@ -38,7 +46,8 @@ std::array<int, 3> sorted_triple(int a, int b, int c) {
 // vertex the mass-weighted centroid of its fine vertices (plain mean without mass), a triangle
 // mesh without degenerate or duplicate faces, and no face flipped: the area-weighted normal of
 // the fine faces that map onto a ghost face (their three vertices in its three clusters) agrees
-// in sign with the ghost face's normal.
+// in sign with the ghost face's normal. No needles either: a ghost face is at least as good as
+// kMinFaceQuality or as the worst fine face mapping onto it.
 void expect_valid_ghost(const TriangleMesh& fine, const Eigen::VectorXd& mass, const Ghost& ghost) {
   const int n = static_cast<int>(fine.V.rows()), g = static_cast<int>(ghost.V.rows());
   ASSERT_EQ(ghost.map.size(), n);
@@ -72,19 +81,27 @@ void expect_valid_ghost(const TriangleMesh& fine, const Eigen::VectorXd& mass, c
         << "duplicate ghost face " << f;
   }
   std::vector<Eigen::Vector3d> ancestors(ghost.F.rows(), Eigen::Vector3d::Zero());
+  std::vector<double> worst_ancestor(ghost.F.rows(), 1.0);
   for (int f = 0; f < fine.F.rows(); ++f) {
     const auto it = face_of.find(
         sorted_triple(ghost.map[fine.F(f, 0)], ghost.map[fine.F(f, 1)], ghost.map[fine.F(f, 2)]));
-    if (it != face_of.end()) ancestors[it->second] += face_normal(fine.V, fine.F, f);
+    if (it == face_of.end()) continue;
+    ancestors[it->second] += face_normal(fine.V, fine.F, f);
+    worst_ancestor[it->second] = std::min(worst_ancestor[it->second], face_quality(fine.V, fine.F, f));
   }
-  int flipped = 0;
-  for (int f = 0; f < ghost.F.rows(); ++f) flipped += !(face_normal(ghost.V, ghost.F, f).dot(ancestors[f]) > 0);
+  int flipped = 0, needles = 0;
+  for (int f = 0; f < ghost.F.rows(); ++f) {
+    flipped += !(face_normal(ghost.V, ghost.F, f).dot(ancestors[f]) > 0);
+    needles += face_quality(ghost.V, ghost.F, f) < std::min(kMinFaceQuality, worst_ancestor[f]) - 1e-6;
+  }
   EXPECT_EQ(flipped, 0) << "of " << ghost.F.rows() << " ghost faces";
+  EXPECT_EQ(needles, 0) << "of " << ghost.F.rows() << " ghost faces";
 }
 
-// On a clean mesh a stronger test holds too: the normal of each ghost face agrees in sign with
-// the area-weighted normal of all fine faces whose vertices lie in its three clusters (including
-// the faces collapsed away inside them).
+// On a clean mesh and a ghost that still resolves its shape a stronger test holds: the normal of
+// each ghost face agrees in sign with the area-weighted normal of all fine faces whose vertices
+// lie in its three clusters (including those collapsed away inside them). It does not hold on
+// the dragons, whose decimation left faces folded back over their neighbours.
 void expect_agrees_with_region_normals(const TriangleMesh& fine, const Ghost& ghost) {
   std::vector<std::vector<int>> faces_around(ghost.V.rows());
   for (int f = 0; f < ghost.F.rows(); ++f)
@@ -132,10 +149,10 @@ std::vector<char> boundary_vertices(const TriangleMesh& mesh) {
 // are kept: same Euler characteristic, components and boundary loops, and the ghost's boundary
 // vertices are exactly the clusters of the fine boundary vertices.
 void expect_topology_kept(const TriangleMesh& fine, int target) {
+  SCOPED_TRACE(::testing::Message() << "target " << target);
   const Eigen::VectorXd mass = lumped_mass(fine.V, fine.F);
   const Ghost ghost = ghost_mesh(fine.V, fine.F, mass, target);
   expect_valid_ghost(fine, mass, ghost);
-  expect_agrees_with_region_normals(fine, ghost);
   EXPECT_EQ(ghost.V.rows(), target);
   const TriangleMesh coarse{ghost.V, ghost.F};
   EXPECT_EQ(euler_characteristic(coarse), euler_characteristic(fine));
@@ -177,15 +194,35 @@ TriangleMesh messy_plane() {
   return mesh;
 }
 
-TEST(Ghost, BunnyStaysAClosedGenusZeroSurface) { expect_topology_kept(shared_mesh("bunny.obj.gz"), 300); }
+// Each shape at a moderate target and at a small one, where only the link condition and the
+// boundary rule stand between the collapse and a changed topology or a pulled-in boundary.
+TEST(Ghost, BunnyStaysAClosedGenusZeroSurface) {
+  for (int target : {300, 20}) expect_topology_kept(shared_mesh("bunny.obj.gz"), target);
+}
 
-TEST(Ghost, GridStaysADiscWithItsBoundary) { expect_topology_kept(grid(30, 30, 10.0, 10.0), 150); }
+TEST(Ghost, GridStaysADiscWithItsBoundary) {
+  for (int target : {150, 12}) expect_topology_kept(grid(30, 30, 10.0, 10.0), target);
+}
 
-TEST(Ghost, CylinderKeepsBothRims) { expect_topology_kept(cylinder(32, 30, 1.0, 6.0), 200); }
+TEST(Ghost, CylinderKeepsBothRims) {
+  for (int target : {200, 12}) expect_topology_kept(cylinder(32, 30, 1.0, 6.0), target);
+}
 
-TEST(Ghost, TwoCylindersStayTwoComponents) { expect_topology_kept(two_cylinders(), 250); }
+TEST(Ghost, TwoCylindersStayTwoComponents) {
+  for (int target : {250, 24}) expect_topology_kept(two_cylinders(), target);
+}
 
-TEST(Ghost, BumpyPlaneKeepsItsBoundary) { expect_topology_kept(bumpy_plane(40, 10.0, 12, 1.0), 300); }
+TEST(Ghost, BumpyPlaneKeepsItsBoundary) {
+  for (int target : {300, 12}) expect_topology_kept(bumpy_plane(40, 10.0, 12, 1.0), target);
+}
+
+TEST(Ghost, FacesAgreeWithTheNormalsOfTheRegionTheyCover) {
+  const std::vector<std::pair<TriangleMesh, int>> cases{{shared_mesh("bunny.obj.gz"), 300},
+                                                        {cylinder(32, 30, 1.0, 6.0), 200},
+                                                        {bumpy_plane(40, 10.0, 12, 1.0), 300}};
+  for (const auto& [mesh, target] : cases)
+    expect_agrees_with_region_normals(mesh, ghost_mesh(mesh.V, mesh.F, lumped_mass(mesh.V, mesh.F), target));
+}
 
 class GhostOfDragon : public ::testing::TestWithParam<std::pair<std::string, int>> {};
 
