@@ -43,11 +43,6 @@ Eigen::MatrixXd restrict_to_ghost(const Eigen::Ref<const Eigen::VectorXi>& map, 
   }
   for (int s = 0; s < num_ghost; ++s)
     if (cluster_size[s] == 0) throw InputError(message("map: no fine vertex maps to ghost vertex ", s));
-  if (!U.allFinite())
-    for (Eigen::Index j = 0; j < U.cols(); ++j)
-      for (Eigen::Index i = 0; i < U.rows(); ++i)
-        if (!std::isfinite(U(i, j))) throw InputError(message("U[", i, ", ", j, "]: not a finite number"));
-
   // The weight of each fine vertex in its cluster's mean; m/m is exactly 1, so a cluster of one
   // vertex restricts to that vertex's values unchanged.
   Eigen::VectorXd weight(n);
@@ -68,6 +63,12 @@ Eigen::MatrixXd restrict_to_ghost(const Eigen::Ref<const Eigen::VectorXi>& map, 
       target[2] += w * in[3 * i + 2];
     }
   }
+  // Weights in [0, 1] summing to 1 keep finite input finite: read all of U again only to name
+  // the culprit.
+  if (!restricted.allFinite())
+    for (Eigen::Index j = 0; j < U.cols(); ++j)
+      for (Eigen::Index i = 0; i < U.rows(); ++i)
+        if (!std::isfinite(U(i, j))) throw InputError(message("U[", i, ", ", j, "]: not a finite number"));
   return restricted;
 }
 
