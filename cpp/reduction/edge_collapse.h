@@ -46,7 +46,8 @@ struct EdgeCollapse {
 // on the same three vertices cancel by orientation (one copy of a surplus orientation stays);
 // vertices left without a face belong to no cluster. A target of at least #V gives (V, F) unchanged, each vertex
 // its own cluster. Reports progress as stage "ghost"; throws Cancelled when told to stop and
-// InputError for bad input (target < 4, mass of the wrong size, negative or not finite).
+// InputError for bad input (see validate_mesh; target < 4; mass of the wrong size, negative or
+// not finite; no triangle left once faces cancel).
 EdgeCollapse collapse_edges(const VerticesRef& V, const FacesRef& F, const VectorRef& mass, int target,
                             Progress* progress = nullptr);
 

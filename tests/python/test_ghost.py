@@ -166,7 +166,8 @@ V_GRID, F_GRID = mdc.grid(4, 4)
 @pytest.mark.parametrize(
     "call, needle",
     [
-        (lambda: mdc.ghost_mesh(V_GRID, F_GRID, vertices=3), "target: a ghost needs at least 4 vertices"),
+        (lambda: mdc.ghost_mesh(V_GRID, F_GRID, vertices=3), "vertices: a ghost needs at least 4 vertices"),
+        (lambda: mdc.ghost_mesh(V_GRID, F_GRID, vertices=-10**12), "vertices: a ghost needs at least 4"),
         (lambda: mdc.ghost_mesh(V_GRID, F_GRID, vertices=10.5), "vertices: expected an integer"),
         (lambda: mdc.ghost_mesh(V_GRID, F_GRID, progress="yes"), "progress: expected a callable"),
         (lambda: mdc.ghost_mesh(V_GRID, [[0, 1, 99]]), "F[0]"),

@@ -28,6 +28,8 @@ def ghost_mesh(V, F, vertices=1000, progress=None):
         vertices = operator.index(vertices)
     except TypeError:
         raise ValueError(f"vertices: expected an integer, got {vertices!r}") from None
+    if vertices < 4:
+        raise ValueError(f"vertices: a ghost needs at least 4 vertices, got {vertices}")
     if progress is not None and not callable(progress):
         raise ValueError(f"progress: expected a callable progress(stage, fraction) or None, got {progress!r}")
     return _native.ghost_mesh(V, F, min(vertices, _INT32_MAX), progress)
