@@ -7,5 +7,8 @@ The pipeline, one module per stage: ``mesh`` (check, mass, test shapes).
 from .._native import Cancelled
 from .energy import Arap
 from .mesh import bar, bumpy_plane, check, cylinder, grid, mass, read_mesh
+from .reduction import ghost_mesh, restrict_to_ghost
 
-__all__ = ["Arap", "Cancelled", "bar", "bumpy_plane", "check", "cylinder", "grid", "mass", "read_mesh"]
+__all__ = ["Cancelled", "bar", "bumpy_plane", "check", "cylinder", "grid", "mass", "read_mesh"]
+__all__ += ["ghost_mesh", "restrict_to_ghost"]
+__all__ += ["Arap"]
