@@ -101,7 +101,6 @@ Arap::Arap(const VerticesRef& V, const FacesRef& F)
     hessian_rows_.insert(hessian_rows_.end(), coupled.begin(), coupled.end());
     hessian_offsets_[k + 1] = static_cast<int>(hessian_rows_.size());
   }
-  rotations_.resize(n);
 }
 
 void Arap::check_positions(const VectorRef& x) const {
@@ -146,12 +145,13 @@ double Arap::value_and_gradient(const VectorRef& x, Eigen::Ref<Eigen::VectorXd> 
   check_positions(x);
   if (gradient.size() != x.size())
     throw InputError(message("gradient: expected ", x.size(), " values, got ", gradient.size()));
-  const std::lock_guard<std::mutex> lock(rotations_mutex_);
+  // One 3x3 per vertex: allocating it per call costs microseconds, far below the SVDs.
+  std::vector<Eigen::Matrix3d> rotations(num_vertices_);
   double energy = 0;
 #pragma omp parallel for schedule(static) reduction(+ : energy) if (parallel_)
   for (int i = 0; i < num_vertices_; ++i) {
-    rotations_[i] = best_rotation(covariance(i, x)).rotation;
-    energy += cell_energy(i, x, rotations_[i]);
+    rotations[i] = best_rotation(covariance(i, x)).rotation;
+    energy += cell_energy(i, x, rotations[i]);
   }
   // Envelope theorem: each R_i minimises its cell, so ∂E/∂R_i = 0 and the gradient is that of
   // E(x, R) with R held fixed. Edge k–j appears in cell k and in cell j (with e_jk = −e_kj), so
@@ -163,7 +163,7 @@ double Arap::value_and_gradient(const VectorRef& x, Eigen::Ref<Eigen::VectorXd> 
       const int j = cell_neighbors_[e];
       const Eigen::Vector3d rest_edge = rest_.segment<3>(3 * k) - rest_.segment<3>(3 * j);
       const Eigen::Vector3d edge = x.segment<3>(3 * k) - x.segment<3>(3 * j);
-      g += 2 * cell_weights_[e] * (2 * edge - (rotations_[k] + rotations_[j]) * rest_edge);
+      g += 2 * cell_weights_[e] * (2 * edge - (rotations[k] + rotations[j]) * rest_edge);
     }
     gradient.segment<3>(3 * k) = g;
   }

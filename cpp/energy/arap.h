@@ -18,10 +18,9 @@
 // an edge unless all its faces are degenerate (or slivers beyond the cotangent clamp). Vertices
 // without edges (those, and unreferenced vertices) add nothing to E; their Hessian rows are zero.
 //
-// Calls on one object are thread-safe; value_and_gradient serialises on its rotation workspace.
+// Calls on one object are thread-safe: the energy keeps no state between calls.
 #pragma once
 
-#include <mutex>
 #include <vector>
 
 #include "energy/energy.h"
@@ -73,9 +72,6 @@ class Arap final : public Energy {
   // hessian_rows_[hessian_offsets_[k] .. hessian_offsets_[k + 1]).
   std::vector<int> hessian_offsets_;
   std::vector<int> hessian_rows_;
-  // value_and_gradient's best rotation per cell.
-  mutable std::vector<Eigen::Matrix3d> rotations_;
-  mutable std::mutex rotations_mutex_;
 };
 
 }  // namespace modal_deform
