@@ -4,6 +4,7 @@
 #include <pybind11/stl.h>
 
 #include "bindings/bindings.h"
+#include "energy/arap.h"
 #include "energy/discrete_shells.h"
 #include "energy/energy.h"
 #include "util/errors.h"
@@ -54,6 +55,9 @@ void bind_energy(py::module_& m) {
           py::arg("x"), py::arg("u"), py::arg("w"), py::call_guard<py::gil_scoped_release>());
 
   // Each energy adds its class here, deriving from Energy.
+
+  py::class_<Arap, Energy>(m, "Arap")
+      .def(py::init<const VerticesRef&, const FacesRef&>(), py::arg("V"), py::arg("F"));
   py::class_<DiscreteShells, Energy>(m, "DiscreteShells")
       .def(py::init<const VerticesRef&, const FacesRef&, double, double>(), py::arg("V"), py::arg("F"),
            py::arg("bending") = 1.0, py::arg("membrane") = 1.0, py::call_guard<py::gil_scoped_release>())

@@ -35,6 +35,19 @@ class _Energy:
         return self._native.third(self._flat(X, "X"), self._flat(U, "U"), self._flat(W, "W"))
 
 
+class Arap(_Energy):
+    """As-rigid-as-possible energy (Sorkine & Alexa 2007) of the rest mesh (V, F), in length².
+
+    Cotangent weights of the rest mesh, clamped at zero (edges whose opposite angles sum to more
+    than 180 degrees drop out, so the rest state stays the minimum); one best rotation per vertex.
+    ``hessian`` is exact at any X (the rotations' Schur complement); ``third`` raises ValueError:
+    modal derivatives need the shells energy.
+    """
+
+    def __init__(self, V, F):
+        super().__init__(_native.Arap(_arrays.vertices(V), _arrays.faces(F)))
+
+
 class DiscreteShells(_Energy):
     """The discrete shells energy of Hildebrandt et al. 2011: E = α E_F + β (E_L + E_A).
 
