@@ -196,12 +196,14 @@ void term_hessian(const Response& q, const double* gradient, const double* hessi
     for (int d = 0; d < c; ++d) full[c * M + d] = full[d * M + c] = 0.5 * (full[c * M + d] + full[d * M + c]);
 }
 
+// y: 3n positions or displacements, named like validate_mesh names V.
 void require_finite_vector(const VectorRef& y, Eigen::Index size, const char* name) {
   if (y.size() != size) throw InputError(message(name, ": expected ", size, " values, got ", y.size()));
   if (y.allFinite()) return;
-  Eigen::Index i = 0;
-  while (std::isfinite(y[i])) ++i;
-  throw InputError(message(name, "[", i, "]: not finite (", y[i], ")"));
+  Eigen::Index v = 0;
+  while (y.segment<3>(3 * v).allFinite()) ++v;
+  throw InputError(message(name, "[", v, "]: vertex ", v, " has a non-finite coordinate (", y[3 * v], ", ",
+                           y[3 * v + 1], ", ", y[3 * v + 2], ")"));
 }
 
 void require_weight(double weight, const char* name) {

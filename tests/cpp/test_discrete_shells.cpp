@@ -503,11 +503,11 @@ TEST(DiscreteShells, BadInputIsRefusedWithItsName) {
   const Eigen::Index size = tube.V.size();
   Eigen::VectorXd x = energy.rest(), gradient(size);
   expect_input_error([&] { energy.value(Eigen::VectorXd::Zero(size - 1)); }, "X: expected");
-  x[7] = std::nan("");
-  expect_input_error([&] { energy.value(x); }, "X[7]");
-  expect_input_error([&] { energy.value_and_gradient(x, gradient); }, "X[7]");
-  expect_input_error([&] { energy.hessian(x); }, "X[7]");
-  expect_input_error([&] { energy.third(energy.rest(), x, energy.rest()); }, "U[7]");
+  x[7] = std::nan("");  // vertex 2
+  expect_input_error([&] { energy.value(x); }, "X[2]: vertex 2");
+  expect_input_error([&] { energy.value_and_gradient(x, gradient); }, "X[2]");
+  expect_input_error([&] { energy.hessian(x); }, "X[2]");
+  expect_input_error([&] { energy.third(energy.rest(), x, energy.rest()); }, "U[2]");
   Eigen::VectorXd short_gradient(size - 3);
   expect_input_error([&] { energy.value_and_gradient(energy.rest(), short_gradient); }, "gradient");
   Eigen::MatrixXd Phi = Eigen::MatrixXd::Ones(size, 3);

@@ -114,7 +114,7 @@ def test_hessian_is_the_derivative_of_the_gradient(bunny):
         (lambda V, F, E: mdc.DiscreteShells(V, F, membrane=np.inf), "membrane"),
         (lambda V, F, E: mdc.DiscreteShells(V[:, :2], F), "V: expected an (n, 3)"),
         (lambda V, F, E: E.value(V[:-1]), "X: expected shape"),
-        (lambda V, F, E: E.value(np.where(np.arange(V.size).reshape(V.shape) == 7, np.nan, V)), "X[7]"),
+        (lambda V, F, E: E.value(np.where(np.arange(V.size).reshape(V.shape) == 7, np.nan, V)), "X[2]: vertex 2"),
         (lambda V, F, E: E.third(V, V, np.full(V.shape, np.inf)), "W[0]"),
         (lambda V, F, E: E.third_batch(V, np.ones((V.size, 2)), [(0, 2)]), "pairs[0]"),
         (lambda V, F, E: E.third_batch(V, np.ones((V.size, 2)), [0, 1]), "pairs: expected a (p, 2)"),
