@@ -4,7 +4,8 @@
 // with Dual<double, N> (one direction per input) gives the Hessian; nesting,
 // Dual<Dual<double, 1>, 1>, gives a hyper-dual number whose mixed part is a second directional
 // derivative (for the third derivative of an energy, the gradient's second derivative along u
-// and w). Only what the element quantities use is defined: + - * / with duals and doubles, sqrt.
+// and w). Only what the element quantities use is defined: + − * / between duals, * by a
+// double, unary −, sqrt.
 #pragma once
 
 #include <array>
