@@ -8,5 +8,6 @@ namespace modal_deform {
 void bind_errors(pybind11::module_& m);
 void bind_mesh(pybind11::module_& m);
 void bind_energy(pybind11::module_& m);
+void bind_modes(pybind11::module_& m);
 
 }  // namespace modal_deform

@@ -6,5 +6,7 @@ The pipeline, one module per stage: ``mesh`` (check, mass, test shapes).
 """
 from .._native import Cancelled
 from .mesh import bar, bumpy_plane, check, cylinder, grid, mass, read_mesh
+from .modes import rigid_motions, solve_in_range, vibration_modes
 
 __all__ = ["Cancelled", "bar", "bumpy_plane", "check", "cylinder", "grid", "mass", "read_mesh"]
+__all__ += ["rigid_motions", "solve_in_range", "vibration_modes"]
