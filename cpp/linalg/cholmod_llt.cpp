@@ -71,6 +71,30 @@ SparseMatrix lower_with_diagonal(const SparseMatrix& A, const VectorRef* shift) 
   return lower;
 }
 
+// The lower triangle of the graph of nodes (groups of b consecutive rows) of `lower`, as a pattern.
+SparseMatrix node_graph(const SparseMatrix& lower, int b) {
+  const int nodes = static_cast<int>(lower.rows()) / b;
+  std::vector<int> marker(static_cast<size_t>(nodes), -1);
+  std::vector<int> outer{0}, inner;
+  for (int J = 0; J < nodes; ++J) {
+    for (int j = b * J; j < b * (J + 1); ++j)
+      for (SparseMatrix::InnerIterator it(lower, j); it; ++it) {
+        const int I = static_cast<int>(it.row()) / b;
+        if (marker[static_cast<size_t>(I)] != J) {
+          marker[static_cast<size_t>(I)] = J;
+          inner.push_back(I);
+        }
+      }
+    std::sort(inner.begin() + outer.back(), inner.end());
+    outer.push_back(static_cast<int>(inner.size()));
+  }
+  SparseMatrix graph(nodes, nodes);
+  graph.resizeNonZeros(static_cast<Eigen::Index>(inner.size()));
+  std::copy(outer.begin(), outer.end(), graph.outerIndexPtr());
+  std::copy(inner.begin(), inner.end(), graph.innerIndexPtr());
+  return graph;
+}
+
 bool same_pattern(const SparseMatrix& a, const SparseMatrix& b) {
   return a.rows() == b.rows() && a.nonZeros() == b.nonZeros() &&
          std::equal(a.outerIndexPtr(), a.outerIndexPtr() + a.cols() + 1, b.outerIndexPtr()) &&
@@ -94,6 +118,11 @@ struct CholmodLLT::Cholmod {
     common.supernodal = CHOLMOD_SUPERNODAL;
     common.final_ll = 1;
     common.quick_return_if_not_posdef = 1;
+    // METIS ends the process when it runs out of memory; with this, CHOLMOD checks for room first
+    // and falls back to AMD.
+    common.metis_memory = 2.0;
+    common.nmethods = 1;
+    common.method[0].ordering = CHOLMOD_GIVEN;
   }
   ~Cholmod() {
     free_factor();
@@ -114,17 +143,18 @@ struct CholmodLLT::Cholmod {
     throw NumericalError(message("CHOLMOD ", what, " failed: ", cholmod_message));
   }
 
-  // A no-copy CHOLMOD view of `lower`, the lower triangle of a symmetric matrix.
-  static cholmod_sparse view(SparseMatrix& lower) {
+  // A no-copy CHOLMOD view of `lower`, the lower triangle of a symmetric matrix (its pattern only
+  // when `values` is false).
+  static cholmod_sparse view(SparseMatrix& lower, bool values = true) {
     cholmod_sparse A{};
     A.nrow = A.ncol = static_cast<size_t>(lower.rows());
     A.nzmax = static_cast<size_t>(lower.nonZeros());
     A.p = lower.outerIndexPtr();
     A.i = lower.innerIndexPtr();
-    A.x = lower.valuePtr();
+    A.x = values ? lower.valuePtr() : nullptr;
     A.stype = -1;  // symmetric, lower triangle stored
     A.itype = CHOLMOD_INT;
-    A.xtype = CHOLMOD_REAL;
+    A.xtype = values ? CHOLMOD_REAL : CHOLMOD_PATTERN;
     A.dtype = CHOLMOD_DOUBLE;
     A.sorted = 1;
     A.packed = 1;
@@ -132,7 +162,9 @@ struct CholmodLLT::Cholmod {
   }
 };
 
-CholmodLLT::CholmodLLT() : cholmod_(std::make_unique<Cholmod>()) {}
+CholmodLLT::CholmodLLT(int dofs_per_node) : cholmod_(std::make_unique<Cholmod>()), dofs_per_node_(dofs_per_node) {
+  if (dofs_per_node < 1) throw InputError(message("dofs_per_node: expected 1 or more, got ", dofs_per_node));
+}
 
 CholmodLLT::~CholmodLLT() = default;
 
@@ -152,8 +184,16 @@ void CholmodLLT::analyze(const SparseMatrix& A) {
 void CholmodLLT::analyze_lower() {
   factorized_ = false;
   cholmod_->free_factor();
+  const int n = rows();
+  const int b = n % dofs_per_node_ == 0 ? dofs_per_node_ : 1;
+  SparseMatrix graph = node_graph(lower_, b);
+  cholmod_sparse graph_view = Cholmod::view(graph, false);
+  std::vector<int> node_order(static_cast<size_t>(n / b)), order(static_cast<size_t>(n));
+  cholmod_->check(cholmod_metis(&graph_view, nullptr, 0, 1, node_order.data(), &cholmod_->common) != 0, "METIS ordering");
+  for (int k = 0; k < n / b; ++k)
+    for (int r = 0; r < b; ++r) order[static_cast<size_t>(b * k + r)] = b * node_order[static_cast<size_t>(k)] + r;
   cholmod_sparse view = Cholmod::view(lower_);
-  cholmod_->factor = cholmod_analyze(&view, &cholmod_->common);
+  cholmod_->factor = cholmod_analyze_p(&view, order.data(), nullptr, 0, &cholmod_->common);
   cholmod_->check(cholmod_->factor != nullptr, "analyze");
 }
 

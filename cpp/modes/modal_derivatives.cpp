@@ -15,10 +15,6 @@
 namespace modal_deform {
 namespace {
 
-// Zᵀ M Z may differ from I by this much.
-constexpr double kOrthonormalTolerance = 1e-8;
-// ‖K z‖ ≤ kKernelTolerance ‖K‖₁ ‖z‖ for each column z of Z.
-constexpr double kKernelTolerance = 1e-8;
 // A pivot of the QR of Z's rows this much smaller than the largest counts as zero.
 constexpr double kRankThreshold = 1e-8;
 // ‖K ψ − P b‖ ≤ kResidualTolerance (‖K‖₁ ‖ψ‖ + ‖P b‖) for each column.
@@ -26,43 +22,14 @@ constexpr double kResidualTolerance = 1e-6;
 // Right-hand sides per solve: blocked solves run at BLAS-3 speed, and the bar moves between them.
 constexpr Eigen::Index kBlockColumns = 64;
 
-// ‖K‖₁, the largest column sum of |K|.
-double norm_1(const SparseMatrix& K) {
-  double largest = 0;
-  for (int j = 0; j < K.outerSize(); ++j) {
-    double sum = 0;
-    for (SparseMatrix::InnerIterator it(K, j); it; ++it) sum += std::abs(it.value());
-    largest = std::max(largest, sum);
-  }
-  return largest;
-}
-
 // A checked kernel basis, zero on the DOFs that take no part in the problem.
 struct Kernel {
   Eigen::MatrixXd Z;
   std::vector<bool> decoupled;
-  double norm_K = 0;
 };
 
 Kernel checked_kernel(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z) {
-  validate_stiffness_and_mass(K, mass);
-  if (Z.rows() != K.rows()) throw InputError(message("Z: expected ", K.rows(), " rows, got ", Z.rows()));
-  if (!Z.allFinite()) throw InputError("Z: has an entry that is not finite");
-  Kernel kernel{Z, decoupled_dofs(K, mass), norm_1(K)};
-  for (Eigen::Index d = 0; d < Z.rows(); ++d)
-    if (kernel.decoupled[static_cast<size_t>(d)]) kernel.Z.row(d).setZero();
-  const Eigen::MatrixXd gram = kernel.Z.transpose() * dof_masses(mass).asDiagonal() * kernel.Z;
-  Eigen::Index i, j;
-  const double error = (gram - Eigen::MatrixXd::Identity(Z.cols(), Z.cols())).cwiseAbs().maxCoeff(&i, &j);
-  if (Z.cols() && error > kOrthonormalTolerance)
-    throw InputError(message("Z: expected M-orthonormal columns, but (Z^T M Z)(", i, ", ", j, ") = ", gram(i, j)));
-  const Eigen::MatrixXd KZ = K * kernel.Z;
-  for (Eigen::Index k = 0; k < Z.cols(); ++k) {
-    const double relative = KZ.col(k).norm() / (kernel.norm_K * kernel.Z.col(k).norm());
-    if (relative > kKernelTolerance)
-      throw InputError(message("Z: column ", k, " is not in the kernel of K (|K z| / (|K| |z|) = ", relative, ")"));
-  }
-  return kernel;
+  return {checked_kernel_basis(K, mass, Z), decoupled_dofs(K, mass)};
 }
 
 std::vector<int> pins_for(const SparseMatrix& K, const Kernel& kernel) {
@@ -117,7 +84,7 @@ Eigen::MatrixXd solve_with_pins(const SparseMatrix& K, const VectorRef& mass, co
   for (int s : pins) pin_stiffness[s] = w;
   for (Eigen::Index d = 0; d < n; ++d)
     if (decoupled[static_cast<size_t>(d)]) pin_stiffness[d] = w > 0 ? w : 1.0;
-  CholmodLLT llt;
+  CholmodLLT llt(3);  // orders vertices, 3 DOFs each
   try {
     llt.factorize(K, pin_stiffness);
   } catch (const NumericalError& e) {
@@ -127,6 +94,7 @@ Eigen::MatrixXd solve_with_pins(const SparseMatrix& K, const VectorRef& mass, co
 
   // P = I − Z (ZᵀZ)⁻¹ Zᵀ, also zero on the decoupled DOFs (part of the kernel, zero rows in Z).
   const Eigen::LLT<Eigen::MatrixXd> gram(Z.transpose() * Z);
+  const double norm_K = norm_1(K);
   Eigen::MatrixXd Psi(n, B.cols());
   for (Eigen::Index first = 0; first < B.cols(); first += kBlockColumns) {
     const Eigen::Index width = std::min(kBlockColumns, B.cols() - first);
@@ -138,7 +106,7 @@ Eigen::MatrixXd solve_with_pins(const SparseMatrix& K, const VectorRef& mass, co
     if (Z.cols()) X -= Z * (Z.transpose() * m.asDiagonal() * X);
     const Eigen::MatrixXd residual = K * X - PB;
     for (Eigen::Index j = 0; j < width; ++j) {
-      const double bound = kResidualTolerance * (kernel.norm_K * X.col(j).norm() + PB.col(j).norm());
+      const double bound = kResidualTolerance * (norm_K * X.col(j).norm() + PB.col(j).norm());
       if (!(residual.col(j).norm() <= bound))
         throw NumericalError(message("solve_in_range: column ", first + j, " has residual ", residual.col(j).norm(),
                                      ", above ", bound, "; does Z span the kernel of K?"));

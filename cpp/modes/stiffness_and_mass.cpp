@@ -11,6 +11,10 @@ namespace {
 // K(i, j) and K(j, i) may differ by this much relative to K's largest entry (rounding in the
 // assembly of element Hessians).
 constexpr double kSymmetryTolerance = 1e-10;
+// Zᵀ M Z may differ from I by this much.
+constexpr double kOrthonormalTolerance = 1e-8;
+// ‖K z‖ ≤ kKernelTolerance ‖K‖₁ ‖z‖ for each column z of a kernel basis.
+constexpr double kKernelTolerance = 1e-8;
 
 // K(row, col), zero when not stored; columns hold sorted row indices.
 double entry(const SparseMatrix& K, int row, int col) {
@@ -62,6 +66,38 @@ std::vector<bool> decoupled_dofs(const SparseMatrix& K, const VectorRef& mass) {
     decoupled[static_cast<size_t>(j)] = empty;
   }
   return decoupled;
+}
+
+double norm_1(const SparseMatrix& K) {
+  double largest = 0;
+  for (int j = 0; j < K.outerSize(); ++j) {
+    double sum = 0;
+    for (SparseMatrix::InnerIterator it(K, j); it; ++it) sum += std::abs(it.value());
+    largest = std::max(largest, sum);
+  }
+  return largest;
+}
+
+Eigen::MatrixXd checked_kernel_basis(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z) {
+  validate_stiffness_and_mass(K, mass);
+  if (Z.rows() != K.rows()) throw InputError(message("Z: expected ", K.rows(), " rows, got ", Z.rows()));
+  if (!Z.allFinite()) throw InputError("Z: has an entry that is not finite");
+  Eigen::MatrixXd basis = Z;
+  const std::vector<bool> decoupled = decoupled_dofs(K, mass);
+  for (Eigen::Index d = 0; d < Z.rows(); ++d)
+    if (decoupled[static_cast<size_t>(d)]) basis.row(d).setZero();
+  const Eigen::MatrixXd gram = basis.transpose() * dof_masses(mass).asDiagonal() * basis;
+  Eigen::Index i = 0, j = 0;
+  if (Z.cols() && (gram - Eigen::MatrixXd::Identity(Z.cols(), Z.cols())).cwiseAbs().maxCoeff(&i, &j) > kOrthonormalTolerance)
+    throw InputError(message("Z: expected M-orthonormal columns, but (Z^T M Z)(", i, ", ", j, ") = ", gram(i, j)));
+  const Eigen::MatrixXd KZ = K * basis;
+  const double norm_K = norm_1(K);
+  for (Eigen::Index k = 0; k < Z.cols(); ++k) {
+    const double relative = KZ.col(k).norm() / (norm_K * basis.col(k).norm());
+    if (relative > kKernelTolerance)
+      throw InputError(message("Z: column ", k, " is not in the kernel of K (|K z| / (|K| |z|) = ", relative, ")"));
+  }
+  return basis;
 }
 
 }  // namespace modal_deform

@@ -60,16 +60,27 @@ double relative_error(const Eigen::MatrixXd& x, const Eigen::MatrixXd& reference
 }
 
 TEST(CholmodLLT, SolvesLikeSimplicialLDLT) {
-  for (const SparseMatrix& A : {random_spd(400, 6, 1), random_spd(2000, 3, 2), bunny_stiffness_plus_mass()}) {
-    const Eigen::MatrixXd B = random_block(A.rows(), 3, 3);
-    CholmodLLT llt;
-    llt.factorize(A);
-    const Eigen::SimplicialLDLT<SparseMatrix> reference(A);
-    ASSERT_EQ(reference.info(), Eigen::Success);
-    EXPECT_LT(relative_error(llt.solve(B), reference.solve(B)), 1e-10) << "n = " << A.rows();
-    EXPECT_GT(llt.rcond(), 0.0);
-    EXPECT_GT(llt.factor_nonzeros(), 0.0);
-  }
+  // 3 DOFs per node orders the node graph; 2000 rows is not a multiple of 3 and falls back to 1.
+  for (const SparseMatrix& A : {random_spd(400, 6, 1), random_spd(2000, 3, 2), bunny_stiffness_plus_mass()})
+    for (int dofs_per_node : {1, 3}) {
+      const Eigen::MatrixXd B = random_block(A.rows(), 3, 3);
+      CholmodLLT llt(dofs_per_node);
+      llt.factorize(A);
+      const Eigen::SimplicialLDLT<SparseMatrix> reference(A);
+      ASSERT_EQ(reference.info(), Eigen::Success);
+      EXPECT_LT(relative_error(llt.solve(B), reference.solve(B)), 1e-10) << "n = " << A.rows();
+      EXPECT_GT(llt.rcond(), 0.0);
+      EXPECT_GT(llt.factor_nonzeros(), 0.0);
+    }
+}
+
+TEST(CholmodLLT, NodeOrderingFillsNoMoreThanRowOrdering) {
+  const SparseMatrix A = bunny_stiffness_plus_mass();
+  CholmodLLT rows(1), nodes(3);
+  rows.analyze(A);
+  nodes.analyze(A);
+  EXPECT_LT(nodes.factor_nonzeros(), 1.1 * rows.factor_nonzeros());
+  EXPECT_THROW(CholmodLLT(0), InputError);
 }
 
 TEST(CholmodLLT, BlockSolveEqualsColumnSolves) {
