@@ -18,11 +18,11 @@ void bind_modes(py::module_& m) {
   using MatrixRef = Eigen::Ref<const Eigen::MatrixXd>;
   m.def(
       "vibration_modes",
-      [](const SparseMatrix& K, const VectorRef& mass, int count) {
-        VibrationModes modes = vibration_modes(K, mass, count);
+      [](const SparseMatrix& K, const VectorRef& mass, int count, const MatrixRef& Z) {
+        VibrationModes modes = vibration_modes(K, mass, count, Z);
         return std::make_pair(std::move(modes.eigenvalues), std::move(modes.modes));
       },
-      py::arg("K"), py::arg("mass"), py::arg("count"), py::call_guard<py::gil_scoped_release>());
+      py::arg("K"), py::arg("mass"), py::arg("count"), py::arg("Z"), py::call_guard<py::gil_scoped_release>());
   m.def(
       "rigid_motions",
       [](const VerticesRef& V, const Eigen::Ref<const Eigen::VectorXi>& labels, const VectorRef& mass) {

@@ -31,9 +31,9 @@ class ShiftInvert {
  public:
   using Scalar = double;
 
-  ShiftInvert(const SparseMatrix& K, const Eigen::VectorXd& dof_mass, Eigen::VectorXd decoupled_stiffness,
-              Progress* progress, int expected_solves)
-      : K_(K), dof_mass_(dof_mass), decoupled_stiffness_(std::move(decoupled_stiffness)), progress_(progress),
+  ShiftInvert(const SparseMatrix& K, const Eigen::VectorXd& dof_mass, const Eigen::MatrixXd& Z,
+              Eigen::VectorXd decoupled_stiffness, Progress* progress, int expected_solves)
+      : K_(K), dof_mass_(dof_mass), Z_(Z), decoupled_stiffness_(std::move(decoupled_stiffness)), progress_(progress),
         expected_solves_(expected_solves) {}
 
   Eigen::Index rows() const { return K_.rows(); }
@@ -53,8 +53,11 @@ class ShiftInvert {
     Eigen::Map<Eigen::VectorXd>(y, rows()) = solve(Eigen::Map<const Eigen::VectorXd>(x, rows()));
   }
 
+  // (K − σM)⁻¹ B, M-orthogonal to Z: Z spans eigenvectors, so projecting commutes with the
+  // inverse and keeps the Krylov space off the deflated kernel.
   Eigen::MatrixXd solve(const Eigen::Ref<const Eigen::MatrixXd>& B) {
     Eigen::MatrixXd X = llt_.solve(B);
+    if (Z_.cols()) X -= Z_ * (Z_.transpose() * dof_mass_.asDiagonal() * X);
     solves_ += static_cast<int>(B.cols());
     // Lanczos needs a few times ncv solves; the bar approaches 1 without reaching it.
     if (progress_) progress_->report("modes", 1.0 - std::exp(-static_cast<double>(solves_) / expected_solves_));
@@ -66,11 +69,12 @@ class ShiftInvert {
  private:
   const SparseMatrix& K_;
   const Eigen::VectorXd& dof_mass_;
+  const Eigen::MatrixXd& Z_;
   Eigen::VectorXd decoupled_stiffness_;
   Progress* progress_;
   int expected_solves_;
   int solves_ = 0;
-  CholmodLLT llt_;
+  CholmodLLT llt_{3};  // orders vertices, 3 DOFs each
 };
 
 // y = M x with the lumped (diagonal) mass matrix: the inner product of the Lanczos vectors.
@@ -83,15 +87,14 @@ struct MassProduct {
   }
 };
 
-}  // namespace
-
-VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int count, Progress* progress) {
-  validate_stiffness_and_mass(K, mass);
+// Z: a checked kernel basis (see checked_kernel_basis), possibly empty.
+VibrationModes deflated_modes(const SparseMatrix& K, const VectorRef& mass, int count, const Eigen::MatrixXd& Z,
+                              Progress* progress) {
   const Eigen::VectorXd m = dof_masses(mass);
   const int n = static_cast<int>(m.size());
-  const int with_mass = static_cast<int>((m.array() > 0).count());
-  if (count < 1 || count >= with_mass)
-    throw InputError(message("count: expected 1 to ", with_mass - 1, " modes (DOFs with mass - 1), got ", count));
+  const int free = static_cast<int>((m.array() > 0).count() - Z.cols());
+  if (count < 1 || count >= free)
+    throw InputError(message("count: expected 1 to ", free - 1, " modes (DOFs with mass, less the deflated kernel, less 1), got ", count));
   const double trace_K = K.diagonal().sum();
   if (!(trace_K > 0)) throw InputError("K: no positive diagonal entry; there is no stiffness to take modes of");
   const double scale = trace_K / m.sum();
@@ -103,9 +106,9 @@ VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int
   for (int d = 0; d < n; ++d)
     if (decoupled[static_cast<size_t>(d)]) decoupled_stiffness[d] = trace_K / (n - num_decoupled);
 
-  const int ncv = std::min(with_mass, std::max(2 * count, count + 20));
+  const int ncv = std::min(free, std::max(2 * count, count + 20));
   if (progress) progress->report("modes", 0.0);
-  ShiftInvert op(K, m, std::move(decoupled_stiffness), progress, 3 * ncv);
+  ShiftInvert op(K, m, Z, std::move(decoupled_stiffness), progress, 3 * ncv);
   MassProduct mass_product{m};
   // Spectra selects among the transformed values ν = 1/(λ − σ): the smallest λ above σ have the
   // largest ν, hence LargestMagn. SmallestAlge only orders the result by ascending λ.
@@ -158,6 +161,18 @@ VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int
   result.solves = op.solves();
   if (progress) progress->report("modes", 1.0);
   return result;
+}
+
+}  // namespace
+
+VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int count, Progress* progress) {
+  validate_stiffness_and_mass(K, mass);
+  return deflated_modes(K, mass, count, Eigen::MatrixXd(K.rows(), 0), progress);
+}
+
+VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int count,
+                               const Eigen::Ref<const Eigen::MatrixXd>& Z, Progress* progress) {
+  return deflated_modes(K, mass, count, checked_kernel_basis(K, mass, Z), progress);
 }
 
 }  // namespace modal_deform

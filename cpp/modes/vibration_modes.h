@@ -25,4 +25,11 @@ struct VibrationModes {
 // mode's residual is too large.
 VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int count, Progress* progress = nullptr);
 
+// The `count` lowest eigenpairs with modes M-orthogonal to the columns of Z (3n by z, M-orthonormal,
+// in the kernel of K: rigid_motions for a rigid-invariant energy). Deflating the known kernel
+// spares Lanczos the eigenvalue 0 of multiplicity 6 per component, slow to resolve and useless to
+// deform with, and lets the shift sit closer to the flexible modes.
+VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int count,
+                               const Eigen::Ref<const Eigen::MatrixXd>& Z, Progress* progress = nullptr);
+
 }  // namespace modal_deform

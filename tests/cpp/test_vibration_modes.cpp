@@ -3,7 +3,9 @@
 #include <Eigen/Eigenvalues>
 
 #include "mesh/mass.h"
+#include "mesh/mesh_topology.h"
 #include "mesh/primitives.h"
+#include "modes/rigid_motions.h"
 #include "modes/stiffness_and_mass.h"
 #include "modes/vibration_modes.h"
 #include "stand_in_stiffness.h"
@@ -75,6 +77,29 @@ TEST(VibrationModes, BunnyHasSixZeroModesAndAccurateResiduals) {
   EXPECT_LT(modes.residuals.maxCoeff(), 1e-9 * modes.eigenvalues[19]);
   expect_m_orthonormal(modes.modes, dof_masses(mass));
   for (int i = 1; i < 20; ++i) EXPECT_LE(modes.eigenvalues[i - 1], modes.eigenvalues[i]);
+}
+
+TEST(VibrationModes, DeflatingTheRigidMotionsLeavesTheFlexibleModes) {
+  const TriangleMesh mesh = two_boxes();
+  const Eigen::VectorXd mass = lumped_mass(mesh.V, mesh.F);
+  const Eigen::VectorXd m = dof_masses(mass);
+  const SparseMatrix K = spring_network_hessian(mesh.V, mesh.F);
+  const std::vector<int> labels = build_topology(mesh.V, mesh.F).vertex_component;
+  const Eigen::MatrixXd Z =
+      rigid_motions(mesh.V, Eigen::Map<const Eigen::VectorXi>(labels.data(), static_cast<Eigen::Index>(labels.size())), mass);
+  const VibrationModes all = vibration_modes(K, mass, 20);
+  const VibrationModes flexible = vibration_modes(K, mass, 8, Z);
+  const double top = all.eigenvalues[19];
+  for (int i = 0; i < 8; ++i) EXPECT_NEAR(flexible.eigenvalues[i], all.eigenvalues[12 + i], 1e-9 * top) << "mode " << i;
+  EXPECT_LT((Z.transpose() * m.asDiagonal() * flexible.modes).cwiseAbs().maxCoeff(), 1e-10);
+  // The same modes up to sign (the eigenvalues are distinct).
+  const Eigen::MatrixXd overlap = all.modes.middleCols(12, 8).transpose() * m.asDiagonal() * flexible.modes;
+  EXPECT_LT((overlap.cwiseAbs() - Eigen::MatrixXd::Identity(8, 8)).cwiseAbs().maxCoeff(), 1e-6);
+  expect_m_orthonormal(flexible.modes, m);
+  EXPECT_LT(flexible.solves, all.solves);
+  // Z must be M-orthonormal, and count leaves room for the deflated kernel.
+  EXPECT_THROW(vibration_modes(K, mass, 8, 2 * Z), InputError);
+  EXPECT_THROW(vibration_modes(K, mass, static_cast<int>(K.rows()) - 12, Z), InputError);
 }
 
 TEST(VibrationModes, UnreferencedVertexStaysStill) {

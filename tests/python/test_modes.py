@@ -96,6 +96,15 @@ def test_rigid_motions_are_the_kernel(two_boxes):
     np.testing.assert_allclose(in_span, modes, atol=1e-8 * np.abs(modes).max())
 
 
+def test_deflated_modes_are_the_flexible_ones(two_boxes):
+    V, F, K, mass, labels = two_boxes
+    Z = mdc.rigid_motions(V, labels, mass)
+    all_eigenvalues, _ = mdc.vibration_modes(K, mass, 18)
+    eigenvalues, modes = mdc.vibration_modes(K, mass, 6, kernel=Z)
+    np.testing.assert_allclose(eigenvalues, all_eigenvalues[12:], rtol=1e-9)
+    assert np.abs(Z.T @ (np.repeat(mass, 3)[:, None] * modes)).max() < 1e-10
+
+
 def test_solve_in_range_is_the_limit_of_k_plus_eps_m(two_boxes):
     V, F, K, mass, labels = two_boxes
     m = np.repeat(mass, 3)
@@ -145,6 +154,7 @@ def test_unsorted_duplicate_entries_are_summed(two_boxes):
         (lambda K, m, Z: mdc.vibration_modes(K, -m, 4), ValueError, "mass[0]"),
         (lambda K, m, Z: mdc.vibration_modes(K - 0.01 * scipy.sparse.diags(np.repeat(m, 3)), m, 4),
          RuntimeError, "not positive definite"),
+        (lambda K, m, Z: mdc.vibration_modes(K, m, 4, kernel=Z[:, :5] + 1), ValueError, "M-orthonormal"),
         (lambda K, m, Z: mdc.solve_in_range(K, m, Z[:-3], np.ones(K.shape[0])), ValueError, "Z: expected shape"),
         (lambda K, m, Z: mdc.solve_in_range(K, m, 2 * Z, np.ones(K.shape[0])), ValueError, "M-orthonormal"),
         (lambda K, m, Z: mdc.solve_in_range(K, m, Z[:, :3], np.ones(K.shape[0])), RuntimeError, "whole kernel"),

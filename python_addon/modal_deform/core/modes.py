@@ -23,13 +23,19 @@ def _stiffness(K):
     return K
 
 
-def vibration_modes(K, mass, count):
+def vibration_modes(K, mass, count, kernel=None):
     """The ``count`` lowest eigenpairs of K φ = λ M φ, rigid motions (λ = 0) included.
 
+    With ``kernel`` (3n, z), M-orthonormal columns in the kernel of K such as rigid_motions, the
+    ``count`` lowest eigenpairs whose modes are M-orthogonal to it: the flexible modes, without
+    spending Lanczos iterations on the 6 zero modes of every component.
     Returns (eigenvalues (count,) ascending, modes (3n, count) M-orthonormal). Raises ValueError
     for bad input and RuntimeError when the eigensolver fails (for instance K is indefinite).
     """
-    return _native.vibration_modes(_stiffness(K), _arrays.values(mass, "mass"), int(count))
+    K = _stiffness(K)
+    kernel = np.zeros((K.shape[0], 0)) if kernel is None else kernel
+    return _native.vibration_modes(K, _arrays.values(mass, "mass"), int(count),
+                                   _arrays.columns(kernel, K.shape[0], "kernel"))
 
 
 def rigid_motions(V, labels, mass):
