@@ -31,8 +31,8 @@ const Problem& dragon() {
     mesh.V *= normalizing_scale(mesh.V);
     Problem p{testing::spring_network_hessian(mesh.V, mesh.F), lumped_mass(mesh.V, mesh.F), {}, {}};
     const std::vector<int> labels = build_topology(mesh.V, mesh.F).vertex_component;
-    p.Z = rigid_motions(mesh.V, Eigen::Map<const Eigen::VectorXi>(labels.data(), static_cast<Eigen::Index>(labels.size())),
-                        p.mass);
+    p.Z = rigid_motions(
+        mesh.V, Eigen::Map<const Eigen::VectorXi>(labels.data(), static_cast<Eigen::Index>(labels.size())), p.mass);
     const Eigen::VectorXd m = dof_masses(p.mass);
     const std::vector<bool> decoupled = decoupled_dofs(p.K, p.mass);
     p.shift = 1e-8 * p.K.diagonal().sum() / m.sum() * m;
@@ -55,7 +55,11 @@ void BM_CholmodAnalyze(benchmark::State& state) {
   state.counters["rows"] = static_cast<double>(p.K.rows());
   state.counters["A_nonzeros"] = static_cast<double>(p.K.nonZeros());
 }
-BENCHMARK(BM_CholmodAnalyze)->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions(3)->ComputeStatistics("min", minimum);
+BENCHMARK(BM_CholmodAnalyze)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1)
+    ->Repetitions(3)
+    ->ComputeStatistics("min", minimum);
 
 void BM_CholmodFactorize(benchmark::State& state) {
   const Problem& p = dragon();
@@ -63,7 +67,11 @@ void BM_CholmodFactorize(benchmark::State& state) {
   llt.analyze(p.K);
   for (auto _ : state) llt.factorize(p.K, p.shift);
 }
-BENCHMARK(BM_CholmodFactorize)->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions(3)->ComputeStatistics("min", minimum);
+BENCHMARK(BM_CholmodFactorize)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1)
+    ->Repetitions(3)
+    ->ComputeStatistics("min", minimum);
 
 void BM_CholmodSolve(benchmark::State& state) {
   const Problem& p = dragon();
@@ -72,7 +80,13 @@ void BM_CholmodSolve(benchmark::State& state) {
   const Eigen::MatrixXd B = Eigen::MatrixXd::Random(p.K.rows(), state.range(0));
   for (auto _ : state) benchmark::DoNotOptimize(llt.solve(B));
 }
-BENCHMARK(BM_CholmodSolve)->Arg(1)->Arg(64)->Unit(benchmark::kMillisecond)->Iterations(3)->Repetitions(3)->ComputeStatistics("min", minimum);
+BENCHMARK(BM_CholmodSolve)
+    ->Arg(1)
+    ->Arg(64)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3)
+    ->Repetitions(3)
+    ->ComputeStatistics("min", minimum);
 
 // The lowest modes M-orthogonal to the rigid motions (the spring network also has 9 mechanisms).
 void BM_VibrationModes(benchmark::State& state) {
@@ -83,7 +97,12 @@ void BM_VibrationModes(benchmark::State& state) {
     state.counters["max_residual"] = modes.residuals.maxCoeff();
   }
 }
-BENCHMARK(BM_VibrationModes)->Arg(20)->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions(2)->ComputeStatistics("min", minimum);
+BENCHMARK(BM_VibrationModes)
+    ->Arg(20)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1)
+    ->Repetitions(2)
+    ->ComputeStatistics("min", minimum);
 
 }  // namespace
 }  // namespace modal_deform

@@ -30,8 +30,7 @@ void record_cholmod_error(int status, const char* file, int line, const char* te
 SparseMatrix lower_with_diagonal(const SparseMatrix& A, const VectorRef* shift) {
   if (A.rows() != A.cols()) throw InputError(message("A: expected a square matrix, got ", A.rows(), " by ", A.cols()));
   const int n = static_cast<int>(A.rows());
-  if (shift && shift->size() != n)
-    throw InputError(message("shift: expected ", n, " values, got ", shift->size()));
+  if (shift && shift->size() != n) throw InputError(message("shift: expected ", n, " values, got ", shift->size()));
   std::vector<int> count(n, 0);
   for (int j = 0; j < n; ++j) {
     int previous = -1;
@@ -189,7 +188,8 @@ void CholmodLLT::analyze_lower() {
   SparseMatrix graph = node_graph(lower_, b);
   cholmod_sparse graph_view = Cholmod::view(graph, false);
   std::vector<int> node_order(static_cast<size_t>(n / b)), order(static_cast<size_t>(n));
-  cholmod_->check(cholmod_metis(&graph_view, nullptr, 0, 1, node_order.data(), &cholmod_->common) != 0, "METIS ordering");
+  cholmod_->check(cholmod_metis(&graph_view, nullptr, 0, 1, node_order.data(), &cholmod_->common) != 0,
+                  "METIS ordering");
   for (int k = 0; k < n / b; ++k)
     for (int r = 0; r < b; ++r) order[static_cast<size_t>(b * k + r)] = b * node_order[static_cast<size_t>(k)] + r;
   cholmod_sparse view = Cholmod::view(lower_);
@@ -220,8 +220,9 @@ void CholmodLLT::factorize_lower(SparseMatrix lower) {
   cholmod_->check(ok != 0, "factorize");
   rcond_ = cholmod_rcond(L, &cholmod_->common);
   if (!(rcond_ >= kSingularRcond))
-    throw NumericalError(message("the matrix is singular to working precision (CHOLMOD's reciprocal condition estimate ",
-                                 rcond_, "): its solutions would be rounding noise"));
+    throw NumericalError(
+        message("the matrix is singular to working precision (CHOLMOD's reciprocal condition estimate ", rcond_,
+                "): its solutions would be rounding noise"));
   factorized_ = true;
 }
 
@@ -239,7 +240,8 @@ Eigen::MatrixXd CholmodLLT::solve(const Eigen::Ref<const Eigen::MatrixXd>& B) {
   rhs.xtype = CHOLMOD_REAL;
   rhs.dtype = CHOLMOD_DOUBLE;
   Cholmod& c = *cholmod_;
-  const int ok = cholmod_solve2(CHOLMOD_A, c.factor, &rhs, nullptr, &c.solution, nullptr, &c.work_y, &c.work_e, &c.common);
+  const int ok =
+      cholmod_solve2(CHOLMOD_A, c.factor, &rhs, nullptr, &c.solution, nullptr, &c.work_y, &c.work_e, &c.common);
   c.check(ok != 0, "solve");
   const auto* x = static_cast<const double*>(c.solution->x);
   for (Eigen::Index j = 0; j < X.cols(); ++j)

@@ -2,7 +2,6 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
-
 #include <algorithm>
 #include <cmath>
 #include <unordered_map>
@@ -94,6 +93,7 @@ Eigen::MatrixXd solve_with_pins(const SparseMatrix& K, const VectorRef& mass, co
 
   // P = I − Z (ZᵀZ)⁻¹ Zᵀ, also zero on the decoupled DOFs (part of the kernel, zero rows in Z).
   const Eigen::LLT<Eigen::MatrixXd> gram(Z.transpose() * Z);
+  const Eigen::MatrixXd MZ = m.asDiagonal() * Z;
   const double norm_K = norm_1(K);
   Eigen::MatrixXd Psi(n, B.cols());
   for (Eigen::Index first = 0; first < B.cols(); first += kBlockColumns) {
@@ -103,7 +103,7 @@ Eigen::MatrixXd solve_with_pins(const SparseMatrix& K, const VectorRef& mass, co
       if (decoupled[static_cast<size_t>(d)]) PB.row(d).setZero();
     if (Z.cols()) PB -= Z * gram.solve(Z.transpose() * PB);
     Eigen::MatrixXd X = llt.solve(PB);
-    if (Z.cols()) X -= Z * (Z.transpose() * m.asDiagonal() * X);
+    if (Z.cols()) X -= Z * (MZ.transpose() * X);
     const Eigen::MatrixXd residual = K * X - PB;
     for (Eigen::Index j = 0; j < width; ++j) {
       const double bound = kResidualTolerance * (norm_K * X.col(j).norm() + PB.col(j).norm());

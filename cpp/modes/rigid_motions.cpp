@@ -1,7 +1,6 @@
 #include "modes/rigid_motions.h"
 
 #include <Eigen/Eigenvalues>
-
 #include <cmath>
 #include <vector>
 

@@ -19,8 +19,7 @@ constexpr double kKernelTolerance = 1e-8;
 // K(row, col), zero when not stored; columns hold sorted row indices.
 double entry(const SparseMatrix& K, int row, int col) {
   const int* begin = K.innerIndexPtr() + K.outerIndexPtr()[col];
-  const int* end = K.isCompressed() ? K.innerIndexPtr() + K.outerIndexPtr()[col + 1]
-                                    : begin + K.innerNonZeroPtr()[col];
+  const int* end = K.isCompressed() ? K.innerIndexPtr() + K.outerIndexPtr()[col + 1] : begin + K.innerNonZeroPtr()[col];
   const int* it = std::lower_bound(begin, end, row);
   return it != end && *it == row ? K.valuePtr()[it - K.innerIndexPtr()] : 0.0;
 }
@@ -34,7 +33,8 @@ void validate_stiffness_and_mass(const SparseMatrix& K, const VectorRef& mass) {
     if (!(std::isfinite(mass[i]) && mass[i] >= 0))
       throw InputError(message("mass[", i, "] = ", mass[i], ": expected a finite non-negative mass"));
   if (K.rows() != 3 * n || K.cols() != 3 * n)
-    throw InputError(message("K: expected ", 3 * n, " by ", 3 * n, " (3 per vertex), got ", K.rows(), " by ", K.cols()));
+    throw InputError(
+        message("K: expected ", 3 * n, " by ", 3 * n, " (3 per vertex), got ", K.rows(), " by ", K.cols()));
   double largest = 0;
   for (int j = 0; j < K.outerSize(); ++j) {
     int previous = -1;
@@ -54,9 +54,7 @@ void validate_stiffness_and_mass(const SparseMatrix& K, const VectorRef& mass) {
     }
 }
 
-Eigen::VectorXd dof_masses(const VectorRef& mass) {
-  return mass.replicate(1, 3).transpose().reshaped();
-}
+Eigen::VectorXd dof_masses(const VectorRef& mass) { return mass.replicate(1, 3).transpose().reshaped(); }
 
 std::vector<bool> decoupled_dofs(const SparseMatrix& K, const VectorRef& mass) {
   std::vector<bool> decoupled(static_cast<size_t>(K.cols()));
@@ -78,7 +76,8 @@ double norm_1(const SparseMatrix& K) {
   return largest;
 }
 
-Eigen::MatrixXd checked_kernel_basis(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z) {
+Eigen::MatrixXd checked_kernel_basis(const SparseMatrix& K, const VectorRef& mass,
+                                     const Eigen::Ref<const Eigen::MatrixXd>& Z) {
   validate_stiffness_and_mass(K, mass);
   if (Z.rows() != K.rows()) throw InputError(message("Z: expected ", K.rows(), " rows, got ", Z.rows()));
   if (!Z.allFinite()) throw InputError("Z: has an entry that is not finite");
@@ -86,9 +85,10 @@ Eigen::MatrixXd checked_kernel_basis(const SparseMatrix& K, const VectorRef& mas
   const std::vector<bool> decoupled = decoupled_dofs(K, mass);
   for (Eigen::Index d = 0; d < Z.rows(); ++d)
     if (decoupled[static_cast<size_t>(d)]) basis.row(d).setZero();
-  const Eigen::MatrixXd gram = basis.transpose() * dof_masses(mass).asDiagonal() * basis;
+  const Eigen::MatrixXd gram = basis.transpose() * (dof_masses(mass).asDiagonal() * basis);
   Eigen::Index i = 0, j = 0;
-  if (Z.cols() && (gram - Eigen::MatrixXd::Identity(Z.cols(), Z.cols())).cwiseAbs().maxCoeff(&i, &j) > kOrthonormalTolerance)
+  if (Z.cols() &&
+      (gram - Eigen::MatrixXd::Identity(Z.cols(), Z.cols())).cwiseAbs().maxCoeff(&i, &j) > kOrthonormalTolerance)
     throw InputError(message("Z: expected M-orthonormal columns, but (Z^T M Z)(", i, ", ", j, ") = ", gram(i, j)));
   const Eigen::MatrixXd KZ = K * basis;
   const double norm_K = norm_1(K);

@@ -27,6 +27,7 @@ double norm_1(const SparseMatrix& K);
 // Z (3n by z) as a basis of (part of) the kernel of K, with zero rows on the decoupled DOFs, after
 // validate_stiffness_and_mass. Throws InputError unless Z is finite, M-orthonormal and, column by
 // column, in the kernel of K up to rounding (‖K z‖ ≤ 1e-8 ‖K‖₁ ‖z‖).
-Eigen::MatrixXd checked_kernel_basis(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z);
+Eigen::MatrixXd checked_kernel_basis(const SparseMatrix& K, const VectorRef& mass,
+                                     const Eigen::Ref<const Eigen::MatrixXd>& Z);
 
 }  // namespace modal_deform

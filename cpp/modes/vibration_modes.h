@@ -12,8 +12,8 @@ struct VibrationModes {
   // ‖K φ − λ M φ‖ in the M⁻¹-norm per mode (count, units of λ): some eigenvalue of the pencil
   // lies within it of the reported one.
   Eigen::VectorXd residuals;
-  double shift = 0;     // σ of the shift-invert transform
-  int solves = 0;       // solves with the factor of K − σM
+  double shift = 0;  // σ of the shift-invert transform
+  int solves = 0;    // solves with the factor of K − σM
 };
 
 // The `count` eigenpairs of K φ = λ M φ with the smallest λ, rigid motions (λ = 0) included.

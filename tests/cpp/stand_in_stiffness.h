@@ -6,11 +6,10 @@
 // laplacian_stiffness has the three translations of each component in its kernel.
 #pragma once
 
+#include <Eigen/SparseCore>
 #include <array>
 #include <random>
 #include <vector>
-
-#include <Eigen/SparseCore>
 
 #include "mesh/mesh_topology.h"
 #include "mesh/primitives.h"
@@ -69,7 +68,8 @@ inline TriangleMesh jittered_bar(int nx, int ny, int nz, double jitter, unsigned
 }
 
 // The meshes side by side in one mesh (one component each), the second shifted by `offset`.
-inline TriangleMesh side_by_side(const TriangleMesh& first, const TriangleMesh& second, const Eigen::RowVector3d& offset) {
+inline TriangleMesh side_by_side(const TriangleMesh& first, const TriangleMesh& second,
+                                 const Eigen::RowVector3d& offset) {
   TriangleMesh mesh;
   mesh.V.resize(first.V.rows() + second.V.rows(), 3);
   mesh.V << first.V, second.V.rowwise() + offset;

@@ -107,7 +107,8 @@ TEST(SolveInRange, SolvesTheProjectedSystemOrthogonalToTheKernel) {
   const Eigen::MatrixXd PB = project_to_range(p.Z, B).topRows(p.K.rows() - 3);
   const Eigen::MatrixXd residual = (p.K * Psi).topRows(p.K.rows() - 3) - PB;
   EXPECT_LT(residual.norm(), 1e-10 * PB.norm());
-  EXPECT_LT((p.Z.transpose() * dof_masses(p.mass).asDiagonal() * Psi).cwiseAbs().maxCoeff(), 1e-10 * Psi.cwiseAbs().maxCoeff());
+  EXPECT_LT((p.Z.transpose() * dof_masses(p.mass).asDiagonal() * Psi).cwiseAbs().maxCoeff(),
+            1e-10 * Psi.cwiseAbs().maxCoeff());
   // The unreferenced vertex stays still.
   EXPECT_EQ(Psi.bottomRows(3).cwiseAbs().maxCoeff(), 0.0);
 }
@@ -148,8 +149,9 @@ TEST(SolveInRange, RejectsAKernelBasisThatIsWrong) {
   // M-orthonormal but not in the kernel.
   const Eigen::MatrixXd sheared = p.Z + 0.01 * random_block(p.Z.rows(), p.Z.cols(), 8);
   const Eigen::MatrixXd m = dof_masses(p.mass).asDiagonal();
-  const Eigen::MatrixXd orthonormal = sheared * (sheared.transpose() * m * sheared).llt().matrixU().solve(
-                                                    Eigen::MatrixXd::Identity(p.Z.cols(), p.Z.cols()));
+  const Eigen::MatrixXd orthonormal =
+      sheared *
+      (sheared.transpose() * m * sheared).llt().matrixU().solve(Eigen::MatrixXd::Identity(p.Z.cols(), p.Z.cols()));
   try {
     solve_in_range(p.K, p.mass, orthonormal, B);
     ADD_FAILURE() << "no exception";

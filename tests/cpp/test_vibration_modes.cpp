@@ -41,7 +41,8 @@ TEST(VibrationModes, MatchDenseGeneralizedEigensolver) {
   const Eigen::VectorXd mass = lumped_mass(mesh.V, mesh.F);
   const Eigen::VectorXd m = dof_masses(mass);
   for (const SparseMatrix& K : {spring_network_hessian(mesh.V, mesh.F), laplacian_stiffness(mesh.V, mesh.F)}) {
-    const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> dense(Eigen::MatrixXd(K), Eigen::MatrixXd(m.asDiagonal()));
+    const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> dense(Eigen::MatrixXd(K),
+                                                                          Eigen::MatrixXd(m.asDiagonal()));
     const int count = 20;
     const VibrationModes modes = vibration_modes(K, mass, count);
     ASSERT_EQ(modes.eigenvalues.size(), count);
@@ -85,8 +86,8 @@ TEST(VibrationModes, DeflatingTheRigidMotionsLeavesTheFlexibleModes) {
   const Eigen::VectorXd m = dof_masses(mass);
   const SparseMatrix K = spring_network_hessian(mesh.V, mesh.F);
   const std::vector<int> labels = build_topology(mesh.V, mesh.F).vertex_component;
-  const Eigen::MatrixXd Z =
-      rigid_motions(mesh.V, Eigen::Map<const Eigen::VectorXi>(labels.data(), static_cast<Eigen::Index>(labels.size())), mass);
+  const Eigen::MatrixXd Z = rigid_motions(
+      mesh.V, Eigen::Map<const Eigen::VectorXi>(labels.data(), static_cast<Eigen::Index>(labels.size())), mass);
   const VibrationModes all = vibration_modes(K, mass, 20);
   const VibrationModes flexible = vibration_modes(K, mass, 8, Z);
   const double top = all.eigenvalues[19];
