@@ -32,8 +32,9 @@ deps:
 	fi
 
 build: deps
-	@cmake -S . -B $(BUILD_DIR) $(CMAKE_FLAGS) -DPython_EXECUTABLE=$(PYTHON) > $(BUILD_DIR).configure.log 2>&1 \
-		|| (cat $(BUILD_DIR).configure.log; exit 1)
+	@mkdir -p $(BUILD_DIR)
+	@cmake -S . -B $(BUILD_DIR) $(CMAKE_FLAGS) -DPython_EXECUTABLE=$(PYTHON) > $(BUILD_DIR)/configure.log 2>&1 \
+		|| (cat $(BUILD_DIR)/configure.log; exit 1)
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 
 test: build
@@ -57,4 +58,4 @@ bench: build
 	$(BUILD_DIR)/bench/modal_deform_bench --benchmark_out=bench/results/native.json --benchmark_out_format=json
 
 clean:
-	rm -rf $(BUILD_DIR) $(BUILD_DIR).configure.log out dist python_addon/modal_deform/_native*.so
+	rm -rf $(BUILD_DIR) out dist python_addon/modal_deform/_native*.so

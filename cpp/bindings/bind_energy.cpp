@@ -1,8 +1,11 @@
 // The energies: one Python class per energy, sharing the methods of the Energy interface.
 #include <pybind11/eigen.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
 
 #include "bindings/bindings.h"
+#include "energy/arap.h"
+#include "energy/discrete_shells.h"
 #include "energy/energy.h"
 #include "util/errors.h"
 
@@ -52,6 +55,19 @@ void bind_energy(py::module_& m) {
           py::arg("x"), py::arg("u"), py::arg("w"), py::call_guard<py::gil_scoped_release>());
 
   // Each energy adds its class here, deriving from Energy.
+
+  py::class_<Arap, Energy>(m, "Arap")
+      .def(py::init<const VerticesRef&, const FacesRef&>(), py::arg("V"), py::arg("F"));
+  py::class_<DiscreteShells, Energy>(m, "DiscreteShells")
+      .def(py::init<const VerticesRef&, const FacesRef&, double, double>(), py::arg("V"), py::arg("F"),
+           py::arg("bending") = 1.0, py::arg("membrane") = 1.0, py::call_guard<py::gil_scoped_release>())
+      .def("third_batch", &DiscreteShells::third_batch, py::arg("x"), py::arg("Phi"), py::arg("pairs"),
+           py::call_guard<py::gil_scoped_release>())
+      .def_property_readonly("term_counts", [](const DiscreteShells& energy) {
+        const auto counts = energy.term_counts();
+        return py::dict(py::arg("edges") = counts.edges, py::arg("triangles") = counts.triangles,
+                        py::arg("hinges") = counts.hinges);
+      });
 }
 
 }  // namespace modal_deform

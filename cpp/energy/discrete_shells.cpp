@@ -1,0 +1,486 @@
+#include "energy/discrete_shells.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <type_traits>
+
+#include "energy/dual.h"
+#include "mesh/mesh_check.h"
+#include "mesh/mesh_topology.h"
+#include "util/errors.h"
+
+namespace modal_deform {
+namespace {
+
+using shells::DihedralAngle;
+using shells::EdgeLength;
+using shells::EdgeTerm;
+using shells::HingeTerm;
+using shells::TriangleArea;
+using shells::TriangleTerm;
+
+// Below this fraction of its rest size an element counts as collapsed (see the header).
+constexpr double kCollapse = kDegenerateAreaRatio;
+
+template <typename Term>
+constexpr int kVerticesOf = Term::Quantity::kVertices;
+// A term's coordinates relative to its first vertex (shell_elements.h).
+template <typename Term>
+constexpr int kDofsOf = 3 * (kVerticesOf<Term> - 1);
+
+// A term's f and its derivatives with respect to s at the current s (the weight included), and
+// whether s is differentiable there.
+struct Response {
+  double f = 0, df = 0, d2f = 0, d3f = 0;
+  bool differentiable = false;
+};
+
+// f(s) = ½ w (s − s̄)².
+Response quadratic(double s, double rest, double weight, bool differentiable) {
+  const double d = s - rest;
+  return {0.5 * weight * d * d, weight * d, weight, 0.0, differentiable};
+}
+
+Response respond(const EdgeTerm& term, const EdgeLength::Frame<double>& frame) {
+  return quadratic(EdgeLength::measure(frame), term.rest_length, term.weight, frame.length > term.collapsed_length);
+}
+
+Response respond(const TriangleTerm& term, const TriangleArea::Frame<double>& frame) {
+  return quadratic(TriangleArea::measure(frame), term.rest_area, term.weight, frame.norm > term.collapsed_norm);
+}
+
+// f(θ) = ½ w (2 sin(δ/2))², δ = θ − θ̄. The factor (2 sin(δ/2))² is the squared distance
+// between the points (cos θ, sin θ) and (cos θ̄, sin θ̄) of the unit circle: no cancellation at
+// small δ, exactly 0 at rest. The derivatives in δ use the angle-difference formulas.
+Response respond(const HingeTerm& term, const DihedralAngle::Frame<double>& frame) {
+  if (frame.n1n1 <= term.collapsed_n1n1 || frame.n2n2 <= term.collapsed_n2n2) return {};
+  const auto [cos_theta, sin_theta] = DihedralAngle::measure(frame);
+  const double cos_delta = cos_theta * term.cos_rest + sin_theta * term.sin_rest;
+  const double sin_delta = sin_theta * term.cos_rest - cos_theta * term.sin_rest;
+  const double chord_squared = (cos_theta - term.cos_rest) * (cos_theta - term.cos_rest) +
+                               (sin_theta - term.sin_rest) * (sin_theta - term.sin_rest);
+  const double w = term.weight;
+  return {0.5 * w * chord_squared, w * sin_delta, w * cos_delta, -w * sin_delta, true};
+}
+
+// r = (y_{v1} − y_{v0}, ..., y_{v_{K−1}} − y_{v0}) for the term's vertices v, y a flat 3n array.
+template <typename Term>
+void relative(const Term& term, const double* y, double* r) {
+  const double* origin = y + 3 * term.vertices[0];
+  for (int m = 1; m < kVerticesOf<Term>; ++m)
+    for (int i = 0; i < 3; ++i) r[3 * (m - 1) + i] = y[3 * term.vertices[m] + i] - origin[i];
+}
+
+template <typename Term>
+Response respond_at(const Term& term, const double* x, double* r) {
+  relative(term, x, r);
+  return respond(term, Term::Quantity::frame(r));
+}
+
+template <int N>
+double dot(const double* a, const double* b) {
+  double sum = 0;
+  for (int i = 0; i < N; ++i) sum += a[i] * b[i];
+  return sum;
+}
+
+// A vector over the relative coordinates as one over the K vertices: the first vertex gets
+// minus the sum of the others (translation invariance).
+template <int K>
+void to_vertices(const double* rel, double* full) {
+  for (int i = 0; i < 3; ++i) full[i] = 0;
+  for (int m = 1; m < K; ++m)
+    for (int i = 0; i < 3; ++i) {
+      full[3 * m + i] = rel[3 * (m - 1) + i];
+      full[i] -= rel[3 * (m - 1) + i];
+    }
+}
+
+// out[3v + i] += full[3m + i] for the term's vertices v = vertices[m] in `owned`.
+template <typename Term>
+void add_owned(const Term& term, const double* full, VertexPartition::Range owned, double* out) {
+  for (int m = 0; m < kVerticesOf<Term>; ++m) {
+    const int v = term.vertices[m];
+    if (!owned.contains(v)) continue;
+    for (int i = 0; i < 3; ++i) out[3 * v + i] += full[3 * m + i];
+  }
+}
+
+// Calls visit(term, index) for the terms of `set` that `part` visits, in order.
+template <typename Term, typename Visit>
+void visit_part(const shells::TermSet<Term>& set, int part, Visit& visit) {
+  if (set.by_part.empty()) {  // a single part visits every term
+    for (int e = 0; e < static_cast<int>(set.terms.size()); ++e) visit(set.terms[e], e);
+  } else {
+    for (int e : set.by_part[part]) visit(set.terms[e], e);
+  }
+}
+
+// ∇s and ∇²s (N by N, symmetrised, row-major) at r: the gradient evaluated on dual numbers
+// with one direction per coordinate.
+template <typename Quantity, int N>
+void second_derivatives(const double* r, double* gradient, double* hessian) {
+  using D = Dual<double, N>;
+  D rd[N], g[N];
+  for (int i = 0; i < N; ++i) {
+    rd[i].v = r[i];
+    rd[i].d[i] = 1.0;
+  }
+  Quantity::gradient(Quantity::frame(rd), g);
+  for (int i = 0; i < N; ++i) {
+    gradient[i] = g[i].v;
+    for (int j = 0; j < N; ++j) hessian[i * N + j] = 0.5 * (g[i].d[j] + g[j].d[i]);
+  }
+}
+
+// ∇s, ∇²s u, ∇²s w and ∇³s(u, w) at r: the gradient evaluated on hyper-dual numbers
+// r + ε1 u + ε2 w, read off at 1, ε2, ε1 and ε1ε2.
+template <typename Quantity, int N>
+void third_derivatives(const double* r, const double* u, const double* w, double* gradient, double* hu, double* hw,
+                       double* tuw) {
+  using H = Dual<Dual<double, 1>, 1>;
+  H rh[N], g[N];
+  for (int i = 0; i < N; ++i) {
+    rh[i].v.v = r[i];
+    rh[i].v.d[0] = w[i];
+    rh[i].d[0].v = u[i];
+  }
+  Quantity::gradient(Quantity::frame(rh), g);
+  for (int i = 0; i < N; ++i) {
+    gradient[i] = g[i].v.v;
+    hw[i] = g[i].v.d[0];
+    hu[i] = g[i].d[0].v;
+    tuw[i] = g[i].d[0].d[0];
+  }
+}
+
+// ∇³(w f(s))(u, w) in relative coordinates (the formula in the header); tuw = ∇³s(u, w) is
+// only read when f' ≠ 0.
+template <int N>
+void third_of_term(const Response& q, const double* gradient, const double* hu, const double* hw, const double* u,
+                   const double* w, const double* tuw, double* out) {
+  const double su = dot<N>(gradient, u), sw = dot<N>(gradient, w);
+  const double along_gradient = q.d3f * su * sw + q.d2f * dot<N>(u, hw);
+  for (int i = 0; i < N; ++i) out[i] = along_gradient * gradient[i] + q.d2f * (su * hw[i] + sw * hu[i]);
+  if (q.df != 0)
+    for (int i = 0; i < N; ++i) out[i] += q.df * tuw[i];
+}
+
+// ∇²(w f(s)) = f'' ∇s∇sᵀ + f' ∇²s over the relative coordinates (N by N), expanded to the
+// 3K by 3K Hessian over the term's vertices (row-major). ∇²s is only read when f' ≠ 0.
+template <int K>
+void term_hessian(const Response& q, const double* gradient, const double* hessian, double* full) {
+  constexpr int N = 3 * (K - 1), M = 3 * K;
+  // Written so that the result is exactly symmetric (the assembled Hessian then is too).
+  for (int i = 0; i < N; ++i)
+    for (int j = 0; j < N; ++j) full[(3 + i) * M + 3 + j] = q.d2f * (gradient[i] * gradient[j]);
+  if (q.df != 0)
+    for (int i = 0; i < N; ++i)
+      for (int j = 0; j < N; ++j) full[(3 + i) * M + 3 + j] += q.df * hessian[i * N + j];
+  // The first vertex's columns, then its rows: minus the sums over the other vertices.
+  for (int i = 3; i < M; ++i)
+    for (int c = 0; c < 3; ++c) {
+      double sum = 0;
+      for (int m = 1; m < K; ++m) sum += full[i * M + 3 * m + c];
+      full[i * M + c] = -sum;
+    }
+  for (int c = 0; c < 3; ++c)
+    for (int j = 0; j < M; ++j) {
+      double sum = 0;
+      for (int m = 1; m < K; ++m) sum += full[(3 * m + c) * M + j];
+      full[c * M + j] = -sum;
+    }
+  for (int c = 0; c < 3; ++c)
+    for (int d = 0; d < c; ++d) full[c * M + d] = full[d * M + c] = 0.5 * (full[c * M + d] + full[d * M + c]);
+}
+
+// y: 3n positions or displacements, named like validate_mesh names V.
+void require_finite_vector(const VectorRef& y, Eigen::Index size, const char* name) {
+  if (y.size() != size) throw InputError(message(name, ": expected ", size, " values, got ", y.size()));
+  if (y.allFinite()) return;
+  Eigen::Index v = 0;
+  while (y.segment<3>(3 * v).allFinite()) ++v;
+  throw InputError(message(name, "[", v, "]: vertex ", v, " has a non-finite coordinate (", y[3 * v], ", ",
+                           y[3 * v + 1], ", ", y[3 * v + 2], ")"));
+}
+
+void require_weight(double weight, const char* name) {
+  if (!(std::isfinite(weight) && weight >= 0))
+    throw InputError(message(name, ": expected a finite weight >= 0, got ", weight));
+}
+
+template <typename Term>
+void add_vertex_pairs(const std::vector<Term>& terms, std::vector<std::array<int, 2>>& pairs) {
+  for (const Term& term : terms)
+    for (int p = 0; p < kVerticesOf<Term>; ++p)
+      for (int q = p + 1; q < kVerticesOf<Term>; ++q)
+        if (term.vertices[p] != term.vertices[q]) pairs.push_back({term.vertices[p], term.vertices[q]});
+}
+
+template <typename Term>
+void finish_set(shells::TermSet<Term>& set, const BlockSparsity& sparsity, const VertexPartition& partition) {
+  constexpr int K = kVerticesOf<Term>;
+  // In the order of their smallest vertex, so that sweeps move through the outputs in order.
+  std::stable_sort(set.terms.begin(), set.terms.end(), [](const Term& a, const Term& b) {
+    return *std::min_element(a.vertices.begin(), a.vertices.end()) < *std::min_element(b.vertices.begin(), b.vertices.end());
+  });
+  set.block_offsets.resize(set.terms.size());
+  for (size_t e = 0; e < set.terms.size(); ++e)
+    for (int p = 0; p < K; ++p)
+      for (int q = 0; q < K; ++q)
+        set.block_offsets[e][p * K + q] = sparsity.offset(set.terms[e].vertices[p], set.terms[e].vertices[q]);
+  if (partition.parts() > 1) set.by_part = elements_by_part(partition, set.terms);
+}
+
+}  // namespace
+
+template <typename Visit>
+void DiscreteShells::for_each_term(int part, Visit&& visit) const {
+  for_each_set([&](const auto& set) { visit_part(set, part, visit); });
+}
+
+DiscreteShells::DiscreteShells(const VerticesRef& V, const FacesRef& F, double bending, double membrane) {
+  validate_mesh(V, F);
+  require_weight(bending, "bending");
+  require_weight(membrane, "membrane");
+  rest_ = flatten(V);
+  const double* x = rest_.data();
+  const int n = static_cast<int>(V.rows());
+  const MeshTopology topology = build_topology(V, F);
+  std::vector<char> degenerate(F.rows());
+  for (int f = 0; f < F.rows(); ++f) degenerate[f] = is_degenerate_face(V, F, f);
+
+  // The rest quantities come from the same code as the deformed ones, so at rest s = s̄ exactly.
+  double longest = 0;
+  for (const auto& [a, b] : topology.edges) longest = std::max(longest, (V.row(b) - V.row(a)).norm());
+  for (const auto& [a, b] : topology.edges) {
+    EdgeTerm term{{a, b}, 0, 0, 0};
+    double r[3];
+    relative(term, x, r);
+    const double length = EdgeLength::measure(EdgeLength::frame(r));
+    if (length <= kCollapse * longest) continue;
+    term.rest_length = length;
+    term.weight = membrane / length;
+    term.collapsed_length = kCollapse * length;
+    edges_.terms.push_back(term);
+  }
+  std::vector<double> area(F.rows(), 0.0);
+  for (int f = 0; f < F.rows(); ++f) {
+    if (degenerate[f]) continue;
+    TriangleTerm term{{F(f, 0), F(f, 1), F(f, 2)}, 0, 0, 0};
+    double r[6];
+    relative(term, x, r);
+    const auto frame = TriangleArea::frame(r);
+    area[f] = TriangleArea::measure(frame);
+    term.rest_area = area[f];
+    term.weight = membrane / area[f];
+    term.collapsed_norm = kCollapse * frame.norm;
+    triangles_.terms.push_back(term);
+  }
+  for (const Hinge& hinge : topology.hinges) {
+    if (degenerate[hinge.faces[0]] || degenerate[hinge.faces[1]]) continue;
+    HingeTerm term{hinge.vertices, 0, 0, 0, 0, 0};
+    double r[9];
+    relative(term, x, r);
+    const auto frame = DihedralAngle::frame(r);
+    const auto [cos_rest, sin_rest] = DihedralAngle::measure(frame);
+    term.cos_rest = cos_rest;
+    term.sin_rest = sin_rest;
+    term.weight = 3 * bending * frame.aa / (area[hinge.faces[0]] + area[hinge.faces[1]]);
+    term.collapsed_n1n1 = std::pow(kCollapse, 2) * frame.n1n1;
+    term.collapsed_n2n2 = std::pow(kCollapse, 2) * frame.n2n2;
+    hinges_.terms.push_back(term);
+  }
+
+  std::vector<std::array<int, 2>> pairs;
+  std::vector<int> work(n, 0);
+  for_each_set([&](const auto& set) {
+    add_vertex_pairs(set.terms, pairs);
+    for (const auto& term : set.terms)
+      for (int v : term.vertices) work[v] += static_cast<int>(term.vertices.size());
+  });
+  sparsity_ = BlockSparsity(n, pairs);
+  const size_t num_terms = edges_.terms.size() + triangles_.terms.size() + hinges_.terms.size();
+  partition_ = balanced_partition(work, num_terms >= kParallelElements ? std::max(1, omp_get_max_threads()) : 1);
+  finish_set(edges_, sparsity_, partition_);
+  finish_set(triangles_, sparsity_, partition_);
+  finish_set(hinges_, sparsity_, partition_);
+}
+
+DiscreteShells::TermCounts DiscreteShells::term_counts() const {
+  return {static_cast<int>(edges_.terms.size()), static_cast<int>(triangles_.terms.size()),
+          static_cast<int>(hinges_.terms.size())};
+}
+
+double DiscreteShells::value(const VectorRef& x) const {
+  require_finite_vector(x, rest_.size(), "X");
+  double energy = 0;
+  for_each_set([&](const auto& set) {
+    using Term = typename std::decay_t<decltype(set.terms)>::value_type;
+    const int count = static_cast<int>(set.terms.size());
+#pragma omp parallel for reduction(+ : energy) schedule(static) if (parallel())
+    for (int e = 0; e < count; ++e) {
+      double r[kDofsOf<Term>];
+      energy += respond_at(set.terms[e], x.data(), r).f;
+    }
+  });
+  return energy;
+}
+
+double DiscreteShells::value_and_gradient(const VectorRef& x, Eigen::Ref<Eigen::VectorXd> gradient) const {
+  require_finite_vector(x, rest_.size(), "X");
+  if (gradient.size() != rest_.size())
+    throw InputError(message("gradient: expected ", rest_.size(), " values, got ", gradient.size()));
+  double energy = 0;
+#pragma omp parallel for reduction(+ : energy) schedule(static, 1) if (parallel())
+  for (int part = 0; part < partition_.parts(); ++part) {
+    const VertexPartition::Range owned = partition_.range(part);
+    gradient.segment(3 * owned.first, 3 * (owned.last - owned.first)).setZero();
+    for_each_term(part, [&](const auto& term, int) {
+      using Term = std::decay_t<decltype(term)>;
+      constexpr int K = kVerticesOf<Term>, N = kDofsOf<Term>;
+      double r[N];
+      relative(term, x.data(), r);
+      const auto frame = Term::Quantity::frame(r);
+      const Response q = respond(term, frame);
+      if (owned.contains(term.vertices[0])) energy += q.f;
+      if (!q.differentiable || q.df == 0) return;
+      double g[N], full[3 * K];
+      Term::Quantity::gradient(frame, g);
+      for (double& gi : g) gi *= q.df;
+      to_vertices<K>(g, full);
+      add_owned(term, full, owned, gradient.data());
+    });
+  }
+  return energy;
+}
+
+SparseMatrix DiscreteShells::hessian(const VectorRef& x) const {
+  require_finite_vector(x, rest_.size(), "X");
+  SparseMatrix H = sparsity_.allocate_matrix();
+  double* values = H.valuePtr();
+#pragma omp parallel for schedule(static, 1) if (parallel())
+  for (int part = 0; part < partition_.parts(); ++part) {
+    const VertexPartition::Range owned = partition_.range(part);
+    sparsity_.zero_columns(H, owned.first, owned.last);
+    for_each_term(part, [&](const auto& term, int e) {
+      using Term = std::decay_t<decltype(term)>;
+      constexpr int K = kVerticesOf<Term>, N = kDofsOf<Term>, M = 3 * K;
+      double r[N];
+      relative(term, x.data(), r);
+      const auto frame = Term::Quantity::frame(r);
+      const Response q = respond(term, frame);
+      if (!q.differentiable) return;
+      double g[N], h[N * N], full[M * M];
+      if (q.df != 0)
+        second_derivatives<typename Term::Quantity, N>(r, g, h);
+      else  // at rest, for instance: ∇²s is not needed
+        Term::Quantity::gradient(frame, g);
+      term_hessian<K>(q, g, h, full);
+      const auto& offsets = set_of(term).block_offsets[e];
+      for (int b = 0; b < K; ++b) {
+        const int column_vertex = term.vertices[b];
+        if (!owned.contains(column_vertex)) continue;
+        const int stride = sparsity_.column_stride(column_vertex);
+        for (int a = 0; a < K; ++a) {
+          double* block = values + offsets[a * K + b];
+          for (int j = 0; j < 3; ++j)
+            for (int i = 0; i < 3; ++i) block[j * stride + i] += full[(3 * a + i) * M + 3 * b + j];
+        }
+      }
+    });
+  }
+  return H;
+}
+
+Eigen::VectorXd DiscreteShells::third(const VectorRef& x, const VectorRef& u, const VectorRef& w) const {
+  require_finite_vector(x, rest_.size(), "X");
+  require_finite_vector(u, rest_.size(), "U");
+  require_finite_vector(w, rest_.size(), "W");
+  Eigen::VectorXd out(rest_.size());
+#pragma omp parallel for schedule(static, 1) if (parallel())
+  for (int part = 0; part < partition_.parts(); ++part) {
+    const VertexPartition::Range owned = partition_.range(part);
+    out.segment(3 * owned.first, 3 * (owned.last - owned.first)).setZero();
+    for_each_term(part, [&](const auto& term, int) {
+      using Term = std::decay_t<decltype(term)>;
+      constexpr int K = kVerticesOf<Term>, N = kDofsOf<Term>;
+      double r[N];
+      const Response q = respond_at(term, x.data(), r);
+      if (!q.differentiable) return;
+      double ur[N], wr[N], g[N], hu[N], hw[N], tuw[N], local[N], full[3 * K];
+      relative(term, u.data(), ur);
+      relative(term, w.data(), wr);
+      third_derivatives<typename Term::Quantity, N>(r, ur, wr, g, hu, hw, tuw);
+      third_of_term<N>(q, g, hu, hw, ur, wr, tuw, local);
+      to_vertices<K>(local, full);
+      add_owned(term, full, owned, out.data());
+    });
+  }
+  return out;
+}
+
+Eigen::MatrixXd DiscreteShells::third_batch(const VectorRef& x, const Eigen::Ref<const Eigen::MatrixXd>& Phi,
+                                            const std::vector<std::array<int, 2>>& pairs) const {
+  require_finite_vector(x, rest_.size(), "X");
+  if (Phi.rows() != rest_.size())
+    throw InputError(message("Phi: expected ", rest_.size(), " rows, got ", Phi.rows()));
+  if (!Phi.allFinite())
+    for (Eigen::Index j = 0; j < Phi.cols(); ++j)
+      for (Eigen::Index i = 0; i < Phi.rows(); ++i)
+        if (!std::isfinite(Phi(i, j)))
+          throw InputError(message("Phi[", i, ", ", j, "]: not finite (", Phi(i, j), ")"));
+  // The columns the pairs use, each gathered once per element.
+  std::vector<int> slot(Phi.cols(), -1), used;
+  for (size_t p = 0; p < pairs.size(); ++p)
+    for (int column : pairs[p]) {
+      if (column < 0 || column >= Phi.cols())
+        throw InputError(message("pairs[", p, "]: column ", column, " outside [0, ", Phi.cols(), ")"));
+      if (slot[column] < 0) {
+        slot[column] = static_cast<int>(used.size());
+        used.push_back(column);
+      }
+    }
+  const int num_used = static_cast<int>(used.size());
+  const int num_pairs = static_cast<int>(pairs.size());
+  Eigen::MatrixXd out(rest_.size(), num_pairs);
+#pragma omp parallel for schedule(static, 1) if (parallel())
+  for (int part = 0; part < partition_.parts(); ++part) {
+    const VertexPartition::Range owned = partition_.range(part);
+    out.middleRows(3 * owned.first, 3 * (owned.last - owned.first)).setZero();
+    // Φ over each element's relative coordinates (slot by slot) and ∇²s times it.
+    constexpr int kMaxDofs = kDofsOf<HingeTerm>;
+    std::vector<double> phi(kMaxDofs * num_used), h_phi(kMaxDofs * num_used);
+    for_each_term(part, [&](const auto& term, int) {
+      using Term = std::decay_t<decltype(term)>;
+      constexpr int K = kVerticesOf<Term>, N = kDofsOf<Term>;
+      double r[N];
+      const Response q = respond_at(term, x.data(), r);
+      if (!q.differentiable) return;
+      double g[N], h[N * N];
+      second_derivatives<typename Term::Quantity, N>(r, g, h);
+      for (int s = 0; s < num_used; ++s) {
+        double* phi_s = &phi[N * s];
+        relative(term, Phi.col(used[s]).data(), phi_s);
+        for (int i = 0; i < N; ++i) h_phi[N * s + i] = dot<N>(&h[i * N], phi_s);
+      }
+      for (int p = 0; p < num_pairs; ++p) {
+        const int i = slot[pairs[p][0]], j = slot[pairs[p][1]];
+        double tuw[N], local[N], full[3 * K];
+        if (q.df != 0) {  // away from rest: ∇³s(Φ_i, Φ_j) too
+          double unused_g[N], unused_hu[N], unused_hw[N];
+          third_derivatives<typename Term::Quantity, N>(r, &phi[N * i], &phi[N * j], unused_g, unused_hu, unused_hw,
+                                                        tuw);
+        }
+        third_of_term<N>(q, g, &h_phi[N * i], &h_phi[N * j], &phi[N * i], &phi[N * j], tuw, local);
+        to_vertices<K>(local, full);
+        add_owned(term, full, owned, out.col(p).data());
+      }
+    });
+  }
+  return out;
+}
+
+}  // namespace modal_deform

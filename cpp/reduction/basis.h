@@ -1,0 +1,49 @@
+// The reduced shape space a bake produces and the solver consumes; stored with the asset.
+//
+// Everything is in the mesh's own units: the fine positions are x = x̄ + U q. The energy is
+// evaluated in the paper's normalised frame (longest bounding-box edge 10), reached by
+// multiplying positions by `scale`; eigenvalues are those of that frame.
+#pragma once
+
+#include <map>
+#include <string>
+
+#include "util/types.h"
+
+namespace modal_deform {
+
+struct Basis {
+  // Fine mesh: #V by 3 rest positions and #V lumped masses (mesh units).
+  RowMatrixX3d rest;
+  Eigen::VectorXd mass;
+  // 3n by r, x = x̄ + U q. Columns: rigid motions, vibration modes, then modal derivatives;
+  // M-orthonormal in the normalised frame. float32 rows: mapping q to the mesh is memory bound.
+  RowMatrixXf vectors;
+  int num_rigid = 0;  // leading columns that are rigid motions
+  int num_modes = 0;  // leading columns that are vibration modes (rigid ones included)
+  Eigen::VectorXd eigenvalues;  // num_modes, ascending (normalised frame)
+  // Ghost: #G by 3 rest positions, #H by 3 triangles, #V fine vertex -> ghost vertex, and
+  // 3g by r restricted basis (mass-weighted means over each ghost vertex's preimage).
+  RowMatrixX3d ghost_vertices;
+  RowMatrixX3i ghost_faces;
+  Eigen::VectorXi ghost_map;
+  Eigen::MatrixXd ghost_vectors;
+  // Energy the basis was built for and the scale of the normalised frame.
+  double scale = 1.0;
+  double bending = 1.0;
+  double membrane = 1.0;
+  // Derivative vectors dropped by the orthonormalisation as numerically dependent.
+  int num_dropped = 0;
+  // Seconds spent in each stage of the bake, by stage name.
+  std::map<std::string, double> timings;
+
+  int num_vertices() const { return static_cast<int>(rest.rows()); }
+  int dimension() const { return static_cast<int>(vectors.cols()); }
+};
+
+// Throws InputError naming the first array that is missing, of the wrong shape, non-finite or
+// out of range, or inconsistent with the others. Stored bases are untrusted: a .blend may be
+// old, edited or hostile, and nothing may be read out of bounds after this passes.
+void validate_basis(const Basis& basis);
+
+}  // namespace modal_deform

@@ -1,0 +1,449 @@
+#include "reduction/edge_collapse.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
+#include <queue>
+#include <tuple>
+#include <vector>
+
+#include "mesh/mesh_check.h"
+#include "util/errors.h"
+
+namespace modal_deform {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// Weight of a boundary edge's constraint plane (through the edge, perpendicular to its face),
+// per edge length squared; face planes weigh their area.
+constexpr double kBoundaryWeight = 10.0;
+// Weight of Ward's criterion (how much the cluster's second moment about its centroid grows)
+// added to the quadric error. Both are area times length squared; where the quadric is flat
+// this keeps clusters compact and alike in size instead of growing one cluster at random.
+constexpr double kCompactnessWeight = 0.1;
+// Heap pops between progress reports (a pop takes microseconds).
+constexpr long kReportInterval = 256;
+
+// Sum of weighted squared distances to planes: q(p) = pᵀAp + 2bᵀp + c with A symmetric,
+// stored as A00 A01 A02 A11 A12 A22 b0 b1 b2 c.
+class Quadric {
+ public:
+  Quadric() { c_.fill(0.0); }
+
+  // w (n·p + d)² for the plane n·p + d = 0, n of unit length.
+  static Quadric plane(const Eigen::Vector3d& n, double d, double w) {
+    Quadric q;
+    q.c_ = {w * n.x() * n.x(), w * n.x() * n.y(), w * n.x() * n.z(), w * n.y() * n.y(), w * n.y() * n.z(),
+            w * n.z() * n.z(), w * d * n.x(),     w * d * n.y(),     w * d * n.z(),     w * d * d};
+    return q;
+  }
+
+  Quadric& operator+=(const Quadric& other) {
+    for (int i = 0; i < 10; ++i) c_[i] += other.c_[i];
+    return *this;
+  }
+
+  double operator()(const Eigen::Vector3d& p) const {
+    const double x = p.x(), y = p.y(), z = p.z();
+    return x * (c_[0] * x + 2 * (c_[1] * y + c_[2] * z + c_[6])) + y * (c_[3] * y + 2 * (c_[4] * z + c_[7])) +
+           z * (c_[5] * z + 2 * c_[8]) + c_[9];
+  }
+
+ private:
+  std::array<double, 10> c_;
+};
+
+// The fine vertices merged into one vertex, summarised by what the collapse needs.
+struct Cluster {
+  Quadric quadric;
+  Eigen::Vector3d weighted_sum = Eigen::Vector3d::Zero();  // Σ m_i x_i
+  Eigen::Vector3d plain_sum = Eigen::Vector3d::Zero();     // Σ x_i
+  double mass = 0;
+  int count = 0;
+};
+
+// Mass-weighted centroid of the union of a and b; the plain mean when it has no mass.
+Eigen::Vector3d merged_centroid(const Cluster& a, const Cluster& b) {
+  const double mass = a.mass + b.mass;
+  if (mass > 0) return (a.weighted_sum + b.weighted_sum) / mass;
+  return (a.plain_sum + b.plain_sum) / (a.count + b.count);
+}
+
+struct TriangleShape {
+  Eigen::Vector3d normal;  // (b - a) × (c - a), of length twice the area
+  double quality;          // 4√3·area / Σ edge², 1 for an equilateral triangle
+  bool degenerate;         // the test of is_degenerate_face
+};
+
+TriangleShape triangle_shape(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  TriangleShape shape;
+  shape.normal = (b - a).cross(c - a);
+  const double ab = (b - a).squaredNorm(), bc = (c - b).squaredNorm(), ca = (a - c).squaredNorm();
+  const double twice_area = shape.normal.norm();
+  shape.quality = ab + bc + ca > 0 ? 2 * std::sqrt(3.0) * twice_area / (ab + bc + ca) : 0.0;
+  shape.degenerate = twice_area <= kDegenerateAreaRatio * std::max({ab, bc, ca});
+  return shape;
+}
+
+struct Neighbour {
+  int vertex;
+  int faces;  // faces containing both this vertex and the centre
+  int face;   // one of them
+};
+
+struct Candidate {
+  double cost;  // negative for the edge of a degenerate face, which goes first
+  int u, v;
+  int version_u, version_v;
+  bool operator>(const Candidate& other) const { return cost > other.cost; }
+};
+
+class Simplifier {
+ public:
+  Simplifier(const VerticesRef& V, const FacesRef& F, const VectorRef& mass);
+  void simplify(int target, Progress* progress);
+  EdgeCollapse result();
+
+ private:
+  bool has_vertex(int f, int x) const { return faces_(f, 0) == x || faces_(f, 1) == x || faces_(f, 2) == x; }
+  const std::vector<int>& live_faces(int x);
+  void tally_neighbours(int x, std::vector<Neighbour>& out);
+  void add_boundary_quadrics();
+  void seed();
+  void push_edges(int x, bool higher_only);
+  double cost(int u, int v) const;
+  bool try_collapse(int u, int v);
+  bool face_stays_sound(int f, int u, int v, const Eigen::Vector3d& p) const;
+  void collapse(int u, int v, const Eigen::Vector3d& p);
+
+  RowMatrixX3i faces_;  // the kept input faces; a collapse of v into u renames v to u
+  std::vector<char> face_alive_;
+  std::vector<Eigen::Vector3d> input_normals_;   // unit normal of each kept input face, 0 if degenerate
+  std::vector<std::vector<int>> vertex_faces_;   // faces around each vertex; dead ones dropped lazily
+  std::vector<Cluster> clusters_;
+  std::vector<Eigen::Vector3d> position_;        // centroid of each live cluster
+  std::vector<int> version_;                     // bumped whenever a vertex's cluster grows
+  std::vector<int> merged_into_;                 // -1 for a live vertex or one no face uses
+  std::vector<char> alive_;
+  int num_alive_ = 0;
+  std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> heap_;
+  // Scratch space of try_collapse and push_edges, kept to avoid allocations per collapse.
+  std::vector<int> shared_, u_only_, v_only_, degenerate_faces_;
+  std::vector<Neighbour> around_u_, around_v_;
+};
+
+Simplifier::Simplifier(const VerticesRef& V, const FacesRef& F, const VectorRef& mass) {
+  const int n = static_cast<int>(V.rows());
+  // Faces on the same three vertices: oppositely oriented copies cancel in pairs (together they
+  // are a sheet of no thickness, which decimated scans are full of); one copy of the orientation
+  // left over, if any, stays. Faces with repeated indices go.
+  struct Copy {
+    std::array<int, 3> key;  // the vertices in increasing order
+    int orientation;         // +1 when the face runs through key cyclically, -1 otherwise
+    int face;
+    bool operator<(const Copy& other) const { return std::tie(key, face) < std::tie(other.key, other.face); }
+  };
+  std::vector<Copy> copies;
+  copies.reserve(F.rows());
+  for (int f = 0; f < F.rows(); ++f) {
+    const int a = F(f, 0), b = F(f, 1), c = F(f, 2);
+    if (a == b || b == c || c == a) continue;
+    std::array<int, 3> key{a, b, c};
+    std::sort(key.begin(), key.end());
+    copies.push_back({key, (a < b) + (b < c) + (c < a) == 2 ? 1 : -1, f});
+  }
+  std::sort(copies.begin(), copies.end());
+  std::vector<int> kept;
+  for (size_t begin = 0, end; begin < copies.size(); begin = end) {
+    int net = 0;
+    for (end = begin; end < copies.size() && copies[end].key == copies[begin].key; ++end) net += copies[end].orientation;
+    for (size_t i = begin; i < end && net != 0; ++i)
+      if (copies[i].orientation * net > 0) {
+        kept.push_back(copies[i].face);
+        break;
+      }
+  }
+  std::sort(kept.begin(), kept.end());
+
+  const int num_faces = static_cast<int>(kept.size());
+  if (num_faces == 0)
+    throw InputError("F: no triangle is left once faces with repeated vertices and oppositely oriented copies go");
+  faces_.resize(num_faces, 3);
+  for (int f = 0; f < num_faces; ++f) faces_.row(f) = F.row(kept[f]);
+  face_alive_.assign(num_faces, 1);
+
+  std::vector<int> degree(n, 0);
+  for (int f = 0; f < num_faces; ++f)
+    for (int k = 0; k < 3; ++k) ++degree[faces_(f, k)];
+  vertex_faces_.resize(n);
+  for (int x = 0; x < n; ++x) vertex_faces_[x].reserve(degree[x]);
+  for (int f = 0; f < num_faces; ++f)
+    for (int k = 0; k < 3; ++k) vertex_faces_[faces_(f, k)].push_back(f);
+
+  clusters_.resize(n);
+  position_.resize(n);
+  for (int x = 0; x < n; ++x) {
+    position_[x] = V.row(x).transpose();
+    clusters_[x].weighted_sum = mass[x] * position_[x];
+    clusters_[x].plain_sum = position_[x];
+    clusters_[x].mass = mass[x];
+    clusters_[x].count = 1;
+  }
+  input_normals_.resize(num_faces);
+  for (int f = 0; f < num_faces; ++f) {
+    const Eigen::Vector3d& a = position_[faces_(f, 0)];
+    const TriangleShape shape = triangle_shape(a, position_[faces_(f, 1)], position_[faces_(f, 2)]);
+    input_normals_[f] = shape.degenerate ? Eigen::Vector3d::Zero() : shape.normal.normalized();
+    if (shape.degenerate) continue;
+    const Quadric plane = Quadric::plane(input_normals_[f], -input_normals_[f].dot(a), 0.5 * shape.normal.norm());
+    for (int k = 0; k < 3; ++k) clusters_[faces_(f, k)].quadric += plane;
+  }
+  add_boundary_quadrics();
+
+  version_.assign(n, 0);
+  merged_into_.assign(n, -1);
+  alive_.assign(n, 0);
+  for (int x = 0; x < n; ++x) alive_[x] = !vertex_faces_[x].empty();
+  num_alive_ = static_cast<int>(std::count(alive_.begin(), alive_.end(), 1));
+}
+
+const std::vector<int>& Simplifier::live_faces(int x) {
+  auto& faces = vertex_faces_[x];
+  faces.erase(std::remove_if(faces.begin(), faces.end(), [this](int f) { return !face_alive_[f]; }), faces.end());
+  return faces;
+}
+
+void Simplifier::tally_neighbours(int x, std::vector<Neighbour>& out) {
+  out.clear();
+  for (int f : live_faces(x))
+    for (int k = 0; k < 3; ++k) {
+      const int w = faces_(f, k);
+      if (w == x) continue;
+      auto it = std::find_if(out.begin(), out.end(), [w](const Neighbour& s) { return s.vertex == w; });
+      if (it == out.end())
+        out.push_back({w, 1, f});
+      else
+        ++it->faces;
+    }
+}
+
+// Garland–Heckbert's boundary constraint: a plane through each boundary edge, perpendicular to
+// its face, so merging along a curved or cornered boundary costs what it cuts off.
+void Simplifier::add_boundary_quadrics() {
+  for (int x = 0; x < static_cast<int>(vertex_faces_.size()); ++x) {
+    tally_neighbours(x, around_u_);
+    for (const Neighbour& s : around_u_) {
+      if (s.faces != 1 || s.vertex < x || input_normals_[s.face].squaredNorm() == 0) continue;
+      const Eigen::Vector3d edge = position_[s.vertex] - position_[x];
+      const Eigen::Vector3d normal = edge.cross(input_normals_[s.face]).normalized();
+      const Quadric plane = Quadric::plane(normal, -normal.dot(position_[x]), kBoundaryWeight * edge.squaredNorm());
+      clusters_[x].quadric += plane;
+      clusters_[s.vertex].quadric += plane;
+    }
+  }
+}
+
+double Simplifier::cost(int u, int v) const {
+  const Cluster &a = clusters_[u], &b = clusters_[v];
+  const Eigen::Vector3d p = merged_centroid(a, b);
+  const double quadric_error = std::max(0.0, a.quadric(p) + b.quadric(p));
+  const double mass = a.mass + b.mass;
+  const double ward = mass > 0 ? a.mass * b.mass / mass * (position_[u] - position_[v]).squaredNorm() : 0.0;
+  return quadric_error + kCompactnessWeight * ward;
+}
+
+void Simplifier::push_edges(int x, bool higher_only) {
+  tally_neighbours(x, around_u_);
+  degenerate_faces_.clear();
+  for (int f : vertex_faces_[x])
+    if (triangle_shape(position_[faces_(f, 0)], position_[faces_(f, 1)], position_[faces_(f, 2)]).degenerate)
+      degenerate_faces_.push_back(f);
+  for (const Neighbour& s : around_u_) {
+    if (higher_only && s.vertex < x) continue;
+    const bool on_degenerate_face = std::any_of(degenerate_faces_.begin(), degenerate_faces_.end(),
+                                                [&](int f) { return has_vertex(f, s.vertex); });
+    heap_.push({on_degenerate_face ? -1.0 : cost(x, s.vertex), x, s.vertex, version_[x], version_[s.vertex]});
+  }
+}
+
+void Simplifier::seed() {
+  for (int x = 0; x < static_cast<int>(alive_.size()); ++x)
+    if (alive_[x]) push_edges(x, true);
+}
+
+bool Simplifier::face_stays_sound(int f, int u, int v, const Eigen::Vector3d& p) const {
+  std::array<Eigen::Vector3d, 3> before, after;
+  for (int k = 0; k < 3; ++k) {
+    const int x = faces_(f, k);
+    before[k] = position_[x];
+    after[k] = (x == u || x == v) ? p : position_[x];
+  }
+  const TriangleShape old_shape = triangle_shape(before[0], before[1], before[2]);
+  const TriangleShape new_shape = triangle_shape(after[0], after[1], after[2]);
+  if (new_shape.degenerate) return old_shape.degenerate;
+  if (new_shape.quality < kMinFaceQuality && new_shape.quality < old_shape.quality) return false;
+  const double max_turn_cosine = std::cos(kMaxNormalTurnDegrees * kPi / 180.0);
+  if (!old_shape.degenerate &&
+      new_shape.normal.dot(old_shape.normal) < max_turn_cosine * new_shape.normal.norm() * old_shape.normal.norm())
+    return false;
+  // Turning in small steps must not add up to a flip against the input.
+  return new_shape.normal.dot(input_normals_[f]) > 0 || input_normals_[f].squaredNorm() == 0;
+}
+
+bool Simplifier::try_collapse(int u, int v) {
+  if (live_faces(u).size() < live_faces(v).size()) std::swap(u, v);  // rename the smaller star
+  shared_.clear();
+  u_only_.clear();
+  v_only_.clear();
+  for (int f : vertex_faces_[u]) (has_vertex(f, v) ? shared_ : u_only_).push_back(f);
+  for (int f : vertex_faces_[v])
+    if (!has_vertex(f, u)) v_only_.push_back(f);
+  if (shared_.empty() || (u_only_.empty() && v_only_.empty())) return false;
+
+  // Boundary: merge two boundary vertices only along a boundary edge, never a boundary vertex
+  // with an interior one.
+  tally_neighbours(u, around_u_);
+  tally_neighbours(v, around_v_);
+  auto on_boundary = [](const std::vector<Neighbour>& around) {
+    return std::any_of(around.begin(), around.end(), [](const Neighbour& s) { return s.faces == 1; });
+  };
+  const bool u_boundary = on_boundary(around_u_);
+  if (u_boundary != on_boundary(around_v_) || (u_boundary && shared_.size() != 1)) return false;
+
+  // Link condition: every common neighbour spans a face with u and v.
+  for (const Neighbour& s : around_u_) {
+    if (s.vertex == v) continue;
+    const bool common = std::any_of(around_v_.begin(), around_v_.end(),
+                                    [&s](const Neighbour& t) { return t.vertex == s.vertex; });
+    const bool opposite =
+        std::any_of(shared_.begin(), shared_.end(), [&](int f) { return has_vertex(f, s.vertex); });
+    if (common && !opposite) return false;
+  }
+
+  // No face of v may land on a face of u.
+  auto other_two = [this](int f, int x) {
+    std::array<int, 2> pair{};
+    int i = 0;
+    for (int k = 0; k < 3; ++k)
+      if (faces_(f, k) != x) pair[i++] = faces_(f, k);
+    if (pair[0] > pair[1]) std::swap(pair[0], pair[1]);
+    return pair;
+  };
+  for (int f : v_only_) {
+    const auto pair = other_two(f, v);
+    for (int g : u_only_)
+      if (other_two(g, u) == pair) return false;
+  }
+
+  const Eigen::Vector3d p = merged_centroid(clusters_[u], clusters_[v]);
+  for (int f : u_only_)
+    if (!face_stays_sound(f, u, v, p)) return false;
+  for (int f : v_only_)
+    if (!face_stays_sound(f, u, v, p)) return false;
+  collapse(u, v, p);
+  return true;
+}
+
+void Simplifier::collapse(int u, int v, const Eigen::Vector3d& p) {
+  for (int f : shared_) face_alive_[f] = 0;
+  for (int f : v_only_) {
+    for (int k = 0; k < 3; ++k)
+      if (faces_(f, k) == v) faces_(f, k) = u;
+    vertex_faces_[u].push_back(f);
+  }
+  std::vector<int>().swap(vertex_faces_[v]);
+
+  Cluster &a = clusters_[u], &b = clusters_[v];
+  a.quadric += b.quadric;
+  a.weighted_sum += b.weighted_sum;
+  a.plain_sum += b.plain_sum;
+  a.mass += b.mass;
+  a.count += b.count;
+  position_[u] = p;
+  alive_[v] = 0;
+  merged_into_[v] = u;
+  --num_alive_;
+  ++version_[u];
+  push_edges(u, false);
+}
+
+void Simplifier::simplify(int target, Progress* progress) {
+  if (progress) progress->report("ghost", 0.0);
+  if (num_alive_ <= target) return;
+  const int start = num_alive_;
+  seed();
+  long pops = 0;
+  int collapses_in_pass = 0;
+  while (num_alive_ > target) {
+    // A rejected candidate returns only when one of its vertices changes; a fresh pass over all
+    // edges catches those whose neighbourhood changed instead.
+    if (heap_.empty()) {
+      if (collapses_in_pass == 0) break;
+      collapses_in_pass = 0;
+      seed();
+      continue;
+    }
+    const Candidate c = heap_.top();
+    heap_.pop();
+    if (progress && ++pops % kReportInterval == 0)
+      progress->report("ghost", double(start - num_alive_) / double(start - target));
+    if (!alive_[c.u] || !alive_[c.v] || version_[c.u] != c.version_u || version_[c.v] != c.version_v) continue;
+    if (try_collapse(c.u, c.v)) ++collapses_in_pass;
+  }
+}
+
+EdgeCollapse Simplifier::result() {
+  const int n = static_cast<int>(alive_.size());
+  std::vector<int> id(n, -1);
+  EdgeCollapse out;
+  out.V.resize(num_alive_, 3);
+  for (int x = 0, next = 0; x < n; ++x)
+    if (alive_[x]) {
+      out.V.row(next) = position_[x].transpose();
+      id[x] = next++;
+    }
+  out.cluster.resize(n);
+  for (int x = 0; x < n; ++x) {
+    int root = x;
+    while (merged_into_[root] >= 0) root = merged_into_[root];
+    for (int y = x; merged_into_[y] >= 0;) {  // path compression
+      const int next = merged_into_[y];
+      if (next != root) merged_into_[y] = root;
+      y = next;
+    }
+    out.cluster[x] = id[root];
+  }
+  const int num_faces = static_cast<int>(std::count(face_alive_.begin(), face_alive_.end(), 1));
+  out.F.resize(num_faces, 3);
+  for (int f = 0, next = 0; f < static_cast<int>(face_alive_.size()); ++f)
+    if (face_alive_[f]) {
+      for (int k = 0; k < 3; ++k) out.F(next, k) = id[faces_(f, k)];
+      ++next;
+    }
+  return out;
+}
+
+}  // namespace
+
+EdgeCollapse collapse_edges(const VerticesRef& V, const FacesRef& F, const VectorRef& mass, int target,
+                            Progress* progress) {
+  validate_mesh(V, F);
+  if (target < 4) throw InputError(message("target: a ghost needs at least 4 vertices, got ", target));
+  if (mass.size() != V.rows())
+    throw InputError(message("mass: expected ", V.rows(), " values (one per vertex), got ", mass.size()));
+  for (Eigen::Index i = 0; i < mass.size(); ++i)
+    if (!std::isfinite(mass[i]) || mass[i] < 0)
+      throw InputError(message("mass[", i, "]: expected a finite value >= 0, got ", mass[i]));
+
+  if (target >= V.rows()) {
+    if (progress) progress->report("ghost", 1.0);
+    EdgeCollapse identity{V, F, Eigen::VectorXi::LinSpaced(V.rows(), 0, static_cast<int>(V.rows()) - 1)};
+    return identity;
+  }
+  Simplifier simplifier(V, F, mass);
+  simplifier.simplify(target, progress);
+  return simplifier.result();
+}
+
+}  // namespace modal_deform

@@ -1,0 +1,75 @@
+#include "reduction/ghost.h"
+
+#include <cmath>
+#include <vector>
+
+#include "reduction/edge_collapse.h"
+#include "util/errors.h"
+
+namespace modal_deform {
+
+Ghost ghost_mesh(const VerticesRef& V, const FacesRef& F, const VectorRef& mass, int target, Progress* progress) {
+  EdgeCollapse collapse = collapse_edges(V, F, mass, target, progress);
+  Ghost ghost;
+  ghost.F = std::move(collapse.F);
+  ghost.map = std::move(collapse.cluster);
+  // Vertices without a face join the nearest cluster. Unreferenced ones have no mass; those whose
+  // faces cancelled (double sheets) have a little, and move the centroid by their share of it.
+  for (Eigen::Index i = 0; i < ghost.map.size(); ++i)
+    if (ghost.map[i] < 0) (collapse.V.rowwise() - V.row(i)).rowwise().squaredNorm().minCoeff(&ghost.map[i]);
+  const int num_ghost = static_cast<int>(collapse.V.rows());
+  const Eigen::MatrixXd positions = restrict_to_ghost(ghost.map, num_ghost, mass, flatten(V));
+  ghost.V = Eigen::Map<const RowMatrixX3d>(positions.data(), num_ghost, 3);
+  if (progress) progress->report("ghost", 1.0);
+  return ghost;
+}
+
+Eigen::MatrixXd restrict_to_ghost(const Eigen::Ref<const Eigen::VectorXi>& map, int num_ghost,
+                                  const VectorRef& fine_mass, const Eigen::Ref<const Eigen::MatrixXd>& U) {
+  const Eigen::Index n = map.size();
+  if (num_ghost < 1) throw InputError(message("num_ghost: expected at least 1 ghost vertex, got ", num_ghost));
+  if (fine_mass.size() != n)
+    throw InputError(message("mass: expected ", n, " values (one per fine vertex), got ", fine_mass.size()));
+  if (U.rows() != 3 * n) throw InputError(message("U: expected ", 3 * n, " rows (3 per fine vertex), got ", U.rows()));
+  std::vector<double> cluster_mass(num_ghost, 0.0);
+  std::vector<int> cluster_size(num_ghost, 0);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (map[i] < 0 || map[i] >= num_ghost)
+      throw InputError(message("map[", i, "]: ghost vertex ", map[i], " is outside [0, ", num_ghost, ")"));
+    if (!std::isfinite(fine_mass[i]) || fine_mass[i] < 0)
+      throw InputError(message("mass[", i, "]: expected a finite value >= 0, got ", fine_mass[i]));
+    cluster_mass[map[i]] += fine_mass[i];
+    ++cluster_size[map[i]];
+  }
+  for (int s = 0; s < num_ghost; ++s)
+    if (cluster_size[s] == 0) throw InputError(message("map: no fine vertex maps to ghost vertex ", s));
+  // The weight of each fine vertex in its cluster's mean; m/m is exactly 1, so a cluster of one
+  // vertex restricts to that vertex's values unchanged.
+  Eigen::VectorXd weight(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const int s = map[i];
+    weight[i] = cluster_mass[s] > 0 ? fine_mass[i] / cluster_mass[s] : 1.0 / cluster_size[s];
+  }
+  Eigen::MatrixXd restricted = Eigen::MatrixXd::Zero(3 * num_ghost, U.cols());
+#pragma omp parallel for schedule(static)
+  for (Eigen::Index j = 0; j < U.cols(); ++j) {
+    const double* in = U.col(j).data();
+    double* out = restricted.col(j).data();
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double w = weight[i];
+      double* target = out + 3 * map[i];
+      target[0] += w * in[3 * i];
+      target[1] += w * in[3 * i + 1];
+      target[2] += w * in[3 * i + 2];
+    }
+  }
+  // Weights in [0, 1] summing to 1 keep finite input finite: read all of U again only to name
+  // the culprit.
+  if (!restricted.allFinite())
+    for (Eigen::Index j = 0; j < U.cols(); ++j)
+      for (Eigen::Index i = 0; i < U.rows(); ++i)
+        if (!std::isfinite(U(i, j))) throw InputError(message("U[", i, ", ", j, "]: not a finite number"));
+  return restricted;
+}
+
+}  // namespace modal_deform
