@@ -7,4 +7,5 @@ PYBIND11_MODULE(_native, m) {
   modal_deform::bind_mesh(m);
   modal_deform::bind_energy(m);
   modal_deform::bind_reduction(m);
+  modal_deform::bind_modes(m);
 }

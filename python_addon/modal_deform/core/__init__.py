@@ -7,9 +7,11 @@ The pipeline, one module per stage: ``mesh`` (check, mass, test shapes).
 from .._native import Cancelled
 from .energy import Arap, DiscreteShells
 from .mesh import bar, bumpy_plane, check, cylinder, grid, mass, read_mesh
+from .modes import rigid_motions, solve_in_range, vibration_modes
 from .reduction import ghost_mesh, restrict_to_ghost
 
 __all__ = ["Cancelled", "bar", "bumpy_plane", "check", "cylinder", "grid", "mass", "read_mesh"]
 __all__ += ["ghost_mesh", "restrict_to_ghost"]
 __all__ += ["Arap"]
 __all__ += ["DiscreteShells"]
+__all__ += ["rigid_motions", "solve_in_range", "vibration_modes"]

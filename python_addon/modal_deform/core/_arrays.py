@@ -34,3 +34,35 @@ def positions(X, num_vertices, name="X"):
         raise ValueError(
             f"{name}: expected shape ({num_vertices}, 3) or ({3 * num_vertices},), got {X.shape}")
     return X.reshape(-1)
+
+
+def values(x, name, length=None):
+    """(length,) float64, C order."""
+    x = np.ascontiguousarray(x, dtype=np.float64)
+    if x.ndim != 1 or (length is not None and x.shape[0] != length):
+        expected = f"({length},)" if length is not None else "a 1-d array"
+        raise ValueError(f"{name}: expected {expected}, got shape {x.shape}")
+    return x
+
+
+def labels(x, length, name="labels"):
+    """(length,) int32 from integer input."""
+    x = np.asarray(x)
+    if x.shape != (length,):
+        raise ValueError(f"{name}: expected shape ({length},), got {x.shape}")
+    if x.dtype.kind not in "iu":
+        raise ValueError(f"{name}: expected integers, got dtype {x.dtype}")
+    if x.size and (x.max() > np.iinfo(np.int32).max or x.min() < np.iinfo(np.int32).min):
+        raise ValueError(f"{name}: a label does not fit in 32 bits")
+    return np.ascontiguousarray(x, dtype=np.int32)
+
+
+def columns(X, rows, name):
+    """(rows, k) float64 in Fortran order, the native core's column-major layout; a (rows,)
+    vector becomes one column."""
+    X = np.asarray(X, dtype=np.float64)
+    if X.ndim == 1:
+        X = X[:, None]
+    if X.ndim != 2 or X.shape[0] != rows:
+        raise ValueError(f"{name}: expected shape ({rows}, k), got {X.shape}")
+    return np.asfortranarray(X)

@@ -1,0 +1,169 @@
+#include "modes/modal_derivatives.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+#include "linalg/cholmod_llt.h"
+#include "mesh/union_find.h"
+#include "modes/stiffness_and_mass.h"
+#include "util/errors.h"
+
+namespace modal_deform {
+namespace {
+
+// A pivot of the QR of Z's rows this much smaller than the largest counts as zero.
+constexpr double kRankThreshold = 1e-8;
+// ‖K ψ − P b‖ ≤ kResidualTolerance (‖K‖₁ ‖ψ‖ + ‖P b‖) for each column.
+constexpr double kResidualTolerance = 1e-6;
+// Right-hand sides per solve: blocked solves run at BLAS-3 speed, and the bar moves between them.
+constexpr Eigen::Index kBlockColumns = 64;
+
+// A checked kernel basis, zero on the DOFs that take no part in the problem.
+struct Kernel {
+  Eigen::MatrixXd Z;
+  std::vector<bool> decoupled;
+};
+
+Kernel checked_kernel(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z) {
+  return {checked_kernel_basis(K, mass, Z), decoupled_dofs(K, mass)};
+}
+
+std::vector<int> pins_for(const SparseMatrix& K, const Kernel& kernel) {
+  const int n = static_cast<int>(K.rows());
+  UnionFind components(n);
+  for (int j = 0; j < K.outerSize(); ++j)
+    for (SparseMatrix::InnerIterator it(K, j); it; ++it)
+      if (it.value() != 0) components.unite(static_cast<int>(it.row()), j);
+  std::unordered_map<int, std::vector<int>> dofs_of;
+  for (int d = 0; d < n; ++d)
+    if (!kernel.decoupled[static_cast<size_t>(d)]) dofs_of[components.find(d)].push_back(d);
+
+  std::vector<int> pins;
+  for (const auto& [root, dofs] : dofs_of) {
+    // The columns of Z that move this component, restricted to its DOFs, transposed: pivoting
+    // picks the DOFs (columns) that best pin down the component's kernel.
+    std::vector<Eigen::Index> columns;
+    for (Eigen::Index k = 0; k < kernel.Z.cols(); ++k)
+      if (std::any_of(dofs.begin(), dofs.end(), [&](int d) { return kernel.Z(d, k) != 0; })) columns.push_back(k);
+    if (columns.empty()) continue;
+    Eigen::MatrixXd rows_t(static_cast<Eigen::Index>(columns.size()), static_cast<Eigen::Index>(dofs.size()));
+    for (size_t a = 0; a < columns.size(); ++a)
+      for (size_t b = 0; b < dofs.size(); ++b) rows_t(a, b) = kernel.Z(dofs[b], columns[a]);
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(rows_t);
+    qr.setThreshold(kRankThreshold);
+    for (Eigen::Index r = 0; r < qr.rank(); ++r) pins.push_back(dofs[qr.colsPermutation().indices()[r]]);
+  }
+  if (static_cast<Eigen::Index>(pins.size()) != kernel.Z.cols())
+    throw InputError(message("Z: its ", kernel.Z.cols(), " columns do not split over the connected components of K ",
+                             "(their ranks per component add up to ", pins.size(), "); Z must span the kernel of K"));
+  std::sort(pins.begin(), pins.end());
+  return pins;
+}
+
+Eigen::MatrixXd solve_with_pins(const SparseMatrix& K, const VectorRef& mass, const Kernel& kernel,
+                                const Eigen::Ref<const Eigen::MatrixXd>& B, const std::vector<int>& pins,
+                                Progress* progress) {
+  const Eigen::Index n = K.rows();
+  if (B.rows() != n) throw InputError(message("B: expected ", n, " rows, got ", B.rows()));
+  if (!B.allFinite()) throw InputError("B: has an entry that is not finite");
+  const Eigen::VectorXd m = dof_masses(mass);
+  const Eigen::MatrixXd& Z = kernel.Z;
+  if (progress) progress->report("derivative solves", 0.0);
+
+  // With P b in the range of K, K ψ = P b has a solution with ψ = 0 at the pins (the pinned rows
+  // of Z are invertible), and that solution also solves (K + w Σ eₛeₛᵀ) ψ = P b, which is definite:
+  // pinning adds a stiffness on the diagonal and keeps the pattern. w: K's mean diagonal entry.
+  const std::vector<bool>& decoupled = kernel.decoupled;
+  const auto coupled = static_cast<double>(std::count(decoupled.begin(), decoupled.end(), false));
+  const double w = K.diagonal().sum() / std::max(coupled, 1.0);
+  Eigen::VectorXd pin_stiffness = Eigen::VectorXd::Zero(n);
+  for (int s : pins) pin_stiffness[s] = w;
+  for (Eigen::Index d = 0; d < n; ++d)
+    if (decoupled[static_cast<size_t>(d)]) pin_stiffness[d] = w > 0 ? w : 1.0;
+  CholmodLLT llt(3);  // orders vertices, 3 DOFs each
+  try {
+    llt.factorize(K, pin_stiffness);
+  } catch (const NumericalError& e) {
+    throw NumericalError(message("solve_in_range: K with its kernel pinned cannot be factored; does Z span the whole ",
+                                 "kernel of K? ", e.what()));
+  }
+
+  // P = I − Z (ZᵀZ)⁻¹ Zᵀ, also zero on the decoupled DOFs (part of the kernel, zero rows in Z).
+  const Eigen::LLT<Eigen::MatrixXd> gram(Z.transpose() * Z);
+  const Eigen::MatrixXd MZ = m.asDiagonal() * Z;
+  const double norm_K = norm_1(K);
+  Eigen::MatrixXd Psi(n, B.cols());
+  for (Eigen::Index first = 0; first < B.cols(); first += kBlockColumns) {
+    const Eigen::Index width = std::min(kBlockColumns, B.cols() - first);
+    Eigen::MatrixXd PB = B.middleCols(first, width);
+    for (Eigen::Index d = 0; d < n; ++d)
+      if (decoupled[static_cast<size_t>(d)]) PB.row(d).setZero();
+    if (Z.cols()) PB -= Z * gram.solve(Z.transpose() * PB);
+    Eigen::MatrixXd X = llt.solve(PB);
+    if (Z.cols()) X -= Z * (MZ.transpose() * X);
+    const Eigen::MatrixXd residual = K * X - PB;
+    for (Eigen::Index j = 0; j < width; ++j) {
+      const double bound = kResidualTolerance * (norm_K * X.col(j).norm() + PB.col(j).norm());
+      if (!(residual.col(j).norm() <= bound))
+        throw NumericalError(message("solve_in_range: column ", first + j, " has residual ", residual.col(j).norm(),
+                                     ", above ", bound, "; does Z span the kernel of K?"));
+    }
+    Psi.middleCols(first, width) = X;
+    if (progress) progress->report("derivative solves", static_cast<double>(first + width) / B.cols());
+  }
+  return Psi;
+}
+
+}  // namespace
+
+std::vector<std::array<int, 2>> derivative_pairs(int num_modes, int count) {
+  const long long available = static_cast<long long>(std::max(num_modes, 0)) * (num_modes + 1) / 2;
+  if (count < 0 || count > available)
+    throw InputError(message("count: ", num_modes, " modes have ", available, " pairs, asked for ", count));
+  std::vector<std::array<int, 2>> pairs;
+  pairs.reserve(static_cast<size_t>(count));
+  for (int j = 0; j < num_modes; ++j)
+    for (int i = 0; i <= j; ++i) {
+      if (static_cast<int>(pairs.size()) == count) return pairs;
+      pairs.push_back({i, j});
+    }
+  return pairs;
+}
+
+std::vector<int> kernel_pins(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z) {
+  return pins_for(K, checked_kernel(K, mass, Z));
+}
+
+Eigen::MatrixXd solve_in_range(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z,
+                               const Eigen::Ref<const Eigen::MatrixXd>& B, Progress* progress) {
+  const Kernel kernel = checked_kernel(K, mass, Z);
+  return solve_with_pins(K, mass, kernel, B, pins_for(K, kernel), progress);
+}
+
+Eigen::MatrixXd solve_in_range(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z,
+                               const Eigen::Ref<const Eigen::MatrixXd>& B, const std::vector<int>& pins,
+                               Progress* progress) {
+  const Kernel kernel = checked_kernel(K, mass, Z);
+  if (static_cast<Eigen::Index>(pins.size()) != Z.cols())
+    throw InputError(message("pins: expected one per column of Z (", Z.cols(), "), got ", pins.size()));
+  std::vector<bool> taken(static_cast<size_t>(K.rows()), false);
+  Eigen::MatrixXd pinned_rows(Z.cols(), Z.cols());
+  for (size_t a = 0; a < pins.size(); ++a) {
+    const int s = pins[a];
+    if (s < 0 || s >= K.rows()) throw InputError(message("pins[", a, "] = ", s, ": not a DOF"));
+    if (taken[static_cast<size_t>(s)]) throw InputError(message("pins[", a, "] = ", s, ": pinned twice"));
+    taken[static_cast<size_t>(s)] = true;
+    pinned_rows.row(static_cast<Eigen::Index>(a)) = kernel.Z.row(s);
+  }
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(pinned_rows);
+  qr.setThreshold(kRankThreshold);
+  if (qr.rank() != Z.cols())
+    throw InputError(message("pins: Z restricted to the pinned DOFs has rank ", qr.rank(), " of ", Z.cols(),
+                             "; they do not pin the kernel"));
+  return solve_with_pins(K, mass, kernel, B, pins, progress);
+}
+
+}  // namespace modal_deform

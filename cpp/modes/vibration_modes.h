@@ -1,0 +1,35 @@
+// The lowest vibration modes: eigenpairs of K φ = λ M φ (the paper's V1, section 4).
+#pragma once
+
+#include "util/progress.h"
+#include "util/types.h"
+
+namespace modal_deform {
+
+struct VibrationModes {
+  Eigen::VectorXd eigenvalues;  // count, ascending; units of K per unit of mass
+  Eigen::MatrixXd modes;        // 3n by count, M-orthonormal (Φᵀ M Φ = I)
+  // ‖K φ − λ M φ‖ in the M⁻¹-norm per mode (count, units of λ): some eigenvalue of the pencil
+  // lies within it of the reported one.
+  Eigen::VectorXd residuals;
+  double shift = 0;  // σ of the shift-invert transform
+  int solves = 0;    // solves with the factor of K − σM
+};
+
+// The `count` eigenpairs of K φ = λ M φ with the smallest λ, rigid motions (λ = 0) included.
+// K: 3n by 3n symmetric positive semidefinite; mass: n vertex masses (M = diag(mass) ⊗ I₃); see
+// stiffness_and_mass.h for the checks and for DOFs without mass, which stay zero.
+// Lanczos (Spectra) on (K − σM)⁻¹M with σ < 0 from the scale of the problem, the inverse applied
+// through one CHOLMOD factorisation. Reports ("modes", fraction) to `progress`, which may cancel.
+// Throws InputError for bad input, NumericalError when the eigensolver does not converge or a
+// mode's residual is too large.
+VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int count, Progress* progress = nullptr);
+
+// The `count` lowest eigenpairs with modes M-orthogonal to the columns of Z (3n by z, M-orthonormal,
+// in the kernel of K: rigid_motions for a rigid-invariant energy). Deflating the known kernel
+// spares Lanczos the eigenvalue 0 of multiplicity 6 per component, slow to resolve and useless to
+// deform with, and lets the shift sit closer to the flexible modes.
+VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int count,
+                               const Eigen::Ref<const Eigen::MatrixXd>& Z, Progress* progress = nullptr);
+
+}  // namespace modal_deform
