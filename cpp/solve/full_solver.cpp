@@ -1,0 +1,127 @@
+#include "solve/full_solver.h"
+
+#include <cmath>
+#include <vector>
+
+#include "linalg/cholmod_llt.h"
+#include "mesh/mass.h"
+#include "mesh/normalization.h"
+#include "util/errors.h"
+
+namespace modal_deform {
+namespace {
+
+// One handle vertex's share of the handle term: weight ‖y_vertex − target‖² (normalised frame).
+struct Pull {
+  int vertex;
+  double weight;
+  Eigen::Vector3d target;
+};
+
+// F(y) = E(y) + Σ pulls, with ∇F(y) written into `gradient`.
+double objective(const Energy& energy, const std::vector<Pull>& pulls, const Eigen::VectorXd& y,
+                 Eigen::VectorXd& gradient) {
+  double value = energy.value_and_gradient(y, gradient);
+  for (const Pull& pull : pulls) {
+    const Eigen::Vector3d d = y.segment<3>(3 * pull.vertex) - pull.target;
+    value += pull.weight * d.squaredNorm();
+    gradient.segment<3>(3 * pull.vertex) += 2 * pull.weight * d;
+  }
+  return value;
+}
+
+}  // namespace
+
+FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handles& handles, const VectorRef& weights,
+                           const Transforms& transforms, double stiffness, EnergyKind energy_kind, double bending,
+                           double membrane, double tolerance, int max_iterations) {
+  const int n = static_cast<int>(V.rows());
+  const Eigen::VectorXd handle_weights = checked_handle_weights(handles, weights, n);
+  check_transforms(transforms, static_cast<int>(handles.size()));
+  if (!(std::isfinite(stiffness) && stiffness > 0))
+    throw InputError(message("stiffness: expected a finite value > 0, got ", stiffness));
+  if (!(tolerance > 0 && tolerance < 1))
+    throw InputError(message("tolerance: expected a value in (0, 1), got ", tolerance));
+  if (max_iterations < 0) throw InputError(message("max_iterations: expected at least 0, got ", max_iterations));
+  const double s = normalizing_scale(V);
+  const RowMatrixX3d rest = s * V;
+  const std::unique_ptr<Energy> energy = make_energy(energy_kind, rest, F, bending, membrane);
+  const Eigen::VectorXd mass = lumped_mass(V, F);
+
+  // The handle term's pulls and its (constant, diagonal) Hessian.
+  std::vector<Pull> pulls;
+  Eigen::VectorXd handle_diagonal = Eigen::VectorXd::Zero(3 * n);
+  for (size_t h = 0; h < handles.size(); ++h) {
+    const Eigen::Matrix3d R = transforms[h].topLeftCorner<3, 3>();
+    const Eigen::Vector3d t = transforms[h].topRightCorner<3, 1>();
+    for (int v : handles[h]) {
+      const double weight = stiffness * handle_weights[h] * s * s * mass[v];
+      pulls.push_back({v, weight, s * (R * V.row(v).transpose() + t)});
+      handle_diagonal.segment<3>(3 * v).array() += 2 * weight;
+    }
+  }
+  // D of the Hessian modification, and a fixed diagonal for the coordinates of vertices in no
+  // energy term and no handle (no mass, zero Hessian block): nothing moves them.
+  Eigen::VectorXd y = flatten(rest);
+  const SparseMatrix rest_hessian = energy->hessian(y);
+  const Eigen::VectorXd hessian_diagonal = rest_hessian.diagonal();
+  Eigen::VectorXd D(3 * n);
+  for (int v = 0; v < n; ++v) D.segment<3>(3 * v).setConstant(s * s * mass[v]);
+  const double mean_mass = D.mean();
+  D = D.cwiseMax(1e-6 * mean_mass);
+  Eigen::VectorXd fixed = Eigen::VectorXd::Zero(3 * n);
+  for (int v = 0; v < n; ++v)
+    if (mass[v] == 0 && hessian_diagonal.segment<3>(3 * v).isZero(0) && handle_diagonal.segment<3>(3 * v).isZero(0))
+      fixed.segment<3>(3 * v).setConstant(mean_mass);
+  // The smallest τ tried: a thousandth of the mean curvature per unit mass at rest.
+  const double tau_min = 1e-3 * (hessian_diagonal + handle_diagonal).cwiseAbs().mean() / mean_mass;
+
+  FullSolveResult result;
+  Eigen::VectorXd gradient(3 * n), y_trial(3 * n), gradient_trial(3 * n), shift(3 * n), p(3 * n);
+  double value = objective(*energy, pulls, y, gradient);
+  result.initial_gradient_norm = gradient.norm();
+  const double target = tolerance * result.initial_gradient_norm;
+  CholmodLLT llt(3);
+  llt.analyze(rest_hessian);
+  double tau = 0;
+  while (result.iterations < max_iterations && gradient.norm() > target) {
+    const SparseMatrix H = energy->hessian(y);
+    tau = tau / 4 >= tau_min ? tau / 4 : 0;
+    for (int attempt = 0;; ++attempt) {
+      shift = handle_diagonal + fixed + tau * D;
+      ++result.factorizations;
+      try {
+        llt.factorize(H, shift);
+        break;
+      } catch (const NumericalError&) {
+        if (attempt == 60) throw NumericalError("solve_full: no shift of the Hessian could be factored");
+        tau = std::max(4 * tau, tau_min);
+      }
+    }
+    p = -llt.solve(gradient);
+    const double slope = gradient.dot(p);
+    double step = 1;
+    bool decreased = false;
+    for (int halving = 0; halving < 60 && slope < 0; ++halving, step /= 2) {
+      y_trial = y + step * p;
+      if (!y_trial.allFinite()) continue;
+      const double value_trial = objective(*energy, pulls, y_trial, gradient_trial);
+      if (value_trial <= value + 1e-4 * step * slope) {
+        decreased = true;
+        value = value_trial;
+        break;
+      }
+    }
+    if (!decreased) break;  // f cannot decrease at this precision along the Newton direction
+    y.swap(y_trial);
+    gradient.swap(gradient_trial);
+    ++result.iterations;
+  }
+  result.energy = value;
+  result.gradient_norm = gradient.norm();
+  result.converged = result.gradient_norm <= target;
+  result.positions = Eigen::Map<const RowMatrixX3d>(y.data(), n, 3) / s;
+  return result;
+}
+
+}  // namespace modal_deform
