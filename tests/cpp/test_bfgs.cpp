@@ -84,10 +84,11 @@ TEST(WolfeLineSearch, ShrinksLongStepsAndGrowsShortOnes) {
     const LineSearchResult result = wolfe_line_search(f, x, value, g, p, x_new, value_new, g_new);
     expect_strong_wolfe(f, x, p, result, value_new, x_new, g_new);
     EXPECT_LT(result.evaluations, 12) << "scale " << scale;
-    if (scale > 1)
+    if (scale > 1) {
       EXPECT_LT(result.step, 1.0);
-    else
+    } else {
       EXPECT_GT(result.step, 1.0);
+    }
   }
 }
 
@@ -153,10 +154,11 @@ TEST(Bfgs, StopsWhenTheGillMurrayWrightConditionsHold) {
       const bool u1 = f_before - f < tolerance * theta;
       const bool u2 = (x_before - bfgs.x()).norm() < std::sqrt(tolerance) * (1 + bfgs.x().norm());
       const bool u3 = bfgs.gradient().norm() <= std::cbrt(tolerance) * theta;
-      if (result.iterations == 1)
+      if (result.iterations == 1) {
         EXPECT_EQ(converged, u1 && u2 && u3) << "tolerance " << tolerance << " step " << steps;
-      else
+      } else {
         EXPECT_TRUE(converged && bfgs.gradient().norm() <= tolerance * theta);
+      }
     }
     EXPECT_TRUE(converged) << "tolerance " << tolerance;
     EXPECT_LE(bfgs.gradient().norm(), std::cbrt(tolerance) * (1 + std::abs(bfgs.value())));

@@ -47,7 +47,9 @@ TEST(SolveFull, ConvergesToAStationaryPointWithTheHandlesNearTheirTargets) {
       EXPECT_LE((result.positions.row(v).transpose() - target).norm(), 0.05) << "vertex " << v;
     }
     // This twist makes the shells Hessian indefinite on the way: the shifted factorisations ran.
-    if (kind == EnergyKind::kShells) EXPECT_GT(result.factorizations, result.iterations);
+    if (kind == EnergyKind::kShells) {
+      EXPECT_GT(result.factorizations, result.iterations);
+    }
     std::printf("solve_full %s: %d iterations, %d factorisations, F = %.6g\n",
                 kind == EnergyKind::kShells ? "shells" : "arap", result.iterations, result.factorizations,
                 result.energy);
