@@ -3,6 +3,7 @@
 #include <pybind11/pybind11.h>
 
 #include "bindings/bindings.h"
+#include "bindings/python_progress.h"
 #include "mesh/mass.h"
 #include "mesh/mesh_check.h"
 #include "reduction/ghost.h"
@@ -10,25 +11,6 @@
 namespace py = pybind11;
 
 namespace modal_deform {
-namespace {
-
-// A Python progress(stage, fraction) callback as a native one (none for None). A false return
-// cancels; None counts as "go on", so a callback that only prints does not stop the work. The
-// native side calls it without the GIL, so it takes the GIL first.
-ProgressCallback python_progress(const py::object& callback) {
-  if (callback.is_none()) return {};
-  return [callback](const std::string& stage, double fraction) {
-    py::gil_scoped_acquire gil;
-    const py::object answer = callback(stage, fraction);
-    if (answer.is_none()) return true;
-    const int truth = PyObject_IsTrue(answer.ptr());
-    if (truth < 0) throw py::error_already_set();
-    return truth == 1;
-  };
-}
-
-}  // namespace
-
 void bind_reduction(py::module_& m) {
   m.def(
       "ghost_mesh",
