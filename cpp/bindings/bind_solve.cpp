@@ -4,6 +4,7 @@
 #include <pybind11/stl.h>
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -62,22 +63,23 @@ void bind_solve(py::module_& m) {
       "solve_full",
       [](const VerticesRef& V, const FacesRef& F, const std::vector<Eigen::VectorXi>& handles,
          const Transforms& transforms, const VectorRef& weights, double stiffness, const std::string& energy,
-         double bending, double membrane, double tolerance, int max_iterations) {
+         double bending, double membrane, double tolerance, int max_iterations,
+         const std::optional<RowMatrixX3d>& initial) {
         FullSolveResult result;
         {
           py::gil_scoped_release release;
           result = solve_full(V, F, to_handles(handles), weights, transforms, stiffness, energy_kind(energy), bending,
-                              membrane, tolerance, max_iterations);
+                              membrane, tolerance, max_iterations, initial ? &*initial : nullptr);
         }
         py::dict stats(py::arg("iterations") = result.iterations, py::arg("energy") = result.energy,
                        py::arg("converged") = result.converged, py::arg("gradient_norm") = result.gradient_norm,
-                       py::arg("initial_gradient_norm") = result.initial_gradient_norm,
+                       py::arg("rest_gradient_norm") = result.rest_gradient_norm,
                        py::arg("factorizations") = result.factorizations);
         return py::make_tuple(std::move(result.positions), stats);
       },
       py::arg("V"), py::arg("F"), py::arg("handles"), py::arg("transforms"), py::arg("weights"),
       py::arg("stiffness"), py::arg("energy"), py::arg("bending"), py::arg("membrane"), py::arg("tolerance"),
-      py::arg("max_iterations"));
+      py::arg("max_iterations"), py::arg("initial"));
 }
 
 }  // namespace modal_deform

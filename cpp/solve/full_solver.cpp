@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <vector>
+#include <cstdio>
+#include <cstdlib>
 
 #include "linalg/cholmod_llt.h"
 #include "mesh/mass.h"
@@ -34,7 +36,7 @@ double objective(const Energy& energy, const std::vector<Pull>& pulls, const Eig
 
 FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handles& handles, const VectorRef& weights,
                            const Transforms& transforms, double stiffness, EnergyKind energy_kind, double bending,
-                           double membrane, double tolerance, int max_iterations) {
+                           double membrane, double tolerance, int max_iterations, const RowMatrixX3d* initial) {
   const int n = static_cast<int>(V.rows());
   const Eigen::VectorXd handle_weights = checked_handle_weights(handles, weights, n);
   check_transforms(transforms, static_cast<int>(handles.size()));
@@ -43,6 +45,9 @@ FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handle
   if (!(tolerance > 0 && tolerance < 1))
     throw InputError(message("tolerance: expected a value in (0, 1), got ", tolerance));
   if (max_iterations < 0) throw InputError(message("max_iterations: expected at least 0, got ", max_iterations));
+  if (initial && (initial->rows() != n || !initial->allFinite()))
+    throw InputError(message("initial: expected ", n, " by 3 finite positions, got ", initial->rows(), " rows",
+                             initial->rows() == n ? " with non-finite entries" : ""));
   const double s = normalizing_scale(V);
   const RowMatrixX3d rest = s * V;
   const std::unique_ptr<Energy> energy = make_energy(energy_kind, rest, F, bending, membrane);
@@ -74,19 +79,23 @@ FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handle
     if (mass[v] == 0 && hessian_diagonal.segment<3>(3 * v).isZero(0) && handle_diagonal.segment<3>(3 * v).isZero(0))
       fixed.segment<3>(3 * v).setConstant(mean_mass);
   // The smallest τ tried: a thousandth of the mean curvature per unit mass at rest.
-  const double tau_min = 1e-3 * (hessian_diagonal + handle_diagonal).cwiseAbs().mean() / mean_mass;
+  const double tau_min = 1e-8 * (hessian_diagonal + handle_diagonal).cwiseAbs().mean() / mean_mass;
 
   FullSolveResult result;
   Eigen::VectorXd gradient(3 * n), y_trial(3 * n), gradient_trial(3 * n), shift(3 * n), p(3 * n);
   double value = objective(*energy, pulls, y, gradient);
-  result.initial_gradient_norm = gradient.norm();
-  const double target = tolerance * result.initial_gradient_norm;
+  result.rest_gradient_norm = gradient.norm();
+  const double target = tolerance * result.rest_gradient_norm;
+  if (initial) {
+    y = s * flatten(*initial);
+    value = objective(*energy, pulls, y, gradient);
+  }
   CholmodLLT llt(3);
   llt.analyze(rest_hessian);
   double tau = 0;
   while (result.iterations < max_iterations && gradient.norm() > target) {
     const SparseMatrix H = energy->hessian(y);
-    tau = tau / 4 >= tau_min ? tau / 4 : 0;
+    tau = tau / 10 >= tau_min ? tau / 10 : 0;
     for (int attempt = 0;; ++attempt) {
       shift = handle_diagonal + fixed + tau * D;
       ++result.factorizations;
@@ -95,23 +104,28 @@ FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handle
         break;
       } catch (const NumericalError&) {
         if (attempt == 60) throw NumericalError("solve_full: no shift of the Hessian could be factored");
-        tau = std::max(4 * tau, tau_min);
+        tau = std::max(10 * tau, tau_min);
       }
     }
     p = -llt.solve(gradient);
     const double slope = gradient.dot(p);
+    // Near the solution the decrease a step promises falls below the rounding of F; then a step
+    // that reduces the gradient norm is taken instead (it would otherwise creep on noise).
+    const double noise = 1e-12 * (1 + std::abs(value));
     double step = 1;
     bool decreased = false;
     for (int halving = 0; halving < 60 && slope < 0; ++halving, step /= 2) {
       y_trial = y + step * p;
       if (!y_trial.allFinite()) continue;
       const double value_trial = objective(*energy, pulls, y_trial, gradient_trial);
-      if (value_trial <= value + 1e-4 * step * slope) {
+      if (value_trial <= value + 1e-4 * step * slope ||
+          (-step * slope < noise && value_trial <= value + noise && gradient_trial.norm() < gradient.norm())) {
         decreased = true;
         value = value_trial;
         break;
       }
     }
+    if (getenv("DBG")) fprintf(stderr, "it %d tau %.3e (min %.3e) step %.3e F %.10g |g| %.3e |p| %.3e slope %.3e\n", result.iterations, tau, tau_min, step, value, gradient.norm(), p.norm(), slope);
     if (!decreased) break;  // f cannot decrease at this precision along the Newton direction
     y.swap(y_trial);
     gradient.swap(gradient_trial);

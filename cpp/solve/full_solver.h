@@ -29,18 +29,22 @@ struct FullSolveResult {
   int factorizations = 0;     // numeric factorisations, failed ones (τ too small) included
   double energy = 0;          // F at the result: deformation energy plus handle term
   double gradient_norm = 0;   // ‖∇F‖ at the result (normalised frame)
-  double initial_gradient_norm = 0;  // ‖∇F‖ at rest, the scale of the relative tolerance
-  bool converged = false;     // gradient_norm ≤ tolerance · initial_gradient_norm
+  double rest_gradient_norm = 0;  // ‖∇F‖ at rest, the scale of the relative tolerance
+  bool converged = false;     // gradient_norm ≤ tolerance · rest_gradient_norm
 };
 
 // V: #V by 3 rest positions, F: #F by 3 triangles (validate_mesh); handles and weights as in
 // checked_handle_weights; transforms: one rigid 4 by 4 transform per handle (check_transforms);
 // stiffness μ > 0; bending, membrane: the shells weights (ignored by ARAP); tolerance in (0, 1):
 // relative reduction of ‖∇F‖ from rest; at most max_iterations ≥ 0 Newton steps, starting at
-// rest. Throws InputError for bad input and NumericalError when no shift makes the Hessian
+// rest, or at `initial` (#V by 3, mesh units) when given: the previous frame's answer lets a
+// large motion be reached in steps (a handle turned by 180° pulls its vertices straight through
+// the axis at rest, so a solve from rest may find a crumpled minimum instead of the twist).
+// Throws InputError for bad input and NumericalError when no shift makes the Hessian
 // factorisable. Runs single-threaded but for CHOLMOD's BLAS and the energy's own threads.
 FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handles& handles, const VectorRef& weights,
                            const Transforms& transforms, double stiffness, EnergyKind energy, double bending,
-                           double membrane, double tolerance, int max_iterations);
+                           double membrane, double tolerance, int max_iterations,
+                           const RowMatrixX3d* initial = nullptr);
 
 }  // namespace modal_deform

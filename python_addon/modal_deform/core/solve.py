@@ -143,16 +143,17 @@ class ReducedSolver:
 
 
 def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, energy="shells", bending=1.0,
-               membrane=1.0, tolerance=1e-8, max_iterations=100, return_stats=False):
+               membrane=1.0, tolerance=1e-8, max_iterations=100, initial=None, return_stats=False):
     """The reference: Newton's method on the full mesh for the reduced solver's objective.
 
     V (n, 3), F (m, 3): the rest mesh; handles, transforms, weights, stiffness, energy as for
-    ReducedSolver, with ``bending`` and ``membrane`` the shells weights. Starts at rest and stops
-    when the gradient norm has dropped by ``tolerance`` relative to rest, or after
+    ReducedSolver, with ``bending`` and ``membrane`` the shells weights. Starts at rest, or at
+    ``initial`` (n, 3) (say, the previous step of a large motion taken in steps), and stops
+    when the gradient norm is below ``tolerance`` times its value at rest, or after
     ``max_iterations`` Newton steps (sparse Cholesky, Hessian shifted by a multiple of the mass
     matrix where it is not positive definite). Returns the positions (n, 3) float64, or with
     ``return_stats=True`` the pair (positions, stats) with stats = {"iterations", "energy",
-    "converged", "gradient_norm", "initial_gradient_norm", "factorizations"}.
+    "converged", "gradient_norm", "rest_gradient_norm", "factorizations"}.
     """
     V, F = _arrays.vertices(V), _arrays.faces(F)
     handles = _handles(handles)
@@ -162,5 +163,6 @@ def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, ene
         raise ValueError(f"max_iterations: expected an integer, got {max_iterations!r}") from None
     X, stats = _native.solve_full(V, F, handles, _transforms(transforms, len(handles)), _weights(weights, len(handles)),
                                   _stiffness(stiffness), str(energy), float(bending), float(membrane),
-                                  float(tolerance), max_iterations)
+                                  float(tolerance), max_iterations,
+                                  None if initial is None else _arrays.vertices(initial, "initial"))
     return (X, stats) if return_stats else X
