@@ -2,13 +2,12 @@
 
 #include <cmath>
 #include <vector>
-#include <cstdio>
-#include <cstdlib>
 
 #include "linalg/cholmod_llt.h"
 #include "mesh/mass.h"
 #include "mesh/normalization.h"
 #include "util/errors.h"
+#include "util/require_positions.h"
 
 namespace modal_deform {
 namespace {
@@ -45,9 +44,7 @@ FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handle
   if (!(tolerance > 0 && tolerance < 1))
     throw InputError(message("tolerance: expected a value in (0, 1), got ", tolerance));
   if (max_iterations < 0) throw InputError(message("max_iterations: expected at least 0, got ", max_iterations));
-  if (initial && (initial->rows() != n || !initial->allFinite()))
-    throw InputError(message("initial: expected ", n, " by 3 finite positions, got ", initial->rows(), " rows",
-                             initial->rows() == n ? " with non-finite entries" : ""));
+  if (initial) require_positions(flatten(*initial), 3 * n, "initial");
   const double s = normalizing_scale(V);
   const RowMatrixX3d rest = s * V;
   const std::unique_ptr<Energy> energy = make_energy(energy_kind, rest, F, bending, membrane);
@@ -125,7 +122,6 @@ FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handle
         break;
       }
     }
-    if (getenv("DBG")) fprintf(stderr, "it %d tau %.3e (min %.3e) step %.3e F %.10g |g| %.3e |p| %.3e slope %.3e\n", result.iterations, tau, tau_min, step, value, gradient.norm(), p.norm(), slope);
     if (!decreased) break;  // f cannot decrease at this precision along the Newton direction
     y.swap(y_trial);
     gradient.swap(gradient_trial);
