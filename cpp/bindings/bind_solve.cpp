@@ -48,13 +48,11 @@ void bind_solve(py::module_& m) {
             }
             return py::dict(py::arg("iterations") = stats.iterations, py::arg("energy") = stats.energy,
                             py::arg("converged") = stats.converged, py::arg("ms") = stats.milliseconds,
-                            py::arg("evaluations") = stats.evaluations,
-                            py::arg("gradient_norm") = stats.gradient_norm);
+                            py::arg("evaluations") = stats.evaluations, py::arg("gradient_norm") = stats.gradient_norm);
           },
           py::arg("max_iterations"), py::arg("tolerance"))
       .def("reset", &ReducedSolver::reset)
-      .def("positions", &ReducedSolver::positions, py::arg("out").noconvert(),
-           py::call_guard<py::gil_scoped_release>())
+      .def("positions", &ReducedSolver::positions, py::arg("out").noconvert(), py::call_guard<py::gil_scoped_release>())
       .def_property_readonly("q", [](const ReducedSolver& solver) { return Eigen::VectorXd(solver.q()); })
       .def_property_readonly("dimension", &ReducedSolver::dimension)
       .def_property_readonly("num_handles", &ReducedSolver::num_handles);
@@ -77,9 +75,9 @@ void bind_solve(py::module_& m) {
                        py::arg("factorizations") = result.factorizations);
         return py::make_tuple(std::move(result.positions), stats);
       },
-      py::arg("V"), py::arg("F"), py::arg("handles"), py::arg("transforms"), py::arg("weights"),
-      py::arg("stiffness"), py::arg("energy"), py::arg("bending"), py::arg("membrane"), py::arg("tolerance"),
-      py::arg("max_iterations"), py::arg("initial"));
+      py::arg("V"), py::arg("F"), py::arg("handles"), py::arg("transforms"), py::arg("weights"), py::arg("stiffness"),
+      py::arg("energy"), py::arg("bending"), py::arg("membrane"), py::arg("tolerance"), py::arg("max_iterations"),
+      py::arg("initial"));
 }
 
 }  // namespace modal_deform

@@ -24,13 +24,13 @@
 namespace modal_deform {
 
 struct FullSolveResult {
-  RowMatrixX3d positions;     // #V by 3, mesh units
-  int iterations = 0;         // Newton steps
-  int factorizations = 0;     // numeric factorisations, failed ones (τ too small) included
-  double energy = 0;          // F at the result: deformation energy plus handle term
-  double gradient_norm = 0;   // ‖∇F‖ at the result (normalised frame)
+  RowMatrixX3d positions;         // #V by 3, mesh units
+  int iterations = 0;             // Newton steps
+  int factorizations = 0;         // numeric factorisations, failed ones (τ too small) included
+  double energy = 0;              // F at the result: deformation energy plus handle term
+  double gradient_norm = 0;       // ‖∇F‖ at the result (normalised frame)
   double rest_gradient_norm = 0;  // ‖∇F‖ at rest, the scale of the relative tolerance
-  bool converged = false;     // gradient_norm ≤ tolerance · rest_gradient_norm
+  bool converged = false;         // gradient_norm ≤ tolerance · rest_gradient_norm
 };
 
 // V: #V by 3 rest positions, F: #F by 3 triangles (validate_mesh); handles and weights as in

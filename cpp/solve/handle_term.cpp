@@ -74,7 +74,8 @@ HandleTerm::HandleTerm(const VerticesRef& rest, const VectorRef& mass, const Eig
       handle.centroid += mass[v] * rest.row(v).transpose();
     }
     // Without mass the term is zero and any centre will do.
-    handle.centroid = handle.mass > 0 ? Eigen::Vector3d(handle.centroid / handle.mass) : Eigen::Vector3d(rest.row(handles[h][0]));
+    handle.centroid =
+        handle.mass > 0 ? Eigen::Vector3d(handle.centroid / handle.mass) : Eigen::Vector3d(rest.row(handles[h][0]));
     handle.second_moment.setZero();
     handle.coefficients = Eigen::MatrixXd::Zero(r, 12);
     for (int v : handles[h]) {

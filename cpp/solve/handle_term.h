@@ -29,7 +29,7 @@
 
 namespace modal_deform {
 
-using Handles = std::vector<std::vector<int>>;  // per handle, its fine vertex indices
+using Handles = std::vector<std::vector<int>>;    // per handle, its fine vertex indices
 using Transforms = std::vector<Eigen::Matrix4d>;  // per handle, a rigid transform (mesh units)
 
 // Throws InputError naming the first problem: no handle, an empty handle, an index outside

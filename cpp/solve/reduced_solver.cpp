@@ -33,8 +33,8 @@ ReducedSolver::ReducedSolver(const Basis& basis, const Handles& handles, const V
                              EnergyKind energy, bool warm_start)
     : basis_(checked(basis)),
       num_handles_(static_cast<int>(handles.size())),
-      energy_(make_energy(energy, basis.scale * basis.ghost_vertices, basis.ghost_faces, basis.bending,
-                          basis.membrane)),
+      energy_(
+          make_energy(energy, basis.scale * basis.ghost_vertices, basis.ghost_faces, basis.bending, basis.membrane)),
       ghost_rest_(basis.scale * flatten(basis.ghost_vertices)),
       ghost_vectors_(basis.scale * basis.ghost_vectors),
       handle_term_(basis.rest, basis.mass, basis.vectors, handles,
@@ -75,9 +75,9 @@ void ReducedSolver::set_transforms(const Transforms& transforms) {
 
 ReducedSolveStats ReducedSolver::solve(int max_iterations, double tolerance) {
   const auto start = std::chrono::steady_clock::now();
-  const BfgsResult result = bfgs_.minimize(
-      [this](const Eigen::VectorXd& q, Eigen::VectorXd& gradient) { return objective(q, gradient); }, max_iterations,
-      tolerance);
+  const BfgsResult result =
+      bfgs_.minimize([this](const Eigen::VectorXd& q, Eigen::VectorXd& gradient) { return objective(q, gradient); },
+                     max_iterations, tolerance);
   q_float_ = q().cast<float>();
   ReducedSolveStats stats;
   stats.iterations = result.iterations;
@@ -108,8 +108,7 @@ double ReducedSolver::objective(const Eigen::VectorXd& q, Eigen::VectorXd& gradi
 void ReducedSolver::positions(Eigen::Ref<Eigen::VectorXf> out) const {
   const RowMatrixXf& U = basis_.vectors;
   const Eigen::Index rows = U.rows();
-  if (out.size() != rows)
-    throw InputError(message("out: expected ", rows, " values (3 per vertex), got ", out.size()));
+  if (out.size() != rows) throw InputError(message("out: expected ", rows, " values (3 per vertex), got ", out.size()));
   const double* rest = basis_.rest.data();
   const Eigen::Index blocks = (rows + kBlockRows - 1) / kBlockRows;
 #pragma omp parallel for schedule(static) if (rows >= kParallelRows)

@@ -31,12 +31,12 @@
 namespace modal_deform {
 
 struct ReducedSolveStats {
-  int iterations = 0;          // BFGS steps of this call
-  int evaluations = 0;         // evaluations of f and ∇f by this call
-  double energy = 0;           // f(q) at the end: deformation energy plus handle term
-  double gradient_norm = 0;    // ‖∇f(q)‖
-  bool converged = false;      // the stopping test holds (bfgs.h)
-  double milliseconds = 0;     // wall time of the call
+  int iterations = 0;        // BFGS steps of this call
+  int evaluations = 0;       // evaluations of f and ∇f by this call
+  double energy = 0;         // f(q) at the end: deformation energy plus handle term
+  double gradient_norm = 0;  // ‖∇f(q)‖
+  bool converged = false;    // the stopping test holds (bfgs.h)
+  double milliseconds = 0;   // wall time of the call
 };
 
 class ReducedSolver {

@@ -29,9 +29,7 @@ struct SmallTube {
   }
 };
 
-double rms(const RowMatrixX3d& a, const RowMatrixX3d& b) {
-  return std::sqrt((a - b).rowwise().squaredNorm().mean());
-}
+double rms(const RowMatrixX3d& a, const RowMatrixX3d& b) { return std::sqrt((a - b).rowwise().squaredNorm().mean()); }
 
 TEST(SolveFull, ConvergesToAStationaryPointWithTheHandlesNearTheirTargets) {
   const SmallTube tube;
@@ -71,8 +69,8 @@ TEST(SolveFull, EqualsTheReducedSolveInAFullBasis) {
   const int r = 3 * static_cast<int>(tube.mesh.V.rows());
   const Basis basis = dense_modal_basis(tube.mesh, r);
   for (EnergyKind kind : {EnergyKind::kShells, EnergyKind::kArap}) {
-    const FullSolveResult full = solve_full(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd(),
-                                            tube.transforms, 1e3, kind, 1.0, 1.0, 1e-12, 100);
+    const FullSolveResult full = solve_full(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd(), tube.transforms,
+                                            1e3, kind, 1.0, 1.0, 1e-12, 100);
     ASSERT_TRUE(full.converged);
     ReducedSolver solver(basis, tube.handles, Eigen::VectorXd(), 1e3, kind);
     solver.set_transforms(tube.transforms);
@@ -80,9 +78,9 @@ TEST(SolveFull, EqualsTheReducedSolveInAFullBasis) {
     for (int call = 0; call < 100 && !stats.converged; ++call) stats = solver.solve(10, 1e-15);
     Eigen::VectorXf x(3 * basis.num_vertices());
     solver.positions(x);
-    const RowMatrixX3d reduced = Eigen::Map<const Eigen::Matrix<float, Eigen::Dynamic, 3, Eigen::RowMajor>>(
-                                     x.data(), basis.num_vertices(), 3)
-                                     .cast<double>();
+    const RowMatrixX3d reduced =
+        Eigen::Map<const Eigen::Matrix<float, Eigen::Dynamic, 3, Eigen::RowMajor>>(x.data(), basis.num_vertices(), 3)
+            .cast<double>();
     const double diagonal = (full.positions.colwise().maxCoeff() - full.positions.colwise().minCoeff()).norm();
     const double error = rms(reduced, full.positions) / diagonal;
     std::printf("full basis (%d), %s: vertex RMS %.2e of the diagonal; F reduced %.12g, full %.12g\n", r,
@@ -97,8 +95,8 @@ TEST(SolveFull, UnreferencedVerticesStayAtRest) {
   const int loose = static_cast<int>(tube.mesh.V.rows());
   tube.mesh.V.conservativeResize(loose + 1, 3);
   tube.mesh.V.row(loose) << 5, 5, 5;
-  const FullSolveResult result = solve_full(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd(),
-                                            tube.transforms, 1e3, EnergyKind::kShells, 1.0, 1.0, 1e-10, 100);
+  const FullSolveResult result = solve_full(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd(), tube.transforms,
+                                            1e3, EnergyKind::kShells, 1.0, 1.0, 1e-10, 100);
   EXPECT_TRUE(result.converged);
   EXPECT_LE((result.positions.row(loose) - tube.mesh.V.row(loose)).norm(), 1e-14);
 }
@@ -108,8 +106,8 @@ TEST(SolveFull, BadInputIsRefused) {
   const Eigen::VectorXd none;
   auto solve = [&](const Handles& handles, const Transforms& transforms, double stiffness, double tolerance,
                    int iterations) {
-    solve_full(tube.mesh.V, tube.mesh.F, handles, none, transforms, stiffness, EnergyKind::kShells, 1.0, 1.0,
-               tolerance, iterations);
+    solve_full(tube.mesh.V, tube.mesh.F, handles, none, transforms, stiffness, EnergyKind::kShells, 1.0, 1.0, tolerance,
+               iterations);
   };
   EXPECT_THROW(solve(tube.handles, {Eigen::Matrix4d::Identity()}, 1.0, 1e-8, 10), InputError);
   EXPECT_THROW(solve({{0, 999}}, {Eigen::Matrix4d::Identity()}, 1.0, 1e-8, 10), InputError);
@@ -118,9 +116,9 @@ TEST(SolveFull, BadInputIsRefused) {
   EXPECT_THROW(solve(tube.handles, tube.transforms, 1.0, 1e-8, -1), InputError);
   RowMatrixX3i F = tube.mesh.F;
   F(2, 1) = 1000;
-  EXPECT_THROW(solve_full(tube.mesh.V, F, tube.handles, none, tube.transforms, 1.0, EnergyKind::kShells, 1.0, 1.0,
-                          1e-8, 10),
-               InputError);
+  EXPECT_THROW(
+      solve_full(tube.mesh.V, F, tube.handles, none, tube.transforms, 1.0, EnergyKind::kShells, 1.0, 1.0, 1e-8, 10),
+      InputError);
 }
 
 }  // namespace

@@ -10,10 +10,10 @@
 #include "mesh/mass.h"
 #include "mesh/normalization.h"
 #include "mesh/triangle_mesh.h"
-#include "reduction/basis.h"
 #include "modes/modal_derivatives.h"
 #include "modes/rigid_motions.h"
 #include "modes/vibration_modes.h"
+#include "reduction/basis.h"
 #include "reduction/ghost.h"
 #include "solve/handle_term.h"
 
@@ -30,7 +30,8 @@ inline Eigen::Matrix4d rigid_transform(const Eigen::Vector3d& axis, double angle
 }
 
 // The vertices of V whose rest position satisfies `inside`.
-inline std::vector<int> vertices_where(const RowMatrixX3d& V, const std::function<bool(const Eigen::Vector3d&)>& inside) {
+inline std::vector<int> vertices_where(const RowMatrixX3d& V,
+                                       const std::function<bool(const Eigen::Vector3d&)>& inside) {
   std::vector<int> selected;
   for (int v = 0; v < V.rows(); ++v)
     if (inside(V.row(v).transpose())) selected.push_back(v);

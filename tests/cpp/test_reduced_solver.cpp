@@ -140,8 +140,8 @@ TEST(ReducedSolver, MovingHandlesUpdatesTheObjectiveInPlace) {
   Eigen::VectorXd gradient(30);
   // Frames of an animation: after each move, BFGS's f(q) is the new objective at the old q.
   for (int frame = 1; frame <= 4; ++frame) {
-    solver.set_transforms({Eigen::Matrix4d::Identity(),
-                           rigid_transform({1, 0, 1}, 0.2 * frame, {0, 0, 4}, {0.25 * frame, 0, 0})});
+    solver.set_transforms(
+        {Eigen::Matrix4d::Identity(), rigid_transform({1, 0, 1}, 0.2 * frame, {0, 0, 4}, {0.25 * frame, 0, 0})});
     const double updated = solver.solve(0, 1e-8).energy;
     EXPECT_NEAR(updated, solver.objective(solver.q(), gradient), 1e-12 * std::abs(updated)) << "frame " << frame;
     const ReducedSolveStats stats = solver.solve(10, 1e-8);
@@ -179,7 +179,8 @@ TEST(ReducedSolver, PositionsAreRestPlusUqInTheCallersBuffer) {
   solver.positions(out);
   EXPECT_EQ(out.data(), buffer);
   const Eigen::VectorXd expected = flatten(basis.rest) + basis.vectors.cast<double>() * solver.q();
-  const double magnitude = flatten(basis.rest).cwiseAbs().maxCoeff() + (expected - flatten(basis.rest)).cwiseAbs().maxCoeff();
+  const double magnitude =
+      flatten(basis.rest).cwiseAbs().maxCoeff() + (expected - flatten(basis.rest)).cwiseAbs().maxCoeff();
   EXPECT_LE((out.cast<double>() - expected).cwiseAbs().maxCoeff(), 1e-6 * magnitude);
   solver.reset();
   solver.positions(out);
