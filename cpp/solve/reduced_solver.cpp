@@ -107,17 +107,23 @@ double ReducedSolver::objective(const Eigen::VectorXd& q, Eigen::VectorXd& gradi
 
 void ReducedSolver::positions(Eigen::Ref<Eigen::VectorXf> out) const {
   const RowMatrixXf& U = basis_.vectors;
-  const Eigen::Index rows = U.rows();
+  const Eigen::Index rows = U.rows(), r = U.cols();
   if (out.size() != rows) throw InputError(message("out: expected ", rows, " values (3 per vertex), got ", out.size()));
   const double* rest = basis_.rest.data();
+  const float* q = q_float_.data();
   const Eigen::Index blocks = (rows + kBlockRows - 1) / kBlockRows;
+  // One SIMD dot product per row (a third faster than Eigen's row-major product here, which
+  // stays below the memory bandwidth); x̄ is added in double and rounded once.
 #pragma omp parallel for schedule(static) if (rows >= kParallelRows)
   for (Eigen::Index block = 0; block < blocks; ++block) {
-    const Eigen::Index begin = block * kBlockRows, count = std::min(kBlockRows, rows - begin);
-    Eigen::Matrix<float, kBlockRows, 1> displacement;
-    displacement.head(count).noalias() = U.middleRows(begin, count) * q_float_;
-    for (Eigen::Index k = 0; k < count; ++k)
-      out[begin + k] = static_cast<float>(rest[begin + k] + static_cast<double>(displacement[k]));
+    const Eigen::Index end = std::min(rows, (block + 1) * kBlockRows);
+    for (Eigen::Index k = block * kBlockRows; k < end; ++k) {
+      const float* u = U.data() + k * r;
+      float dot = 0;
+#pragma omp simd reduction(+ : dot)
+      for (Eigen::Index j = 0; j < r; ++j) dot += u[j] * q[j];
+      out[k] = static_cast<float>(rest[k] + static_cast<double>(dot));
+    }
   }
 }
 
