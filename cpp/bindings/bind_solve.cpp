@@ -69,9 +69,10 @@ void bind_solve(py::module_& m) {
           result = solve_full(V, F, to_handles(handles), weights, transforms, stiffness, energy_kind(energy), bending,
                               membrane, tolerance, max_iterations, initial ? &*initial : nullptr);
         }
-        py::dict stats(py::arg("iterations") = result.iterations, py::arg("energy") = result.energy,
-                       py::arg("converged") = result.converged, py::arg("gradient_norm") = result.gradient_norm,
-                       py::arg("rest_gradient_norm") = result.rest_gradient_norm,
+        py::dict stats(py::arg("steps") = result.steps, py::arg("iterations") = result.iterations,
+                       py::arg("energy") = result.energy, py::arg("converged") = result.converged,
+                       py::arg("gradient_norm") = result.gradient_norm,
+                       py::arg("gradient_scale") = result.gradient_scale,
                        py::arg("factorizations") = result.factorizations);
         return py::make_tuple(std::move(result.positions), stats);
       },

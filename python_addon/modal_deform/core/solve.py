@@ -147,13 +147,16 @@ def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, ene
     """The reference: Newton's method on the full mesh for the reduced solver's objective.
 
     V (n, 3), F (m, 3): the rest mesh; handles, transforms, weights, stiffness, energy as for
-    ReducedSolver, with ``bending`` and ``membrane`` the shells weights. Starts at rest, or at
-    ``initial`` (n, 3) (say, the previous step of a large motion taken in steps), and stops
-    when the gradient norm is below ``tolerance`` times its value at rest, or after
-    ``max_iterations`` Newton steps (sparse Cholesky, Hessian shifted by a multiple of the mass
-    matrix where it is not positive definite). Returns the positions (n, 3) float64, or with
-    ``return_stats=True`` the pair (positions, stats) with stats = {"iterations", "energy",
-    "converged", "gradient_norm", "rest_gradient_norm", "factorizations"}.
+    ReducedSolver, with ``bending`` and ``membrane`` the shells weights. From rest, large motions
+    are taken in load steps (each handle turning by at most 30° and its centre moving by at most
+    a tenth of the bounding-box diagonal per step); with ``initial`` (n, 3) the solve starts there
+    in one step (an animation passes the previous frame's answer). Each step stops when the
+    gradient norm is below ``tolerance`` times its value at rest (or at ``initial``, if larger),
+    or after ``max_iterations``
+    Newton iterations (sparse Cholesky, the Hessian shifted by a multiple of the mass matrix where
+    it is not positive definite). Returns the positions (n, 3) float64, or with
+    ``return_stats=True`` the pair (positions, stats) with stats = {"steps", "iterations",
+    "energy", "converged", "gradient_norm", "gradient_scale", "factorizations"}.
     """
     V, F = _arrays.vertices(V), _arrays.faces(F)
     handles = _handles(handles)
