@@ -81,3 +81,105 @@ def test_solve_full_refuses_bad_input(tube):
         mdc.solve_full(V, F, handles, transforms, stiffness=-1.0)
     with pytest.raises(ValueError, match=r"weights"):
         mdc.solve_full(V, F, handles, transforms, weights=[1.0, -2.0])
+
+
+@pytest.fixture(scope="module")
+def tube_basis(tube):
+    V, F, _, _ = tube
+    return mdc.bake(V, F, modes=20, derivatives=30, ghost=200)
+
+
+def converge(solver, tolerance=1e-8):
+    stats = {"converged": False}
+    for _ in range(50):
+        stats = solver.solve(20, tolerance)
+        if stats["converged"]:
+            break
+    return stats
+
+
+def test_reduced_solver_poses_close_to_the_full_solve(tube, tube_basis):
+    V, F, handles, transforms = tube
+    solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0)
+    assert solver.dimension == tube_basis.dimension
+    solver.set_transforms(transforms)
+    energies = []
+    for _ in range(30):
+        stats = solver.solve(max_iterations=1)
+        assert set(stats) >= {"iterations", "energy", "converged", "ms", "evaluations", "gradient_norm"}
+        energies.append(stats["energy"])
+    assert all(b <= a for a, b in zip(energies, energies[1:]))
+    assert converge(solver)["converged"]
+    X = solver.positions()
+    assert X.shape == V.shape and X.dtype == np.float32
+    reference = mdc.solve_full(V, F, handles, transforms, stiffness=100.0)
+    diagonal = np.linalg.norm(np.ptp(reference, axis=0))
+    assert np.sqrt(np.mean(np.sum((X - reference) ** 2, axis=1))) < 0.02 * diagonal
+
+
+def test_positions_fill_the_callers_buffer(tube, tube_basis):
+    _, _, handles, transforms = tube
+    solver = mdc.ReducedSolver(tube_basis, handles)
+    rest = np.asarray(tube_basis.rest, dtype=np.float32)
+    assert np.array_equal(solver.positions(), rest)
+    solver.set_transforms(transforms)
+    solver.solve(10)
+    for shape in [rest.shape, (rest.size,)]:
+        out = np.full(shape, np.nan, dtype=np.float32)
+        assert solver.positions(out) is out
+        expected = tube_basis.rest.reshape(-1) + tube_basis.vectors.astype(np.float64) @ solver.q
+        assert np.allclose(out.reshape(-1), expected, rtol=0, atol=1e-5 * np.abs(expected).max())
+    for bad in [np.zeros(rest.shape, np.float64), np.zeros((rest.shape[0], 4), np.float32),
+                np.zeros(rest.shape, np.float32, order="F"), [[0.0] * 3] * len(rest)]:
+        with pytest.raises(ValueError, match="out"):
+            solver.positions(bad)
+    read_only = np.zeros(rest.shape, np.float32)
+    read_only.flags.writeable = False
+    with pytest.raises(ValueError, match="writeable"):
+        solver.positions(read_only)
+    solver.reset()
+    assert np.array_equal(solver.positions(), rest)
+
+
+def test_state_persists_across_solves(tube, tube_basis):
+    _, _, handles, transforms = tube
+    once, twice = (mdc.ReducedSolver(tube_basis, handles, stiffness=100.0) for _ in range(2))
+    for solver in (once, twice):
+        solver.set_transforms(transforms)
+    ten = once.solve(10, tolerance=1e-14)
+    first, second = twice.solve(5, tolerance=1e-14), twice.solve(5, tolerance=1e-14)
+    assert first["iterations"] + second["iterations"] == ten["iterations"]
+    assert np.array_equal(once.q, twice.q)
+
+
+def test_arap_objective_in_the_shells_basis(tube, tube_basis):
+    V, F, handles, transforms = tube
+    solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0, energy="arap")
+    solver.set_transforms(transforms)
+    assert converge(solver)["converged"]
+    reference = mdc.solve_full(V, F, handles, transforms, stiffness=100.0, energy="arap")
+    diagonal = np.linalg.norm(np.ptp(reference, axis=0))
+    assert np.sqrt(np.mean(np.sum((solver.positions() - reference) ** 2, axis=1))) < 0.04 * diagonal
+
+
+def test_reduced_solver_refuses_bad_input(tube, tube_basis):
+    _, _, handles, transforms = tube
+    with pytest.raises(ValueError, match=r"handles\[1\]\[0\] = 999999"):
+        mdc.ReducedSolver(tube_basis, [handles[0], [999999]])
+    with pytest.raises(ValueError, match="stiffness"):
+        mdc.ReducedSolver(tube_basis, handles, stiffness=0.0)
+    with pytest.raises(ValueError, match="energy"):
+        mdc.ReducedSolver(tube_basis, handles, energy="springs")
+    with pytest.raises(ValueError, match="weights"):
+        mdc.ReducedSolver(tube_basis, handles, weights=[1.0])
+    solver = mdc.ReducedSolver(tube_basis, handles)
+    sheared = np.eye(4)
+    sheared[0, 1] = 0.2
+    with pytest.raises(ValueError, match=r"transforms\[1\]"):
+        solver.set_transforms([np.eye(4), sheared])
+    with pytest.raises(ValueError, match="expected 2"):
+        solver.set_transforms(transforms[:1])
+    with pytest.raises(ValueError, match="max_iterations"):
+        solver.solve(max_iterations=-1)
+    with pytest.raises(ValueError, match="tolerance"):
+        solver.solve(tolerance=2.0)
