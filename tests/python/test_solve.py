@@ -19,7 +19,7 @@ def rigid(axis, angle, centre, translation):
 @pytest.fixture(scope="module")
 def tube():
     """A tube along z held at its bottom ring, its top ring turned and pushed."""
-    V, F = mdc.cylinder(8, 6, radius=1.0, length=3.0)
+    V, F = mdc.cylinder(16, 12, radius=1.0, length=3.0)
     handles = [np.flatnonzero(V[:, 2] < 1e-9), np.flatnonzero(V[:, 2] > 3 - 1e-9)]
     transforms = [np.eye(4), rigid([1, 0, 1], 0.8, [0, 0, 3], [0.8, 0, -0.3])]
     return V, F, handles, transforms
@@ -86,7 +86,7 @@ def test_solve_full_refuses_bad_input(tube):
 @pytest.fixture(scope="module")
 def tube_basis(tube):
     V, F, _, _ = tube
-    return mdc.bake(V, F, modes=20, derivatives=30, ghost=200)
+    return mdc.bake(V, F, modes=20, derivatives=47, ghost=100)  # the paper's 67 dimensions
 
 
 def converge(solver, tolerance=1e-8):
