@@ -1,5 +1,6 @@
 #include "solve/handle_term.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "util/errors.h"
@@ -50,18 +51,25 @@ HandleTerm::HandleTerm(const VerticesRef& rest, const VectorRef& mass, const Eig
                        const Handles& handles, const VectorRef& weights, double coefficient) {
   const int n = static_cast<int>(rest.rows());
   const Eigen::Index r = U.cols();
-  // A = Σ_i ω_i U_iᵀU_i with ω_i = coefficient Σ_{h∋i} w_h m_i: one product of the gathered rows.
+  // A = Σ_i ω_i U_iᵀU_i with ω_i = coefficient Σ_{h∋i} w_h m_i: rank updates with the gathered
+  // rows √ω_i U_i, a block of vertices at a time (bounded memory for a handle of any size).
   Eigen::VectorXd omega = Eigen::VectorXd::Zero(n);
   for (size_t h = 0; h < handles.size(); ++h)
     for (int v : handles[h]) omega[v] += coefficient * weights[h] * mass[v];
   std::vector<int> members;
   for (int v = 0; v < n; ++v)
     if (omega[v] > 0) members.push_back(v);
-  Eigen::MatrixXd G(3 * members.size(), r);
-  for (size_t k = 0; k < members.size(); ++k)
-    G.middleRows<3>(3 * k) = std::sqrt(omega[members[k]]) * U.middleRows<3>(3 * members[k]).cast<double>();
+  constexpr size_t kBlock = 1024;
   A_ = Eigen::MatrixXd::Zero(r, r);
-  A_.selfadjointView<Eigen::Lower>().rankUpdate(G.transpose());
+  Eigen::MatrixXd G(3 * kBlock, r);
+  for (size_t begin = 0; begin < members.size(); begin += kBlock) {
+    const size_t count = std::min(kBlock, members.size() - begin);
+    for (size_t k = 0; k < count; ++k) {
+      const int v = members[begin + k];
+      G.middleRows<3>(3 * k) = std::sqrt(omega[v]) * U.middleRows<3>(3 * v).cast<double>();
+    }
+    A_.selfadjointView<Eigen::Lower>().rankUpdate(G.topRows(3 * count).transpose());
+  }
   A_.triangularView<Eigen::StrictlyUpper>() = A_.transpose();
 
   for (size_t h = 0; h < handles.size(); ++h) {

@@ -79,6 +79,24 @@ TEST(HandleTerm, EqualsTheSumOverHandleVertices) {
   }
 }
 
+TEST(HandleTerm, LargeHandlesAreSummedInBlocks) {
+  std::srand(5);
+  const int n = 2500;  // more vertices than one block of the Σ m UᵀU accumulation
+  const RowMatrixX3d rest = RowMatrixX3d::Random(n, 3);
+  const Eigen::VectorXd mass = Eigen::VectorXd::Random(n).cwiseAbs();
+  const RowMatrixXf U = RowMatrixXf::Random(3 * n, 4);
+  Handles handles(1);
+  for (int v = 0; v < n; ++v) handles[0].push_back(v);
+  const Eigen::VectorXd weights = Eigen::VectorXd::Ones(1);
+  const Transforms transforms = {rigid_transform({0, 1, 1}, 1.2, {0, 0, 0}, {1, 0, 0})};
+  HandleTerm term(rest, mass, U, handles, weights, 2.0);
+  term.set_transforms(transforms);
+  const Eigen::VectorXd q = Eigen::Vector4d(0.3, -1, 2, 0.5);
+  Eigen::VectorXd gradient(4);
+  const double expected = direct_handle_term(rest, mass, U, handles, weights, transforms, 2.0, q);
+  EXPECT_NEAR(term.value_and_gradient(q, gradient), expected, 1e-10 * expected);
+}
+
 TEST(HandleTerm, ZeroAtRestWithIdentityTransformsAndPositiveAfterAMove) {
   const Handled setup;
   HandleTerm term(setup.rest, setup.mass, setup.U, setup.handles, setup.weights, setup.coefficient);
