@@ -20,7 +20,8 @@
 // far from the origin: no large terms cancel.)
 //
 // A vertex may belong to several handles: its terms add, so it settles between their targets in
-// proportion to their weights. A vertex listed twice in one handle is an input error.
+// proportion to their weights. A vertex listed twice in one handle is an input error. Vertices
+// without mass (in no triangle) pull with zero weight.
 #pragma once
 
 #include <vector>

@@ -8,7 +8,8 @@ scale s), the deformation energy plus the handle term
 with m_i the lumped vertex masses, (R_h, t_h) handle h's rigid 4×4 transform of its rest
 positions (mesh units) and μ the stiffness. A handle is an array of vertex indices; a vertex may
 belong to several handles (its pulls add up, so it settles between their targets in proportion to
-their weights), but not twice to one.
+their weights), but not twice to one. Vertices without mass (in no triangle) pull with zero
+weight.
 """
 import operator
 
@@ -77,6 +78,7 @@ class ReducedSolver:
     arrays; ``weights``: one per handle (default 1); ``stiffness``: μ > 0; ``energy``: "shells"
     (with the basis's material weights) or "arap". The solver starts at rest with every handle at
     its rest position; the inverse Hessian's warm start is computed here, once per handle set.
+    Long calls release the GIL; one solver must not be used from two threads at once.
     """
 
     def __init__(self, basis, handles, stiffness=STIFFNESS, weights=None, energy="shells"):
