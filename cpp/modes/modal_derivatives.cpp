@@ -65,7 +65,7 @@ std::vector<int> pins_for(const SparseMatrix& K, const Kernel& kernel) {
 
 Eigen::MatrixXd solve_with_pins(const SparseMatrix& K, const VectorRef& mass, const Kernel& kernel,
                                 const Eigen::Ref<const Eigen::MatrixXd>& B, const std::vector<int>& pins,
-                                Progress* progress) {
+                                Progress* progress, CholmodLLT* factor) {
   const Eigen::Index n = K.rows();
   if (B.rows() != n) throw InputError(message("B: expected ", n, " rows, got ", B.rows()));
   if (!B.allFinite()) throw InputError("B: has an entry that is not finite");
@@ -83,7 +83,8 @@ Eigen::MatrixXd solve_with_pins(const SparseMatrix& K, const VectorRef& mass, co
   for (int s : pins) pin_stiffness[s] = w;
   for (Eigen::Index d = 0; d < n; ++d)
     if (decoupled[static_cast<size_t>(d)]) pin_stiffness[d] = w > 0 ? w : 1.0;
-  CholmodLLT llt(3);  // orders vertices, 3 DOFs each
+  CholmodLLT own_factor(3);  // orders vertices, 3 DOFs each
+  CholmodLLT& llt = factor ? *factor : own_factor;
   try {
     llt.factorize(K, pin_stiffness);
   } catch (const NumericalError& e) {
@@ -138,9 +139,9 @@ std::vector<int> kernel_pins(const SparseMatrix& K, const VectorRef& mass, const
 }
 
 Eigen::MatrixXd solve_in_range(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z,
-                               const Eigen::Ref<const Eigen::MatrixXd>& B, Progress* progress) {
+                               const Eigen::Ref<const Eigen::MatrixXd>& B, Progress* progress, CholmodLLT* factor) {
   const Kernel kernel = checked_kernel(K, mass, Z);
-  return solve_with_pins(K, mass, kernel, B, pins_for(K, kernel), progress);
+  return solve_with_pins(K, mass, kernel, B, pins_for(K, kernel), progress, factor);
 }
 
 Eigen::MatrixXd solve_in_range(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z,
@@ -163,7 +164,7 @@ Eigen::MatrixXd solve_in_range(const SparseMatrix& K, const VectorRef& mass, con
   if (qr.rank() != Z.cols())
     throw InputError(message("pins: Z restricted to the pinned DOFs has rank ", qr.rank(), " of ", Z.cols(),
                              "; they do not pin the kernel"));
-  return solve_with_pins(K, mass, kernel, B, pins, progress);
+  return solve_with_pins(K, mass, kernel, B, pins, progress, nullptr);
 }
 
 }  // namespace modal_deform

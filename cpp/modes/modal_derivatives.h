@@ -10,6 +10,8 @@
 
 namespace modal_deform {
 
+class CholmodLLT;
+
 // The first `count` pairs (i, j), i ≤ j < num_modes, of non-rigid modes in the paper's order
 // (two loops, so that pairs of low eigenvalues come first): (0,0), (0,1), (1,1), (0,2), (1,2),
 // (2,2), (0,3), ... Throws InputError when count exceeds num_modes (num_modes + 1) / 2.
@@ -32,8 +34,11 @@ std::vector<int> kernel_pins(const SparseMatrix& K, const VectorRef& mass, const
 // mass and stiffness (stiffness_and_mass.h) get zero rows. Throws InputError for inconsistent
 // input (Z not M-orthonormal or not in the kernel, bad pins) and NumericalError when the pinned
 // matrix is singular (Z misses part of the kernel) or a solution fails its residual check.
+// `factor`, when given, is the CholmodLLT (3 DOFs per node) to factor in: one that already holds
+// the analysis of K's pattern (from vibration_modes) skips it.
 Eigen::MatrixXd solve_in_range(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z,
-                               const Eigen::Ref<const Eigen::MatrixXd>& B, Progress* progress = nullptr);
+                               const Eigen::Ref<const Eigen::MatrixXd>& B, Progress* progress = nullptr,
+                               CholmodLLT* factor = nullptr);
 Eigen::MatrixXd solve_in_range(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z,
                                const Eigen::Ref<const Eigen::MatrixXd>& B, const std::vector<int>& pins,
                                Progress* progress = nullptr);

@@ -1,0 +1,195 @@
+#include "reduction/bake.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "energy/arap.h"
+#include "energy/discrete_shells.h"
+#include "linalg/cholmod_llt.h"
+#include "mesh/mass.h"
+#include "mesh/mesh_check.h"
+#include "mesh/normalization.h"
+#include "modes/modal_derivatives.h"
+#include "modes/rigid_motions.h"
+#include "modes/stiffness_and_mass.h"
+#include "modes/vibration_modes.h"
+#include "reduction/attachment.h"
+#include "reduction/ghost.h"
+#include "reduction/orthonormalize.h"
+#include "util/errors.h"
+#include "util/stopwatch.h"
+
+namespace modal_deform {
+namespace {
+
+// Pairs per third_batch call: each call is one pass over the elements, and the bar moves between
+// calls.
+constexpr int kPairsPerPass = 16;
+
+void check_options(const BakeOptions& o) {
+  if (o.modes < 1) throw InputError(message("modes: expected at least 1, got ", o.modes));
+  if (o.derivatives < 0) throw InputError(message("derivatives: expected 0 or more, got ", o.derivatives));
+  if (o.ghost < 4) throw InputError(message("ghost: a ghost needs at least 4 vertices, got ", o.ghost));
+  if (o.energy != "shells" && o.energy != "arap")
+    throw InputError(message("energy: expected \"shells\" or \"arap\", got \"", o.energy, "\""));
+  if (o.energy == "arap" && o.derivatives > 0)
+    throw InputError(message("derivatives: the ARAP energy has no third derivative, so it has no modal derivatives; ",
+                             "bake it with derivatives = 0, or use the shells energy (asked for ", o.derivatives, ")"));
+  if (!(std::isfinite(o.bending) && o.bending >= 0))
+    throw InputError(message("bending: expected a finite weight >= 0, got ", o.bending));
+  if (!(std::isfinite(o.membrane) && o.membrane >= 0))
+    throw InputError(message("membrane: expected a finite weight >= 0, got ", o.membrane));
+}
+
+}  // namespace
+
+Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Progress& progress) {
+  check_options(options);
+  validate_mesh(V, F);
+  Basis basis;
+  auto& time = basis.timings;
+  basis.rest = V;
+  basis.mass = lumped_mass(V, F);
+  basis.scale = normalizing_scale(V);
+  basis.bending = options.bending;
+  basis.membrane = options.membrane;
+  const double scale = basis.scale;
+
+  // 2. The simulated submesh, in the normalised frame.
+  Attachment attachment;
+  {
+    const Stopwatch stopwatch(time["attachment"]);
+    progress.report("attachment", 0.0);
+    attachment = attach(V, F);
+    progress.report("attachment", 1.0);
+  }
+  const auto S = static_cast<Eigen::Index>(attachment.simulated.size());
+  RowMatrixX3d simulated_V(S, 3);
+  Eigen::VectorXd simulated_mass(S);
+  for (Eigen::Index s = 0; s < S; ++s) {
+    simulated_V.row(s) = scale * V.row(attachment.simulated[static_cast<size_t>(s)]);
+    simulated_mass[s] = scale * scale * basis.mass[attachment.simulated[static_cast<size_t>(s)]];
+  }
+  const int num_rigid = 6 * attachment.num_components;
+  if (options.modes <= num_rigid)
+    throw InputError(message("modes: ", options.modes, " modes are not more than the ", num_rigid,
+                             " rigid motions of the mesh's ", attachment.num_components,
+                             " simulated components (6 each); ask for more than ", num_rigid));
+  const int flexible = options.modes - num_rigid;
+  if (flexible >= 3 * S - num_rigid)
+    throw InputError(message("modes: the simulated mesh has ", 3 * S - num_rigid,
+                             " degrees of freedom besides its rigid motions; ask for fewer than ",
+                             3 * S, " modes, got ", options.modes));
+
+  // 3. Stiffness and vibration modes.
+  std::unique_ptr<DiscreteShells> shells;
+  SparseMatrix K;
+  {
+    const Stopwatch stopwatch(time["hessian"]);
+    progress.report("hessian", 0.0);
+    if (options.energy == "shells") {
+      shells = std::make_unique<DiscreteShells>(simulated_V, attachment.faces, options.bending, options.membrane);
+      K = shells->hessian(shells->rest());
+    } else {
+      const Arap arap(simulated_V, attachment.faces);
+      K = arap.hessian(arap.rest());
+    }
+    progress.report("hessian", 1.0);
+  }
+  const Eigen::MatrixXd rigid = rigid_motions(simulated_V, attachment.component, simulated_mass);
+  CholmodLLT factor(3);  // one analysis for the modes and the derivative solves
+  VibrationModes modes;
+  {
+    const double factoring = factor.seconds();
+    {
+      const Stopwatch stopwatch(time["modes"]);
+      modes = vibration_modes(K, simulated_mass, flexible, rigid, &progress, &factor);
+    }
+    time["modes"] -= factor.seconds() - factoring;
+  }
+  const double mean_eigenvalue = K.diagonal().sum() / (3 * simulated_mass.sum());
+  int num_floppy = 0;
+  while (num_floppy < flexible && modes.eigenvalues[num_floppy] < kZeroEigenvalue * mean_eigenvalue) ++num_floppy;
+  basis.num_floppy = num_floppy;
+
+  // 4. Modal derivatives of the pairs of modes that are neither rigid nor zero.
+  const int usable = flexible - num_floppy;
+  Eigen::MatrixXd derivatives(3 * S, options.derivatives);
+  if (options.derivatives > 0) {
+    const long long available = static_cast<long long>(usable) * (usable + 1) / 2;
+    if (options.derivatives > available)
+      throw InputError(message("derivatives: ", options.derivatives, " asked for, but the ", usable,
+                               " modes that are neither rigid",
+                               num_floppy ? message(" nor zero (the mesh has ", num_floppy, " zero modes besides its rigid motions)")
+                                          : std::string(),
+                               " have only ", available, " pairs; ask for more modes or fewer derivatives"));
+    const std::vector<std::array<int, 2>> pairs = derivative_pairs(usable, options.derivatives);
+    const auto phi = modes.modes.rightCols(usable);
+    {
+      const Stopwatch stopwatch(time["third derivatives"]);
+      for (size_t first = 0; first < pairs.size(); first += kPairsPerPass) {
+        progress.report("third derivatives", static_cast<double>(first) / pairs.size());
+        const size_t last = std::min(pairs.size(), first + kPairsPerPass);
+        derivatives.middleCols(static_cast<Eigen::Index>(first), static_cast<Eigen::Index>(last - first)) =
+            shells->third_batch(shells->rest(), phi, {pairs.begin() + first, pairs.begin() + last});
+      }
+      progress.report("third derivatives", 1.0);
+    }
+    Eigen::MatrixXd kernel(3 * S, num_rigid + num_floppy);
+    kernel.leftCols(num_rigid) = rigid;
+    kernel.rightCols(num_floppy) = modes.modes.leftCols(num_floppy);
+    const double factoring = factor.seconds();
+    {
+      const Stopwatch stopwatch(time["derivative solves"]);
+      derivatives = solve_in_range(K, simulated_mass, kernel, derivatives, &progress, &factor);
+    }
+    time["derivative solves"] -= factor.seconds() - factoring;
+  }
+  time["factorisation"] = factor.seconds();
+
+  // 5. [rigid motions, modes, derivatives], M-orthonormal.
+  const int leading = options.modes;
+  Eigen::MatrixXd U(3 * S, leading + options.derivatives);
+  U.leftCols(num_rigid) = rigid;
+  U.middleCols(num_rigid, flexible) = modes.modes;
+  U.rightCols(options.derivatives) = derivatives;
+  derivatives.resize(0, 0);
+  {
+    const Stopwatch stopwatch(time["orthonormalisation"]);
+    const std::vector<int> kept = orthonormalize(U, dof_masses(simulated_mass), kDependentTolerance, &progress);
+    for (int j = 0; j < leading; ++j)
+      if (j >= static_cast<int>(kept.size()) || kept[static_cast<size_t>(j)] != j)
+        throw NumericalError(message("bake: column ", j, " of the rigid motions and modes came out dependent; ",
+                                     "they are not M-orthonormal"));
+  }
+  basis.num_dropped = static_cast<int>(leading + options.derivatives - U.cols());
+  basis.num_rigid = num_rigid;
+  basis.num_modes = options.modes;
+  basis.eigenvalues = Eigen::VectorXd::Zero(options.modes);
+  basis.eigenvalues.tail(flexible) = modes.eigenvalues;
+
+  // 6. Attached rows, mesh units, single precision.
+  {
+    const Stopwatch stopwatch(time["assembly"]);
+    progress.report("assembly", 0.0);
+    if (!attachment.followers.empty()) U = extend_to_attached(attachment, U);
+    U /= scale;
+    basis.vectors = U.cast<float>();
+    progress.report("assembly", 1.0);
+  }
+
+  // 7. The ghost, restricted from the double-precision basis (rigid motions stay exact).
+  {
+    const Stopwatch stopwatch(time["ghost"]);
+    Ghost ghost = ghost_mesh(V, F, basis.mass, options.ghost, &progress);
+    basis.ghost_vectors = restrict_to_ghost(ghost, basis.mass, U);
+    basis.ghost_vertices = std::move(ghost.V);
+    basis.ghost_faces = std::move(ghost.F);
+    basis.ghost_map = std::move(ghost.map);
+  }
+  validate_basis(basis);
+  return basis;
+}
+
+}  // namespace modal_deform
