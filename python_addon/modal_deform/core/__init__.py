@@ -5,6 +5,7 @@
 The pipeline, one module per stage: ``mesh`` (check, mass, test shapes).
 """
 from .._native import Cancelled
+from .bake import Basis, bake
 from .energy import Arap, DiscreteShells
 from .mesh import bar, bumpy_plane, check, cylinder, grid, mass, read_mesh
 from .modes import rigid_motions, solve_in_range, vibration_modes
@@ -15,3 +16,4 @@ __all__ += ["ghost_mesh", "restrict_to_ghost"]
 __all__ += ["Arap"]
 __all__ += ["DiscreteShells"]
 __all__ += ["rigid_motions", "solve_in_range", "vibration_modes"]
+__all__ += ["Basis", "bake"]
