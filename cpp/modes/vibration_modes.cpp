@@ -14,10 +14,13 @@ namespace modal_deform {
 namespace {
 
 // σ = −kShiftFraction · tr K / tr M. The trace ratio is a mass-weighted mean of the spectrum, far
-// above its low end, so σ sits just below λ = 0 while K − σM stays far from singular (CHOLMOD's
-// condition estimate about 1e-6). The count of solves hardly depends on it: on the dragon with
-// 23k vertices, 20 modes took 93 solves for every fraction from 1e-12 to 1e-8 (106 at 1e-6).
-constexpr double kShiftFraction = 1e-8;
+// above its low end and growing with the resolution (2.6e6 on the dragon with 23k vertices, 2.1e8
+// with 100k, whose lowest flexible eigenvalues are 0.024 and 0.037), so σ sits just below λ = 0
+// while K − σM stays definite (the kernel's Rayleigh quotients are rounding, about 1e-16 of the
+// mean). It must not sit far below the wanted modes: with 1e-8 the 100k dragon took 111 solves
+// for 14 modes, with 1e-10 or 1e-12 50; on the 23k dragon 20 modes took 93 solves for every
+// fraction from 1e-12 to 1e-8 (106 at 1e-6).
+constexpr double kShiftFraction = 1e-10;
 // Spectra's convergence tolerance on the transformed eigenvalues.
 constexpr double kEigenTolerance = 1e-10;
 constexpr int kMaxRestarts = 1000;

@@ -26,6 +26,58 @@ namespace {
 // Pairs per third_batch call: each call is one pass over the elements, and the bar moves between
 // calls.
 constexpr int kPairsPerPass = 16;
+// Modes asked for beyond those wanted, for the zero modes of a floppy mesh.
+constexpr int kZeroModeAllowance = 6;
+
+// Vibration modes past the rigid motions: the zero modes of a floppy mesh (λ below
+// kZeroEigenvalue · tr K / tr M), then `flexible` modes with λ above it, ascending.
+struct Modes {
+  Eigen::VectorXd eigenvalues;
+  Eigen::MatrixXd vectors;  // 3n by num_zero + flexible, M-orthonormal
+  int num_zero = 0;
+};
+
+// Asks Lanczos for kZeroModeAllowance modes more than `flexible`, which covers the zero modes of
+// the scans measured (3 to 9) at the price of a few solves; a mesh with more is solved again with
+// the zero modes found deflated, until the flexible modes are complete.
+Modes flexible_modes(const SparseMatrix& K, const Eigen::VectorXd& mass, const Eigen::MatrixXd& rigid, int flexible,
+                     Progress& progress, CholmodLLT& factor) {
+  const double zero = kZeroEigenvalue * K.diagonal().sum() / (3 * mass.sum());
+  const auto free = static_cast<int>(K.rows() - rigid.cols());
+  Eigen::MatrixXd kernel = rigid;
+  Modes result;
+  std::vector<Eigen::VectorXd> zero_modes;
+  std::vector<double> zero_values;
+  for (;;) {
+    const int known = static_cast<int>(zero_modes.size());
+    const int count = std::min(flexible + kZeroModeAllowance, free - known - 1);
+    if (count < flexible)
+      throw InputError(message("modes: the simulated mesh has only ", free - known,
+                               " degrees of freedom besides its rigid motions and ", known,
+                               " zero modes; ask for fewer modes"));
+    const VibrationModes modes = vibration_modes(K, mass, count, kernel, &progress, &factor);
+    int found = 0;
+    while (found < count && modes.eigenvalues[found] < zero) ++found;
+    for (int i = 0; i < found; ++i) {
+      zero_modes.push_back(modes.modes.col(i));
+      zero_values.push_back(modes.eigenvalues[i]);
+    }
+    if (count - found >= flexible) {
+      result.num_zero = static_cast<int>(zero_modes.size());
+      result.eigenvalues.resize(result.num_zero + flexible);
+      result.vectors.resize(K.rows(), result.num_zero + flexible);
+      for (int i = 0; i < result.num_zero; ++i) {
+        result.eigenvalues[i] = zero_values[static_cast<size_t>(i)];
+        result.vectors.col(i) = zero_modes[static_cast<size_t>(i)];
+      }
+      result.eigenvalues.tail(flexible) = modes.eigenvalues.segment(found, flexible);
+      result.vectors.rightCols(flexible) = modes.modes.middleCols(found, flexible);
+      return result;
+    }
+    kernel.conservativeResize(Eigen::NoChange, kernel.cols() + found);
+    kernel.rightCols(found) = modes.modes.leftCols(found);
+  }
+}
 
 void check_options(const BakeOptions& o) {
   if (o.modes < 1) throw InputError(message("modes: expected at least 1, got ", o.modes));
@@ -99,33 +151,28 @@ Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, 
   }
   const Eigen::MatrixXd rigid = rigid_motions(simulated_V, attachment.component, simulated_mass);
   CholmodLLT factor(3);  // one analysis for the modes and the derivative solves
-  VibrationModes modes;
+  Modes modes;
   {
     const double factoring = factor.seconds();
     {
       const Stopwatch stopwatch(time["modes"]);
-      modes = vibration_modes(K, simulated_mass, flexible, rigid, &progress, &factor);
+      modes = flexible_modes(K, simulated_mass, rigid, flexible, progress, factor);
     }
     time["modes"] -= factor.seconds() - factoring;
   }
-  const double mean_eigenvalue = K.diagonal().sum() / (3 * simulated_mass.sum());
-  int num_floppy = 0;
-  while (num_floppy < flexible && modes.eigenvalues[num_floppy] < kZeroEigenvalue * mean_eigenvalue) ++num_floppy;
-  basis.num_floppy = num_floppy;
+  const int num_zero = modes.num_zero;
+  basis.num_floppy = num_zero;
 
   // 4. Modal derivatives of the pairs of modes that are neither rigid nor zero.
-  const int usable = flexible - num_floppy;
   Eigen::MatrixXd derivatives(3 * S, options.derivatives);
   if (options.derivatives > 0) {
-    const long long available = static_cast<long long>(usable) * (usable + 1) / 2;
+    const long long available = static_cast<long long>(flexible) * (flexible + 1) / 2;
     if (options.derivatives > available)
-      throw InputError(message("derivatives: ", options.derivatives, " asked for, but the ", usable,
-                               " modes that are neither rigid",
-                               num_floppy ? message(" nor zero (the mesh has ", num_floppy, " zero modes besides its rigid motions)")
-                                          : std::string(),
-                               " have only ", available, " pairs; ask for more modes or fewer derivatives"));
-    const std::vector<std::array<int, 2>> pairs = derivative_pairs(usable, options.derivatives);
-    const auto phi = modes.modes.rightCols(usable);
+      throw InputError(message("derivatives: ", options.derivatives, " asked for, but the ", flexible,
+                               " vibration modes besides the rigid motions have only ", available,
+                               " pairs; ask for more modes or fewer derivatives"));
+    const std::vector<std::array<int, 2>> pairs = derivative_pairs(flexible, options.derivatives);
+    const auto phi = modes.vectors.rightCols(flexible);
     {
       const Stopwatch stopwatch(time["third derivatives"]);
       for (size_t first = 0; first < pairs.size(); first += kPairsPerPass) {
@@ -136,9 +183,9 @@ Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, 
       }
       progress.report("third derivatives", 1.0);
     }
-    Eigen::MatrixXd kernel(3 * S, num_rigid + num_floppy);
+    Eigen::MatrixXd kernel(3 * S, num_rigid + num_zero);
     kernel.leftCols(num_rigid) = rigid;
-    kernel.rightCols(num_floppy) = modes.modes.leftCols(num_floppy);
+    kernel.rightCols(num_zero) = modes.vectors.leftCols(num_zero);
     const double factoring = factor.seconds();
     {
       const Stopwatch stopwatch(time["derivative solves"]);
@@ -148,11 +195,11 @@ Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, 
   }
   time["factorisation"] = factor.seconds();
 
-  // 5. [rigid motions, modes, derivatives], M-orthonormal.
-  const int leading = options.modes;
+  // 5. [rigid motions, zero modes, modes, derivatives], M-orthonormal.
+  const int leading = options.modes + num_zero;
   Eigen::MatrixXd U(3 * S, leading + options.derivatives);
   U.leftCols(num_rigid) = rigid;
-  U.middleCols(num_rigid, flexible) = modes.modes;
+  U.middleCols(num_rigid, num_zero + flexible) = modes.vectors;
   U.rightCols(options.derivatives) = derivatives;
   derivatives.resize(0, 0);
   {
@@ -165,9 +212,9 @@ Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, 
   }
   basis.num_dropped = static_cast<int>(leading + options.derivatives - U.cols());
   basis.num_rigid = num_rigid;
-  basis.num_modes = options.modes;
-  basis.eigenvalues = Eigen::VectorXd::Zero(options.modes);
-  basis.eigenvalues.tail(flexible) = modes.eigenvalues;
+  basis.num_modes = leading;
+  basis.eigenvalues = Eigen::VectorXd::Zero(leading);
+  basis.eigenvalues.tail(num_zero + flexible) = modes.eigenvalues;
 
   // 6. Attached rows, mesh units, single precision.
   {

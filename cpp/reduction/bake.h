@@ -9,8 +9,10 @@
 //   3. K = ∇²E(x̄) of the simulated submesh, M lumped. The rigid motions of its components come
 //      first (analytic, M-orthonormal, 6 per component); the vibration modes are the lowest
 //      eigenpairs M-orthogonal to them (deflation). A floppy mesh (flaps at non-manifold
-//      vertices, duplicate faces) has further zero modes: those with λ < kZeroEigenvalue tr K/tr M
-//      stay in the basis as modes (Basis::num_floppy) but join the kernel for step 4.
+//      vertices, duplicate faces; all three shared dragons) has further zero modes, with
+//      λ < kZeroEigenvalue tr K/tr M: they come on top of `modes` (a scan's count of mechanisms is
+//      not known before the bake, and each would take the place of a deformation mode), stay in
+//      the basis after the rigid motions (Basis::num_floppy) and join the kernel for step 4.
 //   4. Modal derivatives (eq. 13) for the pairs of the remaining modes in the paper's order:
 //      right-hand sides ∇³E(x̄)(φᵢ, φⱼ) (third_batch), solved in the range of K against the
 //      kernel [rigid motions, zero modes], in the factor the modes used (one CHOLMOD analysis).
@@ -50,10 +52,11 @@ struct BakeOptions {
 };
 
 // The reduced space of (V #V by 3, F #F by 3, any length unit) per the pipeline above: a Basis in
-// the mesh's units with r = modes + derivatives − dropped columns. Throws InputError for a bad
-// mesh or option (naming it), among them: modes not above the rigid motions of the simulated
-// components (6 each), more derivatives than pairs of non-rigid, non-zero modes, "arap" with
-// derivatives; NumericalError when a solver fails; Cancelled when `progress` says stop.
+// the mesh's units with num_modes = modes + num_floppy and r = num_modes + derivatives − dropped
+// columns. Throws InputError for a bad mesh or option (naming it), among them: modes not above the
+// rigid motions of the simulated components (6 each), more derivatives than pairs of the modes
+// that are neither rigid nor zero, "arap" with derivatives; NumericalError when a solver fails;
+// Cancelled when `progress` says stop.
 Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Progress& progress);
 
 }  // namespace modal_deform

@@ -156,9 +156,10 @@ def bake(V, F, modes=20, derivatives=52, ghost=1000, energy="shells", bending=1.
     at least every second or so (not during a CHOLMOD factorisation, about 2 s at 100k vertices);
     returning False raises ``Cancelled``, and an exception it raises propagates.
 
-    Returns a ``Basis`` with dimension modes + derivatives - num_dropped. Raises ValueError for a
-    bad mesh or option, RuntimeError when a solver fails. Warns when the mesh is floppy (zero modes
-    besides its rigid motions: they stay as modes without derivatives).
+    Returns a ``Basis`` with dimension modes + num_floppy + derivatives - num_dropped. Raises
+    ValueError for a bad mesh or option, RuntimeError when a solver fails. Warns when the mesh is
+    floppy: its zero modes besides the rigid motions (mechanisms) come on top of ``modes``, after
+    the rigid motions, and get no modal derivatives.
     """
     V, F = _arrays.vertices(V), _arrays.faces(F)
     if not isinstance(energy, str):
@@ -169,7 +170,7 @@ def bake(V, F, modes=20, derivatives=52, ghost=1000, energy="shells", bending=1.
                           _count(ghost, "ghost", 4), energy, float(bending), float(membrane), progress)
     basis = Basis(native)
     if basis.num_floppy:
-        warnings.warn(f"the mesh is floppy: {basis.num_floppy} of its modes besides the rigid motions have "
-                      f"eigenvalue zero (mechanisms, e.g. flaps at non-manifold edges or vertices); they stay in "
-                      f"the basis without modal derivatives", stacklevel=2)
+        warnings.warn(f"the mesh is floppy: it has {basis.num_floppy} zero modes besides its rigid motions "
+                      f"(mechanisms, e.g. flaps at non-manifold edges or vertices); they are in the basis on top "
+                      f"of the {modes} modes asked for, without modal derivatives", stacklevel=2)
     return basis
