@@ -34,13 +34,26 @@ std::vector<int> kernel_pins(const SparseMatrix& K, const VectorRef& mass, const
 // mass and stiffness (stiffness_and_mass.h) get zero rows. Throws InputError for inconsistent
 // input (Z not M-orthonormal or not in the kernel, bad pins) and NumericalError when the pinned
 // matrix is singular (Z misses part of the kernel) or a solution fails its residual check.
-// `factor`, when given, is the CholmodLLT (3 DOFs per node) to factor in: one that already holds
-// the analysis of K's pattern (from vibration_modes) skips it.
 Eigen::MatrixXd solve_in_range(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z,
-                               const Eigen::Ref<const Eigen::MatrixXd>& B, Progress* progress = nullptr,
-                               CholmodLLT* factor = nullptr);
+                               const Eigen::Ref<const Eigen::MatrixXd>& B, Progress* progress = nullptr);
 Eigen::MatrixXd solve_in_range(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z,
                                const Eigen::Ref<const Eigen::MatrixXd>& B, const std::vector<int>& pins,
                                Progress* progress = nullptr);
+
+// The same Ψ without a factorisation of its own, in `shifted`, the factor of K − σM (σ < 0) the
+// eigensolver used (vibration_modes leaves it there), with the eigenpairs it found: eigenvalues
+// (k, > 0) and modes (3n by k, M-orthonormal, M-orthogonal to Z). A solve with K − σM is off by
+// the factor λ/(λ − σ) along each eigenvector: exact correction on the known ones, and steps of
+// iterative refinement (ψ += (K − σM)⁻¹ (P b − K ψ), corrected again) on the others, each
+// leaving at most −σ/(λmax − σ) of the error, until below 1e-3 of each such component (two steps
+// on the shared dragons; they are the small, high-frequency part of a derivative).
+// Saves a factorisation (2.5 s at 100k vertices) for a solve and a product with K per step.
+// Throws InputError for inconsistent input, or a σ so far below the eigenvalues given that more
+// than 6 steps would be needed; NumericalError when a column fails the residual check.
+Eigen::MatrixXd solve_in_range_shifted(const SparseMatrix& K, const VectorRef& mass,
+                                       const Eigen::Ref<const Eigen::MatrixXd>& Z,
+                                       const Eigen::Ref<const Eigen::MatrixXd>& B, CholmodLLT& shifted, double sigma,
+                                       const VectorRef& eigenvalues, const Eigen::Ref<const Eigen::MatrixXd>& modes,
+                                       Progress* progress = nullptr);
 
 }  // namespace modal_deform

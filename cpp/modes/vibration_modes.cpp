@@ -13,14 +13,17 @@
 namespace modal_deform {
 namespace {
 
-// σ = −kShiftFraction · tr K / tr M. The trace ratio is a mass-weighted mean of the spectrum, far
-// above its low end and growing with the resolution (2.6e6 on the dragon with 23k vertices, 2.1e8
-// with 100k, whose lowest flexible eigenvalues are 0.024 and 0.037), so σ sits just below λ = 0
-// while K − σM stays definite (the kernel's Rayleigh quotients are rounding, about 1e-16 of the
-// mean). It must not sit far below the wanted modes: with 1e-8 the 100k dragon took 111 solves
-// for 14 modes, with 1e-10 or 1e-12 50; on the 23k dragon 20 modes took 93 solves for every
-// fraction from 1e-12 to 1e-8 (106 at 1e-6).
-constexpr double kShiftFraction = 1e-10;
+// σ = −kShiftFraction · tr K / tr M, or kDeflatedShiftFraction when a kernel is deflated. The
+// trace ratio is a mass-weighted mean of the spectrum, far above its low end and growing with the
+// resolution (2.6e6 on the dragon with 23k vertices, 2.1e8 with 100k, whose lowest flexible
+// eigenvalues are 0.024 and 0.037), so σ sits just below λ = 0 while K − σM stays far from
+// singular. Zero modes left in K (undeflated ones, a floppy mesh's mechanisms) want σ not too
+// close to 0: at 1e-10 the residuals of the other modes of two small spring networks exceed
+// 1e-8 of the top eigenvalue. The wanted modes want it not far below them: deflating the rigid
+// motions, the 100k dragon took 111 solves for 14 modes at 1e-8, 50 at 1e-10 or 1e-12; on the
+// 23k dragon 20 modes took 93 solves for every fraction from 1e-12 to 1e-8 (106 at 1e-6).
+constexpr double kShiftFraction = 1e-8;
+constexpr double kDeflatedShiftFraction = 1e-10;
 // Spectra's convergence tolerance on the transformed eigenvalues.
 constexpr double kEigenTolerance = 1e-10;
 constexpr int kMaxRestarts = 1000;
@@ -112,7 +115,7 @@ VibrationModes deflated_modes(const SparseMatrix& K, const VectorRef& mass, int 
   const double trace_K = K.diagonal().sum();
   if (!(trace_K > 0)) throw InputError("K: no positive diagonal entry; there is no stiffness to take modes of");
   const double scale = trace_K / m.sum();
-  const double sigma = -kShiftFraction * scale;
+  const double sigma = -(Z.cols() ? kDeflatedShiftFraction : kShiftFraction) * scale;
 
   const std::vector<bool> decoupled = decoupled_dofs(K, mass);
   const int num_decoupled = static_cast<int>(std::count(decoupled.begin(), decoupled.end(), true));

@@ -37,6 +37,11 @@ struct Modes {
   Eigen::VectorXd eigenvalues;
   Eigen::MatrixXd vectors;  // 3n by num_zero + flexible, M-orthonormal
   int num_zero = 0;
+  // The shift σ of the factor of K − σM left in the CholmodLLT, and all the non-zero eigenpairs
+  // found with it (the flexible ones and those past them): solve_in_range_shifted corrects them.
+  double shift = 0;
+  Eigen::VectorXd known_eigenvalues;
+  Eigen::MatrixXd known_vectors;
 };
 
 // Asks Lanczos for kZeroModeAllowance modes more than `flexible`, which covers the zero modes of
@@ -74,6 +79,9 @@ Modes flexible_modes(const SparseMatrix& K, const Eigen::VectorXd& mass, const E
       }
       result.eigenvalues.tail(flexible) = modes.eigenvalues.segment(found, flexible);
       result.vectors.rightCols(flexible) = modes.modes.middleCols(found, flexible);
+      result.shift = modes.shift;
+      result.known_eigenvalues = modes.eigenvalues.tail(count - found);
+      result.known_vectors = modes.modes.rightCols(count - found);
       return result;
     }
     kernel.conservativeResize(Eigen::NoChange, kernel.cols() + found);
@@ -179,7 +187,7 @@ Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, 
   const Eigen::MatrixXd rigid = rigid_motions(simulated_V, attachment.component, simulated_mass);
   // 7, started now: the ghost of the whole mesh, while the eigensolver's solves leave a core idle.
   GhostInBackground ghost(V, F, basis.mass, options.ghost);
-  CholmodLLT factor(3);  // one analysis for the modes and the derivative solves
+  CholmodLLT factor(3);  // one factorisation for the modes and the derivative solves
   Modes modes;
   {
     const double factoring = factor.seconds();
@@ -215,12 +223,9 @@ Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, 
     Eigen::MatrixXd kernel(3 * S, num_rigid + num_zero);
     kernel.leftCols(num_rigid) = rigid;
     kernel.rightCols(num_zero) = modes.vectors.leftCols(num_zero);
-    const double factoring = factor.seconds();
-    {
-      const Stopwatch stopwatch(time["derivative solves"]);
-      derivatives = solve_in_range(K, simulated_mass, kernel, derivatives, &progress, &factor);
-    }
-    time["derivative solves"] -= factor.seconds() - factoring;
+    const Stopwatch stopwatch(time["derivative solves"]);
+    derivatives = solve_in_range_shifted(K, simulated_mass, kernel, derivatives, factor, modes.shift,
+                                         modes.known_eigenvalues, modes.known_vectors, &progress);
   }
   time["factorisation"] = factor.seconds();
 

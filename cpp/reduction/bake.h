@@ -15,15 +15,19 @@
 //      the basis after the rigid motions (Basis::num_floppy) and join the kernel for step 4.
 //   4. Modal derivatives (eq. 13) for the pairs of the remaining modes in the paper's order:
 //      right-hand sides ∇³E(x̄)(φᵢ, φⱼ) (third_batch), solved in the range of K against the
-//      kernel [rigid motions, zero modes], in the factor the modes used (one CHOLMOD analysis).
+//      kernel [rigid motions, zero modes] with the eigensolver's factor of K − σM, corrected on
+//      the eigenpairs found and refined (solve_in_range_shifted): one CHOLMOD factorisation in
+//      all, the most expensive step at 100k vertices.
 //   5. [rigid motions, modes, derivatives] M-orthonormalised (orthonormalize.h), numerically
 //      dependent derivatives dropped (Basis::num_dropped).
 //   6. Attached rows, conversion to mesh units (x = x̄ + U q), float32 vectors.
 //   7. Ghost: edge collapse of the whole mesh to about `ghost` vertices, the basis restricted.
 //
 // Stages are timed into Basis::timings ("attachment", "hessian", "factorisation" (CHOLMOD
-// analysis and numeric factorisations), "modes", "third derivatives", "derivative solves",
-// "orthonormalisation", "ghost"; seconds) and reported through Progress with the same names.
+// analysis and numeric factorisation, done inside the modes), "modes" (the rest of them),
+// "third derivatives", "derivative solves", "orthonormalisation", "assembly" (step 6), "ghost"
+// (what the ghost adds: it is simplified on a thread of its own during steps 3 to 6); seconds)
+// and reported through Progress with the same names.
 // A cancel throws Cancelled at the next report and leaves nothing behind. CHOLMOD cannot report
 // during a factorisation (about 2 s at 100k vertices): the bar pauses there.
 #pragma once
