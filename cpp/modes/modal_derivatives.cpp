@@ -69,7 +69,7 @@ std::vector<int> pins_for(const SparseMatrix& K, const Kernel& kernel) {
   return pins;
 }
 
-// K X, over blocks of columns in parallel (Eigen's sparse products run on one thread here).
+// K X, columns in parallel (Eigen's sparse products run on one thread here).
 Eigen::MatrixXd product(const SparseMatrix& K, const Eigen::MatrixXd& X) {
   Eigen::MatrixXd KX(K.rows(), X.cols());
 #pragma omp parallel for schedule(dynamic)

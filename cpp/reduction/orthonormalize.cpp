@@ -59,10 +59,10 @@ void solve_upper_on_the_right(Eigen::Ref<Eigen::MatrixXd> X, const Eigen::Matrix
   }
 }
 
-// Removes from X its components along the M-orthonormal columns Q, twice ("twice is enough").
+// Removes from X its components along the M-orthonormal columns Q (classical Gram–Schmidt; each
+// of the two passes does it once, which makes it twice, "twice is enough").
 void project_out(Eigen::Ref<Eigen::MatrixXd> X, const Eigen::Ref<const Eigen::MatrixXd>& Q, const VectorRef& dof_mass) {
-  if (Q.cols() == 0) return;
-  for (int pass = 0; pass < 2; ++pass) subtract_product(X, Q, m_inner(Q, dof_mass, X));
+  if (Q.cols()) subtract_product(X, Q, m_inner(Q, dof_mass, X));
 }
 
 // Cholesky factor R (upper) of the Gram matrix G over the columns it keeps: column j is dropped

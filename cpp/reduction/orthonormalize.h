@@ -19,9 +19,11 @@ constexpr double kDependentTolerance = 1e-6;
 // `tolerance` times its own; otherwise it becomes the next column of Q, which spans the kept
 // columns up to it (Q = U_kept R⁻¹, R upper triangular). So a leading block that is already
 // M-orthonormal (rigid motions) stays what it was up to rounding.
-// Blocks of columns are projected against the columns before them twice and orthonormalised
-// by Cholesky-QR twice (the second pass removes what the first lost to rounding); the dense
-// products run over row blocks in parallel. Reports ("orthonormalisation", fraction) per block.
+// Blocks of columns are projected against the columns before them and orthonormalised by
+// Cholesky-QR, twice (block classical Gram–Schmidt with re-orthogonalisation: the second pass
+// removes what the first lost to rounding). About 4 n r² flops for r columns of n rows (22 GFlop
+// for 136 columns of the 100k dragon); the dense products run over row blocks in parallel.
+// Reports ("orthonormalisation", fraction) per block.
 // Throws InputError for a non-finite entry or a wrong dof_mass size.
 std::vector<int> orthonormalize(Eigen::MatrixXd& U, const VectorRef& dof_mass, double tolerance = kDependentTolerance,
                                 Progress* progress = nullptr);
