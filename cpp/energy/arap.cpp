@@ -9,6 +9,7 @@
 #include "mesh/mesh_check.h"
 #include "mesh/mesh_topology.h"
 #include "util/errors.h"
+#include "util/require_positions.h"
 
 namespace modal_deform {
 namespace {
@@ -103,14 +104,6 @@ Arap::Arap(const VerticesRef& V, const FacesRef& F)
   }
 }
 
-void Arap::check_positions(const VectorRef& x) const {
-  if (x.size() != 3 * num_vertices_)
-    throw InputError(message("X: expected ", 3 * num_vertices_, " values, got ", x.size()));
-  for (int i = 0; i < num_vertices_; ++i)
-    if (!x.segment<3>(3 * i).allFinite())
-      throw InputError(message("X[", i, "]: vertex ", i, " has a non-finite coordinate"));
-}
-
 Eigen::Matrix3d Arap::covariance(int i, const VectorRef& x) const {
   Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
   for (int e = cell_offsets_[i]; e < cell_offsets_[i + 1]; ++e) {
@@ -134,7 +127,7 @@ double Arap::cell_energy(int i, const VectorRef& x, const Eigen::Matrix3d& rotat
 }
 
 double Arap::value(const VectorRef& x) const {
-  check_positions(x);
+  require_positions(x, 3 * num_vertices_, "X");
   double energy = 0;
 #pragma omp parallel for schedule(static) reduction(+ : energy) if (parallel_)
   for (int i = 0; i < num_vertices_; ++i) energy += cell_energy(i, x, best_rotation(covariance(i, x)).rotation);
@@ -142,7 +135,7 @@ double Arap::value(const VectorRef& x) const {
 }
 
 double Arap::value_and_gradient(const VectorRef& x, Eigen::Ref<Eigen::VectorXd> gradient) const {
-  check_positions(x);
+  require_positions(x, 3 * num_vertices_, "X");
   if (gradient.size() != x.size())
     throw InputError(message("gradient: expected ", x.size(), " values, got ", gradient.size()));
   // One 3x3 per vertex: allocating it per call costs microseconds, far below the SVDs.
@@ -200,7 +193,7 @@ void Arap::rotation_factors(int i, const VectorRef& x, Eigen::Matrix3d* out) con
 }
 
 SparseMatrix Arap::hessian(const VectorRef& x) const {
-  check_positions(x);
+  require_positions(x, 3 * num_vertices_, "X");
   const int n = num_vertices_;
   // Cell i's factors live at factors[cell_offsets_[i] + i ...]: vertex i, then its neighbours.
   std::vector<Eigen::Matrix3d> factors(cell_offsets_[n] + n);

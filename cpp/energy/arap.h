@@ -50,7 +50,6 @@ class Arap final : public Energy {
   Eigen::VectorXd third(const VectorRef& x, const VectorRef& u, const VectorRef& w) const override;
 
  private:
-  void check_positions(const VectorRef& x) const;
   // Cell i's covariance S_i = Σ_j w_ij ē_ij e_ijᵀ (S&A eq. 5) at positions x.
   Eigen::Matrix3d covariance(int i, const VectorRef& x) const;
   // Σ_j w_ij ‖e_ij − R ē_ij‖² of cell i.

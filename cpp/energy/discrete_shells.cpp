@@ -10,6 +10,7 @@
 #include "mesh/mesh_check.h"
 #include "mesh/mesh_topology.h"
 #include "util/errors.h"
+#include "util/require_positions.h"
 
 namespace modal_deform {
 namespace {
@@ -197,15 +198,6 @@ void term_hessian(const Response& q, const double* gradient, const double* hessi
 }
 
 // y: 3n positions or displacements, named like validate_mesh names V.
-void require_finite_vector(const VectorRef& y, Eigen::Index size, const char* name) {
-  if (y.size() != size) throw InputError(message(name, ": expected ", size, " values, got ", y.size()));
-  if (y.allFinite()) return;
-  Eigen::Index v = 0;
-  while (y.segment<3>(3 * v).allFinite()) ++v;
-  throw InputError(message(name, "[", v, "]: vertex ", v, " has a non-finite coordinate (", y[3 * v], ", ",
-                           y[3 * v + 1], ", ", y[3 * v + 2], ")"));
-}
-
 void require_weight(double weight, const char* name) {
   if (!(std::isfinite(weight) && weight >= 0))
     throw InputError(message(name, ": expected a finite weight >= 0, got ", weight));
@@ -315,7 +307,7 @@ DiscreteShells::TermCounts DiscreteShells::term_counts() const {
 }
 
 double DiscreteShells::value(const VectorRef& x) const {
-  require_finite_vector(x, rest_.size(), "X");
+  require_positions(x, rest_.size(), "X");
   double energy = 0;
   for_each_set([&](const auto& set) {
     using Term = typename std::decay_t<decltype(set.terms)>::value_type;
@@ -330,7 +322,7 @@ double DiscreteShells::value(const VectorRef& x) const {
 }
 
 double DiscreteShells::value_and_gradient(const VectorRef& x, Eigen::Ref<Eigen::VectorXd> gradient) const {
-  require_finite_vector(x, rest_.size(), "X");
+  require_positions(x, rest_.size(), "X");
   if (gradient.size() != rest_.size())
     throw InputError(message("gradient: expected ", rest_.size(), " values, got ", gradient.size()));
   double energy = 0;
@@ -358,7 +350,7 @@ double DiscreteShells::value_and_gradient(const VectorRef& x, Eigen::Ref<Eigen::
 }
 
 SparseMatrix DiscreteShells::hessian(const VectorRef& x) const {
-  require_finite_vector(x, rest_.size(), "X");
+  require_positions(x, rest_.size(), "X");
   SparseMatrix H = sparsity_.allocate_matrix();
   double* values = H.valuePtr();
 #pragma omp parallel for schedule(static, 1) if (parallel())
@@ -396,9 +388,9 @@ SparseMatrix DiscreteShells::hessian(const VectorRef& x) const {
 }
 
 Eigen::VectorXd DiscreteShells::third(const VectorRef& x, const VectorRef& u, const VectorRef& w) const {
-  require_finite_vector(x, rest_.size(), "X");
-  require_finite_vector(u, rest_.size(), "U");
-  require_finite_vector(w, rest_.size(), "W");
+  require_positions(x, rest_.size(), "X");
+  require_positions(u, rest_.size(), "U");
+  require_positions(w, rest_.size(), "W");
   Eigen::VectorXd out(rest_.size());
 #pragma omp parallel for schedule(static, 1) if (parallel())
   for (int part = 0; part < partition_.parts(); ++part) {
@@ -424,7 +416,7 @@ Eigen::VectorXd DiscreteShells::third(const VectorRef& x, const VectorRef& u, co
 
 Eigen::MatrixXd DiscreteShells::third_batch(const VectorRef& x, const Eigen::Ref<const Eigen::MatrixXd>& Phi,
                                             const std::vector<std::array<int, 2>>& pairs) const {
-  require_finite_vector(x, rest_.size(), "X");
+  require_positions(x, rest_.size(), "X");
   if (Phi.rows() != rest_.size())
     throw InputError(message("Phi: expected ", rest_.size(), " rows, got ", Phi.rows()));
   if (!Phi.allFinite())

@@ -13,6 +13,7 @@
 
 #include "mesh/mesh_topology.h"
 #include "mesh/primitives.h"
+#include "test_support.h"
 
 namespace modal_deform::testing {
 
@@ -64,17 +65,6 @@ inline TriangleMesh jittered_bar(int nx, int ny, int nz, double jitter, unsigned
   std::mt19937 random(seed);
   std::uniform_real_distribution<double> uniform(-jitter, jitter);
   for (Eigen::Index i = 0; i < mesh.V.size(); ++i) mesh.V.data()[i] += uniform(random);
-  return mesh;
-}
-
-// The meshes side by side in one mesh (one component each), the second shifted by `offset`.
-inline TriangleMesh side_by_side(const TriangleMesh& first, const TriangleMesh& second,
-                                 const Eigen::RowVector3d& offset) {
-  TriangleMesh mesh;
-  mesh.V.resize(first.V.rows() + second.V.rows(), 3);
-  mesh.V << first.V, second.V.rowwise() + offset;
-  mesh.F.resize(first.F.rows() + second.F.rows(), 3);
-  mesh.F << first.F, second.F.array() + static_cast<int>(first.V.rows());
   return mesh;
 }
 

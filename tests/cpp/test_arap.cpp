@@ -17,29 +17,17 @@
 #include "mesh/mesh_topology.h"
 #include "mesh/normalization.h"
 #include "mesh/primitives.h"
-#include "test_meshes.h"
+#include "test_support.h"
 #include "util/errors.h"
 
 namespace modal_deform {
 namespace {
 
+using testing::normalized;
+using testing::random_vector;
 using testing::shared_mesh;
+using testing::side_by_side;
 constexpr double kPi = 3.14159265358979323846;
-
-TriangleMesh normalized(TriangleMesh mesh) {
-  mesh.V *= normalizing_scale(mesh.V);
-  return mesh;
-}
-
-// Two meshes side by side as one (two connected components).
-TriangleMesh join(const TriangleMesh& a, const TriangleMesh& b) {
-  TriangleMesh mesh;
-  mesh.V.resize(a.V.rows() + b.V.rows(), 3);
-  mesh.V << a.V, b.V.rowwise() + Eigen::RowVector3d(20, 0, 0);
-  mesh.F.resize(a.F.rows() + b.F.rows(), 3);
-  mesh.F << a.F, b.F.array() + static_cast<int>(a.V.rows());
-  return mesh;
-}
 
 using Deformation = std::function<Eigen::Vector3d(const Eigen::Vector3d&)>;
 
@@ -72,14 +60,6 @@ std::vector<std::pair<std::string, Eigen::VectorXd>> large_deformations(const Ro
                 })},
       {"mirrored", deformed(V, [](const Eigen::Vector3d& p) { return Eigen::Vector3d(-p.x(), p.y(), p.z()); })},
   };
-}
-
-Eigen::VectorXd random_vector(Eigen::Index size, unsigned seed) {
-  std::mt19937 random(seed);
-  std::normal_distribution<double> normal;
-  Eigen::VectorXd v(size);
-  for (Eigen::Index i = 0; i < size; ++i) v[i] = normal(random);
-  return v;
 }
 
 Eigen::VectorXd gradient_at(const Energy& energy, const Eigen::VectorXd& x) {
@@ -254,7 +234,7 @@ TEST(Arap, RestHessianIsPsdWithSixZeroModesPerComponent) {
       {"bar", bar(2, 2, 3, 1.0, 1.0, 3.0), 1},
       {"bumpy plane", bumpy_plane(6, 10.0, 3, 2.0), 1},
       {"jittered grid", jittered, 1},
-      {"cylinder and bar", join(cylinder(8, 3, 1.0, 3.0), bar(2, 2, 3, 1.0, 1.0, 3.0)), 2},
+      {"cylinder and bar", side_by_side(cylinder(8, 3, 1.0, 3.0), bar(2, 2, 3, 1.0, 1.0, 3.0), Eigen::RowVector3d(20, 0, 0)), 2},
   };
   for (const auto& [name, mesh, components] : cases) {
     SCOPED_TRACE(name);

@@ -5,7 +5,7 @@
 
 #include "mesh/primitives.h"
 #include "mesh/triangle_mesh.h"
-#include "stand_in_stiffness.h"
+#include "test_support.h"
 
 namespace modal_deform::testing {
 

@@ -7,7 +7,7 @@
 #include "mesh/mass.h"
 #include "modes/stiffness_and_mass.h"
 #include "stand_in_stiffness.h"
-#include "test_meshes.h"
+#include "test_support.h"
 #include "util/errors.h"
 
 namespace modal_deform {

@@ -17,29 +17,20 @@
 #include "mesh/mesh_topology.h"
 #include "mesh/normalization.h"
 #include "mesh/primitives.h"
-#include "test_meshes.h"
+#include "test_support.h"
 #include "util/errors.h"
 
 namespace modal_deform {
 namespace {
 
+using testing::expect_input_error;
+using testing::normalized;
+using testing::random_vector;
 using testing::shared_mesh;
+using testing::side_by_side;
 constexpr double kPi = 3.14159265358979323846;
 
-TriangleMesh normalized(TriangleMesh mesh) {
-  mesh.V *= normalizing_scale(mesh.V);
-  return mesh;
-}
-
 Eigen::VectorXd flat(const RowMatrixX3d& X) { return Eigen::Map<const Eigen::VectorXd>(X.data(), X.size()); }
-
-Eigen::VectorXd random_vector(Eigen::Index size, unsigned seed) {
-  std::mt19937 generator(seed);
-  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  Eigen::VectorXd v(size);
-  for (Eigen::Index i = 0; i < size; ++i) v[i] = uniform(generator);
-  return v;
-}
 
 Eigen::Matrix3d rotation(double angle, const Eigen::Vector3d& axis) {
   return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
@@ -306,15 +297,6 @@ void expect_rigid_kernel(const TriangleMesh& mesh, int components, const std::st
               std::abs(lambda[zeros - 1]) / largest, zeros + 1, lambda[zeros] / largest);
 }
 
-TriangleMesh two_copies(const TriangleMesh& mesh, const Eigen::RowVector3d& offset) {
-  TriangleMesh both;
-  both.V.resize(2 * mesh.V.rows(), 3);
-  both.V << mesh.V, mesh.V.rowwise() + offset;
-  both.F.resize(2 * mesh.F.rows(), 3);
-  both.F << mesh.F, mesh.F.array() + static_cast<int>(mesh.V.rows());
-  return both;
-}
-
 // A closed, curved, irregular blob: a subdivided box pushed onto a lumpy sphere.
 TriangleMesh blob() {
   TriangleMesh mesh = bar(3, 3, 3, 1, 1, 1);
@@ -331,7 +313,7 @@ TEST(DiscreteShells, RestHessianKernelIsSixRigidMotionsPerComponent) {
   expect_rigid_kernel(bar(1, 1, 3, 1.0, 1.0, 3.0), 1, "closed bar");
   expect_rigid_kernel(grid(4, 3, 2.0, 1.5), 1, "flat grid");
   expect_rigid_kernel(blob(), 1, "closed blob");
-  expect_rigid_kernel(two_copies(cylinder(8, 3, 1.0, 3.0), Eigen::RowVector3d(5, 0, 0)), 2, "two disjoint cylinders");
+  expect_rigid_kernel(side_by_side(cylinder(8, 3, 1.0, 3.0), cylinder(8, 3, 1.0, 3.0), Eigen::RowVector3d(5, 0, 0)), 2, "two disjoint cylinders");
 }
 
 // What `energy` returns at x is finite everywhere.
@@ -479,16 +461,6 @@ TEST(DiscreteShells, ResultsDoNotDependOnTheNumberOfThreads) {
   EXPECT_EQ(serial.third(x, Phi.col(0), Phi.col(1)), parallel.third(x, Phi.col(0), Phi.col(1)));
   EXPECT_EQ(serial.third_batch(x, Phi, {{0, 1}}), parallel.third_batch(x, Phi, {{0, 1}}));
   omp_set_num_threads(threads);
-}
-
-template <typename Call>
-void expect_input_error(Call call, const std::string& needle) {
-  try {
-    call();
-    ADD_FAILURE() << "no InputError, expected one mentioning " << needle;
-  } catch (const InputError& error) {
-    EXPECT_NE(std::string(error.what()).find(needle), std::string::npos) << error.what();
-  }
 }
 
 TEST(DiscreteShells, BadInputIsRefusedWithItsName) {

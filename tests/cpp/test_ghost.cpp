@@ -16,12 +16,13 @@
 #include "mesh/union_find.h"
 #include "reduction/edge_collapse.h"
 #include "reduction/ghost.h"
-#include "test_meshes.h"
+#include "test_support.h"
 #include "util/errors.h"
 
 namespace modal_deform {
 namespace {
 
+using testing::expect_input_error;
 using testing::shared_mesh;
 
 Eigen::Vector3d face_normal(const RowMatrixX3d& V, const RowMatrixX3i& F, int f) {
@@ -165,13 +166,7 @@ void expect_topology_kept(const TriangleMesh& fine, int target) {
 }
 
 TriangleMesh two_cylinders() {
-  const TriangleMesh a = cylinder(24, 20, 1.0, 4.0), b = cylinder(16, 30, 0.5, 6.0);
-  TriangleMesh both;
-  both.V.resize(a.V.rows() + b.V.rows(), 3);
-  both.V << a.V, b.V.rowwise() + Eigen::RowVector3d(3.0, 0.0, 0.0);
-  both.F.resize(a.F.rows() + b.F.rows(), 3);
-  both.F << a.F, b.F.array() + static_cast<int>(a.V.rows());
-  return both;
+  return testing::side_by_side(cylinder(24, 20, 1.0, 4.0), cylinder(16, 30, 0.5, 6.0), Eigen::RowVector3d(3, 0, 0));
 }
 
 // A bumpy plane with what scans contain: coincident vertices (zero-area faces), a face with a
@@ -349,16 +344,6 @@ TEST(Ghost, ProgressIsReportedOftenAndCancelStopsIt) {
   Progress cancel_third([&](const std::string&, double) { return ++calls < 3; }, 0.0);
   EXPECT_THROW(ghost_mesh(dragon.V, dragon.F, mass, 1000, &cancel_third), Cancelled);
   EXPECT_EQ(calls, 3);
-}
-
-template <typename Call>
-void expect_input_error(Call call, const std::string& needle) {
-  try {
-    call();
-    ADD_FAILURE() << "no InputError, expected one naming " << needle;
-  } catch (const InputError& error) {
-    EXPECT_NE(std::string(error.what()).find(needle), std::string::npos) << error.what();
-  }
 }
 
 TEST(Ghost, BadInputIsRefusedNamingIt) {

@@ -6,7 +6,7 @@
 #include "mesh/mesh_check.h"
 #include "mesh/mesh_topology.h"
 #include "mesh/primitives.h"
-#include "test_meshes.h"
+#include "test_support.h"
 #include "util/errors.h"
 
 namespace modal_deform {

@@ -3,17 +3,14 @@
 #include <random>
 
 #include "reduction/orthonormalize.h"
+#include "test_support.h"
 #include "util/errors.h"
 
 namespace modal_deform {
 namespace {
 
 Eigen::MatrixXd random_matrix(Eigen::Index rows, Eigen::Index cols, unsigned seed) {
-  std::mt19937 random(seed);
-  std::normal_distribution<double> normal;
-  Eigen::MatrixXd A(rows, cols);
-  for (Eigen::Index i = 0; i < A.size(); ++i) A.data()[i] = normal(random);
-  return A;
+  return testing::random_vector(rows * cols, seed).reshaped(rows, cols);
 }
 
 Eigen::VectorXd random_masses(Eigen::Index n, unsigned seed) {

@@ -9,7 +9,7 @@
 #include "modes/stiffness_and_mass.h"
 #include "modes/vibration_modes.h"
 #include "stand_in_stiffness.h"
-#include "test_meshes.h"
+#include "test_support.h"
 #include "util/errors.h"
 
 namespace modal_deform {

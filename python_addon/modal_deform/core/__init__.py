@@ -2,7 +2,9 @@
 
     import modal_deform.core as mdc
 
-The pipeline, one module per stage: ``mesh`` (check, mass, test shapes).
+The pipeline, one module per stage: ``mesh`` (check, mass, test shapes), ``energy`` (discrete
+shells, ARAP), ``modes`` (vibration modes, rigid motions, modal-derivative solves), ``reduction``
+(the ghost), ``bake`` (the whole preprocess, mesh to Basis).
 """
 from .._native import Cancelled
 from .bake import Basis, bake
@@ -11,9 +13,8 @@ from .mesh import bar, bumpy_plane, check, cylinder, grid, mass, read_mesh
 from .modes import rigid_motions, solve_in_range, vibration_modes
 from .reduction import ghost_mesh, restrict_to_ghost
 
-__all__ = ["Cancelled", "bar", "bumpy_plane", "check", "cylinder", "grid", "mass", "read_mesh"]
-__all__ += ["ghost_mesh", "restrict_to_ghost"]
-__all__ += ["Arap"]
-__all__ += ["DiscreteShells"]
-__all__ += ["rigid_motions", "solve_in_range", "vibration_modes"]
-__all__ += ["Basis", "bake"]
+__all__ = [
+    "Arap", "Basis", "Cancelled", "DiscreteShells", "bake", "bar", "bumpy_plane", "check", "cylinder",
+    "ghost_mesh", "grid", "mass", "read_mesh", "restrict_to_ghost", "rigid_motions", "solve_in_range",
+    "vibration_modes",
+]
