@@ -77,8 +77,9 @@ Eigen::MatrixXd product(const SparseMatrix& K, const Eigen::MatrixXd& X) {
   return KX;
 }
 
-// Ψ (3n by p) with K Ψ = P B and Zᵀ M Ψ = 0, block by block: `solve` maps a block of P B to
-// its solution (any kernel part is removed here), whose residuals are then checked.
+// Ψ (3n by p) with K Ψ = P B and Zᵀ M Ψ = 0, block by block: solve(P B, report) maps a block
+// of P B to its solution (any kernel part is removed here), whose residuals are then checked;
+// report(part) tells the bar what part of the block is done.
 template <typename Solve>
 Eigen::MatrixXd solve_by_blocks(const SparseMatrix& K, const VectorRef& mass, const Kernel& kernel,
                                 const Eigen::Ref<const Eigen::MatrixXd>& B, Solve&& solve, Progress* progress) {
@@ -97,7 +98,9 @@ Eigen::MatrixXd solve_by_blocks(const SparseMatrix& K, const VectorRef& mass, co
     for (Eigen::Index d = 0; d < n; ++d)
       if (decoupled[static_cast<size_t>(d)]) PB.row(d).setZero();
     if (Z.cols()) PB -= Z * gram.solve(Z.transpose() * PB);
-    Eigen::MatrixXd X = solve(PB);
+    Eigen::MatrixXd X = solve(PB, [&](double part) {
+      if (progress) progress->report("derivative solves", (static_cast<double>(first) + part * width) / B.cols());
+    });
     if (Z.cols()) X -= Z * (MZ.transpose() * X);
     const Eigen::MatrixXd residual = product(K, X) - PB;
     for (Eigen::Index j = 0; j < width; ++j) {
@@ -142,7 +145,7 @@ Eigen::MatrixXd solve_with_pins(const SparseMatrix& K, const VectorRef& mass, co
                                  "kernel of K? ", e.what()));
   }
   return solve_by_blocks(
-      K, mass, kernel, B, [&](const Eigen::MatrixXd& PB) { return llt.solve(PB); }, progress);
+      K, mass, kernel, B, [&](const Eigen::MatrixXd& PB, const auto&) { return llt.solve(PB); }, progress);
 }
 
 }  // namespace
@@ -232,9 +235,12 @@ Eigen::MatrixXd solve_in_range_shifted(const SparseMatrix& K, const VectorRef& m
   };
   return solve_by_blocks(
       K, mass, kernel, B,
-      [&](const Eigen::MatrixXd& PB) {
+      [&](const Eigen::MatrixXd& PB, const auto& report) {
         Eigen::MatrixXd X = apply(PB);
-        for (int step = 1; step < steps; ++step) X += apply(PB - product(K, X));
+        for (int step = 1; step < steps; ++step) {
+          report(static_cast<double>(step) / steps);
+          X += apply(PB - product(K, X));
+        }
         return X;
       },
       progress);

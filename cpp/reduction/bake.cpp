@@ -188,6 +188,13 @@ Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, 
   // 7, started now: the ghost of the whole mesh, while the eigensolver's solves leave a core idle.
   GhostInBackground ghost(V, F, basis.mass, options.ghost);
   CholmodLLT factor(3);  // one factorisation for the modes and the derivative solves
+  {
+    // Analysed here rather than inside the eigensolver's first factorisation, so the bar moves
+    // between the two (CHOLMOD reports nothing during either).
+    progress.report("factorisation", 0.0);
+    factor.analyze(K);
+    progress.report("factorisation", 1.0);
+  }
   Modes modes;
   {
     const double factoring = factor.seconds();
