@@ -227,19 +227,25 @@ Eigen::MatrixXd solve_in_range_shifted(const SparseMatrix& K, const VectorRef& m
                              ": ", steps, " refinement steps would be needed"));
   const Eigen::VectorXd m = dof_masses(mass);
   const Eigen::MatrixXd MZ = m.asDiagonal() * kernel.Z;
-  const auto apply = [&](const Eigen::MatrixXd& R) {
-    Eigen::MatrixXd X = shifted.solve(R);
-    if (kernel.Z.cols()) X -= kernel.Z * (MZ.transpose() * X);
-    X.noalias() += modes * (correction.asDiagonal() * (modes.transpose() * R));
-    return X;
+  // One step: X = (K − σM)⁻¹ R less its kernel part, corrected on the known pairs by w. What it
+  // leaves of R needs no product with K: K (K − σM)⁻¹ R = R + σM (K − σM)⁻¹ R, K Z = 0 and
+  // K Φ = M Φ Λ, so R − K X = −σ M (K − σM)⁻¹ R − M Φ Λ w.
+  const auto step = [&](const Eigen::MatrixXd& R, Eigen::MatrixXd& X, Eigen::MatrixXd& left) {
+    const Eigen::MatrixXd Y = shifted.solve(R);
+    const Eigen::MatrixXd w = correction.asDiagonal() * (modes.transpose() * R);
+    X.noalias() += Y;
+    if (kernel.Z.cols()) X.noalias() -= kernel.Z * (MZ.transpose() * Y);
+    X.noalias() += modes * w;
+    left = m.asDiagonal() * ((-sigma) * Y - modes * (eigenvalues.asDiagonal() * w));
   };
   return solve_by_blocks(
       K, mass, kernel, B,
       [&](const Eigen::MatrixXd& PB, const auto& report) {
-        Eigen::MatrixXd X = apply(PB);
-        for (int step = 1; step < steps; ++step) {
-          report(static_cast<double>(step) / steps);
-          X += apply(PB - product(K, X));
+        Eigen::MatrixXd X = Eigen::MatrixXd::Zero(PB.rows(), PB.cols()), left;
+        step(PB, X, left);
+        for (int k = 1; k < steps; ++k) {
+          report(static_cast<double>(k) / steps);
+          step(Eigen::MatrixXd(left), X, left);
         }
         return X;
       },
