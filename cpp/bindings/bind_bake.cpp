@@ -45,8 +45,8 @@ void bind_bake(py::module_& m) {
            }),
            py::arg("rest"), py::arg("mass"), py::arg("vectors"), py::arg("num_rigid"), py::arg("num_modes"),
            py::arg("num_floppy"), py::arg("eigenvalues"), py::arg("ghost_vertices"), py::arg("ghost_faces"),
-           py::arg("ghost_map"), py::arg("ghost_vectors"), py::arg("scale"), py::arg("bending"),
-           py::arg("membrane"), py::arg("num_dropped"))
+           py::arg("ghost_map"), py::arg("ghost_vectors"), py::arg("scale"), py::arg("bending"), py::arg("membrane"),
+           py::arg("num_dropped"))
       .def_property_readonly("rest", [](const Basis& b) -> const RowMatrixX3d& { return b.rest; })
       .def_property_readonly("mass", [](const Basis& b) -> const Eigen::VectorXd& { return b.mass; })
       .def_property_readonly("vectors", [](const Basis& b) -> const RowMatrixXf& { return b.vectors; })

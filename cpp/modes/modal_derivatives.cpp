@@ -197,7 +197,6 @@ Eigen::MatrixXd solve_in_range(const SparseMatrix& K, const VectorRef& mass, con
   return solve_with_pins(K, mass, kernel, B, pins, progress);
 }
 
-
 Eigen::MatrixXd solve_in_range_shifted(const SparseMatrix& K, const VectorRef& mass,
                                        const Eigen::Ref<const Eigen::MatrixXd>& Z,
                                        const Eigen::Ref<const Eigen::MatrixXd>& B, CholmodLLT& shifted, double sigma,
@@ -206,7 +205,8 @@ Eigen::MatrixXd solve_in_range_shifted(const SparseMatrix& K, const VectorRef& m
   const Kernel kernel = checked_kernel(K, mass, Z);
   check_right_hand_sides(K, B);
   const Eigen::Index n = K.rows();
-  if (!(sigma < 0 && std::isfinite(sigma))) throw InputError(message("sigma: expected a finite shift < 0, got ", sigma));
+  if (!(sigma < 0 && std::isfinite(sigma)))
+    throw InputError(message("sigma: expected a finite shift < 0, got ", sigma));
   if (shifted.rows() != n)
     throw InputError(message("shifted: a factor of ", shifted.rows(), " rows, expected ", n, " (K - sigma M)"));
   if (modes.rows() != n || modes.cols() != eigenvalues.size())
@@ -223,8 +223,8 @@ Eigen::MatrixXd solve_in_range_shifted(const SparseMatrix& K, const VectorRef& m
   const double contraction = -sigma / (eigenvalues.maxCoeff() - sigma);
   const int steps = static_cast<int>(std::ceil(std::log(kRefinementTolerance) / std::log(contraction)));
   if (steps > kMaxRefinementSteps)
-    throw InputError(message("sigma: ", sigma, " is too far below the largest eigenvalue given, ", eigenvalues.maxCoeff(),
-                             ": ", steps, " refinement steps would be needed"));
+    throw InputError(message("sigma: ", sigma, " is too far below the largest eigenvalue given, ",
+                             eigenvalues.maxCoeff(), ": ", steps, " refinement steps would be needed"));
   const Eigen::VectorXd m = dof_masses(mass);
   const Eigen::MatrixXd MZ = m.asDiagonal() * kernel.Z;
   // One step: X = (K − σM)⁻¹ R less its kernel part, corrected on the known pairs by w. What it

@@ -183,15 +183,19 @@ Attachment attach(const VerticesRef& V, const FacesRef& F) {
 
 Eigen::MatrixXd extend_to_attached(const Attachment& attachment, const Eigen::Ref<const Eigen::MatrixXd>& U) {
   const auto S = static_cast<Eigen::Index>(attachment.simulated.size());
-  if (U.rows() != 3 * S) throw InputError(message("U: expected ", 3 * S, " rows (3 per simulated vertex), got ", U.rows()));
+  if (U.rows() != 3 * S)
+    throw InputError(message("U: expected ", 3 * S, " rows (3 per simulated vertex), got ", U.rows()));
   const Eigen::Index n = attachment.submesh_index.size();
   Eigen::MatrixXd out(3 * n, U.cols());
 #pragma omp parallel for schedule(static)
   for (Eigen::Index j = 0; j < U.cols(); ++j) {
-    for (Eigen::Index s = 0; s < S; ++s) out.col(j).segment<3>(3 * attachment.simulated[static_cast<size_t>(s)]) = U.col(j).segment<3>(3 * s);
+    for (Eigen::Index s = 0; s < S; ++s)
+      out.col(j).segment<3>(3 * attachment.simulated[static_cast<size_t>(s)]) = U.col(j).segment<3>(3 * s);
     for (const Attachment::Follower& follower : attachment.followers) {
       Eigen::Vector3d row = Eigen::Vector3d::Zero();
-      for (int k = 0; k < 4; ++k) row += follower.weights[static_cast<size_t>(k)] * U.col(j).segment<3>(3 * follower.anchors[static_cast<size_t>(k)]);
+      for (int k = 0; k < 4; ++k)
+        row += follower.weights[static_cast<size_t>(k)] *
+               U.col(j).segment<3>(3 * follower.anchors[static_cast<size_t>(k)]);
       out.col(j).segment<3>(3 * follower.vertex) = row;
     }
   }

@@ -96,9 +96,8 @@ class GhostInBackground {
  public:
   GhostInBackground(const VerticesRef& V, const FacesRef& F, const Eigen::VectorXd& mass, int target)
       : progress_([this](const std::string&, double) { return !stop_.load(); }),
-        ghost_(std::async(std::launch::async, [&V, &F, &mass, target, this] {
-          return ghost_mesh(V, F, mass, target, &progress_);
-        })) {}
+        ghost_(std::async(std::launch::async,
+                          [&V, &F, &mass, target, this] { return ghost_mesh(V, F, mass, target, &progress_); })) {}
   ~GhostInBackground() {
     stop_ = true;
     if (ghost_.valid()) ghost_.wait();
@@ -166,8 +165,8 @@ Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, 
   const int flexible = options.modes - num_rigid;
   if (flexible >= 3 * S - num_rigid)
     throw InputError(message("modes: the simulated mesh has ", 3 * S - num_rigid,
-                             " degrees of freedom besides its rigid motions; ask for fewer than ",
-                             3 * S, " modes, got ", options.modes));
+                             " degrees of freedom besides its rigid motions; ask for fewer than ", 3 * S,
+                             " modes, got ", options.modes));
 
   // 3. Stiffness and vibration modes.
   std::unique_ptr<DiscreteShells> shells;

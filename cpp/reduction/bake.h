@@ -48,12 +48,12 @@ namespace modal_deform {
 constexpr double kZeroEigenvalue = 1e-12;
 
 struct BakeOptions {
-  int modes = 20;                   // vibration modes, rigid motions included
-  int derivatives = 52;             // modal derivatives
-  int ghost = 1000;                 // ghost vertices to aim for (≥ 4; the mesh itself when ≥ #V)
-  std::string energy = "shells";    // "shells", or "arap" with derivatives = 0
-  double bending = 1.0;             // shells: α (finite, ≥ 0)
-  double membrane = 1.0;            // shells: β (finite, ≥ 0)
+  int modes = 20;                 // vibration modes, rigid motions included
+  int derivatives = 52;           // modal derivatives
+  int ghost = 1000;               // ghost vertices to aim for (≥ 4; the mesh itself when ≥ #V)
+  std::string energy = "shells";  // "shells", or "arap" with derivatives = 0
+  double bending = 1.0;           // shells: α (finite, ≥ 0)
+  double membrane = 1.0;          // shells: β (finite, ≥ 0)
 };
 
 // The reduced space of (V #V by 3, F #F by 3, any length unit) per the pipeline above: a Basis in

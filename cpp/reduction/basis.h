@@ -21,8 +21,8 @@ struct Basis {
   // vertices, bake.h, ride along without mass). float32 rows: mapping q to the mesh is memory
   // bound.
   RowMatrixXf vectors;
-  int num_rigid = 0;   // leading columns that are rigid motions
-  int num_modes = 0;   // leading columns that are vibration modes (rigid ones included)
+  int num_rigid = 0;  // leading columns that are rigid motions
+  int num_modes = 0;  // leading columns that are vibration modes (rigid ones included)
   // Modes after the rigid ones with eigenvalue numerically zero (mechanisms of a floppy mesh):
   // columns num_rigid .. num_rigid + num_floppy − 1. They have no modal derivatives.
   int num_floppy = 0;

@@ -28,8 +28,8 @@ Eigen::MatrixXd m_inner(const Eigen::Ref<const Eigen::MatrixXd>& A, const Vector
 #pragma omp for schedule(static)
     for (Eigen::Index block = 0; block < blocks; ++block) {
       const Eigen::Index first = block * kBlockRows, rows = std::min(kBlockRows, A.rows() - first);
-      partial.noalias() +=
-          A.middleRows(first, rows).transpose() * (dof_mass.segment(first, rows).asDiagonal() * B.middleRows(first, rows));
+      partial.noalias() += A.middleRows(first, rows).transpose() *
+                           (dof_mass.segment(first, rows).asDiagonal() * B.middleRows(first, rows));
     }
 #pragma omp critical
     sum += partial;

@@ -1,8 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
-#include <utility>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "energy/discrete_shells.h"
@@ -23,9 +23,9 @@
 namespace modal_deform {
 namespace {
 
+using testing::expect_input_error;
 using testing::head_with_eyes;
 using testing::rigid_misfit;
-using testing::expect_input_error;
 using testing::shared_mesh;
 using testing::side_by_side;
 
@@ -76,8 +76,8 @@ TEST(Bake, TwoTubesHaveTwelveRigidMotionsFirstAndAnOrthonormalBasis) {
     EXPECT_LT(rigid_misfit(mesh.V.middleRows(moving, half), u.segment(3 * moving, 3 * half)), 1e-5) << j;
     EXPECT_EQ(u.segment(3 * resting, 3 * half).cwiseAbs().maxCoeff(), 0.0) << j;
   }
-  for (const char* stage : {"attachment", "hessian", "factorisation", "modes", "third derivatives",
-                            "derivative solves", "orthonormalisation", "assembly", "ghost"})
+  for (const char* stage : {"attachment", "hessian", "factorisation", "modes", "third derivatives", "derivative solves",
+                            "orthonormalisation", "assembly", "ghost"})
     EXPECT_GE(basis.timings.at(stage), 0.0) << stage;
 }
 
@@ -130,8 +130,8 @@ TEST(Bake, BasisSpansTheModalDerivativesOfEquation13) {
   // within 1e-3 on the others, so within 1e-3 in all. With σ near 0 they are hardly off; with σ
   // at a third of the lowest eigenvalue, uncorrected steps would leave 2% of that component.
   const Eigen::VectorXd m = dof_masses(mass);
-  for (const auto& [sigma, tolerance] : {std::pair{-1e-9 * K.diagonal().sum() / m.sum(), 1e-7},
-                                         std::pair{-0.3 * modes.eigenvalues[0], 1e-3}}) {
+  for (const auto& [sigma, tolerance] :
+       {std::pair{-1e-9 * K.diagonal().sum() / m.sum(), 1e-7}, std::pair{-0.3 * modes.eigenvalues[0], 1e-3}}) {
     CholmodLLT shifted(3);
     shifted.factorize(K, -sigma * m, 0.0);
     const Eigen::MatrixXd Psi_shifted =
@@ -200,8 +200,8 @@ TEST(Bake, GhostMapsEveryVertexAndKeepsRigidMotionsRigid) {
   for (int j = 0; j < basis.num_rigid; ++j)
     EXPECT_LT(rigid_misfit(basis.ghost_vertices, basis.ghost_vectors.col(j)), 1e-12) << "rigid motion " << j;
   // The restriction of the float32 vectors agrees with the ghost vectors to float precision.
-  const Eigen::MatrixXd restricted = restrict_to_ghost(basis.ghost_map, static_cast<int>(g), basis.mass,
-                                                       basis.vectors.cast<double>());
+  const Eigen::MatrixXd restricted =
+      restrict_to_ghost(basis.ghost_map, static_cast<int>(g), basis.mass, basis.vectors.cast<double>());
   EXPECT_LT((restricted - basis.ghost_vectors).cwiseAbs().maxCoeff(), 1e-6 * basis.ghost_vectors.cwiseAbs().maxCoeff());
   // A ghost at least as large as the mesh is the mesh.
   const Basis whole = bake_with(mesh, 12, 0, 100000);
@@ -256,8 +256,8 @@ TEST(Bake, RefusesBadOptionsNamingThem) {
 
 TEST(Bake, CancelsAtTheNextReportAndLeavesNothing) {
   const TriangleMesh mesh = bumpy_plane(30, 2.0, 5, 0.3);
-  for (const std::string stop_at : {"hessian", "modes", "third derivatives", "derivative solves",
-                                    "orthonormalisation", "ghost"}) {
+  for (const std::string stop_at :
+       {"hessian", "modes", "third derivatives", "derivative solves", "orthonormalisation", "ghost"}) {
     bool stopped = false;
     Progress progress([&](const std::string& stage, double) { return !(stopped = stopped || stage == stop_at); });
     BakeOptions options;

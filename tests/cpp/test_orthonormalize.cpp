@@ -35,11 +35,11 @@ TEST(Orthonormalize, DropsDependentColumnsAcrossBlocksAndKeepsTheSpan) {
   const Eigen::Index n = 3000;
   const Eigen::VectorXd m = random_masses(n, 1);
   Eigen::MatrixXd U = random_matrix(n, 80, 2);
-  U.col(5).setZero();                                    // nothing
-  U.col(17) = 2 * U.col(3) - U.col(11);                  // dependent within the first block
-  U.col(50) = U.col(1) + 1e-9 * U.col(50);               // dependent up to 1e-9, across blocks
-  U.col(70) = U.col(40) - 3 * U.col(65) + U.col(2);      // dependent on columns of three blocks
-  U.col(79) = U.col(78) + 1e-3 * U.col(79);              // nearly dependent, but above the tolerance
+  U.col(5).setZero();                                // nothing
+  U.col(17) = 2 * U.col(3) - U.col(11);              // dependent within the first block
+  U.col(50) = U.col(1) + 1e-9 * U.col(50);           // dependent up to 1e-9, across blocks
+  U.col(70) = U.col(40) - 3 * U.col(65) + U.col(2);  // dependent on columns of three blocks
+  U.col(79) = U.col(78) + 1e-3 * U.col(79);          // nearly dependent, but above the tolerance
   const Eigen::MatrixXd original = U;
   const std::vector<int> kept = orthonormalize(U, m);
   std::vector<int> expected;
