@@ -12,7 +12,8 @@ namespace {
 // Columns orthonormalised together: wide enough for BLAS-3 speed, narrow enough that progress
 // moves.
 constexpr Eigen::Index kBlockColumns = 32;
-// Rows per parallel task of the dense products.
+// Rows per parallel task of the dense products; a basis of fewer rows stays on the calling thread
+// (waking a team of threads on a busy machine costs more than such a product).
 constexpr Eigen::Index kBlockRows = 8192;
 
 Eigen::Index row_blocks(Eigen::Index rows) { return (rows + kBlockRows - 1) / kBlockRows; }
@@ -22,7 +23,7 @@ Eigen::MatrixXd m_inner(const Eigen::Ref<const Eigen::MatrixXd>& A, const Vector
                         const Eigen::Ref<const Eigen::MatrixXd>& B) {
   Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(A.cols(), B.cols());
   const Eigen::Index blocks = row_blocks(A.rows());
-#pragma omp parallel
+#pragma omp parallel if (blocks > 1)
   {
     Eigen::MatrixXd partial = Eigen::MatrixXd::Zero(A.cols(), B.cols());
 #pragma omp for schedule(static)
@@ -41,7 +42,7 @@ Eigen::MatrixXd m_inner(const Eigen::Ref<const Eigen::MatrixXd>& A, const Vector
 void subtract_product(Eigen::Ref<Eigen::MatrixXd> X, const Eigen::Ref<const Eigen::MatrixXd>& Q,
                       const Eigen::MatrixXd& C) {
   const Eigen::Index blocks = row_blocks(X.rows());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (blocks > 1)
   for (Eigen::Index block = 0; block < blocks; ++block) {
     const Eigen::Index first = block * kBlockRows, rows = std::min(kBlockRows, X.rows() - first);
     X.middleRows(first, rows).noalias() -= Q.middleRows(first, rows) * C;
@@ -51,7 +52,7 @@ void subtract_product(Eigen::Ref<Eigen::MatrixXd> X, const Eigen::Ref<const Eige
 // X ← X R⁻¹ for upper triangular R, over row blocks in parallel.
 void solve_upper_on_the_right(Eigen::Ref<Eigen::MatrixXd> X, const Eigen::MatrixXd& R) {
   const Eigen::Index blocks = row_blocks(X.rows());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (blocks > 1)
   for (Eigen::Index block = 0; block < blocks; ++block) {
     const Eigen::Index first = block * kBlockRows, rows = std::min(kBlockRows, X.rows() - first);
     auto part = X.middleRows(first, rows);
