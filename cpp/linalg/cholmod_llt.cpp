@@ -9,14 +9,10 @@
 #include <vector>
 
 #include "util/errors.h"
+#include "util/stopwatch.h"
 
 namespace modal_deform {
 namespace {
-
-// Below this estimate of the reciprocal condition number the factor is of a matrix that is
-// singular up to rounding: its solutions would be noise. Exactly singular positive semidefinite
-// matrices give estimates near machine epsilon, since their last pivot is rounding error.
-constexpr double kSingularRcond = 1e-13;
 
 // CHOLMOD's error handler has no user pointer; the calling thread's last message is kept here and
 // read right after the failing call, on the same thread.
@@ -177,6 +173,7 @@ double CholmodLLT::factor_nonzeros() const {
 }
 
 void CholmodLLT::analyze(const SparseMatrix& A) {
+  const Stopwatch stopwatch(seconds_);
   lower_ = lower_with_diagonal(A, nullptr);
   analyze_lower();
 }
@@ -198,13 +195,14 @@ void CholmodLLT::analyze_lower() {
   cholmod_->check(cholmod_->factor != nullptr, "analyze");
 }
 
-void CholmodLLT::factorize(const SparseMatrix& A) { factorize_lower(lower_with_diagonal(A, nullptr)); }
+void CholmodLLT::factorize(const SparseMatrix& A) { factorize_lower(lower_with_diagonal(A, nullptr), kSingularRcond); }
 
-void CholmodLLT::factorize(const SparseMatrix& A, const VectorRef& shift) {
-  factorize_lower(lower_with_diagonal(A, &shift));
+void CholmodLLT::factorize(const SparseMatrix& A, const VectorRef& shift, double min_rcond) {
+  factorize_lower(lower_with_diagonal(A, &shift), min_rcond);
 }
 
-void CholmodLLT::factorize_lower(SparseMatrix lower) {
+void CholmodLLT::factorize_lower(SparseMatrix lower, double min_rcond) {
+  const Stopwatch stopwatch(seconds_);
   factorized_ = false;
   const bool new_pattern = !cholmod_->factor || !same_pattern(lower, lower_);
   lower_ = std::move(lower);
@@ -220,7 +218,7 @@ void CholmodLLT::factorize_lower(SparseMatrix lower) {
   }
   cholmod_->check(ok != 0, "factorize");
   rcond_ = cholmod_rcond(L, &cholmod_->common);
-  if (!(rcond_ >= kSingularRcond))
+  if (!(rcond_ >= min_rcond))
     throw NumericalError(
         message("the matrix is singular to working precision (CHOLMOD's reciprocal condition estimate ", rcond_,
                 "): its solutions would be rounding noise"));

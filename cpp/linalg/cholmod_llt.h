@@ -29,11 +29,18 @@ class CholmodLLT {
   // both triangles stored; only the lower triangle and the diagonal are read).
   void analyze(const SparseMatrix& A);
 
+  // Below this estimate of the reciprocal condition number the factor is of a matrix that is
+  // singular up to rounding: its solutions would be noise. Exactly singular positive semidefinite
+  // matrices give estimates near machine epsilon, since their last pivot is rounding error.
+  static constexpr double kSingularRcond = 1e-13;
+
   // Numeric factorisation of A + diag(shift) (shift: one value per row). Analyses A first when
   // its pattern differs from the one analysed last. Throws InputError for a malformed A and
   // NumericalError, naming the row where the factorisation broke down, when the matrix is not
-  // numerically positive definite.
-  void factorize(const SparseMatrix& A, const VectorRef& shift);
+  // numerically positive definite, or when rcond() is below min_rcond. A caller that knows the
+  // matrix is definite and wants it nearly singular (shift-invert) passes 0: on a scan with
+  // slivers, such as dragon_vrip_res2, the estimate falls below 1e-13 for any useful shift.
+  void factorize(const SparseMatrix& A, const VectorRef& shift, double min_rcond = kSingularRcond);
   void factorize(const SparseMatrix& A);
 
   // X = (A + diag(shift))⁻¹ B for a rows() by k block of right-hand sides (k = 1 for a vector).
@@ -45,10 +52,13 @@ class CholmodLLT {
   double rcond() const { return rcond_; }
   // Nonzeros of the factor L.
   double factor_nonzeros() const;
+  // Wall seconds spent in analyze and factorize since construction, solves excluded (the bake
+  // reports factorisation apart from the stages that call it).
+  double seconds() const { return seconds_; }
 
  private:
   void analyze_lower();
-  void factorize_lower(SparseMatrix lower);
+  void factorize_lower(SparseMatrix lower, double min_rcond);
 
   struct Cholmod;  // the CHOLMOD objects, freed by its destructor on every path
   std::unique_ptr<Cholmod> cholmod_;
@@ -56,6 +66,7 @@ class CholmodLLT {
   SparseMatrix lower_;  // lower triangle of A + diag(shift), the matrix CHOLMOD factors
   bool factorized_ = false;
   double rcond_ = 0;
+  double seconds_ = 0;
 };
 
 }  // namespace modal_deform

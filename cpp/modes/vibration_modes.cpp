@@ -13,11 +13,17 @@
 namespace modal_deform {
 namespace {
 
-// σ = −kShiftFraction · tr K / tr M. The trace ratio is a mass-weighted mean of the spectrum, far
-// above its low end, so σ sits just below λ = 0 while K − σM stays far from singular (CHOLMOD's
-// condition estimate about 1e-6). The count of solves hardly depends on it: on the dragon with
-// 23k vertices, 20 modes took 93 solves for every fraction from 1e-12 to 1e-8 (106 at 1e-6).
+// σ = −kShiftFraction · tr K / tr M, or kDeflatedShiftFraction when a kernel is deflated. The
+// trace ratio is a mass-weighted mean of the spectrum, far above its low end and growing with the
+// resolution (2.6e6 on the dragon with 23k vertices, 2.1e8 with 100k, whose lowest flexible
+// eigenvalues are 0.024 and 0.037), so σ sits just below λ = 0 while K − σM stays far from
+// singular. Zero modes left in K (undeflated ones, a floppy mesh's mechanisms) want σ not too
+// close to 0: at 1e-10 the residuals of the other modes of two small spring networks exceed
+// 1e-8 of the top eigenvalue. The wanted modes want it not far below them: deflating the rigid
+// motions, the 100k dragon took 111 solves for 14 modes at 1e-8, 50 at 1e-10 or 1e-12; on the
+// 23k dragon 20 modes took 93 solves for every fraction from 1e-12 to 1e-8 (106 at 1e-6).
 constexpr double kShiftFraction = 1e-8;
+constexpr double kDeflatedShiftFraction = 1e-10;
 // Spectra's convergence tolerance on the transformed eigenvalues.
 constexpr double kEigenTolerance = 1e-10;
 constexpr int kMaxRestarts = 1000;
@@ -33,22 +39,25 @@ class ShiftInvert {
   using Scalar = double;
 
   ShiftInvert(const SparseMatrix& K, const Eigen::VectorXd& dof_mass, const Eigen::MatrixXd& Z,
-              Eigen::VectorXd decoupled_stiffness, Progress* progress, int expected_solves)
+              Eigen::VectorXd decoupled_stiffness, Progress* progress, int expected_solves, CholmodLLT& llt)
       : K_(K),
         dof_mass_(dof_mass),
         Z_(Z),
         MZ_(dof_mass.asDiagonal() * Z),
         decoupled_stiffness_(std::move(decoupled_stiffness)),
         progress_(progress),
-        expected_solves_(expected_solves) {}
+        expected_solves_(expected_solves),
+        llt_(llt) {}
 
   Eigen::Index rows() const { return K_.rows(); }
   Eigen::Index cols() const { return K_.cols(); }
 
-  // Factors K − σM; DOFs outside the problem get a stiffness so the matrix stays definite.
+  // Factors K − σM; DOFs outside the problem get a stiffness so the matrix stays definite. With
+  // σ < 0 and K semidefinite it is definite however ill-conditioned (shift-invert wants it near
+  // singular), so only a failed pivot, K indefinite, is an error.
   void set_shift(double sigma) {
     try {
-      llt_.factorize(K_, decoupled_stiffness_ - sigma * dof_mass_);
+      llt_.factorize(K_, decoupled_stiffness_ - sigma * dof_mass_, 0.0);
     } catch (const NumericalError& e) {
       throw NumericalError(message("vibration modes: K - sigma M with sigma = ", sigma,
                                    " cannot be factored; is K positive semidefinite? ", e.what()));
@@ -81,7 +90,7 @@ class ShiftInvert {
   Progress* progress_;
   int expected_solves_;
   int solves_ = 0;
-  CholmodLLT llt_{3};  // orders vertices, 3 DOFs each
+  CholmodLLT& llt_;
 };
 
 // y = M x with the lumped (diagonal) mass matrix: the inner product of the Lanczos vectors.
@@ -96,7 +105,7 @@ struct MassProduct {
 
 // Z: a checked kernel basis (see checked_kernel_basis), possibly empty.
 VibrationModes deflated_modes(const SparseMatrix& K, const VectorRef& mass, int count, const Eigen::MatrixXd& Z,
-                              Progress* progress) {
+                              Progress* progress, CholmodLLT* factor) {
   const Eigen::VectorXd m = dof_masses(mass);
   const int n = static_cast<int>(m.size());
   const int free = static_cast<int>((m.array() > 0).count() - Z.cols());
@@ -106,7 +115,7 @@ VibrationModes deflated_modes(const SparseMatrix& K, const VectorRef& mass, int 
   const double trace_K = K.diagonal().sum();
   if (!(trace_K > 0)) throw InputError("K: no positive diagonal entry; there is no stiffness to take modes of");
   const double scale = trace_K / m.sum();
-  const double sigma = -kShiftFraction * scale;
+  const double sigma = -(Z.cols() ? kDeflatedShiftFraction : kShiftFraction) * scale;
 
   const std::vector<bool> decoupled = decoupled_dofs(K, mass);
   const int num_decoupled = static_cast<int>(std::count(decoupled.begin(), decoupled.end(), true));
@@ -116,7 +125,8 @@ VibrationModes deflated_modes(const SparseMatrix& K, const VectorRef& mass, int 
 
   const int ncv = std::min(free, std::max(2 * count, count + 20));
   if (progress) progress->report("modes", 0.0);
-  ShiftInvert op(K, m, Z, std::move(decoupled_stiffness), progress, 3 * ncv);
+  CholmodLLT own_factor(3);  // orders vertices, 3 DOFs each
+  ShiftInvert op(K, m, Z, std::move(decoupled_stiffness), progress, 3 * ncv, factor ? *factor : own_factor);
   MassProduct mass_product{m};
   // Spectra selects among the transformed values ν = 1/(λ − σ): the smallest λ above σ have the
   // largest ν, hence LargestMagn. SmallestAlge only orders the result by ascending λ.
@@ -177,12 +187,12 @@ VibrationModes deflated_modes(const SparseMatrix& K, const VectorRef& mass, int 
 
 VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int count, Progress* progress) {
   validate_stiffness_and_mass(K, mass);
-  return deflated_modes(K, mass, count, Eigen::MatrixXd(K.rows(), 0), progress);
+  return deflated_modes(K, mass, count, Eigen::MatrixXd(K.rows(), 0), progress, nullptr);
 }
 
 VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int count,
-                               const Eigen::Ref<const Eigen::MatrixXd>& Z, Progress* progress) {
-  return deflated_modes(K, mass, count, checked_kernel_basis(K, mass, Z), progress);
+                               const Eigen::Ref<const Eigen::MatrixXd>& Z, Progress* progress, CholmodLLT* factor) {
+  return deflated_modes(K, mass, count, checked_kernel_basis(K, mass, Z), progress, factor);
 }
 
 }  // namespace modal_deform

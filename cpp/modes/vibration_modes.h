@@ -6,6 +6,8 @@
 
 namespace modal_deform {
 
+class CholmodLLT;
+
 struct VibrationModes {
   Eigen::VectorXd eigenvalues;  // count, ascending; units of K per unit of mass
   Eigen::MatrixXd modes;        // 3n by count, M-orthonormal (Φᵀ M Φ = I)
@@ -29,7 +31,11 @@ VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int
 // in the kernel of K: rigid_motions for a rigid-invariant energy). Deflating the known kernel
 // spares Lanczos the eigenvalue 0 of multiplicity 6 per component, slow to resolve and useless to
 // deform with, and lets the shift sit closer to the flexible modes.
+// `factor`, when given, is the CholmodLLT (3 DOFs per node) that K − σM is factored in, and holds
+// that factor afterwards (σ = VibrationModes::shift): the bake's derivative solves reuse it
+// (solve_in_range_shifted).
 VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int count,
-                               const Eigen::Ref<const Eigen::MatrixXd>& Z, Progress* progress = nullptr);
+                               const Eigen::Ref<const Eigen::MatrixXd>& Z, Progress* progress = nullptr,
+                               CholmodLLT* factor = nullptr);
 
 }  // namespace modal_deform

@@ -24,11 +24,16 @@ void validate_basis(const Basis& b) {
   require(r > 0, "vectors has no columns");
   require(b.mass.size() == n, message("mass has ", b.mass.size(), " entries for ", n, " vertices"));
   require(b.vectors.rows() == 3 * n, message("vectors has ", b.vectors.rows(), " rows, expected ", 3 * n));
-  require(0 <= b.num_rigid && b.num_rigid <= b.num_modes && b.num_modes <= r,
-          message("counts out of order: rigid ", b.num_rigid, ", modes ", b.num_modes, ", dimension ", r));
+  require(
+      0 <= b.num_rigid && b.num_rigid <= b.num_modes && b.num_modes <= r,
+      message("num_rigid, num_modes out of order: rigid ", b.num_rigid, ", modes ", b.num_modes, ", dimension ", r));
+  require(
+      0 <= b.num_floppy && b.num_floppy <= b.num_modes - b.num_rigid,
+      message("num_floppy is ", b.num_floppy, ", outside [0, ", b.num_modes - b.num_rigid, "] (the non-rigid modes)"));
   require(b.eigenvalues.size() == b.num_modes,
           message("eigenvalues has ", b.eigenvalues.size(), " entries for ", b.num_modes, " modes"));
   require(g > 0, "ghost_vertices is empty");
+  require(b.ghost_faces.rows() > 0, "ghost_faces is empty");
   require(b.ghost_map.size() == n, message("ghost_map has ", b.ghost_map.size(), " entries for ", n, " vertices"));
   require(b.ghost_vectors.rows() == 3 * g && b.ghost_vectors.cols() == r,
           message("ghost_vectors is ", b.ghost_vectors.rows(), " by ", b.ghost_vectors.cols(), ", expected ", 3 * g,

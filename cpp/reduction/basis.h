@@ -17,10 +17,15 @@ struct Basis {
   RowMatrixX3d rest;
   Eigen::VectorXd mass;
   // 3n by r, x = x̄ + U q. Columns: rigid motions, vibration modes, then modal derivatives;
-  // M-orthonormal in the normalised frame. float32 rows: mapping q to the mesh is memory bound.
+  // M-orthonormal in the normalised frame over the simulated vertices (the bake's attached
+  // vertices, bake.h, ride along without mass). float32 rows: mapping q to the mesh is memory
+  // bound.
   RowMatrixXf vectors;
   int num_rigid = 0;  // leading columns that are rigid motions
   int num_modes = 0;  // leading columns that are vibration modes (rigid ones included)
+  // Modes after the rigid ones with eigenvalue numerically zero (mechanisms of a floppy mesh):
+  // columns num_rigid .. num_rigid + num_floppy − 1. They have no modal derivatives.
+  int num_floppy = 0;
   Eigen::VectorXd eigenvalues;  // num_modes, ascending (normalised frame)
   // Ghost: #G by 3 rest positions, #H by 3 triangles, #V fine vertex -> ghost vertex, and
   // 3g by r restricted basis (mass-weighted means over each ghost vertex's preimage).

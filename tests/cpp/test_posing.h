@@ -1,5 +1,6 @@
 // What the solver tests share: rigid transforms, handles picked by position, and a reduced basis
-// small enough to build with a dense eigensolver (the ghost is the mesh itself).
+// small enough to build with a dense eigensolver (the ghost is the mesh itself), which can span
+// the whole shape space (the bake's Lanczos cannot).
 #pragma once
 
 #include <Eigen/Eigenvalues>
@@ -10,11 +11,7 @@
 #include "mesh/mass.h"
 #include "mesh/normalization.h"
 #include "mesh/triangle_mesh.h"
-#include "modes/modal_derivatives.h"
-#include "modes/rigid_motions.h"
-#include "modes/vibration_modes.h"
 #include "reduction/basis.h"
-#include "reduction/ghost.h"
 #include "solve/handle_term.h"
 
 namespace modal_deform::testing {
@@ -63,49 +60,6 @@ inline Basis dense_modal_basis(const TriangleMesh& mesh, int r) {
   basis.ghost_faces = mesh.F;
   basis.ghost_map = Eigen::VectorXi::LinSpaced(n, 0, n - 1);
   basis.ghost_vectors = basis.vectors.cast<double>();  // exactly the fine rows: ghost = mesh
-  basis.scale = s;
-  return basis;
-}
-
-// The paper's basis: 6 rigid motions, the lowest `modes` − 6 vibration modes and the first
-// `derivatives` modal derivatives (paper order), M-orthonormal in the normalised frame (modified
-// Gram–Schmidt, twice), with a ghost of about `ghost` vertices. A single-component mesh.
-inline Basis modal_derivative_basis(const TriangleMesh& mesh, int modes, int derivatives, int ghost) {
-  const int n = static_cast<int>(mesh.V.rows());
-  const double s = normalizing_scale(mesh.V);
-  const RowMatrixX3d scaled = s * mesh.V;
-  const Eigen::VectorXd x = flatten(scaled);
-  const DiscreteShells shells(scaled, mesh.F);
-  const SparseMatrix K = shells.hessian(x);
-  const Eigen::VectorXd mass = lumped_mass(mesh.V, mesh.F), scaled_mass = s * s * mass;
-  const Eigen::MatrixXd Z = rigid_motions(scaled, Eigen::VectorXi::Zero(n), scaled_mass);
-  const VibrationModes vibration = vibration_modes(K, scaled_mass, modes - 6, Z);
-  Eigen::MatrixXd U(3 * n, modes + derivatives);
-  U << Z, vibration.modes, Eigen::MatrixXd::Zero(3 * n, derivatives);
-  if (derivatives > 0) {
-    const Eigen::MatrixXd B = shells.third_batch(x, vibration.modes, derivative_pairs(modes - 6, derivatives));
-    U.rightCols(derivatives) = solve_in_range(K, scaled_mass, Z, B);
-  }
-  Eigen::VectorXd dof_mass(3 * n);
-  for (int v = 0; v < n; ++v) dof_mass.segment<3>(3 * v).setConstant(scaled_mass[v]);
-  for (int j = modes; j < U.cols(); ++j)
-    for (int pass = 0; pass < 2; ++pass) {
-      for (int k = 0; k < j; ++k) U.col(j) -= U.col(k).dot(dof_mass.cwiseProduct(U.col(j))) * U.col(k);
-      U.col(j) /= std::sqrt(U.col(j).dot(dof_mass.cwiseProduct(U.col(j))));
-    }
-  Basis basis;
-  basis.rest = mesh.V;
-  basis.mass = mass;
-  basis.vectors = (U / s).cast<float>();
-  basis.num_rigid = 6;
-  basis.num_modes = modes;
-  basis.eigenvalues.resize(modes);
-  basis.eigenvalues << Eigen::VectorXd::Zero(6), vibration.eigenvalues;
-  const Ghost coarse = ghost_mesh(mesh.V, mesh.F, mass, ghost);
-  basis.ghost_vertices = coarse.V;
-  basis.ghost_faces = coarse.F;
-  basis.ghost_map = coarse.map;
-  basis.ghost_vectors = restrict_to_ghost(coarse, mass, basis.vectors.cast<double>());
   basis.scale = s;
   return basis;
 }

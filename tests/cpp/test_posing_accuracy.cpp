@@ -14,6 +14,7 @@
 #include <string>
 
 #include "mesh/primitives.h"
+#include "reduction/bake.h"
 #include "solve/full_solver.h"
 #include "solve/reduced_solver.h"
 #include "test_posing.h"
@@ -21,7 +22,6 @@
 namespace modal_deform {
 namespace {
 
-using testing::modal_derivative_basis;
 using testing::rigid_transform;
 using testing::vertices_where;
 
@@ -71,16 +71,16 @@ double relative_rms(const RowMatrixX3d& X, const RowMatrixX3d& reference) {
   return std::sqrt((X - reference).rowwise().squaredNorm().mean()) / diagonal;
 }
 
-// Bases of a scenario's mesh, built once per mesh: modal derivatives and linear modes.
+// Bases of a scenario's mesh, baked once per mesh: modal derivatives and linear modes.
 const Basis& basis(const std::string& mesh_name, const TriangleMesh& mesh, bool derivatives) {
   static std::map<std::string, Basis> cache;
   const std::string key = mesh_name + (derivatives ? " 20+47" : " 67");
   auto it = cache.find(key);
-  if (it == cache.end())
-    it = cache
-             .emplace(key, derivatives ? modal_derivative_basis(mesh, 20, 47, 1000)
-                                       : modal_derivative_basis(mesh, 67, 0, 1000))
-             .first;
+  if (it == cache.end()) {
+    Progress quiet;
+    const BakeOptions options{derivatives ? 20 : 67, derivatives ? 47 : 0, 1000, "shells", 1.0, 1.0};
+    it = cache.emplace(key, bake(mesh.V, mesh.F, options, quiet)).first;
+  }
   return it->second;
 }
 

@@ -4,9 +4,10 @@
 
 The pipeline, one module per stage: ``mesh`` (check, mass, test shapes), ``energy`` (discrete
 shells, ARAP), ``modes`` (vibration modes, rigid motions, modal-derivative solves), ``reduction``
-(the ghost).
+(the ghost), ``bake`` (the whole preprocess, mesh to Basis).
 """
 from .._native import Cancelled
+from .bake import Basis, bake
 from .energy import Arap, DiscreteShells
 from .mesh import bar, bumpy_plane, check, cylinder, grid, mass, read_mesh
 from .modes import rigid_motions, solve_in_range, vibration_modes
@@ -14,8 +15,8 @@ from .reduction import ghost_mesh, restrict_to_ghost
 from .solve import ReducedSolver, solve_full
 
 __all__ = [
-    "Arap", "Cancelled", "DiscreteShells", "bar", "bumpy_plane", "check", "cylinder", "ghost_mesh",
-    "grid", "mass", "read_mesh", "restrict_to_ghost", "rigid_motions", "solve_in_range",
+    "Arap", "Basis", "Cancelled", "DiscreteShells", "bake", "bar", "bumpy_plane", "check", "cylinder",
+    "ghost_mesh", "grid", "mass", "read_mesh", "restrict_to_ghost", "rigid_motions", "solve_in_range",
     "vibration_modes",
 ]
 __all__ += ["ReducedSolver", "solve_full"]

@@ -1,0 +1,285 @@
+#include "reduction/bake.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <future>
+#include <memory>
+
+#include "energy/arap.h"
+#include "energy/discrete_shells.h"
+#include "linalg/cholmod_llt.h"
+#include "mesh/mass.h"
+#include "mesh/mesh_check.h"
+#include "mesh/normalization.h"
+#include "modes/modal_derivatives.h"
+#include "modes/rigid_motions.h"
+#include "modes/stiffness_and_mass.h"
+#include "modes/vibration_modes.h"
+#include "reduction/attachment.h"
+#include "reduction/ghost.h"
+#include "reduction/orthonormalize.h"
+#include "util/errors.h"
+#include "util/stopwatch.h"
+
+namespace modal_deform {
+namespace {
+
+// Pairs per third_batch call: each call is one pass over the elements (on dragon_vrip_res2 about
+// 0.45 s plus 13 ms per pair on the shared machine), and the bar moves between calls.
+constexpr int kPairsPerPass = 32;
+// Modes asked for beyond those wanted, for the zero modes of a floppy mesh.
+constexpr int kZeroModeAllowance = 6;
+
+// Vibration modes past the rigid motions: the zero modes of a floppy mesh (λ below
+// kZeroEigenvalue · tr K / tr M), then `flexible` modes with λ above it, ascending.
+struct Modes {
+  Eigen::VectorXd eigenvalues;
+  Eigen::MatrixXd vectors;  // 3n by num_zero + flexible, M-orthonormal
+  int num_zero = 0;
+  // The shift σ of the factor of K − σM left in the CholmodLLT, and all the non-zero eigenpairs
+  // found with it (the flexible ones and those past them): solve_in_range_shifted corrects them.
+  double shift = 0;
+  Eigen::VectorXd known_eigenvalues;
+  Eigen::MatrixXd known_vectors;
+};
+
+// Asks Lanczos for kZeroModeAllowance modes more than `flexible`, which covers the zero modes of
+// the scans measured (3 to 9) at the price of a few solves; a mesh with more is solved again with
+// the zero modes found deflated, until the flexible modes are complete.
+Modes flexible_modes(const SparseMatrix& K, const Eigen::VectorXd& mass, const Eigen::MatrixXd& rigid, int flexible,
+                     Progress& progress, CholmodLLT& factor) {
+  const double zero = kZeroEigenvalue * K.diagonal().sum() / (3 * mass.sum());
+  const auto free = static_cast<int>(K.rows() - rigid.cols());
+  Eigen::MatrixXd kernel = rigid;
+  Modes result;
+  std::vector<Eigen::VectorXd> zero_modes;
+  std::vector<double> zero_values;
+  for (;;) {
+    const int known = static_cast<int>(zero_modes.size());
+    const int count = std::min(flexible + kZeroModeAllowance, free - known - 1);
+    if (count < flexible)
+      throw InputError(message("modes: the simulated mesh has only ", free - known,
+                               " degrees of freedom besides its rigid motions and ", known,
+                               " zero modes; ask for fewer modes"));
+    const VibrationModes modes = vibration_modes(K, mass, count, kernel, &progress, &factor);
+    int found = 0;
+    while (found < count && modes.eigenvalues[found] < zero) ++found;
+    for (int i = 0; i < found; ++i) {
+      zero_modes.push_back(modes.modes.col(i));
+      zero_values.push_back(modes.eigenvalues[i]);
+    }
+    if (count - found >= flexible) {
+      result.num_zero = static_cast<int>(zero_modes.size());
+      result.eigenvalues.resize(result.num_zero + flexible);
+      result.vectors.resize(K.rows(), result.num_zero + flexible);
+      for (int i = 0; i < result.num_zero; ++i) {
+        result.eigenvalues[i] = zero_values[static_cast<size_t>(i)];
+        result.vectors.col(i) = zero_modes[static_cast<size_t>(i)];
+      }
+      result.eigenvalues.tail(flexible) = modes.eigenvalues.segment(found, flexible);
+      result.vectors.rightCols(flexible) = modes.modes.middleCols(found, flexible);
+      result.shift = modes.shift;
+      result.known_eigenvalues = modes.eigenvalues.tail(count - found);
+      result.known_vectors = modes.modes.rightCols(count - found);
+      return result;
+    }
+    kernel.conservativeResize(Eigen::NoChange, kernel.cols() + found);
+    kernel.rightCols(found) = modes.modes.leftCols(found);
+  }
+}
+
+// The ghost mesh, simplified on its own thread while the bake solves (edge collapse is serial,
+// and the eigensolver's solves leave a core idle). It reports nothing itself; when the bake stops
+// early, the destructor cancels it and waits, so nothing outlives the bake.
+class GhostInBackground {
+ public:
+  GhostInBackground(const VerticesRef& V, const FacesRef& F, const Eigen::VectorXd& mass, int target)
+      : progress_([this](const std::string&, double) { return !stop_.load(); }),
+        ghost_(std::async(std::launch::async,
+                          [&V, &F, &mass, target, this] { return ghost_mesh(V, F, mass, target, &progress_); })) {}
+  ~GhostInBackground() {
+    stop_ = true;
+    if (ghost_.valid()) ghost_.wait();
+  }
+  GhostInBackground(const GhostInBackground&) = delete;
+  GhostInBackground& operator=(const GhostInBackground&) = delete;
+
+  Ghost get() { return ghost_.get(); }
+
+ private:
+  std::atomic<bool> stop_{false};
+  Progress progress_;
+  std::future<Ghost> ghost_;
+};
+
+void check_options(const BakeOptions& o) {
+  if (o.modes < 1) throw InputError(message("modes: expected at least 1, got ", o.modes));
+  if (o.derivatives < 0) throw InputError(message("derivatives: expected 0 or more, got ", o.derivatives));
+  if (o.ghost < 4) throw InputError(message("ghost: a ghost needs at least 4 vertices, got ", o.ghost));
+  if (o.energy != "shells" && o.energy != "arap")
+    throw InputError(message("energy: expected \"shells\" or \"arap\", got \"", o.energy, "\""));
+  if (o.energy == "arap" && o.derivatives > 0)
+    throw InputError(message("derivatives: the ARAP energy has no third derivative, so it has no modal derivatives; ",
+                             "bake it with derivatives = 0, or use the shells energy (asked for ", o.derivatives, ")"));
+  if (!(std::isfinite(o.bending) && o.bending >= 0))
+    throw InputError(message("bending: expected a finite weight >= 0, got ", o.bending));
+  if (!(std::isfinite(o.membrane) && o.membrane >= 0))
+    throw InputError(message("membrane: expected a finite weight >= 0, got ", o.membrane));
+}
+
+}  // namespace
+
+Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Progress& progress) {
+  check_options(options);
+  validate_mesh(V, F);
+  Basis basis;
+  auto& time = basis.timings;
+  basis.rest = V;
+  basis.mass = lumped_mass(V, F);
+  basis.scale = normalizing_scale(V);
+  basis.bending = options.bending;
+  basis.membrane = options.membrane;
+  const double scale = basis.scale;
+
+  // 2. The simulated submesh, in the normalised frame.
+  Attachment attachment;
+  {
+    const Stopwatch stopwatch(time["attachment"]);
+    progress.report("attachment", 0.0);
+    attachment = attach(V, F);
+    progress.report("attachment", 1.0);
+  }
+  const auto S = static_cast<Eigen::Index>(attachment.simulated.size());
+  RowMatrixX3d simulated_V(S, 3);
+  Eigen::VectorXd simulated_mass(S);
+  for (Eigen::Index s = 0; s < S; ++s) {
+    simulated_V.row(s) = scale * V.row(attachment.simulated[static_cast<size_t>(s)]);
+    simulated_mass[s] = scale * scale * basis.mass[attachment.simulated[static_cast<size_t>(s)]];
+  }
+  const int num_rigid = 6 * attachment.num_components;
+  if (options.modes <= num_rigid)
+    throw InputError(message("modes: ", options.modes, " modes are not more than the ", num_rigid,
+                             " rigid motions of the mesh's ", attachment.num_components,
+                             " simulated components (6 each); ask for more than ", num_rigid));
+  const int flexible = options.modes - num_rigid;
+  if (flexible >= 3 * S - num_rigid)
+    throw InputError(message("modes: the simulated mesh has ", 3 * S - num_rigid,
+                             " degrees of freedom besides its rigid motions; ask for fewer than ", 3 * S,
+                             " modes, got ", options.modes));
+
+  // 3. Stiffness and vibration modes.
+  std::unique_ptr<DiscreteShells> shells;
+  SparseMatrix K;
+  {
+    const Stopwatch stopwatch(time["hessian"]);
+    progress.report("hessian", 0.0);
+    if (options.energy == "shells") {
+      shells = std::make_unique<DiscreteShells>(simulated_V, attachment.faces, options.bending, options.membrane);
+      K = shells->hessian(shells->rest());
+    } else {
+      const Arap arap(simulated_V, attachment.faces);
+      K = arap.hessian(arap.rest());
+    }
+    progress.report("hessian", 1.0);
+  }
+  const Eigen::MatrixXd rigid = rigid_motions(simulated_V, attachment.component, simulated_mass);
+  // 7, started now: the ghost of the whole mesh, while the eigensolver's solves leave a core idle.
+  GhostInBackground ghost(V, F, basis.mass, options.ghost);
+  CholmodLLT factor(3);  // one factorisation for the modes and the derivative solves
+  {
+    // Analysed here rather than inside the eigensolver's first factorisation, so the bar moves
+    // between the two (CHOLMOD reports nothing during either).
+    progress.report("factorisation", 0.0);
+    factor.analyze(K);
+    progress.report("factorisation", 1.0);
+  }
+  Modes modes;
+  {
+    const double factoring = factor.seconds();
+    {
+      const Stopwatch stopwatch(time["modes"]);
+      modes = flexible_modes(K, simulated_mass, rigid, flexible, progress, factor);
+    }
+    time["modes"] -= factor.seconds() - factoring;
+  }
+  const int num_zero = modes.num_zero;
+  basis.num_floppy = num_zero;
+
+  // 4. Modal derivatives of the pairs of modes that are neither rigid nor zero.
+  Eigen::MatrixXd derivatives(3 * S, options.derivatives);
+  if (options.derivatives > 0) {
+    const long long available = static_cast<long long>(flexible) * (flexible + 1) / 2;
+    if (options.derivatives > available)
+      throw InputError(message("derivatives: ", options.derivatives, " asked for, but the ", flexible,
+                               " vibration modes besides the rigid motions have only ", available,
+                               " pairs; ask for more modes or fewer derivatives"));
+    const std::vector<std::array<int, 2>> pairs = derivative_pairs(flexible, options.derivatives);
+    const auto phi = modes.vectors.rightCols(flexible);
+    {
+      const Stopwatch stopwatch(time["third derivatives"]);
+      for (size_t first = 0; first < pairs.size(); first += kPairsPerPass) {
+        progress.report("third derivatives", static_cast<double>(first) / pairs.size());
+        const size_t last = std::min(pairs.size(), first + kPairsPerPass);
+        derivatives.middleCols(static_cast<Eigen::Index>(first), static_cast<Eigen::Index>(last - first)) =
+            shells->third_batch(shells->rest(), phi, {pairs.begin() + first, pairs.begin() + last});
+      }
+      progress.report("third derivatives", 1.0);
+    }
+    Eigen::MatrixXd kernel(3 * S, num_rigid + num_zero);
+    kernel.leftCols(num_rigid) = rigid;
+    kernel.rightCols(num_zero) = modes.vectors.leftCols(num_zero);
+    const Stopwatch stopwatch(time["derivative solves"]);
+    derivatives = solve_in_range_shifted(K, simulated_mass, kernel, derivatives, factor, modes.shift,
+                                         modes.known_eigenvalues, modes.known_vectors, &progress);
+  }
+  time["factorisation"] = factor.seconds();
+
+  // 5. [rigid motions, zero modes, modes, derivatives], M-orthonormal.
+  const int leading = options.modes + num_zero;
+  Eigen::MatrixXd U(3 * S, leading + options.derivatives);
+  U.leftCols(num_rigid) = rigid;
+  U.middleCols(num_rigid, num_zero + flexible) = modes.vectors;
+  U.rightCols(options.derivatives) = derivatives;
+  derivatives.resize(0, 0);
+  {
+    const Stopwatch stopwatch(time["orthonormalisation"]);
+    const std::vector<int> kept = orthonormalize(U, dof_masses(simulated_mass), kDependentTolerance, &progress);
+    for (int j = 0; j < leading; ++j)
+      if (j >= static_cast<int>(kept.size()) || kept[static_cast<size_t>(j)] != j)
+        throw NumericalError(message("bake: column ", j, " of the rigid motions and modes came out dependent; ",
+                                     "they are not M-orthonormal"));
+  }
+  basis.num_dropped = static_cast<int>(leading + options.derivatives - U.cols());
+  basis.num_rigid = num_rigid;
+  basis.num_modes = leading;
+  basis.eigenvalues = Eigen::VectorXd::Zero(leading);
+  basis.eigenvalues.tail(num_zero + flexible) = modes.eigenvalues;
+
+  // 6. Attached rows, mesh units, single precision.
+  {
+    const Stopwatch stopwatch(time["assembly"]);
+    progress.report("assembly", 0.0);
+    if (!attachment.followers.empty()) U = extend_to_attached(attachment, U);
+    U /= scale;
+    basis.vectors = U.cast<float>();
+    progress.report("assembly", 1.0);
+  }
+
+  // 7. The ghost, restricted from the double-precision basis (rigid motions stay exact). "ghost"
+  // times what it adds to the bake: waiting for the thread, and the restriction.
+  {
+    const Stopwatch stopwatch(time["ghost"]);
+    progress.report("ghost", 0.0);
+    Ghost coarse = ghost.get();
+    basis.ghost_vectors = restrict_to_ghost(coarse, basis.mass, U);
+    basis.ghost_vertices = std::move(coarse.V);
+    basis.ghost_faces = std::move(coarse.F);
+    basis.ghost_map = std::move(coarse.map);
+    progress.report("ghost", 1.0);
+  }
+  validate_basis(basis);
+  return basis;
+}
+
+}  // namespace modal_deform

@@ -1,0 +1,67 @@
+// The bake: the paper's preprocess (sections 4 and 5), from a mesh to the reduced space the
+// solver poses in. One forward pipeline:
+//
+//   1. validate_mesh; scale = normalizing_scale(V): the energy lives in the paper's normalised
+//      frame (longest bounding-box edge 10).
+//   2. Simulated vertices (attachment.h): components with less than 10% of the largest one's
+//      area, unreferenced vertices and vertices without mass are attached, not simulated; they
+//      follow the affine motion of four simulated vertices near them.
+//   3. K = ∇²E(x̄) of the simulated submesh, M lumped. The rigid motions of its components come
+//      first (analytic, M-orthonormal, 6 per component); the vibration modes are the lowest
+//      eigenpairs M-orthogonal to them (deflation). A floppy mesh (flaps at non-manifold
+//      vertices, duplicate faces; all three shared dragons) has further zero modes, with
+//      λ < kZeroEigenvalue tr K/tr M: they come on top of `modes` (a scan's count of mechanisms is
+//      not known before the bake, and each would take the place of a deformation mode), stay in
+//      the basis after the rigid motions (Basis::num_floppy) and join the kernel for step 4.
+//   4. Modal derivatives (eq. 13) for the pairs of the remaining modes in the paper's order:
+//      right-hand sides ∇³E(x̄)(φᵢ, φⱼ) (third_batch), solved in the range of K against the
+//      kernel [rigid motions, zero modes] with the eigensolver's factor of K − σM, corrected on
+//      the eigenpairs found and refined (solve_in_range_shifted): one CHOLMOD factorisation in
+//      all, the most expensive step at 100k vertices.
+//   5. [rigid motions, modes, derivatives] M-orthonormalised (orthonormalize.h), numerically
+//      dependent derivatives dropped (Basis::num_dropped).
+//   6. Attached rows, conversion to mesh units (x = x̄ + U q), float32 vectors.
+//   7. Ghost: edge collapse of the whole mesh to about `ghost` vertices, the basis restricted.
+//
+// Stages are timed into Basis::timings ("attachment", "hessian", "factorisation" (CHOLMOD
+// analysis and numeric factorisation, done inside the modes), "modes" (the rest of them),
+// "third derivatives", "derivative solves", "orthonormalisation", "assembly" (step 6), "ghost"
+// (what the ghost adds: it is simplified on a thread of its own during steps 3 to 6); seconds)
+// and reported through Progress with the same names.
+// A cancel throws Cancelled at the next report and leaves nothing behind. CHOLMOD cannot report
+// during its analysis and factorisation (about 1 s and 2.5 s at 100k vertices), nor a blocked
+// solve during its right-hand sides (1 s for 47): the bar pauses there.
+#pragma once
+
+#include <string>
+
+#include "reduction/basis.h"
+#include "util/progress.h"
+#include "util/types.h"
+
+namespace modal_deform {
+
+// A mode with λ below this fraction of tr K / tr M (a mass-weighted mean of the spectrum, which
+// grows with the resolution as rounding in K does) is a zero mode. Measured on the shells
+// Hessians of the dragons, zero modes / lowest flexible mode relative to that mean: res4 (9 zero
+// modes) 2e-15 / 1.7e-7, res3 (3) 4e-14 / 9e-9, res2 (6) 3e-15 / 1.8e-10.
+constexpr double kZeroEigenvalue = 1e-12;
+
+struct BakeOptions {
+  int modes = 20;                 // vibration modes, rigid motions included
+  int derivatives = 52;           // modal derivatives
+  int ghost = 1000;               // ghost vertices to aim for (≥ 4; the mesh itself when ≥ #V)
+  std::string energy = "shells";  // "shells", or "arap" with derivatives = 0
+  double bending = 1.0;           // shells: α (finite, ≥ 0)
+  double membrane = 1.0;          // shells: β (finite, ≥ 0)
+};
+
+// The reduced space of (V #V by 3, F #F by 3, any length unit) per the pipeline above: a Basis in
+// the mesh's units with num_modes = modes + num_floppy and r = num_modes + derivatives − dropped
+// columns. Throws InputError for a bad mesh or option (naming it), among them: modes not above the
+// rigid motions of the simulated components (6 each), more derivatives than pairs of the modes
+// that are neither rigid nor zero, "arap" with derivatives; NumericalError when a solver fails;
+// Cancelled when `progress` says stop.
+Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Progress& progress);
+
+}  // namespace modal_deform

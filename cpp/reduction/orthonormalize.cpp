@@ -1,0 +1,137 @@
+#include "reduction/orthonormalize.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+
+#include "util/errors.h"
+
+namespace modal_deform {
+namespace {
+
+// Columns orthonormalised together: wide enough for BLAS-3 speed, narrow enough that progress
+// moves.
+constexpr Eigen::Index kBlockColumns = 32;
+// Rows per parallel task of the dense products; a basis of fewer rows stays on the calling thread
+// (waking a team of threads on a busy machine costs more than such a product).
+constexpr Eigen::Index kBlockRows = 8192;
+
+Eigen::Index row_blocks(Eigen::Index rows) { return (rows + kBlockRows - 1) / kBlockRows; }
+
+// Aᵀ M B (a by b) for A (3n by a), B (3n by b), summed over row blocks in parallel.
+Eigen::MatrixXd m_inner(const Eigen::Ref<const Eigen::MatrixXd>& A, const VectorRef& dof_mass,
+                        const Eigen::Ref<const Eigen::MatrixXd>& B) {
+  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(A.cols(), B.cols());
+  const Eigen::Index blocks = row_blocks(A.rows());
+#pragma omp parallel if (blocks > 1)
+  {
+    Eigen::MatrixXd partial = Eigen::MatrixXd::Zero(A.cols(), B.cols());
+#pragma omp for schedule(static)
+    for (Eigen::Index block = 0; block < blocks; ++block) {
+      const Eigen::Index first = block * kBlockRows, rows = std::min(kBlockRows, A.rows() - first);
+      partial.noalias() += A.middleRows(first, rows).transpose() *
+                           (dof_mass.segment(first, rows).asDiagonal() * B.middleRows(first, rows));
+    }
+#pragma omp critical
+    sum += partial;
+  }
+  return sum;
+}
+
+// X −= Q C, over row blocks in parallel.
+void subtract_product(Eigen::Ref<Eigen::MatrixXd> X, const Eigen::Ref<const Eigen::MatrixXd>& Q,
+                      const Eigen::MatrixXd& C) {
+  const Eigen::Index blocks = row_blocks(X.rows());
+#pragma omp parallel for schedule(static) if (blocks > 1)
+  for (Eigen::Index block = 0; block < blocks; ++block) {
+    const Eigen::Index first = block * kBlockRows, rows = std::min(kBlockRows, X.rows() - first);
+    X.middleRows(first, rows).noalias() -= Q.middleRows(first, rows) * C;
+  }
+}
+
+// X ← X R⁻¹ for upper triangular R, over row blocks in parallel.
+void solve_upper_on_the_right(Eigen::Ref<Eigen::MatrixXd> X, const Eigen::MatrixXd& R) {
+  const Eigen::Index blocks = row_blocks(X.rows());
+#pragma omp parallel for schedule(static) if (blocks > 1)
+  for (Eigen::Index block = 0; block < blocks; ++block) {
+    const Eigen::Index first = block * kBlockRows, rows = std::min(kBlockRows, X.rows() - first);
+    auto part = X.middleRows(first, rows);
+    R.triangularView<Eigen::Upper>().solveInPlace<Eigen::OnTheRight>(part);
+  }
+}
+
+// Removes from X its components along the M-orthonormal columns Q (classical Gram–Schmidt; each
+// of the two passes does it once, which makes it twice, "twice is enough").
+void project_out(Eigen::Ref<Eigen::MatrixXd> X, const Eigen::Ref<const Eigen::MatrixXd>& Q, const VectorRef& dof_mass) {
+  if (Q.cols()) subtract_product(X, Q, m_inner(Q, dof_mass, X));
+}
+
+// Cholesky factor R (upper) of the Gram matrix G over the columns it keeps: column j is dropped
+// when its squared residual norm, G_jj less its components along the kept columns before it, is
+// at most floor[j]. Writes the kept indices into `kept`.
+Eigen::MatrixXd dropping_cholesky(const Eigen::MatrixXd& G, const Eigen::VectorXd& floor, std::vector<int>& kept) {
+  const Eigen::Index w = G.rows();
+  Eigen::MatrixXd R = Eigen::MatrixXd::Zero(w, w);  // rows and columns of kept indices only
+  kept.clear();
+  for (Eigen::Index j = 0; j < w; ++j) {
+    double residual = G(j, j);
+    // Rows of R are indexed by position among the kept columns; the entries of the candidate
+    // column j go into column kept.size().
+    const auto c = static_cast<Eigen::Index>(kept.size());
+    for (Eigen::Index a = 0; a < c; ++a) {
+      double r = G(kept[static_cast<size_t>(a)], j);
+      for (Eigen::Index b = 0; b < a; ++b) r -= R(b, a) * R(b, c);
+      R(a, c) = r / R(a, a);
+      residual -= R(a, c) * R(a, c);
+    }
+    if (residual > floor[j]) {
+      R(c, c) = std::sqrt(residual);
+      kept.push_back(static_cast<int>(j));
+    } else {
+      R.col(c).setZero();
+    }
+  }
+  const auto r = static_cast<Eigen::Index>(kept.size());
+  return R.topLeftCorner(r, r);
+}
+
+}  // namespace
+
+std::vector<int> orthonormalize(Eigen::MatrixXd& U, const VectorRef& dof_mass, double tolerance, Progress* progress) {
+  if (dof_mass.size() != U.rows())
+    throw InputError(message("dof_mass: expected ", U.rows(), " values (one per row of U), got ", dof_mass.size()));
+  if (!U.allFinite()) throw InputError("U: has an entry that is not finite");
+  if (!(tolerance >= 0 && tolerance < 1)) throw InputError(message("tolerance: expected [0, 1), got ", tolerance));
+  std::vector<int> kept_columns;
+  Eigen::Index done = 0;  // columns of Q so far: U's leading columns
+  if (progress) progress->report("orthonormalisation", 0.0);
+  for (Eigen::Index first = 0; first < U.cols(); first += kBlockColumns) {
+    const Eigen::Index width = std::min(kBlockColumns, U.cols() - first);
+    Eigen::MatrixXd X = U.middleCols(first, width);
+    const auto Q = U.leftCols(done);
+    const Eigen::VectorXd floor =
+        (tolerance * tolerance) * m_inner(X, dof_mass, X).diagonal();  // squared M-norms before projection
+    project_out(X, Q, dof_mass);
+    std::vector<int> kept;
+    const Eigen::MatrixXd R = dropping_cholesky(m_inner(X, dof_mass, X), floor, kept);
+    Eigen::MatrixXd Y(X.rows(), static_cast<Eigen::Index>(kept.size()));
+    for (size_t a = 0; a < kept.size(); ++a) Y.col(static_cast<Eigen::Index>(a)) = X.col(kept[a]);
+    X.resize(0, 0);
+    solve_upper_on_the_right(Y, R);
+    // Second pass: Y is orthonormal up to rounding amplified by R's condition; once more makes it
+    // orthonormal to working precision.
+    project_out(Y, Q, dof_mass);
+    const Eigen::LLT<Eigen::MatrixXd> second(m_inner(Y, dof_mass, Y));
+    if (second.info() != Eigen::Success)
+      throw NumericalError("orthonormalize: the second Cholesky-QR pass failed; the columns are too dependent");
+    solve_upper_on_the_right(Y, Eigen::MatrixXd(second.matrixU()));
+    U.middleCols(done, Y.cols()) = Y;
+    done += Y.cols();
+    for (int k : kept) kept_columns.push_back(static_cast<int>(first) + k);
+    if (progress) progress->report("orthonormalisation", static_cast<double>(first + width) / U.cols());
+  }
+  U.conservativeResize(Eigen::NoChange, done);
+  return kept_columns;
+}
+
+}  // namespace modal_deform

@@ -1,0 +1,314 @@
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "energy/discrete_shells.h"
+#include "linalg/cholmod_llt.h"
+#include "mesh/mass.h"
+#include "mesh/normalization.h"
+#include "mesh/primitives.h"
+#include "modes/modal_derivatives.h"
+#include "modes/rigid_motions.h"
+#include "modes/stiffness_and_mass.h"
+#include "modes/vibration_modes.h"
+#include "reduction/bake.h"
+#include "reduction/ghost.h"
+#include "test_bake_meshes.h"
+#include "test_support.h"
+#include "util/errors.h"
+
+namespace modal_deform {
+namespace {
+
+using testing::expect_input_error;
+using testing::head_with_eyes;
+using testing::rigid_misfit;
+using testing::shared_mesh;
+using testing::side_by_side;
+
+Basis bake_with(const TriangleMesh& mesh, int modes, int derivatives, int ghost = 1000,
+                const std::string& energy = "shells") {
+  BakeOptions options;
+  options.modes = modes;
+  options.derivatives = derivatives;
+  options.ghost = ghost;
+  options.energy = energy;
+  Progress progress;
+  return bake(mesh.V, mesh.F, options, progress);
+}
+
+// Uᵀ M U in the normalised frame over the vertices with `simulated` set (all when empty).
+Eigen::MatrixXd normalised_gram(const Basis& basis, const std::vector<bool>& simulated = {}) {
+  const Eigen::MatrixXd U = basis.vectors.cast<double>() * basis.scale;
+  Eigen::VectorXd m(U.rows());
+  for (Eigen::Index v = 0; v < basis.num_vertices(); ++v) {
+    const bool counts = simulated.empty() || simulated[static_cast<size_t>(v)];
+    m.segment<3>(3 * v).setConstant(counts ? basis.scale * basis.scale * basis.mass[v] : 0.0);
+  }
+  return U.transpose() * m.asDiagonal() * U;
+}
+
+double identity_error(const Eigen::MatrixXd& gram) {
+  return (gram - Eigen::MatrixXd::Identity(gram.rows(), gram.cols())).cwiseAbs().maxCoeff();
+}
+
+TEST(Bake, TwoTubesHaveTwelveRigidMotionsFirstAndAnOrthonormalBasis) {
+  const TriangleMesh tube = cylinder(16, 8, 0.5, 2.0);
+  const TriangleMesh mesh = side_by_side(tube, tube, Eigen::RowVector3d(3, 0, 0));
+  const Basis basis = bake_with(mesh, 20, 20);
+  validate_basis(basis);
+  EXPECT_EQ(basis.num_rigid, 12);
+  EXPECT_EQ(basis.num_floppy, 0);
+  EXPECT_EQ(basis.num_modes, 20);
+  EXPECT_EQ(basis.dimension() + basis.num_dropped, 40);
+  EXPECT_EQ(basis.eigenvalues.head(12), Eigen::VectorXd::Zero(12));
+  for (int i = 12; i < 20; ++i) EXPECT_GT(basis.eigenvalues[i], 1e-6) << "mode " << i;
+  for (int i = 13; i < 20; ++i) EXPECT_GE(basis.eigenvalues[i], basis.eigenvalues[i - 1]);
+  EXPECT_LT(identity_error(normalised_gram(basis)), 1e-5);  // float32 storage
+  // Each rigid column moves one tube rigidly and leaves the other alone.
+  const Eigen::Index half = tube.V.rows();
+  for (int j = 0; j < 12; ++j) {
+    const Eigen::VectorXd u = basis.vectors.col(j).cast<double>();
+    const Eigen::Index moving = j < 6 ? 0 : half, resting = j < 6 ? half : 0;
+    EXPECT_LT(rigid_misfit(mesh.V.middleRows(moving, half), u.segment(3 * moving, 3 * half)), 1e-5) << j;
+    EXPECT_EQ(u.segment(3 * resting, 3 * half).cwiseAbs().maxCoeff(), 0.0) << j;
+  }
+  for (const char* stage : {"attachment", "hessian", "factorisation", "modes", "third derivatives", "derivative solves",
+                            "orthonormalisation", "assembly", "ghost"})
+    EXPECT_GE(basis.timings.at(stage), 0.0) << stage;
+}
+
+TEST(Bake, ModesAreTheEigenpairsOfTheNormalisedShellsHessian) {
+  const TriangleMesh mesh = bar(4, 3, 5, 0.02, 0.015, 0.03);  // mesh units far from the normalised frame
+  const Basis basis = bake_with(mesh, 16, 10);
+  const double s = basis.scale;
+  EXPECT_NEAR(s, normalizing_scale(mesh.V), 0);
+  const RowMatrixX3d X = s * mesh.V;
+  const DiscreteShells shells(X, mesh.F);
+  const SparseMatrix K = shells.hessian(shells.rest());
+  const Eigen::VectorXd m = dof_masses(s * s * lumped_mass(mesh.V, mesh.F));
+  const double top = basis.eigenvalues.maxCoeff();
+  for (int i = 6; i < basis.num_modes; ++i) {
+    const Eigen::VectorXd phi = s * basis.vectors.col(i).cast<double>();
+    const Eigen::VectorXd residual = K * phi - basis.eigenvalues[i] * m.cwiseProduct(phi);
+    EXPECT_LT(std::sqrt(residual.cwiseAbs2().cwiseQuotient(m).sum()), 1e-5 * top) << "mode " << i;
+  }
+}
+
+TEST(Bake, BasisSpansTheModalDerivativesOfEquation13) {
+  // The derivatives solved independently of the bake (rigid kernel pinned at other DOFs) lie in
+  // the span of the baked basis; K ψ = P ∇³E(φᵢ, φⱼ) holds, and ψᵢⱼ = ψⱼᵢ.
+  const TriangleMesh mesh = bumpy_plane(10, 1.0, 4, 0.2);
+  const Basis basis = bake_with(mesh, 12, 12);
+  const double s = basis.scale;
+  const RowMatrixX3d X = s * mesh.V;
+  const DiscreteShells shells(X, mesh.F);
+  const SparseMatrix K = shells.hessian(shells.rest());
+  const Eigen::VectorXd mass = s * s * lumped_mass(mesh.V, mesh.F);
+  const Eigen::MatrixXd Z = rigid_motions(X, Eigen::VectorXi::Zero(X.rows()), mass);
+  const VibrationModes modes = vibration_modes(K, mass, 6, Z);
+  const std::vector<std::array<int, 2>> pairs = derivative_pairs(6, 12), swapped = [&] {
+    std::vector<std::array<int, 2>> p;
+    for (const auto& [i, j] : pairs) p.push_back({j, i});
+    return p;
+  }();
+  const Eigen::MatrixXd B = shells.third_batch(shells.rest(), modes.modes, pairs);
+  const Eigen::MatrixXd Psi = solve_in_range(K, mass, Z, B);
+  // Other pins: the last DOFs of a 3-2-1 set at the far corner instead of QR's choice.
+  const int far = static_cast<int>(X.rows()) - 1, near = far - 1, side = far - 11;
+  const Eigen::MatrixXd Psi_swapped =
+      solve_in_range(K, mass, Z, shells.third_batch(shells.rest(), modes.modes, swapped),
+                     std::vector<int>{3 * far, 3 * far + 1, 3 * far + 2, 3 * near + 1, 3 * near + 2, 3 * side + 2});
+  EXPECT_LT((Psi - Psi_swapped).norm(), 1e-8 * Psi.norm());
+  const Eigen::MatrixXd PB = B - Z * (Z.transpose() * Z).ldlt().solve(Z.transpose() * B);
+  for (Eigen::Index c = 0; c < Psi.cols(); ++c)
+    EXPECT_LT((K * Psi.col(c) - PB.col(c)).norm(), 1e-8 * PB.col(c).norm()) << "pair " << c;
+  // The same from factors of K − σM, as the bake solves them: exact on the known eigenvectors,
+  // within 1e-3 on the others, so within 1e-3 in all. With σ near 0 they are hardly off; with σ
+  // at a third of the lowest eigenvalue, uncorrected steps would leave 2% of that component.
+  const Eigen::VectorXd m = dof_masses(mass);
+  for (const auto& [sigma, tolerance] :
+       {std::pair{-1e-9 * K.diagonal().sum() / m.sum(), 1e-7}, std::pair{-0.3 * modes.eigenvalues[0], 1e-3}}) {
+    CholmodLLT shifted(3);
+    shifted.factorize(K, -sigma * m, 0.0);
+    const Eigen::MatrixXd Psi_shifted =
+        solve_in_range_shifted(K, mass, Z, B, shifted, sigma, modes.eigenvalues, modes.modes);
+    EXPECT_LT((Psi - Psi_shifted).norm(), tolerance * Psi.norm()) << "sigma " << sigma;
+  }
+
+  const Eigen::MatrixXd U = s * basis.vectors.cast<double>();
+  for (Eigen::Index c = 0; c < Psi.cols(); ++c) {
+    const Eigen::VectorXd psi = Psi.col(c);
+    const Eigen::VectorXd outside = psi - U * (U.transpose() * m.cwiseProduct(psi));
+    EXPECT_LT(std::sqrt(outside.dot(m.cwiseProduct(outside)) / psi.dot(m.cwiseProduct(psi))), 1e-4) << "pair " << c;
+  }
+}
+
+TEST(Bake, ShiftedSolvesRefuseInconsistentInput) {
+  const TriangleMesh mesh = bumpy_plane(6, 1.0, 2, 0.2);
+  const RowMatrixX3d X = normalizing_scale(mesh.V) * mesh.V;
+  const DiscreteShells shells(X, mesh.F);
+  const SparseMatrix K = shells.hessian(shells.rest());
+  const Eigen::VectorXd mass = lumped_mass(X, mesh.F);
+  const Eigen::MatrixXd Z = rigid_motions(X, Eigen::VectorXi::Zero(X.rows()), mass);
+  CholmodLLT shifted(3);
+  const VibrationModes modes = vibration_modes(K, mass, 4, Z, nullptr, &shifted);
+  const Eigen::MatrixXd B = Eigen::MatrixXd::Random(K.rows(), 2);
+  EXPECT_NO_THROW(solve_in_range_shifted(K, mass, Z, B, shifted, modes.shift, modes.eigenvalues, modes.modes));
+  EXPECT_THROW(solve_in_range_shifted(K, mass, Z, B, shifted, 0.0, modes.eigenvalues, modes.modes), InputError);
+  EXPECT_THROW(solve_in_range_shifted(K, mass, Z, B, shifted, modes.shift, modes.eigenvalues.head(3), modes.modes),
+               InputError);
+  EXPECT_THROW(solve_in_range_shifted(K, mass, Z, B, shifted, modes.shift, -modes.eigenvalues, modes.modes),
+               InputError);
+  EXPECT_THROW(solve_in_range_shifted(K, mass, Z, B.topRows(6), shifted, modes.shift, modes.eigenvalues, modes.modes),
+               InputError);
+  // A shift far below the eigenvalues given would need too many refinement steps.
+  EXPECT_THROW(solve_in_range_shifted(K, mass, Z, B, shifted, -1e3 * modes.eigenvalues.maxCoeff(), modes.eigenvalues,
+                                      modes.modes),
+               InputError);
+  CholmodLLT other(3);
+  EXPECT_THROW(solve_in_range_shifted(K, mass, Z, B, other, modes.shift, modes.eigenvalues, modes.modes), InputError);
+}
+
+TEST(Bake, EyesDoNotEatTheModeBudgetAndFollowTheHead) {
+  const TriangleMesh mesh = head_with_eyes();
+  const Basis basis = bake_with(mesh, 10, 5);
+  EXPECT_EQ(basis.num_rigid, 6);
+  const Eigen::Index head = 218;
+  std::vector<bool> simulated(static_cast<size_t>(mesh.V.rows()), false);
+  std::fill(simulated.begin(), simulated.begin() + head, true);
+  EXPECT_LT(identity_error(normalised_gram(basis, simulated)), 1e-5);
+  for (int j = 0; j < 6; ++j)  // the whole mesh, eyes included, moves rigidly
+    EXPECT_LT(rigid_misfit(mesh.V, basis.vectors.col(j).cast<double>()), 1e-5) << "rigid motion " << j;
+  for (int j = 6; j < basis.dimension(); ++j)  // eyes move, as one piece each with the head beside them
+    EXPECT_GT(basis.vectors.col(j).tail(3 * (mesh.V.rows() - head)).cwiseAbs().maxCoeff(), 0.0f);
+}
+
+TEST(Bake, GhostMapsEveryVertexAndKeepsRigidMotionsRigid) {
+  const TriangleMesh mesh = bumpy_plane(24, 2.0, 5, 0.3);
+  const Basis basis = bake_with(mesh, 12, 8, 100);
+  const Eigen::Index g = basis.ghost_vertices.rows();
+  EXPECT_LE(g, 150);
+  ASSERT_EQ(basis.ghost_map.size(), mesh.V.rows());
+  EXPECT_GE(basis.ghost_map.minCoeff(), 0);
+  EXPECT_LT(basis.ghost_map.maxCoeff(), g);
+  EXPECT_EQ(basis.ghost_vectors.rows(), 3 * g);
+  EXPECT_EQ(basis.ghost_vectors.cols(), basis.dimension());
+  for (int j = 0; j < basis.num_rigid; ++j)
+    EXPECT_LT(rigid_misfit(basis.ghost_vertices, basis.ghost_vectors.col(j)), 1e-12) << "rigid motion " << j;
+  // The restriction of the float32 vectors agrees with the ghost vectors to float precision.
+  const Eigen::MatrixXd restricted =
+      restrict_to_ghost(basis.ghost_map, static_cast<int>(g), basis.mass, basis.vectors.cast<double>());
+  EXPECT_LT((restricted - basis.ghost_vectors).cwiseAbs().maxCoeff(), 1e-6 * basis.ghost_vectors.cwiseAbs().maxCoeff());
+  // A ghost at least as large as the mesh is the mesh.
+  const Basis whole = bake_with(mesh, 12, 0, 100000);
+  EXPECT_EQ(whole.ghost_vertices, mesh.V);
+  EXPECT_EQ(whole.ghost_map, Eigen::VectorXi::LinSpaced(mesh.V.rows(), 0, static_cast<int>(mesh.V.rows()) - 1));
+}
+
+TEST(Bake, ArapWithoutDerivatives) {
+  const Basis basis = bake_with(bar(3, 3, 3, 1, 1, 1), 12, 0, 1000, "arap");
+  EXPECT_EQ(basis.dimension(), 12);
+  EXPECT_EQ(basis.num_rigid, 6);
+  EXPECT_GT(basis.eigenvalues[6], 0);
+}
+
+// Expects the bake of `mesh` with `options` to throw InputError naming `needle`.
+void expect_refused(const TriangleMesh& mesh, const BakeOptions& options, const std::string& needle) {
+  expect_input_error(
+      [&] {
+        Progress progress;
+        bake(mesh.V, mesh.F, options, progress);
+      },
+      needle);
+}
+
+TEST(Bake, RefusesBadOptionsNamingThem) {
+  const TriangleMesh tube = cylinder(12, 6, 0.5, 2.0);
+  const TriangleMesh two = side_by_side(tube, tube, Eigen::RowVector3d(3, 0, 0));
+  BakeOptions options;
+  options.modes = 12;  // two tubes: 12 rigid motions
+  expect_refused(two, options, "modes:");
+  options = {};
+  options.derivatives = 106;  // 14 flexible modes: 105 pairs
+  expect_refused(tube, options, "derivatives:");
+  options = {};
+  options.energy = "arap";
+  expect_refused(tube, options, "derivatives:");
+  options.energy = "springs";
+  expect_refused(tube, options, "energy:");
+  options = {};
+  options.ghost = 3;
+  expect_refused(tube, options, "ghost:");
+  options = {};
+  options.bending = -1;
+  expect_refused(tube, options, "bending:");
+  options = {};
+  options.modes = 3 * static_cast<int>(tube.V.rows());
+  expect_refused(tube, options, "modes:");
+  RowMatrixX3i F = tube.F;
+  F(4, 1) = 10000;
+  expect_refused({tube.V, F}, {}, "F[4]");
+}
+
+TEST(Bake, CancelsAtTheNextReportAndLeavesNothing) {
+  const TriangleMesh mesh = bumpy_plane(30, 2.0, 5, 0.3);
+  for (const std::string stop_at :
+       {"hessian", "modes", "third derivatives", "derivative solves", "orthonormalisation", "ghost"}) {
+    bool stopped = false;
+    Progress progress([&](const std::string& stage, double) { return !(stopped = stopped || stage == stop_at); });
+    BakeOptions options;
+    options.ghost = 200;
+    EXPECT_THROW(bake(mesh.V, mesh.F, options, progress), Cancelled) << stop_at;
+    EXPECT_TRUE(stopped) << stop_at;
+  }
+}
+
+// The shared scans: dragon_vrip_res4 is floppy (9 zero modes besides the rigid motions, from flaps
+// at its non-manifold edges; more than the bake's first eigensolve allows for, so it takes a
+// second). They come on top of the modes asked for, and get no derivatives.
+TEST(Bake, FloppyDragonKeepsItsZeroModesOnTopWithoutDerivatives) {
+  const TriangleMesh& dragon = shared_mesh("dragon_vrip_res4.ply.gz");
+  std::vector<double> gaps;
+  auto last = std::chrono::steady_clock::now();
+  Progress progress(
+      [&](const std::string&, double) {
+        const auto now = std::chrono::steady_clock::now();
+        gaps.push_back(std::chrono::duration<double>(now - last).count());
+        last = now;
+        return true;
+      },
+      0.0);
+  BakeOptions options;
+  options.modes = 20;
+  options.derivatives = 30;
+  const Basis basis = bake(dragon.V, dragon.F, options, progress);
+  EXPECT_EQ(basis.num_rigid, 6);
+  EXPECT_EQ(basis.num_floppy, 9);
+  EXPECT_EQ(basis.num_modes, 29);
+  EXPECT_EQ(basis.dimension() + basis.num_dropped, 59);
+  const double top = basis.eigenvalues[28];
+  for (int i = 6; i < 15; ++i) EXPECT_LT(std::abs(basis.eigenvalues[i]), 1e-9 * top) << i;
+  EXPECT_GT(basis.eigenvalues[15], 1e-3 * top);
+  for (int i = 16; i < 29; ++i) EXPECT_GE(basis.eigenvalues[i], basis.eigenvalues[i - 1]);
+  EXPECT_LT(identity_error(normalised_gram(basis)), 1e-4);
+  // The bar moves often enough to cancel within a second (measured here on a shared machine).
+  EXPECT_LT(*std::max_element(gaps.begin(), gaps.end()), 1.0);
+  options.derivatives = 106;  // 14 modes neither rigid nor zero: 105 pairs
+  expect_refused(dragon, options, "derivatives:");
+}
+
+TEST(Bake, DragonWithDebrisAndSeveralThousandVertices) {
+  const TriangleMesh& dragon = shared_mesh("dragon_vrip_res3.ply.gz");
+  const Basis basis = bake_with(dragon, 20, 30);
+  validate_basis(basis);
+  EXPECT_EQ(basis.num_rigid, 6);
+  EXPECT_EQ(basis.num_vertices(), dragon.V.rows());
+  EXPECT_LE(basis.ghost_vertices.rows(), 1100);
+}
+
+}  // namespace
+}  // namespace modal_deform
