@@ -2,7 +2,7 @@
 // one thread per core, and its threads wait for each other busily: on the 2-core machine the bake
 // was measured on, the modes stage (factorisation and 62 single solves, while the ghost is
 // simplified on the other core) took 20-23 s wall and 15-17 s CPU of the process with two BLAS
-// threads, 13-14 s and 8-10 s with one.
+// threads, 13-16 s and 8-10 s with one.
 #pragma once
 
 namespace modal_deform {
