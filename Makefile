@@ -57,5 +57,9 @@ bench: build
 	@mkdir -p bench/results
 	$(BUILD_DIR)/bench/modal_deform_bench --benchmark_out=bench/results/native.json --benchmark_out_format=json
 
+# dist/modal_deform-<version>.zip: the add-on folder with the compiled extension, for Blender's installer.
+addon: build
+	$(PYTHON) python_addon/package.py dist
+
 clean:
 	rm -rf $(BUILD_DIR) out dist python_addon/modal_deform/_native*.so
