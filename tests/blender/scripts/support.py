@@ -61,6 +61,11 @@ def add_handle(obj, mask):
     return obj.modal_deform.handles[-1]
 
 
+def stored_bases():
+    """Names of the datablocks holding baked bases (the startup file has a palette of its own)."""
+    return sorted(p.name for p in bpy.data.palettes if p.name.startswith(".Modal Deform"))
+
+
 def mesh_state(obj):
     """Everything of the mesh a cancelled or restoring operator must leave as it was."""
     mesh = obj.data
@@ -69,6 +74,34 @@ def mesh_state(obj):
         "polygons": len(mesh.polygons), "loops": len(mesh.loops),
         "shape_keys": None if mesh.shape_keys is None else [
             (b.name, b.value, b.mute, key_positions(obj, b.name).tobytes()) for b in mesh.shape_keys.key_blocks],
-        "basis": obj.modal_deform.basis, "palettes": len(bpy.data.palettes),
+        "basis": obj.modal_deform.basis, "palettes": stored_bases(),
         "status": obj.modal_deform.status.dimension, "vertex_groups": len(obj.vertex_groups),
     }
+
+
+def arguments():
+    """The script's arguments (after "--")."""
+    return sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+
+
+def mesh_object(name, V, F):
+    """A mesh object from arrays (V #V by 3, F a list of faces of any size), active, in the scene."""
+    for obj in list(bpy.data.objects):
+        bpy.data.objects.remove(obj)
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata([tuple(v) for v in V], [], [tuple(f) for f in F])
+    obj = bpy.data.objects.new(name, mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+    return obj
+
+
+def expect_error(operator, fragment, **kwargs):
+    """Run `operator` and check that it fails with a message containing `fragment`."""
+    try:
+        operator(**kwargs)
+    except RuntimeError as error:
+        assert fragment in str(error), f"expected {fragment!r} in the error, got: {error}"
+        return str(error)
+    raise AssertionError(f"{operator} did not fail (expected {fragment!r})")
