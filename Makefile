@@ -18,7 +18,7 @@ PACKAGES := cmake g++ make pkg-config \
 
 BLENDER_TEST := $(BLENDER) -b --factory-startup --python-exit-code 1
 
-.PHONY: all deps build test test-cpp test-python test-blender demo bench addon clean
+.PHONY: all deps build test test-cpp test-python test-blender test-gui demo bench addon clean
 
 all: build
 
@@ -38,7 +38,7 @@ build: deps
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 
 test: build
-	$(MAKE) --no-print-directory test-cpp test-python test-blender
+	$(MAKE) --no-print-directory test-cpp test-python test-blender test-gui
 
 test-cpp:
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
@@ -48,6 +48,10 @@ test-python:
 
 test-blender:
 	PYTHONPATH=python_addon $(PYTHON) -m pytest -q tests/blender
+
+# Blender with a window under Xvfb, driven by simulated mouse and keyboard events.
+test-gui:
+	PYTHONPATH=python_addon $(PYTHON) -m pytest -q tests/gui
 
 demo: build
 	@mkdir -p out

@@ -20,6 +20,20 @@ class HandleError(Exception):
     """A handle that cannot be used, with what is wrong and which handle."""
 
 
+def owner(obj):
+    """The mesh object whose Modal Deform settings apply while `obj` is active: obj itself when it
+    is a mesh, or the mesh whose handle it controls (so the sidebar and the operators stay with the
+    mesh while the artist selects and moves a controller); None otherwise."""
+    if obj is None:
+        return None
+    if obj.type == "MESH":
+        return obj
+    parent = obj.parent
+    if parent is not None and parent.type == "MESH" and any(h.controller == obj for h in parent.modal_deform.handles):
+        return parent
+    return None
+
+
 def object_space(obj, other):
     """other's world matrix in obj's space (obj's matrix may be singular: then its closest inverse)."""
     return obj.matrix_world.inverted_safe() @ other.matrix_world

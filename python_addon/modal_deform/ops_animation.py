@@ -8,7 +8,7 @@ import re
 
 import bpy
 
-from . import mesh_io, posing
+from . import handles, mesh_io, posing
 from .ops_bake import _mesh_poll
 from .ops_pose import _FAILURES
 
@@ -109,7 +109,7 @@ render without the add-on. Esc cancels"""
         end = self.frame_end if self.properties.is_property_set("frame_end") else scene.frame_end
         if end < start:
             raise ValueError(f"frame range: the end ({end}) is before the start ({start})")
-        return AnimationJob(context, context.object, range(start, end + 1))
+        return AnimationJob(context, handles.owner(context.object), range(start, end + 1))
 
     def _finish(self, job):
         job.finish()
@@ -155,7 +155,7 @@ render without the add-on. Esc cancels"""
             job.cancel()
             self.report({"WARNING"}, "Animation bake cancelled: nothing changed")
             return {"CANCELLED"}
-        if event.type != "TIMER" or event.timer is not self.timer:
+        if event.type != "TIMER":
             return {"RUNNING_MODAL"}
         try:
             more = job.step()

@@ -5,7 +5,7 @@ import time
 import bpy
 
 from . import core as mdc
-from . import mesh_io, storage
+from . import handles, mesh_io, storage
 
 
 class BakeJob:
@@ -74,9 +74,9 @@ class BakeJob:
 
 
 def _mesh_poll(cls, context):
-    obj = context.object
-    if obj is None or obj.type != "MESH":
-        cls.poll_message_set("Select a mesh object")
+    obj = handles.owner(context.object)
+    if obj is None:
+        cls.poll_message_set("Select a mesh object (or a controller of one)")
         return False
     if obj.mode != "OBJECT":
         cls.poll_message_set("Switch to Object Mode")
@@ -97,14 +97,14 @@ the file. Esc cancels"""
     poll = classmethod(_mesh_poll)
 
     def execute(self, context):
-        job = BakeJob(context.object)
+        job = BakeJob(handles.owner(context.object))
         job.run()
         level, message = job.finish()
         self.report({level}, message)
         return {"FINISHED"} if level == "INFO" else {"CANCELLED"}
 
     def invoke(self, context, event):
-        self.job = BakeJob(context.object)
+        self.job = BakeJob(handles.owner(context.object))
         self.job.start()
         wm = context.window_manager
         self.timer = wm.event_timer_add(0.1, window=context.window)
@@ -122,7 +122,7 @@ the file. Esc cancels"""
     def modal(self, context, event):
         if event.type == "ESC" and event.value == "PRESS":
             self.job.cancel()
-        if event.type != "TIMER" or event.timer is not self.timer:
+        if event.type != "TIMER":
             return {"RUNNING_MODAL"} if event.type == "ESC" else {"PASS_THROUGH"}
         if not self.job.done:
             self._show(context)
@@ -146,10 +146,10 @@ class MODAL_DEFORM_OT_clear_basis(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return _mesh_poll(cls, context) and context.object.modal_deform.basis is not None
+        return _mesh_poll(cls, context) and handles.owner(context.object).modal_deform.basis is not None
 
     def execute(self, context):
-        storage.clear(context.object)
+        storage.clear(handles.owner(context.object))
         return {"FINISHED"}
 
 

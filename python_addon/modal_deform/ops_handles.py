@@ -7,8 +7,8 @@ from . import handles
 
 
 def _mesh(context):
-    obj = context.object
-    return obj if obj is not None and obj.type == "MESH" and obj.library is None else None
+    obj = handles.owner(context.object)
+    return obj if obj is not None and obj.library is None else None
 
 
 class MODAL_DEFORM_OT_add_handle(bpy.types.Operator):
@@ -23,13 +23,13 @@ that moves them (like Hook to New Object). Object Mode: a pinned handle on the a
         if _mesh(context) is None:
             cls.poll_message_set("Select a mesh object of this file")
             return False
-        if context.object.mode not in {"EDIT", "OBJECT"}:
+        if _mesh(context).mode not in {"EDIT", "OBJECT"}:
             cls.poll_message_set("Switch to Edit Mode (select vertices) or Object Mode")
             return False
         return True
 
     def execute(self, context):
-        obj = context.object
+        obj = _mesh(context)
         if obj.mode == "EDIT":
             return self._from_selection(context, obj)
         group = obj.vertex_groups.active
@@ -80,7 +80,7 @@ class MODAL_DEFORM_OT_remove_handle(bpy.types.Operator):
         return obj is not None and 0 <= obj.modal_deform.active_handle < len(obj.modal_deform.handles)
 
     def execute(self, context):
-        settings = context.object.modal_deform
+        settings = _mesh(context).modal_deform
         settings.handles.remove(settings.active_handle)
         settings.active_handle = min(settings.active_handle, len(settings.handles) - 1)
         return {"FINISHED"}

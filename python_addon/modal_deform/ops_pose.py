@@ -23,7 +23,7 @@ keeps the pose, Esc restores the mesh as it was"""
 
     def invoke(self, context, event):
         global _running
-        obj = context.object
+        obj = handles.owner(context.object)
         try:
             self.pose = posing.Pose(context, obj)
         except _FAILURES as error:
@@ -48,7 +48,7 @@ keeps the pose, Esc restores the mesh as it was"""
     def modal(self, context, event):
         if self.request is not None:
             return self._end(context, self.request)
-        if event.type == "TIMER" and event.timer is self.timer:
+        if event.type == "TIMER":  # ours or another's: a tick either way (3.x events do not say whose)
             return self._tick(context)
         if event.value == "PRESS":
             if event.type == "ESC":
@@ -145,7 +145,7 @@ class MODAL_DEFORM_OT_solve(bpy.types.Operator):
     poll = classmethod(_mesh_poll)
 
     def execute(self, context):
-        obj = context.object
+        obj = handles.owner(context.object)
         try:
             pose = posing.Pose(context, obj)
             pose.follow_controllers()
@@ -173,7 +173,7 @@ class MODAL_DEFORM_OT_reset(bpy.types.Operator):
     poll = classmethod(_mesh_poll)
 
     def execute(self, context):
-        obj = context.object
+        obj = handles.owner(context.object)
         for item in obj.modal_deform.handles:
             if item.controller is not None and item.controller.library is None:
                 item.controller.matrix_world = obj.matrix_world @ item.bind_matrix

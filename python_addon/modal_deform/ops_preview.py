@@ -2,7 +2,7 @@
 import bpy
 import numpy as np
 
-from . import mesh_io, storage
+from . import handles, mesh_io, storage
 from .ops_bake import _mesh_poll
 
 PREVIEW_KEY = "Modal Deform Preview"
@@ -58,7 +58,7 @@ class MODAL_DEFORM_OT_preview_mode(bpy.types.Operator):
     poll = classmethod(_mesh_poll)
 
     def execute(self, context):
-        obj = context.object
+        obj = handles.owner(context.object)
         if showing(obj):
             mesh_io.remove_shape_keys(obj, [PREVIEW_KEY])
             return {"FINISHED"}

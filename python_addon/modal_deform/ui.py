@@ -1,7 +1,7 @@
 """The sidebar (View3D > N > Modal Deform): bake settings and status, handles, pose, animation, preview."""
 import bpy
 
-from . import ops_preview, storage
+from . import handles, ops_preview, storage
 
 
 class MODAL_DEFORM_UL_handles(bpy.types.UIList):
@@ -24,14 +24,14 @@ class _Panel:
 
     @classmethod
     def poll(cls, context):
-        return context.object is not None and context.object.type == "MESH"
+        return handles.owner(context.object) is not None
 
 
 class VIEW3D_PT_modal_deform(_Panel, bpy.types.Panel):
     bl_label = "Modal Deform"
 
     def draw(self, context):
-        obj = context.object
+        obj = handles.owner(context.object)
         settings = obj.modal_deform
         layout = self.layout
         if settings.basis is None:
@@ -50,7 +50,7 @@ class VIEW3D_PT_modal_deform_bake(_Panel, bpy.types.Panel):
     bl_parent_id = "VIEW3D_PT_modal_deform"
 
     def draw(self, context):
-        obj = context.object
+        obj = handles.owner(context.object)
         settings = obj.modal_deform
         layout = self.layout
         layout.use_property_split = True
@@ -93,7 +93,7 @@ class VIEW3D_PT_modal_deform_handles(_Panel, bpy.types.Panel):
     bl_parent_id = "VIEW3D_PT_modal_deform"
 
     def draw(self, context):
-        obj = context.object
+        obj = handles.owner(context.object)
         settings = obj.modal_deform
         layout = self.layout
         row = layout.row()
@@ -119,7 +119,7 @@ class VIEW3D_PT_modal_deform_pose(_Panel, bpy.types.Panel):
     bl_parent_id = "VIEW3D_PT_modal_deform"
 
     def draw(self, context):
-        settings = context.object.modal_deform
+        settings = handles.owner(context.object).modal_deform
         layout = self.layout
         column = layout.column()
         column.use_property_split = True
@@ -138,7 +138,7 @@ class VIEW3D_PT_modal_deform_preview(_Panel, bpy.types.Panel):
     bl_options = {"DEFAULT_CLOSED"}
 
     def draw(self, context):
-        obj = context.object
+        obj = handles.owner(context.object)
         settings = obj.modal_deform
         layout = self.layout
         column = layout.column()
