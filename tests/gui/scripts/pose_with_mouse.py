@@ -124,7 +124,6 @@ def steps():
         bpy.ops.view3d.view_axis(type="FRONT")
         bpy.ops.view3d.view_all()
         area.spaces.active.show_region_ui = True
-    yield 0.2
     yield 0.5
 
     # Start posing the way the Pose button does, select the controller, grab it: G, move, click.
