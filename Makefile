@@ -60,6 +60,7 @@ demo: build
 bench: build
 	@mkdir -p bench/results
 	$(BUILD_DIR)/bench/modal_deform_bench --benchmark_out=bench/results/native.json --benchmark_out_format=json
+	$(BLENDER_TEST) --python bench/blender_pose.py -- --output bench/results/blender_pose.json
 
 # dist/modal_deform-<version>.zip: the add-on folder with the compiled extension, for Blender's installer.
 addon: build

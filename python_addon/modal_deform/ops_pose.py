@@ -65,6 +65,10 @@ keeps the pose, Esc restores the mesh as it was"""
 
     def _tick(self, context):
         obj = self.pose.obj
+        try:
+            obj.mode
+        except ReferenceError:  # deleted while posing
+            return self._end(context, "CANCEL")
         if obj.mode != "OBJECT":
             self.report({"WARNING"}, "Left Object Mode: the pose so far is kept")
             return self._end(context, "APPLY")
@@ -89,13 +93,16 @@ keeps the pose, Esc restores the mesh as it was"""
         global _running
         _running = None
         context.window_manager.event_timer_remove(self.timer)
-        context.workspace.status_text_set(None)
-        if self.area is not None:
-            self.area.header_text_set(None)
-        if how == "CANCEL":
-            self.state.restore()
+        if context.workspace is not None:
+            context.workspace.status_text_set(None)
+        try:
+            if self.area is not None:
+                self.area.header_text_set(None)
+            if how == "CANCEL":
+                self.state.restore()
+        except ReferenceError:  # the object (or the screen) went away while posing: nothing to restore
             return {"CANCELLED"}
-        return {"FINISHED"}
+        return {"CANCELLED"} if how == "CANCEL" else {"FINISHED"}
 
     def cancel(self, context):
         """Blender ends the operator (file loaded, window closed): put the mesh back."""
