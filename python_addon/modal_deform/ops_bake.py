@@ -8,6 +8,11 @@ from . import core as mdc
 from . import handles, mesh_io, storage
 
 
+# The bake's stages in order (cpp/reduction/bake.h), for one bar over the whole bake.
+STAGES = ("attachment", "hessian", "factorisation", "modes", "third derivatives", "derivative solves",
+          "orthonormalisation", "assembly", "ghost")
+
+
 class BakeJob:
     """One bake of obj's mesh as it is now, run by run() here or on a thread by start().
 
@@ -34,6 +39,13 @@ class BakeJob:
     def _progress(self, stage, fraction):
         self.stage, self.fraction = stage, fraction
         return not self.cancelling
+
+    @property
+    def overall(self):
+        """Fraction of the whole bake done, counting each stage alike (their costs vary by mesh)."""
+        if self.stage not in STAGES:
+            return 0.0
+        return (STAGES.index(self.stage) + self.fraction) / len(STAGES)
 
     def run(self):
         start = time.perf_counter()
@@ -115,7 +127,7 @@ the file. Esc cancels"""
 
     def _show(self, context):
         job = self.job
-        context.window_manager.progress_update(int(1000 * job.fraction))
+        context.window_manager.progress_update(int(1000 * job.overall))
         action = "cancelling" if job.cancelling else f"{job.stage} {100 * job.fraction:.0f}%"
         context.workspace.status_text_set(f"Modal Deform: baking '{job.object_name}': {action}   (Esc: cancel)")
 
@@ -127,15 +139,25 @@ the file. Esc cancels"""
         if not self.job.done:
             self._show(context)
             return {"RUNNING_MODAL"}
-        wm = context.window_manager
-        wm.event_timer_remove(self.timer)
-        wm.progress_end()
-        context.workspace.status_text_set(None)
+        self._stop(context)
         level, message = self.job.finish()
         self.report({level}, message)
         for area in context.screen.areas:
             area.tag_redraw()
         return {"FINISHED"} if level == "INFO" else {"CANCELLED"}
+
+
+    def _stop(self, context):
+        wm = context.window_manager
+        wm.event_timer_remove(self.timer)
+        wm.progress_end()
+        if context.workspace is not None:
+            context.workspace.status_text_set(None)
+
+    def cancel(self, context):
+        """Blender ends the operator (file loaded, window closed): the bake stops, nothing is stored."""
+        self.job.cancel()
+        self._stop(context)
 
 
 class MODAL_DEFORM_OT_clear_basis(bpy.types.Operator):

@@ -116,7 +116,8 @@ class MODAL_DEFORM_OT_pose_end(bpy.types.Operator):
     bl_options = {"INTERNAL"}
 
     how: bpy.props.EnumProperty(items=(("APPLY", "Apply", "Keep the pose in the shape key"),
-                                       ("CANCEL", "Cancel", "Restore the mesh as it was before posing")))
+                                       ("CANCEL", "Cancel", "Restore the mesh as it was before posing")),
+                                description="Whether the pose is kept or the mesh restored")
 
     @classmethod
     def poll(cls, context):

@@ -9,6 +9,7 @@ Writes OUTPUT/result.json ({"ok": bool, "log": [...]}) and screenshots, then qui
 import json
 import os
 import sys
+import threading
 import time
 import traceback
 
@@ -83,6 +84,22 @@ def steps():
         bpy.ops.object.shade_smooth()
     settings = obj.modal_deform
     settings.ghost = 500
+
+    # Bake as the button does: on a thread, with progress; Esc cancels and changes nothing.
+    def baking():
+        return any(thread.name == "modal_deform bake" for thread in threading.enumerate())
+
+    window, _, region = view3d()
+    with override():
+        assert bpy.ops.modal_deform.bake("INVOKE_DEFAULT") == {"RUNNING_MODAL"}
+    yield 0.3
+    assert baking(), "the bake is not running on its thread"
+    window.event_simulate(type="ESC", value="PRESS", x=region.x + 10, y=region.y + 10)
+    window.event_simulate(type="ESC", value="RELEASE", x=region.x + 10, y=region.y + 10)
+    yield from wait_until(lambda: not baking(), 60)
+    yield 0.5  # the operator's next timer event ends it
+    assert obj.modal_deform.basis is None and not any(p.name.startswith(".Modal") for p in bpy.data.palettes)
+    say("bake cancelled with Esc: nothing changed")
 
     # Undo takes a bake back (the bake's datablock and status go with it); redo brings it again.
     with override():
