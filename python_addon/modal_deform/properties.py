@@ -97,7 +97,7 @@ class ModalDeformSettings(bpy.types.PropertyGroup):
         description="How hard the handles pull their vertices toward the controllers: higher follows the "
                     "controllers more exactly, lower lets the surface's energy hold them back")
     budget: FloatProperty(
-        name="Milliseconds per Update", default=12.0, min=1.0, soft_max=100.0,
+        name="Milliseconds per Update", default=5.0, min=0.5, soft_max=50.0,
         description="Milliseconds the interactive pose spends in the solver per update: more converge faster "
                     "and lower the frame rate")
     handles: CollectionProperty(type=ModalDeformHandle, name="Handles")
