@@ -60,6 +60,17 @@ def screenshot(name):
         bpy.ops.screen.screenshot(filepath=os.path.join(output, name))
 
 
+def show_sidebar_tab():
+    """Click the sidebar's "Modal Deform" tab (3.4 has no Python access to the active tab): the
+    fourth tab of a factory-startup sidebar (Item, Tool, View, Modal Deform) at the right edge."""
+    window, area, _ = view3d()
+    sidebar = next(r for r in area.regions if r.type == "UI")
+    x, y = sidebar.x + sidebar.width - 10, sidebar.y + sidebar.height - 182
+    window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x, y=y)
+    window.event_simulate(type="LEFTMOUSE", value="PRESS", x=x, y=y)
+    window.event_simulate(type="LEFTMOUSE", value="RELEASE", x=x, y=y)
+
+
 def wait_until(condition, seconds):
     """Yield to Blender until condition() holds; fail after `seconds`."""
     start = time.time()
@@ -175,6 +186,7 @@ def steps():
     assert np.linalg.norm(followed - moved) < 0.05 * np.linalg.norm(moved), (followed, moved)
     assert base_positions(obj).tobytes() == rest.tobytes(), "posing wrote to the base mesh"
     say("mesh followed by", np.round(followed, 3).tolist(), "at", f"{ops_pose._running.tick_ms:.1f} ms per update")
+    show_sidebar_tab()
     yield 0.5
     screenshot("pose.png")
 
