@@ -10,6 +10,7 @@ void bind_mesh(pybind11::module_& m);
 void bind_energy(pybind11::module_& m);
 void bind_reduction(pybind11::module_& m);
 void bind_modes(pybind11::module_& m);
+void bind_solve(pybind11::module_& m);
 void bind_bake(pybind11::module_& m);
 
 }  // namespace modal_deform

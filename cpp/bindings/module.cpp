@@ -8,5 +8,6 @@ PYBIND11_MODULE(_native, m) {
   modal_deform::bind_energy(m);
   modal_deform::bind_reduction(m);
   modal_deform::bind_modes(m);
+  modal_deform::bind_solve(m);
   modal_deform::bind_bake(m);
 }

@@ -1,0 +1,84 @@
+// Posing: the reduced solver and the full-space reference solve.
+#include <pybind11/eigen.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bindings/bindings.h"
+#include "solve/full_solver.h"
+#include "solve/reduced_solver.h"
+
+namespace py = pybind11;
+
+namespace modal_deform {
+namespace {
+
+// Handles arrive as a list of int32 arrays (checked by modal_deform.core.solve).
+Handles to_handles(const std::vector<Eigen::VectorXi>& arrays) {
+  Handles handles;
+  handles.reserve(arrays.size());
+  for (const Eigen::VectorXi& a : arrays) handles.emplace_back(a.data(), a.data() + a.size());
+  return handles;
+}
+
+}  // namespace
+
+void bind_solve(py::module_& m) {
+  py::class_<ReducedSolver>(m, "ReducedSolver")
+      .def(py::init([](const Basis& basis, const std::vector<Eigen::VectorXi>& handles, const VectorRef& weights,
+                       double stiffness, const std::string& energy) {
+             py::gil_scoped_release release;
+             return std::make_unique<ReducedSolver>(basis, to_handles(handles), weights, stiffness,
+                                                    energy_kind(energy));
+           }),
+           py::arg("basis"), py::arg("handles"), py::arg("weights"), py::arg("stiffness"), py::arg("energy"),
+           py::keep_alive<1, 2>())
+      .def("set_transforms", &ReducedSolver::set_transforms, py::arg("transforms"))
+      .def(
+          "solve",
+          [](ReducedSolver& solver, int max_iterations, double tolerance) {
+            ReducedSolveStats stats;
+            {
+              py::gil_scoped_release release;
+              stats = solver.solve(max_iterations, tolerance);
+            }
+            return py::dict(py::arg("iterations") = stats.iterations, py::arg("energy") = stats.energy,
+                            py::arg("converged") = stats.converged, py::arg("ms") = stats.milliseconds,
+                            py::arg("evaluations") = stats.evaluations, py::arg("gradient_norm") = stats.gradient_norm);
+          },
+          py::arg("max_iterations"), py::arg("tolerance"))
+      .def("reset", &ReducedSolver::reset)
+      .def("positions", &ReducedSolver::positions, py::arg("out").noconvert(), py::call_guard<py::gil_scoped_release>())
+      .def_property_readonly("q", [](const ReducedSolver& solver) { return Eigen::VectorXd(solver.q()); })
+      .def_property_readonly("dimension", &ReducedSolver::dimension)
+      .def_property_readonly("num_handles", &ReducedSolver::num_handles);
+
+  m.def(
+      "solve_full",
+      [](const VerticesRef& V, const FacesRef& F, const std::vector<Eigen::VectorXi>& handles,
+         const Transforms& transforms, const VectorRef& weights, double stiffness, const std::string& energy,
+         double bending, double membrane, double tolerance, int max_iterations,
+         const std::optional<RowMatrixX3d>& initial) {
+        FullSolveResult result;
+        {
+          py::gil_scoped_release release;
+          result = solve_full(V, F, to_handles(handles), weights, transforms, stiffness, energy_kind(energy), bending,
+                              membrane, tolerance, max_iterations, initial ? &*initial : nullptr);
+        }
+        py::dict stats(py::arg("steps") = result.steps, py::arg("iterations") = result.iterations,
+                       py::arg("energy") = result.energy, py::arg("converged") = result.converged,
+                       py::arg("gradient_norm") = result.gradient_norm,
+                       py::arg("gradient_scale") = result.gradient_scale,
+                       py::arg("factorizations") = result.factorizations);
+        return py::make_tuple(std::move(result.positions), stats);
+      },
+      py::arg("V"), py::arg("F"), py::arg("handles"), py::arg("transforms"), py::arg("weights"), py::arg("stiffness"),
+      py::arg("energy"), py::arg("bending"), py::arg("membrane"), py::arg("tolerance"), py::arg("max_iterations"),
+      py::arg("initial"));
+}
+
+}  // namespace modal_deform

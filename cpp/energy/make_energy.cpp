@@ -1,0 +1,21 @@
+#include "energy/make_energy.h"
+
+#include "energy/arap.h"
+#include "energy/discrete_shells.h"
+#include "util/errors.h"
+
+namespace modal_deform {
+
+EnergyKind energy_kind(const std::string& name) {
+  if (name == "shells") return EnergyKind::kShells;
+  if (name == "arap") return EnergyKind::kArap;
+  throw InputError(message("energy: expected \"shells\" or \"arap\", got \"", name, "\""));
+}
+
+std::unique_ptr<Energy> make_energy(EnergyKind kind, const VerticesRef& V, const FacesRef& F, double bending,
+                                    double membrane) {
+  if (kind == EnergyKind::kArap) return std::make_unique<Arap>(V, F);
+  return std::make_unique<DiscreteShells>(V, F, bending, membrane);
+}
+
+}  // namespace modal_deform

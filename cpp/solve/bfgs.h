@@ -1,0 +1,67 @@
+// BFGS with a dense inverse Hessian, a strong Wolfe line search and the Gill–Murray–Wright
+// stopping test: the reduced solver's minimiser (paper section 5).
+//
+// The state (x, the inverse Hessian H, f and ∇f at x) persists between calls of minimize, so an
+// interactive session runs a few iterations per frame and continues from where it stopped. When
+// the objective changes (a handle moved), the caller either says by how much f and ∇f changed at
+// x (cheap when only a known term changed) or has them re-evaluated.
+//
+// Stopping (paper eq. 14, after Gill, Murray & Wright, Practical Optimization, 8.2.3.2): with
+// tolerance ε, iteration k ends the search when
+//   f(x_{k−1}) − f(x_k) < ε (1 + |f(x_k)|),
+//   ‖x_{k−1} − x_k‖ < √ε (1 + ‖x_k‖),
+//   ‖∇f(x_k)‖ ≤ ∛ε (1 + |f(x_k)|)
+// all hold (Euclidean norms), and before any iteration when ‖∇f(x)‖ ≤ ε (1 + |f(x)|) (GMW's
+// test U4, e.g. at rest with the handles at rest). Once converged, further calls return at once
+// until the objective changes.
+#pragma once
+
+#include "solve/line_search.h"
+#include "util/types.h"
+
+namespace modal_deform {
+
+struct BfgsResult {
+  int iterations = 0;   // steps taken by this call
+  int evaluations = 0;  // objective calls by this call
+  bool converged = false;
+};
+
+class Bfgs {
+ public:
+  // Starts at x (n) with the initial inverse Hessian H0 (n by n, symmetric positive definite),
+  // kept for restarts; f and ∇f are evaluated by the next minimize.
+  void start(const Eigen::VectorXd& x, const Eigen::MatrixXd& initial_inverse_hessian);
+
+  // The objective changed by `value_change` and `gradient_change` (n) at the current x.
+  void objective_changed(double value_change, const VectorRef& gradient_change);
+  // The objective changed in an unknown way: f and ∇f are evaluated again by the next minimize.
+  void objective_changed();
+
+  // Up to max_iterations ≥ 0 BFGS steps with the stopping test above (tolerance ε in (0, 1)).
+  // Each step searches along p = −H∇f; H takes the BFGS update (N&W eq. 6.17) when the step's
+  // curvature yᵀs is positive, as the Wolfe conditions ensure. When p is not a descent direction
+  // or the line search finds no decrease, H restarts from H0 once; a second failure ends the
+  // call unconverged (the objective cannot be decreased at this precision). Throws
+  // NumericalError when f is not finite at the current x.
+  BfgsResult minimize(const Objective& objective, int max_iterations, double tolerance);
+
+  const Eigen::VectorXd& x() const { return x_; }
+  const Eigen::MatrixXd& inverse_hessian() const { return H_; }
+  // f and ∇f at x; valid after a minimize.
+  double value() const { return value_; }
+  const Eigen::VectorXd& gradient() const { return gradient_; }
+
+ private:
+  Eigen::VectorXd x_, gradient_;
+  double value_ = 0;
+  bool evaluated_ = false;  // value_ and gradient_ belong to x_ and the current objective
+  bool converged_ = false;
+  bool at_initial_ = true;  // H_ == H0_
+  Eigen::MatrixXd H_, H0_;
+  // Work space, sized once.
+  Eigen::VectorXd p_, x_new_, gradient_new_, s_, y_, Hy_;
+  double value_new_ = 0;
+};
+
+}  // namespace modal_deform

@@ -1,0 +1,76 @@
+// Handles and the handle term of the posing objective (paper section 5, E_C), in reduced
+// coordinates.
+//
+// A handle is a set of fine vertices that follows a rigid transform T_h = [R_h t_h; 0 0 0 1] of
+// its rest positions (mesh units), with a weight w_h ≥ 0. In the normalised frame (scale s,
+// normalization.h) the term is
+//
+//   E_C(q) = μ Σ_h w_h Σ_{i∈h} s²m_i ‖s (x̄_i + U_i q − R_h x̄_i − t_h)‖²
+//          = qᵀ A q + 2 bᵀ q + c,
+//
+// with m_i the fine lumped masses (mesh units, so s²m_i is the normalised mass) and U_i the
+// 3 by r rows of vertex i. A = μs⁴ Σ_h w_h Σ_i m_i U_iᵀU_i depends only on the handle set; with
+// x̄_i = c_h + r_i about the handle's mass centroid c_h, D_h = I − R_h and e_h = D_h c_h − t_h,
+//
+//   b = μs⁴ Σ_h w_h (C_h vec(D_h) + T_h e_h),   c = μs⁴ Σ_h w_h (tr(D_h S_h D_hᵀ) + M_h ‖e_h‖²),
+//
+// where C_h = Σ_i m_i U_iᵀ ⊗ r_iᵀ (r by 9), T_h = Σ_i m_i U_iᵀ (r by 3), S_h = Σ_i m_i r_i r_iᵀ and
+// M_h = Σ_i m_i are computed once. Moving handles then costs O(r) per handle, and evaluating the
+// term O(r²), whatever the number of handle vertices. (Centring keeps c exact when the mesh lies
+// far from the origin: no large terms cancel.)
+//
+// A vertex may belong to several handles: its terms add, so it settles between their targets in
+// proportion to their weights. A vertex listed twice in one handle is an input error. Vertices
+// without mass (in no triangle) pull with zero weight.
+#pragma once
+
+#include <vector>
+
+#include "util/types.h"
+
+namespace modal_deform {
+
+using Handles = std::vector<std::vector<int>>;    // per handle, its fine vertex indices
+using Transforms = std::vector<Eigen::Matrix4d>;  // per handle, a rigid transform (mesh units)
+
+// Throws InputError naming the first problem: no handle, an empty handle, an index outside
+// [0, num_vertices), an index repeated within a handle, or weights (empty, or one per handle)
+// that are negative or not finite. Returns the weights, all 1 when `weights` is empty.
+Eigen::VectorXd checked_handle_weights(const Handles& handles, const VectorRef& weights, int num_vertices);
+
+// Throws InputError naming the first transform that is not rigid: not finite, a last row other
+// than (0, 0, 0, 1), a rotation block R with max |RᵀR − I| > 1e-5, or det R < 0 (a reflection);
+// or when there is not one transform per handle.
+void check_transforms(const Transforms& transforms, int num_handles);
+
+class HandleTerm {
+ public:
+  // rest: #V by 3 and mass: #V (mesh units); U: 3#V by r (x = x̄ + U q); coefficient: μs⁴.
+  // The handles must pass checked_handle_weights. Transforms start at the identity.
+  HandleTerm(const VerticesRef& rest, const VectorRef& mass, const Eigen::Ref<const RowMatrixXf>& U,
+             const Handles& handles, const VectorRef& weights, double coefficient);
+
+  // One transform per handle (check_transforms first).
+  void set_transforms(const Transforms& transforms);
+
+  // E_C(q), with ∇E_C(q) = 2 (A q + b) written into `gradient` (r).
+  double value_and_gradient(const VectorRef& q, Eigen::Ref<Eigen::VectorXd> gradient) const;
+  // ∇²E_C = 2A (r by r), constant.
+  Eigen::MatrixXd hessian() const { return 2 * A_; }
+
+  int dimension() const { return static_cast<int>(A_.rows()); }
+
+ private:
+  struct Handle {
+    Eigen::Vector3d centroid;
+    double mass;
+    Eigen::Matrix3d second_moment;  // S_h
+    Eigen::MatrixXd coefficients;   // r by 12: [C_h T_h]
+  };
+  std::vector<Handle> handles_;  // coefficient and weights folded in
+  Eigen::MatrixXd A_;
+  Eigen::VectorXd b_;
+  double c_ = 0;
+};
+
+}  // namespace modal_deform

@@ -1,0 +1,89 @@
+// The interactive solver (paper section 5): BFGS in the reduced space x = x̄ + U q, with the
+// energy evaluated on the ghost and the handle term exact on the fine mesh.
+//
+// Objective, in the normalised frame (scale s = basis.scale):
+//
+//   f(q) = E_ghost(s (x̄_s + U_s q)) + E_C(q)
+//
+// E_ghost is the discrete shells energy with the basis's weights, or ARAP, of the ghost mesh
+// scaled by s; E_C the handle term with stiffness μ (handle_term.h). An iteration costs one or a
+// few evaluations of E_ghost and its gradient (O(#ghost vertices · r)) plus O(r²) for BFGS and
+// the handles, whatever the size of the fine mesh; only positions() touches the fine mesh.
+//
+// Warm start (paper): BFGS's initial inverse Hessian is the inverse of the reduced Hessian of f
+// at rest, s² U_sᵀ ∇²E_ghost(s x̄_s) U_s + 2A, computed once per solver (per handle set). Motions
+// that neither the energy nor the handles resist (rigid motions when the handles are a single
+// vertex or collinear, or a whole component without a handle) make it singular; it is inverted
+// after adding δI with δ = 1e-8 times its largest diagonal entry, which leaves the well-determined
+// directions alone and lets BFGS learn the curvature along the free ones from its first steps.
+//
+// Not thread-safe: one solver per thread.
+#pragma once
+
+#include <memory>
+
+#include "energy/energy.h"
+#include "energy/make_energy.h"
+#include "reduction/basis.h"
+#include "solve/bfgs.h"
+#include "solve/handle_term.h"
+
+namespace modal_deform {
+
+struct ReducedSolveStats {
+  int iterations = 0;        // BFGS steps of this call
+  int evaluations = 0;       // evaluations of f and ∇f by this call
+  double energy = 0;         // f(q) at the end: deformation energy plus handle term
+  double gradient_norm = 0;  // ‖∇f(q)‖
+  bool converged = false;    // the stopping test holds (bfgs.h)
+  double milliseconds = 0;   // wall time of the call
+};
+
+class ReducedSolver {
+ public:
+  // basis: validated here (validate_basis); it must outlive the solver, which keeps a reference
+  // to its fine arrays. handles, weights: see checked_handle_weights (fine vertex indices; empty
+  // weights mean 1). stiffness: μ > 0. energy: evaluated on the ghost. warm_start false starts
+  // BFGS from the identity instead of the rest Hessian (for comparison). The solver starts at
+  // rest with identity transforms.
+  ReducedSolver(const Basis& basis, const Handles& handles, const VectorRef& weights, double stiffness,
+                EnergyKind energy = EnergyKind::kShells, bool warm_start = true);
+  ReducedSolver(const ReducedSolver&) = delete;
+  ReducedSolver& operator=(const ReducedSolver&) = delete;
+
+  // One rigid 4 by 4 transform per handle, applied to its rest positions (check_transforms).
+  // O(r) per handle; the next solve continues from the current q and inverse Hessian.
+  void set_transforms(const Transforms& transforms);
+
+  // Up to max_iterations ≥ 0 BFGS iterations with stopping tolerance ε in (0, 1) (bfgs.h).
+  ReducedSolveStats solve(int max_iterations, double tolerance);
+
+  // Back to rest (q = 0) and the initial inverse Hessian; the transforms stay.
+  void reset();
+
+  // x̄ + U q on the fine mesh (3#V, interleaved, mesh units) in single precision, written into
+  // `out`. Rows are split over threads in blocks; throws InputError for a wrong size.
+  void positions(Eigen::Ref<Eigen::VectorXf> out) const;
+
+  // f(q) with ∇f(q) (r) written into `gradient`; +inf where the ghost positions overflow.
+  double objective(const Eigen::VectorXd& q, Eigen::VectorXd& gradient);
+
+  const Eigen::VectorXd& q() const { return bfgs_.x(); }
+  int dimension() const { return static_cast<int>(ghost_vectors_.cols()); }
+  int num_handles() const { return num_handles_; }
+
+ private:
+  const Basis& basis_;
+  int num_handles_;
+  std::unique_ptr<Energy> energy_;  // of the ghost, normalised frame
+  Eigen::VectorXd ghost_rest_;      // s x̄_s (3g)
+  Eigen::MatrixXd ghost_vectors_;   // s U_s (3g by r)
+  HandleTerm handle_term_;
+  Eigen::MatrixXd initial_inverse_hessian_;
+  Bfgs bfgs_;
+  Eigen::VectorXf q_float_;  // q for positions()
+  // Work space, sized once.
+  Eigen::VectorXd ghost_x_, ghost_gradient_, handle_gradient_, handle_gradient_old_;
+};
+
+}  // namespace modal_deform

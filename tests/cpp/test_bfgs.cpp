@@ -1,0 +1,221 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "solve/bfgs.h"
+#include "solve/line_search.h"
+
+namespace modal_deform {
+namespace {
+
+// The extended Rosenbrock function, Σ 100 (x_{2k+1} − x_{2k}²)² + (1 − x_{2k})²: minimum 0 at 1.
+double rosenbrock(const Eigen::VectorXd& x, Eigen::VectorXd& g) {
+  double f = 0;
+  g.setZero(x.size());
+  for (Eigen::Index k = 0; k + 1 < x.size(); k += 2) {
+    const double a = x[k + 1] - x[k] * x[k], b = 1 - x[k];
+    f += 100 * a * a + b * b;
+    g[k] += -400 * a * x[k] - 2 * b;
+    g[k + 1] += 200 * a;
+  }
+  return f;
+}
+
+Eigen::VectorXd rosenbrock_start(int n) {
+  Eigen::VectorXd x(n);
+  for (int k = 0; k < n; k += 2) x.segment<2>(k) = Eigen::Vector2d(-1.2, 1.0);
+  return x;
+}
+
+// f = ½ xᵀAx − bᵀx with A symmetric positive definite.
+struct Quadratic {
+  Eigen::MatrixXd A;
+  Eigen::VectorXd b;
+  explicit Quadratic(int n) {
+    std::srand(3);
+    const Eigen::MatrixXd R = Eigen::MatrixXd::Random(n, n);
+    A = R * R.transpose() + Eigen::MatrixXd::Identity(n, n);
+    b = Eigen::VectorXd::Random(n);
+  }
+  double operator()(const Eigen::VectorXd& x, Eigen::VectorXd& g) const {
+    g = A * x - b;
+    return 0.5 * x.dot(A * x) - b.dot(x);
+  }
+};
+
+void expect_strong_wolfe(const Objective& f, const Eigen::VectorXd& x, const Eigen::VectorXd& p,
+                         const LineSearchResult& result, double value_new, const Eigen::VectorXd& x_new,
+                         const Eigen::VectorXd& gradient_new) {
+  Eigen::VectorXd g(x.size());
+  const double value = f(x, g);
+  const WolfeConditions c;
+  ASSERT_TRUE(result.wolfe);
+  EXPECT_LE((x_new - (x + result.step * p)).norm(), 1e-15 * (1 + x_new.norm()));
+  EXPECT_LE(value_new, value + c.sufficient_decrease * result.step * g.dot(p));
+  EXPECT_LE(std::abs(gradient_new.dot(p)), c.curvature * std::abs(g.dot(p)));
+  Eigen::VectorXd check(x.size());
+  EXPECT_EQ(f(x_new, check), value_new);
+  EXPECT_EQ(check, gradient_new);
+}
+
+TEST(WolfeLineSearch, TheNewtonStepOfAQuadraticCostsOneEvaluation) {
+  const Quadratic f(6);
+  const Eigen::VectorXd x = Eigen::VectorXd::Random(6);
+  Eigen::VectorXd g(6), x_new(6), g_new(6);
+  const double value = f(x, g);
+  const Eigen::VectorXd p = -f.A.llt().solve(g);
+  double value_new;
+  const LineSearchResult result = wolfe_line_search(f, x, value, g, p, x_new, value_new, g_new);
+  EXPECT_EQ(result.step, 1.0);
+  EXPECT_EQ(result.evaluations, 1);
+  expect_strong_wolfe(f, x, p, result, value_new, x_new, g_new);
+}
+
+TEST(WolfeLineSearch, ShrinksLongStepsAndGrowsShortOnes) {
+  const Quadratic f(6);
+  const Eigen::VectorXd x = Eigen::VectorXd::Random(6);
+  Eigen::VectorXd g(6), x_new(6), g_new(6);
+  const double value = f(x, g);
+  const Eigen::VectorXd newton = -f.A.llt().solve(g);
+  for (double scale : {1e4, 30.0, 1e-2, 1e-5}) {
+    const Eigen::VectorXd p = scale * newton;
+    double value_new;
+    const LineSearchResult result = wolfe_line_search(f, x, value, g, p, x_new, value_new, g_new);
+    expect_strong_wolfe(f, x, p, result, value_new, x_new, g_new);
+    EXPECT_LT(result.evaluations, 12) << "scale " << scale;
+    if (scale > 1) {
+      EXPECT_LT(result.step, 1.0);
+    } else {
+      EXPECT_GT(result.step, 1.0);
+    }
+  }
+}
+
+TEST(WolfeLineSearch, BacksOffFromPointsThatCannotBeEvaluated) {
+  // Rosenbrock, undefined beyond |x| = 2: the first trial lands there.
+  const Objective f = [](const Eigen::VectorXd& x, Eigen::VectorXd& g) {
+    return x.norm() > 2 ? std::numeric_limits<double>::infinity() : rosenbrock(x, g);
+  };
+  const Eigen::VectorXd x = Eigen::Vector2d(0, 0);
+  Eigen::VectorXd g(2), x_new(2), g_new(2);
+  const double value = f(x, g);
+  const Eigen::VectorXd p = -100 * g;
+  double value_new;
+  const LineSearchResult result = wolfe_line_search(f, x, value, g, p, x_new, value_new, g_new);
+  expect_strong_wolfe(f, x, p, result, value_new, x_new, g_new);
+}
+
+TEST(WolfeLineSearch, AnAscentDirectionTakesNoStep) {
+  const Quadratic f(4);
+  const Eigen::VectorXd x = Eigen::VectorXd::Random(4);
+  Eigen::VectorXd g(4), x_new(4), g_new(4);
+  const double value = f(x, g);
+  double value_new;
+  const LineSearchResult result = wolfe_line_search(f, x, value, g, g, x_new, value_new, g_new);
+  EXPECT_EQ(result.step, 0.0);
+  EXPECT_EQ(result.evaluations, 0);
+  EXPECT_EQ(x_new, x);
+  EXPECT_EQ(value_new, value);
+}
+
+TEST(Bfgs, MinimisesRosenbrockWithMonotoneDecrease) {
+  Bfgs bfgs;
+  bfgs.start(rosenbrock_start(10), Eigen::MatrixXd::Identity(10, 10));
+  double previous = std::numeric_limits<double>::infinity();
+  int iterations = 0;
+  for (; iterations < 500; ++iterations) {
+    const BfgsResult result = bfgs.minimize(rosenbrock, 1, 1e-15);
+    EXPECT_LE(bfgs.value(), previous);
+    previous = bfgs.value();
+    if (result.converged) break;
+  }
+  EXPECT_LT(iterations, 200);
+  EXPECT_LE((bfgs.x() - Eigen::VectorXd::Ones(10)).norm(), 1e-4);
+}
+
+// Paper eq. 14: the call reports convergence exactly when the three conditions hold for its last
+// step (or the gradient was already negligible).
+TEST(Bfgs, StopsWhenTheGillMurrayWrightConditionsHold) {
+  for (double tolerance : {1e-4, 1e-8, 1e-12}) {
+    Bfgs bfgs;
+    bfgs.start(rosenbrock_start(4), Eigen::MatrixXd::Identity(4, 4));
+    bfgs.minimize(rosenbrock, 0, tolerance);  // evaluates f at the start
+    bool converged = false;
+    int steps = 0;
+    for (int call = 0; call < 500 && !converged; ++call) {
+      const Eigen::VectorXd x_before = bfgs.x();
+      const double f_before = bfgs.value();
+      const BfgsResult result = bfgs.minimize(rosenbrock, 1, tolerance);
+      steps += result.iterations;
+      converged = result.converged;
+      const double f = bfgs.value();
+      const double theta = 1 + std::abs(f);
+      const bool u1 = f_before - f < tolerance * theta;
+      const bool u2 = (x_before - bfgs.x()).norm() < std::sqrt(tolerance) * (1 + bfgs.x().norm());
+      const bool u3 = bfgs.gradient().norm() <= std::cbrt(tolerance) * theta;
+      if (result.iterations == 1) {
+        EXPECT_EQ(converged, u1 && u2 && u3) << "tolerance " << tolerance << " step " << steps;
+      } else {
+        EXPECT_TRUE(converged && bfgs.gradient().norm() <= tolerance * theta);
+      }
+    }
+    EXPECT_TRUE(converged) << "tolerance " << tolerance;
+    EXPECT_LE(bfgs.gradient().norm(), std::cbrt(tolerance) * (1 + std::abs(bfgs.value())));
+  }
+}
+
+TEST(Bfgs, StatePersistsAcrossCalls) {
+  Bfgs once, twice;
+  once.start(rosenbrock_start(6), Eigen::MatrixXd::Identity(6, 6));
+  twice.start(rosenbrock_start(6), Eigen::MatrixXd::Identity(6, 6));
+  const BfgsResult ten = once.minimize(rosenbrock, 10, 1e-12);
+  const BfgsResult first = twice.minimize(rosenbrock, 5, 1e-12);
+  const BfgsResult second = twice.minimize(rosenbrock, 5, 1e-12);
+  EXPECT_EQ(ten.iterations, 10);
+  EXPECT_EQ(first.iterations + second.iterations, 10);
+  EXPECT_EQ(first.evaluations + second.evaluations, ten.evaluations);
+  EXPECT_EQ(once.x(), twice.x());
+  EXPECT_EQ(once.inverse_hessian(), twice.inverse_hessian());
+}
+
+TEST(Bfgs, TheExactInverseHessianSolvesAQuadraticInOneStep) {
+  const Quadratic f(8);
+  Bfgs bfgs;
+  bfgs.start(Eigen::VectorXd::Zero(8), f.A.inverse());
+  const BfgsResult result = bfgs.minimize(f, 10, 1e-10);
+  EXPECT_TRUE(result.converged);
+  EXPECT_EQ(result.iterations, 1);
+  EXPECT_EQ(result.evaluations, 2);  // the start and the unit step
+  EXPECT_LE((bfgs.x() - f.A.llt().solve(f.b)).norm(), 1e-12);
+  // Converged: nothing more to do until the objective changes.
+  const BfgsResult again = bfgs.minimize(f, 10, 1e-10);
+  EXPECT_TRUE(again.converged);
+  EXPECT_EQ(again.evaluations, 0);
+}
+
+TEST(Bfgs, AKnownChangeOfTheObjectiveEqualsReevaluation) {
+  // f_c = rosenbrock + cᵀx: moving c changes f by Δcᵀx and ∇f by Δc.
+  Eigen::VectorXd c = Eigen::VectorXd::Zero(4);
+  const Objective f = [&c](const Eigen::VectorXd& x, Eigen::VectorXd& g) {
+    const double value = rosenbrock(x, g) + c.dot(x);
+    g += c;
+    return value;
+  };
+  Bfgs told, reevaluated;
+  told.start(rosenbrock_start(4), Eigen::MatrixXd::Identity(4, 4));
+  reevaluated.start(rosenbrock_start(4), Eigen::MatrixXd::Identity(4, 4));
+  told.minimize(f, 6, 1e-12);
+  reevaluated.minimize(f, 6, 1e-12);
+  const Eigen::VectorXd change = Eigen::Vector4d(0.3, -0.2, 0.1, 0.5);
+  c += change;
+  told.objective_changed(change.dot(told.x()), change);
+  reevaluated.objective_changed();
+  const BfgsResult a = told.minimize(f, 6, 1e-12);
+  const BfgsResult b = reevaluated.minimize(f, 6, 1e-12);
+  EXPECT_EQ(a.evaluations + 1, b.evaluations);
+  EXPECT_LE((told.x() - reevaluated.x()).norm(), 1e-10);
+}
+
+}  // namespace
+}  // namespace modal_deform

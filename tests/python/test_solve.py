@@ -1,0 +1,185 @@
+"""Posing through the Python API: mdc.solve_full and mdc.ReducedSolver."""
+import numpy as np
+import pytest
+
+import modal_deform.core as mdc
+
+
+def rigid(axis, angle, centre, translation):
+    """4x4: rotation by ``angle`` about ``axis`` through ``centre``, then a translation."""
+    axis = np.asarray(axis, float) / np.linalg.norm(axis)
+    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    R = np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+    T = np.eye(4)
+    T[:3, :3] = R
+    T[:3, 3] = np.asarray(centre) + np.asarray(translation) - R @ centre
+    return T
+
+
+@pytest.fixture(scope="module")
+def tube():
+    """A tube along z held at its bottom ring, its top ring turned and pushed."""
+    V, F = mdc.cylinder(16, 12, radius=1.0, length=3.0)
+    handles = [np.flatnonzero(V[:, 2] < 1e-9), np.flatnonzero(V[:, 2] > 3 - 1e-9)]
+    transforms = [np.eye(4), rigid([1, 0, 1], 0.8, [0, 0, 3], [0.8, 0, -0.3])]
+    return V, F, handles, transforms
+
+
+def objective_gradient(V, F, handles, transforms, X, stiffness, energy):
+    """∇F in the normalised frame, assembled independently from mdc's energies and masses."""
+    s = 10.0 / np.ptp(V, axis=0).max()
+    E = mdc.DiscreteShells(s * V, F) if energy == "shells" else mdc.Arap(s * V, F)
+    g = E.gradient(s * X).reshape(-1, 3)
+    m = mdc.mass(V, F)
+    for idx, T in zip(handles, transforms):
+        target = V[idx] @ T[:3, :3].T + T[:3, 3]
+        g[idx] += 2 * stiffness * s**2 * m[idx, None] * s * (X[idx] - target)
+    return g.ravel()
+
+
+@pytest.mark.parametrize("energy", ["shells", "arap"])
+def test_solve_full_finds_a_stationary_point(tube, energy):
+    V, F, handles, transforms = tube
+    X, stats = mdc.solve_full(V, F, handles, transforms, stiffness=100.0, energy=energy, tolerance=1e-10,
+                              return_stats=True)
+    assert X.shape == V.shape and X.dtype == np.float64
+    assert stats["converged"] and stats["iterations"] > 0
+    assert stats["gradient_norm"] <= 1e-10 * stats["gradient_scale"]
+    g = objective_gradient(V, F, handles, transforms, X, 100.0, energy)
+    g0 = objective_gradient(V, F, handles, transforms, V, 100.0, energy)
+    assert np.linalg.norm(g) <= 1e-8 * np.linalg.norm(g0)
+    # Without stats: the positions alone.
+    assert np.array_equal(mdc.solve_full(V, F, handles, transforms, stiffness=100.0, energy=energy, tolerance=1e-10), X)
+
+
+def test_solve_full_refuses_bad_input(tube):
+    V, F, handles, transforms = tube
+    scaled = transforms[1].copy()
+    scaled[:3, :3] *= 1.1
+    with pytest.raises(ValueError, match=r"transforms\[1\]"):
+        mdc.solve_full(V, F, handles, [np.eye(4), scaled])
+    mirrored = np.diag([1.0, 1.0, -1.0, 1.0])
+    with pytest.raises(ValueError, match=r"transforms\[0\].*reflection"):
+        mdc.solve_full(V, F, handles, [mirrored, np.eye(4)])
+    with pytest.raises(ValueError, match=r"transforms\[1\]: expected a 4x4"):
+        mdc.solve_full(V, F, handles, [np.eye(4), np.eye(3)])
+    with pytest.raises(ValueError, match="expected 2"):
+        mdc.solve_full(V, F, handles, [np.eye(4)])
+    with pytest.raises(ValueError, match=r"handles\[1\]\[0\] = 999"):
+        mdc.solve_full(V, F, [handles[0], [999]], transforms)
+    with pytest.raises(ValueError, match=r"handles\[0\] lists vertex 3 twice"):
+        mdc.solve_full(V, F, [[3, 4, 3]], [np.eye(4)])
+    with pytest.raises(ValueError, match=r"handles\[1\]: expected a non-empty"):
+        mdc.solve_full(V, F, [handles[0], []], transforms)
+    with pytest.raises(ValueError, match="a single index array"):
+        mdc.solve_full(V, F, handles[0], [np.eye(4)])
+    with pytest.raises(ValueError, match="no handle"):
+        mdc.solve_full(V, F, [], [])
+    with pytest.raises(ValueError, match="energy"):
+        mdc.solve_full(V, F, handles, transforms, energy="neo-hookean")
+    with pytest.raises(ValueError, match="stiffness"):
+        mdc.solve_full(V, F, handles, transforms, stiffness=-1.0)
+    with pytest.raises(ValueError, match=r"weights"):
+        mdc.solve_full(V, F, handles, transforms, weights=[1.0, -2.0])
+
+
+@pytest.fixture(scope="module")
+def tube_basis(tube):
+    V, F, _, _ = tube
+    return mdc.bake(V, F, modes=20, derivatives=47, ghost=100)  # the paper's 67 dimensions
+
+
+def converge(solver, tolerance=1e-8):
+    stats = {"converged": False}
+    for _ in range(50):
+        stats = solver.solve(20, tolerance)
+        if stats["converged"]:
+            break
+    return stats
+
+
+def test_reduced_solver_poses_close_to_the_full_solve(tube, tube_basis):
+    V, F, handles, transforms = tube
+    solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0)
+    assert solver.dimension == tube_basis.dimension
+    solver.set_transforms(transforms)
+    energies = []
+    for _ in range(30):
+        stats = solver.solve(max_iterations=1)
+        assert set(stats) >= {"iterations", "energy", "converged", "ms", "evaluations", "gradient_norm"}
+        energies.append(stats["energy"])
+    assert all(b <= a for a, b in zip(energies, energies[1:]))
+    assert converge(solver)["converged"]
+    X = solver.positions()
+    assert X.shape == V.shape and X.dtype == np.float32
+    reference = mdc.solve_full(V, F, handles, transforms, stiffness=100.0)
+    diagonal = np.linalg.norm(np.ptp(reference, axis=0))
+    assert np.sqrt(np.mean(np.sum((X - reference) ** 2, axis=1))) < 0.02 * diagonal
+
+
+def test_positions_fill_the_callers_buffer(tube, tube_basis):
+    _, _, handles, transforms = tube
+    solver = mdc.ReducedSolver(tube_basis, handles)
+    rest = np.asarray(tube_basis.rest, dtype=np.float32)
+    assert np.array_equal(solver.positions(), rest)
+    solver.set_transforms(transforms)
+    solver.solve(10)
+    for shape in [rest.shape, (rest.size,)]:
+        out = np.full(shape, np.nan, dtype=np.float32)
+        assert solver.positions(out) is out
+        expected = tube_basis.rest.reshape(-1) + tube_basis.vectors.astype(np.float64) @ solver.q
+        assert np.allclose(out.reshape(-1), expected, rtol=0, atol=1e-5 * np.abs(expected).max())
+    for bad in [np.zeros(rest.shape, np.float64), np.zeros((rest.shape[0], 4), np.float32),
+                np.zeros(rest.shape, np.float32, order="F"), [[0.0] * 3] * len(rest)]:
+        with pytest.raises(ValueError, match="out"):
+            solver.positions(bad)
+    read_only = np.zeros(rest.shape, np.float32)
+    read_only.flags.writeable = False
+    with pytest.raises(ValueError, match="writeable"):
+        solver.positions(read_only)
+    solver.reset()
+    assert np.array_equal(solver.positions(), rest)
+
+
+def test_state_persists_across_solves(tube, tube_basis):
+    _, _, handles, transforms = tube
+    once, twice = (mdc.ReducedSolver(tube_basis, handles, stiffness=100.0) for _ in range(2))
+    for solver in (once, twice):
+        solver.set_transforms(transforms)
+    ten = once.solve(10, tolerance=1e-14)
+    first, second = twice.solve(5, tolerance=1e-14), twice.solve(5, tolerance=1e-14)
+    assert first["iterations"] + second["iterations"] == ten["iterations"]
+    assert np.array_equal(once.q, twice.q)
+
+
+def test_arap_objective_in_the_shells_basis(tube, tube_basis):
+    V, F, handles, transforms = tube
+    solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0, energy="arap")
+    solver.set_transforms(transforms)
+    assert converge(solver)["converged"]
+    reference = mdc.solve_full(V, F, handles, transforms, stiffness=100.0, energy="arap")
+    diagonal = np.linalg.norm(np.ptp(reference, axis=0))
+    assert np.sqrt(np.mean(np.sum((solver.positions() - reference) ** 2, axis=1))) < 0.04 * diagonal
+
+
+def test_reduced_solver_refuses_bad_input(tube, tube_basis):
+    _, _, handles, transforms = tube
+    with pytest.raises(ValueError, match=r"handles\[1\]\[0\] = 999999"):
+        mdc.ReducedSolver(tube_basis, [handles[0], [999999]])
+    with pytest.raises(ValueError, match="stiffness"):
+        mdc.ReducedSolver(tube_basis, handles, stiffness=0.0)
+    with pytest.raises(ValueError, match="energy"):
+        mdc.ReducedSolver(tube_basis, handles, energy="springs")
+    with pytest.raises(ValueError, match="weights"):
+        mdc.ReducedSolver(tube_basis, handles, weights=[1.0])
+    solver = mdc.ReducedSolver(tube_basis, handles)
+    sheared = np.eye(4)
+    sheared[0, 1] = 0.2
+    with pytest.raises(ValueError, match=r"transforms\[1\]"):
+        solver.set_transforms([np.eye(4), sheared])
+    with pytest.raises(ValueError, match="expected 2"):
+        solver.set_transforms(transforms[:1])
+    with pytest.raises(ValueError, match="max_iterations"):
+        solver.solve(max_iterations=-1)
+    with pytest.raises(ValueError, match="tolerance"):
+        solver.solve(tolerance=2.0)
