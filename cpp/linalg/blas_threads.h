@@ -12,7 +12,9 @@ int blas_threads();
 
 // While it lives, the BLAS leaves one core to a thread of the caller's: it runs on one thread fewer
 // than it had (at least one); the destructor restores the count. The count is global to the
-// process: guards must not overlap in time on different threads.
+// process (numpy in the same process shares it when it uses the same OpenBLAS): guards that
+// overlap in time on different threads (two bakes at once) leave it right when the last ends,
+// and either count in between, which changes only the speed.
 class BlasLeavesACore {
  public:
   BlasLeavesACore();
