@@ -77,7 +77,8 @@ FUZZ_TARGETS := mesh_entry_points bake_and_pose stored_basis
 CHECKED_FLAGS := -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g -D_GLIBCXX_ASSERTIONS" \
 	-DMODAL_DEFORM_BENCH=OFF
 # CPython is not instrumented: the ASan runtime must be loaded before it (LD_PRELOAD), and its
-# allocations at exit are not leaks to report.
+# allocations at exit are not leaks to report. libstdc++ is preloaded too: loaded later (with the
+# extension), ASan's __cxa_throw interceptor finds no real function and aborts at the first throw.
 SANITIZE_ENV := ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 
 # The extension goes into its own copy of the package (links to the Python sources), so the
@@ -91,7 +92,8 @@ sanitize: deps
 		|| (cat $(SANITIZE_DIR)/configure.log; exit 1)
 	@cmake --build $(SANITIZE_DIR) -j $(JOBS)
 	cd $(SANITIZE_DIR) && $(SANITIZE_ENV) ctest --output-on-failure -j $(JOBS)
-	$(SANITIZE_ENV) LD_PRELOAD=$$($(CXX) -print-file-name=libasan.so) PYTHONPATH=$(SANITIZE_DIR)/python_addon \
+	$(SANITIZE_ENV) LD_PRELOAD="$$($(CXX) -print-file-name=libasan.so) $$($(CXX) -print-file-name=libstdc++.so)" \
+		PYTHONPATH=$(SANITIZE_DIR)/python_addon \
 		$(PYTHON) -m pytest -q -p no:cacheprovider tests/python
 
 # libFuzzer comes with Debian's clang (its runtime in libclang-rt-14-dev); only this target needs it.
