@@ -18,7 +18,7 @@ PACKAGES := cmake g++ make pkg-config \
 
 BLENDER_TEST := $(BLENDER) -b --factory-startup --python-exit-code 1
 
-.PHONY: all deps build test test-cpp test-python test-blender demo bench addon clean
+.PHONY: all deps build test test-cpp test-python test-blender test-gui demo bench addon clean
 
 all: build
 
@@ -38,7 +38,7 @@ build: deps
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 
 test: build
-	$(MAKE) --no-print-directory test-cpp test-python test-blender
+	$(MAKE) --no-print-directory test-cpp test-python test-blender test-gui
 
 test-cpp:
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
@@ -49,6 +49,10 @@ test-python:
 test-blender:
 	PYTHONPATH=python_addon $(PYTHON) -m pytest -q tests/blender
 
+# Blender with a window under Xvfb, driven by simulated mouse and keyboard events.
+test-gui:
+	PYTHONPATH=python_addon $(PYTHON) -m pytest -q tests/gui
+
 demo: build
 	@mkdir -p out
 	$(BLENDER_TEST) --python blender_scripts/demo.py -- --output out
@@ -56,6 +60,11 @@ demo: build
 bench: build
 	@mkdir -p bench/results
 	$(BUILD_DIR)/bench/modal_deform_bench --benchmark_out=bench/results/native.json --benchmark_out_format=json
+	$(BLENDER_TEST) --python bench/blender_pose.py -- --output bench/results/blender_pose.json
+
+# dist/modal_deform-<version>.zip: the add-on folder with the compiled extension, for Blender's installer.
+addon: build
+	$(PYTHON) python_addon/package.py dist
 
 clean:
 	rm -rf $(BUILD_DIR) out dist python_addon/modal_deform/_native*.so

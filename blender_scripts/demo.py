@@ -1,8 +1,10 @@
-"""The main job, headless: Suzanne, subdivided to about 30k vertices, bent, with its shells energy.
+"""The main job, headless: bake Suzanne (~31k vertices), pose it with two handles, render before/after.
 
     blender -b --factory-startup --python blender_scripts/demo.py -- --output out
 
-Writes OUTPUT/demo.blend with the bend as a shape key (the base mesh stays the rest state).
+Writes OUTPUT/demo.png (Cycles on the CPU, rest and posed side by side) and OUTPUT/demo.blend,
+ready to pose: select the mesh, Sidebar > Modal Deform > Pose, then move the Empties with G/R.
+Prints the bake time and the time per interactive update.
 """
 import argparse
 import math
@@ -10,78 +12,158 @@ import pathlib
 import sys
 import time
 
+import addon_utils
 import bpy
 import numpy as np
+from mathutils import Matrix, Vector
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "python_addon"))
-import modal_deform.core as mdc  # noqa: E402
 
 
 def arguments():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-    parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--output", default="out", help="folder for demo.blend")
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--output", default="out", help="folder for demo.png and demo.blend")
     parser.add_argument("--subdivisions", type=int, default=3, help="Catmull-Clark levels (3: ~31k vertices)")
+    parser.add_argument("--samples", type=int, default=16, help="Cycles samples per pixel")
     return parser.parse_args(argv)
 
 
 def subdivided_suzanne(levels):
-    bpy.ops.wm.read_factory_settings(use_empty=True)
+    for obj in list(bpy.data.objects):
+        bpy.data.objects.remove(obj)
     bpy.ops.mesh.primitive_monkey_add()
     suzanne = bpy.context.object
     modifier = suzanne.modifiers.new("Subdivision", "SUBSURF")
     modifier.levels = levels
     bpy.ops.object.modifier_apply(modifier=modifier.name)
+    bpy.ops.object.shade_smooth()
     return suzanne
 
 
-def mesh_arrays(mesh):
-    V = np.empty(3 * len(mesh.vertices), np.float64)
-    mesh.vertices.foreach_get("co", V)
-    mesh.calc_loop_triangles()
-    F = np.empty(3 * len(mesh.loop_triangles), np.int32)
-    mesh.loop_triangles.foreach_get("vertices", F)
-    return V.reshape(-1, 3), F.reshape(-1, 3)
+def add_handle(obj, mask):
+    """A handle of the vertices in `mask`, made as an artist does: select them, Add Handle."""
+    mesh = obj.data
+    mesh.polygons.foreach_set("select", np.zeros(len(mesh.polygons), bool))
+    mesh.edges.foreach_set("select", np.zeros(len(mesh.edges), bool))
+    mesh.vertices.foreach_set("select", mask)
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.ops.modal_deform.add_handle()
+    bpy.ops.object.mode_set(mode="OBJECT")
+    return obj.modal_deform.handles[-1]
 
 
-def bend(V, degrees):
-    """Bend about the x axis: each vertex turns in proportion to its height, top by `degrees`."""
-    z = V[:, 2]
-    angle = math.radians(degrees) * (z - z.min()) / np.ptp(z)
-    y, c, s = V[:, 1], np.cos(angle), np.sin(angle)
-    bent = V.copy()
-    bent[:, 1] = c * y - s * z
-    bent[:, 2] = s * y + c * z
-    return bent
+def interactive_updates(obj, count):
+    """Time `count` updates of the interactive pose (what each timer tick of the Pose operator does:
+    controllers -> solver within its budget -> shape key) while the controllers move in steps."""
+    from modal_deform import posing
+    pose = posing.Pose(bpy.context, obj)
+    state = posing.ShapeKeyState(obj, posing.POSE_KEY)
+    block = state.ensure()
+    times = []
+    for _ in range(count):
+        start = time.perf_counter()
+        pose.follow_controllers()
+        pose.step(obj.modal_deform.budget)
+        pose.write(block)
+        times.append(1e3 * (time.perf_counter() - start))
+    state.restore()
+    return times
+
+
+def stage(camera_target):
+    scene = bpy.context.scene
+    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    scene.collection.objects.link(camera)
+    camera.location = (1.2, -6.8, 0.8)
+    direction = camera_target - camera.location
+    camera.rotation_euler = direction.to_track_quat("-Z", "Y").to_euler()
+    camera.data.lens = 50
+    scene.camera = camera
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    sun.data.energy = 4.0
+    sun.rotation_euler = (math.radians(50), math.radians(10), math.radians(30))
+    scene.collection.objects.link(sun)
+    world = bpy.data.worlds.new("World")
+    world.color = (0.05, 0.05, 0.06)
+    world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.6
+    scene.world = world
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    scene.cycles.samples = 16
+    scene.cycles.use_denoising = False
+    scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = 480, 270, 100
+    scene.render.image_settings.file_format = "PNG"
+
+
+def render(path):
+    bpy.context.scene.render.filepath = str(path)
+    bpy.ops.render.render(write_still=True)
+    image = bpy.data.images.load(str(path))
+    pixels = np.empty(image.size[0] * image.size[1] * 4, np.float32)
+    image.pixels.foreach_get(pixels)
+    bpy.data.images.remove(image)
+    return pixels.reshape(270, 480, 4)
+
+
+def side_by_side(left, right, path):
+    both = np.concatenate([left, right], axis=1)
+    image = bpy.data.images.new("demo", both.shape[1], both.shape[0], alpha=True)
+    image.pixels.foreach_set(both.ravel())
+    image.filepath_raw = str(path)
+    image.file_format = "PNG"
+    image.save()
+    bpy.data.images.remove(image)
 
 
 def main():
     args = arguments()
-    suzanne = subdivided_suzanne(args.subdivisions)
-    V, F = mesh_arrays(suzanne.data)
-    report = mdc.check(V, F)
-    print(f"Suzanne: {report['vertices']} vertices, {report['faces']} triangles, "
-          f"{report['components']} components")
-
-    scale = 10.0 / np.ptp(V, axis=0).max()  # the paper's frame: longest bounding-box edge 10
-    start = time.perf_counter()
-    energy = mdc.DiscreteShells(V * scale, F)
-    build = time.perf_counter() - start
-    bent = bend(V, 45.0)
-    start = time.perf_counter()
-    value = energy.value(bent * scale)
-    gradient = energy.gradient(bent * scale)
-    evaluate = time.perf_counter() - start
-    print(f"shells energy under a 45 degree bend: {value:.6g} "
-          f"(|gradient| {np.linalg.norm(gradient):.4g}; built in {build * 1e3:.0f} ms, "
-          f"value + gradient in {evaluate * 1e3:.1f} ms)")
-
-    suzanne.shape_key_add(name="Basis")
-    key = suzanne.shape_key_add(name="Bend 45")
-    key.data.foreach_set("co", bent.astype(np.float32).ravel())
-    key.value = 1.0
+    addon_utils.enable("modal_deform", default_set=True)
+    from modal_deform import posing
     output = pathlib.Path(args.output).resolve()
     output.mkdir(parents=True, exist_ok=True)
+
+    suzanne = subdivided_suzanne(args.subdivisions)
+    V = np.empty(3 * len(suzanne.data.vertices), np.float32)
+    suzanne.data.vertices.foreach_get("co", V)
+    V = V.reshape(-1, 3)
+    print(f"Suzanne: {len(V)} vertices, {len(suzanne.data.polygons)} faces")
+
+    start = time.perf_counter()
+    assert bpy.ops.modal_deform.bake() == {"FINISHED"}
+    status = suzanne.modal_deform.status
+    print(f"bake: {time.perf_counter() - start:.1f} s ({status.dimension} dimensions, ghost {status.ghost_vertices} "
+          f"vertices)")
+
+    # Handles: the top of the head, tilted to the side; the chin, pulled down and forward.
+    head = add_handle(suzanne, V[:, 2] > 0.6)
+    chin = add_handle(suzanne, (V[:, 2] < -0.55) & (V[:, 1] < -0.3))
+    head_empty, chin_empty = head.controller, chin.controller
+    head_empty.matrix_world = (Matrix.Translation((0.25, 0.0, 0.05)) @ head_empty.matrix_world
+                               @ Matrix.Rotation(math.radians(-15), 4, "Y"))
+    chin_empty.location += Vector((0.0, -0.15, -0.2))  # in Suzanne's space: Add Handle parents the Empty
+    bpy.context.view_layer.update()
+
+    times = interactive_updates(suzanne, 30)
+    print(f"interactive pose: {np.median(times):.1f} ms per update (median of {len(times)}; first {times[0]:.1f} ms; "
+          f"budget {suzanne.modal_deform.budget:.0f} ms for the solver)")
+    assert bpy.ops.modal_deform.solve() == {"FINISHED"}
+
+    stage(suzanne.matrix_world.translation + Vector((0.15, 0.0, 0.0)))
+    bpy.context.scene.cycles.samples = args.samples
+    key = suzanne.data.shape_keys.key_blocks[posing.POSE_KEY]
+    start = time.perf_counter()
+    key.value = 0.0
+    before = render(output / "demo_before.png")
+    key.value = 1.0
+    after = render(output / "demo_after.png")
+    side_by_side(before, after, output / "demo.png")
+    print(f"rendered {output / 'demo.png'} in {time.perf_counter() - start:.1f} s")
+
+    bpy.context.view_layer.objects.active = suzanne
+    for obj in bpy.context.view_layer.objects:
+        obj.select_set(obj == suzanne)
     bpy.ops.wm.save_as_mainfile(filepath=str(output / "demo.blend"))
     print(f"wrote {output / 'demo.blend'}")
 

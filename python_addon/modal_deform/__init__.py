@@ -1,7 +1,7 @@
 """Modal Deform: pose high-resolution meshes with a physically based energy in a reduced space.
 
 This file only registers the Blender layer. ``modal_deform.core`` is the bpy-free API and
-imports without Blender.
+imports without Blender, so the Blender modules are imported inside register().
 """
 bl_info = {
     "name": "Modal Deform",
@@ -13,10 +13,20 @@ bl_info = {
     "category": "Mesh",
 }
 
+# The Blender modules in registration order (properties before what refers to them).
+_MODULES = ("properties", "storage", "ops_bake", "ops_handles", "ops_pose", "ops_animation", "ops_preview", "ui")
+
+
+def _modules():
+    import importlib
+    return [importlib.import_module(f".{name}", __name__) for name in _MODULES]
+
 
 def register():
-    pass
+    for module in _modules():
+        module.register()
 
 
 def unregister():
-    pass
+    for module in reversed(_modules()):
+        module.unregister()

@@ -1,0 +1,301 @@
+"""Posing in headless Blender: time per update on dragon_vrip_res2 (100k vertices) at 67 and 130
+dimensions, Blender's Laplacian Deform on a subdivided Suzanne of similar size, basis load time,
+.blend size, and what storing the basis on the Object would cost every update.
+
+    blender -b --factory-startup --python bench/blender_pose.py -- --output bench/results/blender_pose.json
+
+One update is what the Pose operator does per timer tick, each step timed: controller matrices →
+set_transforms → 10 BFGS iterations → positions(out=float32) → shape key foreach_set →
+mesh.update(). Blender then evaluates the mesh for display ("evaluate": view_layer.update()).
+Medians over the updates, with the controller moving a little each time.
+"""
+import argparse
+import json
+import math
+import os
+import pathlib
+import sys
+import tempfile
+import time
+
+import addon_utils
+import bpy
+import numpy as np
+from mathutils import Matrix
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "python_addon"))
+MESHES = ROOT.parent / "shared" / "meshes"
+
+
+def arguments():
+    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--output", default="bench/results/blender_pose.json")
+    parser.add_argument("--updates", type=int, default=30, help="pose updates timed per basis")
+    parser.add_argument("--laplacian-updates", type=int, default=3, help="Laplacian Deform updates timed")
+    return parser.parse_args(argv)
+
+
+def clear_scene():
+    for obj in list(bpy.data.objects):
+        bpy.data.objects.remove(obj)
+    bpy.data.orphans_purge(do_recursive=True)
+
+
+def milliseconds(start):
+    return 1e3 * (time.perf_counter() - start)
+
+
+def dragon():
+    from modal_deform import core as mdc
+    V, F = mdc.read_mesh(MESHES / "dragon_vrip_res2.ply.gz")
+    mesh = bpy.data.meshes.new("Dragon")
+    mesh.vertices.add(len(V))
+    mesh.vertices.foreach_set("co", V.astype(np.float32).ravel())
+    mesh.loops.add(F.size)
+    mesh.loops.foreach_set("vertex_index", F.ravel())
+    mesh.polygons.add(len(F))
+    mesh.polygons.foreach_set("loop_start", np.arange(0, F.size, 3, dtype=np.int32))
+    mesh.polygons.foreach_set("loop_total", np.full(len(F), 3, np.int32))
+    mesh.update(calc_edges=True)
+    obj = bpy.data.objects.new("Dragon", mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    return obj
+
+
+def add_handle(obj, mask):
+    mesh = obj.data
+    mesh.polygons.foreach_set("select", np.zeros(len(mesh.polygons), bool))
+    mesh.edges.foreach_set("select", np.zeros(len(mesh.edges), bool))
+    mesh.vertices.foreach_set("select", mask)
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.ops.modal_deform.add_handle()
+    bpy.ops.object.mode_set(mode="OBJECT")
+    return obj.modal_deform.handles[-1]
+
+
+def time_updates(obj, controller, updates):
+    """Per-step medians (ms) of `updates` pose updates while the controller turns and slides."""
+    from modal_deform import handles, mesh_io, posing
+    pose = posing.Pose(bpy.context, obj)
+    state = posing.ShapeKeyState(obj, posing.POSE_KEY)
+    block = state.ensure()
+    size = max(obj.dimensions)
+    steps = {name: [] for name in ("controllers", "set_transforms", "solve", "positions", "write", "tick",
+                                   "evaluate")}
+    iterations = []
+    start_matrix = controller.matrix_world.copy()
+    for i in range(updates):
+        controller.matrix_world = (Matrix.Translation((0.0, 0.01 * size * i, 0.005 * size * i)) @ start_matrix
+                                   @ Matrix.Rotation(math.radians(1.0 * i), 4, "X"))
+        bpy.context.view_layer.update()
+        tick = time.perf_counter()
+        t = time.perf_counter()
+        transforms = handles.transforms(obj, pose.handles)
+        steps["controllers"].append(milliseconds(t))
+        t = time.perf_counter()
+        pose.solver.set_transforms(transforms)
+        steps["set_transforms"].append(milliseconds(t))
+        t = time.perf_counter()
+        # A tolerance no iterate meets: the 10 iterations a tick may spend (fewer only when BFGS stalls).
+        iterations.append(pose.solver.solve(max_iterations=10, tolerance=1e-12)["iterations"])
+        steps["solve"].append(milliseconds(t))
+        t = time.perf_counter()
+        pose.solver.positions(pose.out)
+        steps["positions"].append(milliseconds(t))
+        t = time.perf_counter()
+        mesh_io.write_shape_key(obj.data, block, pose.out)
+        steps["write"].append(milliseconds(t))
+        steps["tick"].append(milliseconds(tick))
+        t = time.perf_counter()
+        bpy.context.view_layer.update()
+        steps["evaluate"].append(milliseconds(t))
+    controller.matrix_world = start_matrix
+    state.restore()
+    result = {name: float(np.median(values)) for name, values in steps.items()}
+    result["iterations"] = float(np.median(iterations))
+    return result
+
+
+def time_shape_key_update(obj, block, repeats=10):
+    """Median ms of foreach_set + mesh.update() + depsgraph evaluation of a shape key."""
+    co = np.empty(3 * len(obj.data.vertices), np.float32)
+    block.data.foreach_get("co", co)
+    times = []
+    for _ in range(repeats):
+        t = time.perf_counter()
+        block.data.foreach_set("co", co)
+        obj.data.update()
+        bpy.context.view_layer.update()
+        times.append(milliseconds(t))
+    return float(np.median(times))
+
+
+def storage_figures(obj, folder):
+    """Load time and file sizes of the stored basis; the cost of keeping it on the Object instead."""
+    from modal_deform import posing, storage
+    figures = {}
+    state = posing.ShapeKeyState(obj, posing.POSE_KEY)
+    key = state.ensure()
+    figures["update_ms_basis_in_palette"] = time_shape_key_update(obj, key)
+    obj["vectors_probe"] = np.frombuffer(obj.modal_deform.basis["vectors"], np.float32)
+    figures["update_ms_basis_on_object"] = time_shape_key_update(obj, key)
+    del obj["vectors_probe"]
+    state.restore()
+
+    with_basis = os.path.join(folder, "with_basis.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=with_basis, copy=True)
+    data = sum(a.nbytes for a in storage.load(obj).to_arrays().values())
+    palette = obj.modal_deform.basis
+    obj.modal_deform.basis = None
+    without = os.path.join(folder, "without_basis.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=without, copy=True)
+    obj.modal_deform.basis = palette
+    figures["blend_mb"] = os.path.getsize(with_basis) / 1e6
+    figures["blend_growth_mb"] = (os.path.getsize(with_basis) - os.path.getsize(without)) / 1e6
+    figures["basis_data_mb"] = data / 1e6
+
+    t = time.perf_counter()
+    bpy.ops.wm.open_mainfile(filepath=with_basis)
+    figures["open_blend_s"] = time.perf_counter() - t
+    obj = bpy.data.objects["Dragon"]
+    loads = []
+    for _ in range(3):
+        storage._forget_everything()
+        t = time.perf_counter()
+        storage.load(obj)
+        loads.append(time.perf_counter() - t)
+    figures["basis_load_s"] = min(loads)
+    return figures
+
+
+def components(mesh):
+    """Connected-component label of each vertex (the smallest vertex index in it)."""
+    edges = np.empty(2 * len(mesh.edges), np.int32)
+    mesh.edges.foreach_get("vertices", edges)
+    a, b = edges.reshape(-1, 2).T
+    label = np.arange(len(mesh.vertices))
+    while True:
+        low = np.minimum(label[a], label[b])
+        updated = label.copy()
+        np.minimum.at(updated, a, low)
+        np.minimum.at(updated, b, low)
+        updated = updated[updated]  # jump to the label's label: halves the remaining distance
+        if np.array_equal(updated, label):
+            return label
+        label = updated
+
+
+def laplacian_deform(updates):
+    """Blender's Laplacian Deform on Suzanne at 4 subdivision levels: bind time and time per update
+    (1 iteration, the modifier's default) with a hook moving the top anchors."""
+    clear_scene()
+    bpy.ops.mesh.primitive_monkey_add()
+    obj = bpy.context.object
+    subdivision = obj.modifiers.new("Subdivision", "SUBSURF")
+    subdivision.levels = 4
+    bpy.ops.object.modifier_apply(modifier=subdivision.name)
+    V = np.empty(3 * len(obj.data.vertices), np.float32)
+    obj.data.vertices.foreach_get("co", V)
+    V = V.reshape(-1, 3)
+    top, bottom = np.flatnonzero(V[:, 2] > 0.6), np.flatnonzero(V[:, 2] < -0.55)
+    # Every connected component needs an anchor, or the modifier finds no solution: the eyes too.
+    label = components(obj.data)
+    eyes = np.flatnonzero(label != label[top[0]])
+    anchors = obj.vertex_groups.new(name="Anchors")
+    anchors.add(np.concatenate([top, bottom, eyes]).tolist(), 1.0, "REPLACE")
+    moving = obj.vertex_groups.new(name="Top")
+    moving.add(top.tolist(), 1.0, "REPLACE")
+    empty = bpy.data.objects.new("Hook", None)
+    bpy.context.scene.collection.objects.link(empty)
+    hook = obj.modifiers.new("Hook", "HOOK")
+    hook.object, hook.vertex_group = empty, "Top"
+    laplacian = obj.modifiers.new("LaplacianDeform", "LAPLACIANDEFORM")
+    laplacian.vertex_group = "Anchors"
+    bpy.context.view_layer.update()
+    t = time.perf_counter()
+    with bpy.context.temp_override(object=obj, active_object=obj):
+        bpy.ops.object.laplaciandeform_bind(modifier=laplacian.name)
+    bpy.context.view_layer.update()
+    bind = time.perf_counter() - t
+    times = []
+    for i in range(updates):
+        empty.location = (0.02 * (i + 1), 0.0, 0.01 * (i + 1))
+        t = time.perf_counter()
+        bpy.context.view_layer.update()
+        times.append(milliseconds(t))
+    # Failing, the modifier passes the hooked mesh through: vertices away from the anchors stay.
+    free = np.ones(len(V), bool)
+    free[np.concatenate([top, bottom, eyes])] = False
+    solved = bool(np.abs(evaluated_positions(obj)[free] - V[free]).max() > 0)
+    return {"vertices": len(V), "bind_s": bind, "update_ms": float(np.median(times)), "solved": solved}
+
+
+def evaluated_positions(obj):
+    evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    mesh = evaluated.to_mesh()
+    co = np.empty(3 * len(mesh.vertices), np.float32)
+    mesh.vertices.foreach_get("co", co)
+    evaluated.to_mesh_clear()
+    return co.reshape(-1, 3)
+
+
+def main():
+    args = arguments()
+    addon_utils.enable("modal_deform", default_set=True)
+    clear_scene()
+    obj = dragon()
+    V = np.empty(3 * len(obj.data.vertices), np.float32)
+    obj.data.vertices.foreach_get("co", V)
+    V = V.reshape(-1, 3)
+    axis = int(np.argmax(np.ptp(V, axis=0)))
+    low, high = np.quantile(V[:, axis], [0.05, 0.95])
+    moving = add_handle(obj, V[:, axis] > high)
+    add_handle(obj, V[:, axis] < low).controller = None
+    results = {"mesh": "dragon_vrip_res2", "vertices": len(V), "bases": {}}
+    # dragon_vrip_res2 has 6 floppy zero modes on top of the modes asked for: 16 + 6 + 45 = 67 and
+    # 20 + 6 + 104 = 130 dimensions (bench_solve.cpp bakes the same).
+    for modes, derivatives in ((16, 45), (20, 104)):
+        settings = obj.modal_deform
+        settings.modes, settings.derivatives, settings.ghost = modes, derivatives, 1000
+        t = time.perf_counter()
+        bpy.ops.modal_deform.bake()
+        bake = time.perf_counter() - t
+        dimension = settings.status.dimension
+        figures = time_updates(obj, moving.controller, args.updates)
+        figures["bake_s"] = bake
+        results["bases"][str(dimension)] = figures
+        print(f"{dimension} dimensions: baked in {bake:.1f} s; update {figures['tick']:.1f} ms "
+              f"({figures['iterations']:.0f} iterations)", flush=True)
+    with tempfile.TemporaryDirectory() as folder:
+        results["storage"] = storage_figures(obj, folder)
+    results["laplacian_deform"] = laplacian_deform(args.laplacian_updates)
+
+    print("\nPose update on dragon_vrip_res2 (100,250 vertices), headless, shared 2-core machine; ms, medians")
+    print(f"{'dims':>5} {'ctrl':>6} {'set':>6} {'solve':>6} {'map':>6} {'write':>6} {'tick':>6} {'eval':>6} "
+          f"{'iters':>5} {'bake s':>7}")
+    for dims, f in results["bases"].items():
+        print(f"{dims:>5} {f['controllers']:6.2f} {f['set_transforms']:6.2f} {f['solve']:6.2f} {f['positions']:6.2f} "
+              f"{f['write']:6.2f} {f['tick']:6.2f} {f['evaluate']:6.1f} {f['iterations']:5.0f} {f['bake_s']:7.1f}")
+    lap = results["laplacian_deform"]
+    print(f"\nLaplacian Deform, Suzanne {lap['vertices']} vertices: bind {lap['bind_s']:.1f} s, "
+          f"{lap['update_ms']:.0f} ms per update (solved: {lap['solved']})")
+    for dims, f in results["bases"].items():
+        f["laplacian_ratio_tick"] = lap["update_ms"] / f["tick"]
+        f["laplacian_ratio_tick_and_evaluate"] = lap["update_ms"] / (f["tick"] + f["evaluate"])
+        print(f"  ratio to Modal Deform at {dims} dims: {f['laplacian_ratio_tick']:.0f}x per tick, "
+              f"{f['laplacian_ratio_tick_and_evaluate']:.0f}x with Blender's evaluation of both")
+    s = results["storage"]
+    print(f"\nStorage: .blend {s['blend_mb']:.1f} MB, grows {s['blend_growth_mb']:.1f} MB for {s['basis_data_mb']:.1f} MB "
+          f"of basis; open {s['open_blend_s']:.2f} s; basis load {s['basis_load_s'] * 1e3:.0f} ms")
+    print(f"Shape-key update + evaluation: {s['update_ms_basis_in_palette']:.1f} ms with the basis in its palette, "
+          f"{s['update_ms_basis_on_object']:.1f} ms with the vectors on the Object")
+    output = pathlib.Path(args.output)
+    output.parent.mkdir(parents=True, exist_ok=True)
+    output.write_text(json.dumps(results, indent=1))
+    print(f"wrote {output}")
+
+
+main()

@@ -1,0 +1,203 @@
+"""Posing operators: interactive (modal, timer-driven), solve (converged, for scripts), reset."""
+import time
+
+import bpy
+
+from . import handles, mesh_io, posing, storage
+from .ops_bake import _mesh_poll
+
+_FAILURES = (storage.NotReady, handles.HandleError, ValueError, RuntimeError)
+
+# The running interactive pose, so the right-click menu's items can end it.
+_running = None
+
+
+class MODAL_DEFORM_OT_pose(bpy.types.Operator):
+    """Pose interactively: move the controllers (G, R) and the mesh follows. Enter or right-click > Apply \
+keeps the pose, Esc restores the mesh as it was"""
+    bl_idname = "modal_deform.pose"
+    bl_label = "Pose"
+    bl_options = {"REGISTER", "UNDO"}
+
+    poll = classmethod(_mesh_poll)
+
+    def invoke(self, context, event):
+        global _running
+        obj = handles.owner(context.object)
+        try:
+            self.pose = posing.Pose(context, obj)
+        except _FAILURES as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        for warning in self.pose.warnings:
+            self.report({"WARNING"}, warning)
+        self.state = posing.ShapeKeyState(obj, posing.POSE_KEY)
+        self.block = self.state.ensure()
+        self.block_name = self.block.name
+        self.area = context.area
+        self.request = None
+        self.tick_ms = 0.0
+        wm = context.window_manager
+        self.timer = wm.event_timer_add(1.0 / 60.0, window=context.window)
+        wm.modal_handler_add(self)
+        context.workspace.status_text_set(
+            "Modal Deform: move the controllers (G, R)   Enter: apply   Esc: cancel   Right-click: menu")
+        _running = self
+        return {"RUNNING_MODAL"}
+
+    def modal(self, context, event):
+        if self.request is not None:
+            return self._end(context, self.request)
+        if event.type == "TIMER":  # ours or another's: a tick either way (3.x events do not say whose)
+            return self._tick(context)
+        if event.value == "PRESS":
+            if event.type == "ESC":
+                return self._end(context, "CANCEL")
+            if event.type in {"RET", "NUMPAD_ENTER"}:
+                return self._end(context, "APPLY")
+            if event.type == "RIGHTMOUSE":
+                bpy.ops.wm.call_menu(name=MODAL_DEFORM_MT_pose.bl_idname)
+                return {"RUNNING_MODAL"}
+            if event.type == "Z" and (event.ctrl or event.oskey):
+                self.report({"WARNING"}, "Undo is off while posing: Enter applies, Esc cancels")
+                return {"RUNNING_MODAL"}
+        return {"PASS_THROUGH"}
+
+    def _tick(self, context):
+        obj = self.pose.obj
+        try:
+            obj.mode
+        except ReferenceError:  # deleted while posing
+            return self._end(context, "CANCEL")
+        if obj.mode != "OBJECT":
+            self.report({"WARNING"}, "Left Object Mode: the pose so far is kept")
+            return self._end(context, "APPLY")
+        start = time.perf_counter()
+        try:
+            moved = self.pose.follow_controllers()
+            if moved or not self.pose.stats["converged"]:
+                self.pose.step(obj.modal_deform.budget)
+                self.pose.write(self.block)
+                self.tick_ms = 1e3 * (time.perf_counter() - start)
+        except _FAILURES as error:  # e.g. a controller deleted while posing
+            self.report({"ERROR"}, str(error))
+            return self._end(context, "CANCEL")
+        stats = self.pose.stats
+        state = "converged" if stats["converged"] else "solving"
+        if self.area is not None:
+            self.area.header_text_set(f"Modal Deform: {state}, {stats['iterations']} iterations, energy "
+                                      f"{stats['energy']:.5g}, {self.tick_ms:.1f} ms per update")
+        return {"PASS_THROUGH"}
+
+    def _end(self, context, how):
+        global _running
+        _running = None
+        context.window_manager.event_timer_remove(self.timer)
+        if context.workspace is not None:
+            context.workspace.status_text_set(None)
+        try:
+            if self.area is not None:
+                self.area.header_text_set(None)
+            if how == "CANCEL":
+                self.state.restore()
+        except ReferenceError:  # the object (or the screen) went away while posing: nothing to restore
+            return {"CANCELLED"}
+        return {"CANCELLED"} if how == "CANCEL" else {"FINISHED"}
+
+    def cancel(self, context):
+        """Blender ends the operator (file loaded, window closed): put the mesh back."""
+        self._end(context, "CANCEL")
+
+
+class MODAL_DEFORM_OT_pose_end(bpy.types.Operator):
+    """End the interactive pose"""
+    bl_idname = "modal_deform.pose_end"
+    bl_label = "End Pose"
+    bl_options = {"INTERNAL"}
+
+    how: bpy.props.EnumProperty(items=(("APPLY", "Apply", "Keep the pose in the shape key"),
+                                       ("CANCEL", "Cancel", "Restore the mesh as it was before posing")),
+                                description="Whether the pose is kept or the mesh restored")
+
+    @classmethod
+    def poll(cls, context):
+        return _running is not None
+
+    def execute(self, context):
+        _running.request = self.how
+        return {"FINISHED"}
+
+
+class MODAL_DEFORM_MT_pose(bpy.types.Menu):
+    bl_idname = "MODAL_DEFORM_MT_pose"
+    bl_label = "Modal Deform"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.operator(MODAL_DEFORM_OT_pose_end.bl_idname, text="Apply", icon="CHECKMARK").how = "APPLY"
+        layout.operator(MODAL_DEFORM_OT_pose_end.bl_idname, text="Cancel", icon="CANCEL").how = "CANCEL"
+
+
+class MODAL_DEFORM_OT_solve(bpy.types.Operator):
+    """Solve the pose for the controllers as they are, to convergence, into the "Modal Deform" shape key"""
+    bl_idname = "modal_deform.solve"
+    bl_label = "Solve"
+    bl_options = {"REGISTER", "UNDO"}
+
+    max_iterations: bpy.props.IntProperty(name="Max Iterations", default=2000, min=1,
+                                          description="BFGS iterations at most; fewer may leave the pose unfinished")
+    tolerance: bpy.props.FloatProperty(name="Tolerance", default=1e-6, min=1e-12, max=0.5,
+                                       description="Stopping tolerance of the Gill-Murray-Wright test: smaller "
+                                                   "solves more exactly and takes longer")
+
+    poll = classmethod(_mesh_poll)
+
+    def execute(self, context):
+        obj = handles.owner(context.object)
+        try:
+            pose = posing.Pose(context, obj)
+            pose.follow_controllers()
+            stats = pose.converge(self.max_iterations, self.tolerance)
+        except _FAILURES as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        for warning in pose.warnings:
+            self.report({"WARNING"}, warning)
+        block, _ = mesh_io.shape_key(obj, posing.POSE_KEY)
+        block.value, block.mute = 1.0, False
+        pose.write(block)
+        level = "INFO" if stats["converged"] else "WARNING"
+        self.report({level}, f"{'Converged' if stats['converged'] else 'Not converged'} after {stats['iterations']} "
+                             f"iterations in {stats['ms']:.0f} ms (energy {stats['energy']:.5g})")
+        return {"FINISHED"}
+
+
+class MODAL_DEFORM_OT_reset(bpy.types.Operator):
+    """Back to rest: controllers return to where they were assigned and the "Modal Deform" shape key goes"""
+    bl_idname = "modal_deform.reset"
+    bl_label = "Reset Pose"
+    bl_options = {"REGISTER", "UNDO"}
+
+    poll = classmethod(_mesh_poll)
+
+    def execute(self, context):
+        obj = handles.owner(context.object)
+        for item in obj.modal_deform.handles:
+            if item.controller is not None and item.controller.library is None:
+                item.controller.matrix_world = obj.matrix_world @ item.bind_matrix
+        mesh_io.remove_shape_keys(obj, [posing.POSE_KEY])
+        return {"FINISHED"}
+
+
+CLASSES = (MODAL_DEFORM_OT_pose, MODAL_DEFORM_OT_pose_end, MODAL_DEFORM_MT_pose, MODAL_DEFORM_OT_solve,
+           MODAL_DEFORM_OT_reset)
+
+
+def register():
+    for cls in CLASSES:
+        bpy.utils.register_class(cls)
+
+
+def unregister():
+    for cls in reversed(CLASSES):
+        bpy.utils.unregister_class(cls)

@@ -1,0 +1,169 @@
+"""The sidebar (View3D > N > Modal Deform): bake settings and status, handles, pose, animation, preview."""
+import bpy
+
+from . import handles, ops_preview, storage
+
+
+class MODAL_DEFORM_UL_handles(bpy.types.UIList):
+    """A row per handle: name, vertex group, controller (or pinned), weight."""
+
+    def draw_item(self, context, layout, data, item, icon, active_data, active_property, index=0, flt_flag=0):
+        row = layout.row(align=True)
+        row.prop(item, "name", text="", emboss=False, icon="GROUP_VERTEX")
+        if item.controller is not None:
+            row.label(text=item.controller.name, icon="EMPTY_AXIS")
+        else:
+            row.label(text="pinned", icon="PINNED")
+        row.prop(item, "weight", text="", emboss=False)
+
+
+class _Panel:
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = "Modal Deform"
+
+    @classmethod
+    def poll(cls, context):
+        return handles.owner(context.object) is not None
+
+
+class VIEW3D_PT_modal_deform(_Panel, bpy.types.Panel):
+    bl_label = "Modal Deform"
+
+    def draw(self, context):
+        obj = handles.owner(context.object)
+        settings = obj.modal_deform
+        layout = self.layout
+        if settings.basis is None:
+            layout.label(text="Not baked: set the basis up and Bake", icon="INFO")
+            return
+        reason = storage.stale_reason(obj, cached=True)
+        if reason:
+            layout.alert = True
+            layout.label(text=f"Mesh edited after the bake ({reason}): re-bake", icon="ERROR")
+        else:
+            layout.label(text="Ready to pose", icon="CHECKMARK")
+
+
+class VIEW3D_PT_modal_deform_bake(_Panel, bpy.types.Panel):
+    bl_label = "Basis"
+    bl_parent_id = "VIEW3D_PT_modal_deform"
+
+    def draw(self, context):
+        obj = handles.owner(context.object)
+        settings = obj.modal_deform
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        column = layout.column()
+        column.prop(settings, "energy")
+        column.prop(settings, "modes")
+        row = column.row()
+        row.enabled = settings.energy == "SHELLS"
+        row.prop(settings, "derivatives")
+        column.prop(settings, "ghost")
+        shells = column.column(align=True)
+        shells.enabled = settings.energy == "SHELLS"
+        shells.prop(settings, "bending")
+        shells.prop(settings, "membrane")
+
+        box = layout.box()
+        if settings.basis is None:
+            box.label(text="Not baked", icon="INFO")
+        else:
+            status = settings.status
+            box.label(text=f"{status.dimension} dimensions: {status.num_modes} modes, "
+                           f"{status.num_derivatives} derivatives", icon="OUTLINER_DATA_LIGHTPROBE")
+            box.label(text=f"Ghost: {status.ghost_vertices} vertices ({status.energy.title()})")
+            box.label(text=f"Baked {status.baked_at} in {status.seconds:.1f} s")
+            if status.num_floppy:
+                box.label(text=f"{status.num_floppy} floppy zero modes (non-manifold flaps)", icon="INFO")
+            reason = storage.stale_reason(obj, cached=True)
+            if reason:
+                row = box.row()
+                row.alert = True
+                row.label(text=f"Stale ({reason}): re-bake", icon="ERROR")
+        row = layout.row(align=True)
+        row.operator("modal_deform.bake", text="Re-bake" if settings.basis else "Bake", icon="RENDER_STILL")
+        row.operator("modal_deform.clear_basis", text="", icon="X")
+
+
+class VIEW3D_PT_modal_deform_handles(_Panel, bpy.types.Panel):
+    bl_label = "Handles"
+    bl_parent_id = "VIEW3D_PT_modal_deform"
+
+    def draw(self, context):
+        obj = handles.owner(context.object)
+        settings = obj.modal_deform
+        layout = self.layout
+        row = layout.row()
+        row.template_list("MODAL_DEFORM_UL_handles", "", settings, "handles", settings, "active_handle", rows=3)
+        column = row.column(align=True)
+        column.operator("modal_deform.add_handle", text="", icon="ADD")
+        column.operator("modal_deform.remove_handle", text="", icon="REMOVE")
+        if 0 <= settings.active_handle < len(settings.handles):
+            item = settings.handles[settings.active_handle]
+            column = layout.column()
+            column.use_property_split = True
+            column.use_property_decorate = False
+            column.prop_search(item, "vertex_group", obj, "vertex_groups")
+            column.prop(item, "controller")
+            column.prop(item, "weight")
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        layout.prop(settings, "stiffness")
+
+
+class VIEW3D_PT_modal_deform_pose(_Panel, bpy.types.Panel):
+    bl_label = "Pose"
+    bl_parent_id = "VIEW3D_PT_modal_deform"
+
+    def draw(self, context):
+        settings = handles.owner(context.object).modal_deform
+        layout = self.layout
+        column = layout.column()
+        column.use_property_split = True
+        column.use_property_decorate = False
+        column.prop(settings, "budget")
+        row = layout.row(align=True)
+        row.operator("modal_deform.pose", icon="PLAY")
+        row.operator("modal_deform.solve", icon="CHECKMARK")
+        layout.operator("modal_deform.reset", icon="LOOP_BACK")
+        layout.operator("modal_deform.bake_animation", icon="RENDER_ANIMATION")
+
+
+class VIEW3D_PT_modal_deform_preview(_Panel, bpy.types.Panel):
+    bl_label = "Mode Preview"
+    bl_parent_id = "VIEW3D_PT_modal_deform"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        obj = handles.owner(context.object)
+        settings = obj.modal_deform
+        layout = self.layout
+        column = layout.column()
+        column.use_property_split = True
+        column.use_property_decorate = False
+        column.prop(settings, "preview_vector")
+        column.prop(settings, "preview_amplitude")
+        status = settings.status
+        if settings.basis is not None:
+            index = min(settings.preview_vector, status.dimension - 1)
+            layout.label(text=f"Vector {index} of {status.dimension}: {ops_preview.describe(status, index)}")
+        showing = ops_preview.showing(obj)
+        layout.operator("modal_deform.preview_mode", text="Hide Preview" if showing else "Show Preview",
+                        icon="HIDE_OFF" if showing else "HIDE_ON", depress=showing)
+
+
+CLASSES = (MODAL_DEFORM_UL_handles, VIEW3D_PT_modal_deform, VIEW3D_PT_modal_deform_bake,
+           VIEW3D_PT_modal_deform_handles, VIEW3D_PT_modal_deform_pose, VIEW3D_PT_modal_deform_preview)
+
+
+def register():
+    for cls in CLASSES:
+        bpy.utils.register_class(cls)
+
+
+def unregister():
+    for cls in reversed(CLASSES):
+        bpy.utils.unregister_class(cls)

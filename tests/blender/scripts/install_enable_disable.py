@@ -1,0 +1,43 @@
+"""Install the zip like Preferences > Add-ons > Install, then enable, disable, enable again: nothing
+may be left behind by disabling (classes, properties, handlers, timers), and the installed copy
+(not the source tree) bakes."""
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(__file__))
+import addon_utils  # noqa: E402
+import bpy  # noqa: E402
+import support  # noqa: E402
+
+zip_path, user_scripts = support.arguments()
+handlers = {name: len(getattr(bpy.app.handlers, name)) for name in ("depsgraph_update_post", "load_post")}
+assert "modal_deform" not in sys.modules
+assert bpy.ops.preferences.addon_install(filepath=zip_path) == {"FINISHED"}
+
+
+def enable_and_bake():
+    module = addon_utils.enable("modal_deform", default_set=True, handle_error=None)
+    assert module is not None, "enabling failed"
+    assert os.path.realpath(module.__file__).startswith(os.path.realpath(user_scripts)), module.__file__
+    assert hasattr(bpy.types.Object, "modal_deform") and hasattr(bpy.types, "VIEW3D_PT_modal_deform")
+    obj = support.suzanne(0)
+    obj.modal_deform.modes, obj.modal_deform.derivatives, obj.modal_deform.ghost = 10, 5, 100
+    assert bpy.ops.modal_deform.bake() == {"FINISHED"}
+    assert obj.modal_deform.status.dimension >= 15
+
+
+def disable():
+    addon_utils.disable("modal_deform", default_set=True)
+    assert not hasattr(bpy.types.Object, "modal_deform")
+    for name in ("VIEW3D_PT_modal_deform", "MODAL_DEFORM_UL_handles", "ModalDeformSettings"):
+        assert not hasattr(bpy.types, name), f"{name} is still registered"
+    assert "bake" not in dir(bpy.ops.modal_deform)
+    now = {name: len(getattr(bpy.app.handlers, name)) for name in handlers}
+    assert now == handlers, f"handlers left behind: {now} vs {handlers}"
+
+
+enable_and_bake()
+disable()
+enable_and_bake()
+disable()
+print("INSTALL_OK")

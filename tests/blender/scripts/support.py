@@ -1,0 +1,107 @@
+"""Helpers shared by the headless test scripts (imported from the script's folder)."""
+import os
+import sys
+
+import addon_utils
+import bpy
+import numpy as np
+
+
+def enable_addon():
+    """Enable modal_deform from the source tree (ADDON_PATH) and return its package."""
+    sys.path.insert(0, os.environ["ADDON_PATH"])
+    addon_utils.enable("modal_deform", default_set=True)
+    import modal_deform
+    assert hasattr(bpy.types.Object, "modal_deform"), "the add-on did not register"
+    return modal_deform
+
+
+def tmp(name):
+    return os.path.join(os.environ["TEST_TMP"], name)
+
+
+def suzanne(levels=1):
+    """Suzanne with `levels` of Catmull-Clark subdivision applied (quads), selected and active, in
+    place of the startup file's objects."""
+    for obj in list(bpy.data.objects):
+        bpy.data.objects.remove(obj)
+    bpy.ops.mesh.primitive_monkey_add()
+    obj = bpy.context.object
+    if levels:
+        modifier = obj.modifiers.new("Subdivision", "SUBSURF")
+        modifier.levels = levels
+        bpy.ops.object.modifier_apply(modifier=modifier.name)
+    return obj
+
+
+def positions(obj):
+    co = np.empty(3 * len(obj.data.vertices), np.float32)
+    obj.data.vertices.foreach_get("co", co)
+    return co.reshape(-1, 3)
+
+
+def key_positions(obj, name):
+    block = obj.data.shape_keys.key_blocks[name]
+    co = np.empty(3 * len(block.data), np.float32)
+    block.data.foreach_get("co", co)
+    return co.reshape(-1, 3)
+
+
+def add_handle(obj, mask):
+    """Add a handle from the vertices in the boolean mask, through the Edit Mode operator."""
+    bpy.context.view_layer.objects.active = obj
+    mesh = obj.data
+    mesh.polygons.foreach_set("select", np.zeros(len(mesh.polygons), bool))
+    mesh.edges.foreach_set("select", np.zeros(len(mesh.edges), bool))
+    mesh.vertices.foreach_set("select", mask)
+    bpy.ops.object.mode_set(mode="EDIT")
+    result = bpy.ops.modal_deform.add_handle()
+    bpy.ops.object.mode_set(mode="OBJECT")
+    assert result == {"FINISHED"}, result
+    return obj.modal_deform.handles[-1]
+
+
+def stored_bases():
+    """Names of the datablocks holding baked bases (the startup file has a palette of its own)."""
+    return sorted(p.name for p in bpy.data.palettes if p.name.startswith(".Modal Deform"))
+
+
+def mesh_state(obj):
+    """Everything of the mesh a cancelled or restoring operator must leave as it was."""
+    mesh = obj.data
+    return {
+        "co": positions(obj).tobytes(),
+        "polygons": len(mesh.polygons), "loops": len(mesh.loops),
+        "shape_keys": None if mesh.shape_keys is None else [
+            (b.name, b.value, b.mute, key_positions(obj, b.name).tobytes()) for b in mesh.shape_keys.key_blocks],
+        "basis": obj.modal_deform.basis, "palettes": stored_bases(),
+        "status": obj.modal_deform.status.dimension, "vertex_groups": len(obj.vertex_groups),
+    }
+
+
+def arguments():
+    """The script's arguments (after "--")."""
+    return sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+
+
+def mesh_object(name, V, F):
+    """A mesh object from arrays (V #V by 3, F a list of faces of any size), active, in the scene."""
+    for obj in list(bpy.data.objects):
+        bpy.data.objects.remove(obj)
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata([tuple(v) for v in V], [], [tuple(f) for f in F])
+    obj = bpy.data.objects.new(name, mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+    return obj
+
+
+def expect_error(operator, fragment, **kwargs):
+    """Run `operator` and check that it fails with a message containing `fragment`."""
+    try:
+        operator(**kwargs)
+    except RuntimeError as error:
+        assert fragment in str(error), f"expected {fragment!r} in the error, got: {error}"
+        return str(error)
+    raise AssertionError(f"{operator} did not fail (expected {fragment!r})")

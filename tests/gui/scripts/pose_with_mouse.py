@@ -1,0 +1,231 @@
+"""Blender with a window (under Xvfb, --enable-event-simulate): pose through the UI as an artist does.
+
+Bake Suzanne, add a handle, start the Pose operator from the sidebar's context, grab the controller
+with a simulated G + mouse motion + click, let the timer solve, check the mesh followed; Esc
+restores the mesh; the converged pose equals the Solve operator's; undo takes a bake back.
+Each step runs from bpy.app.timers so Blender handles the simulated events in between.
+Writes OUTPUT/result.json ({"ok": bool, "log": [...]}) and screenshots, then quits.
+"""
+import json
+import os
+import sys
+import threading
+import time
+import traceback
+
+import addon_utils
+import bpy
+import numpy as np
+from mathutils import Vector
+
+output = sys.argv[sys.argv.index("--") + 1]
+sys.path.insert(0, os.environ["ADDON_PATH"])
+bpy.context.preferences.view.show_splash = False
+log = []
+
+
+def say(*words):
+    log.append(" ".join(map(str, words)))
+    print("GUI:", *words, flush=True)
+
+
+def view3d():
+    window = bpy.context.window_manager.windows[0]
+    area = next(a for a in window.screen.areas if a.type == "VIEW_3D")
+    region = next(r for r in area.regions if r.type == "WINDOW")
+    return window, area, region
+
+
+def override():
+    window, area, region = view3d()
+    return bpy.context.temp_override(window=window, screen=window.screen, area=area, region=region)
+
+
+def key_positions(obj, name):
+    block = obj.data.shape_keys.key_blocks[name]
+    co = np.empty(3 * len(block.data), np.float32)
+    block.data.foreach_get("co", co)
+    return co.reshape(-1, 3)
+
+
+def base_positions(obj):
+    co = np.empty(3 * len(obj.data.vertices), np.float32)
+    obj.data.vertices.foreach_get("co", co)
+    return co.reshape(-1, 3)
+
+
+def screenshot(name):
+    window, _, _ = view3d()
+    with bpy.context.temp_override(window=window):
+        bpy.ops.screen.screenshot(filepath=os.path.join(output, name))
+
+
+def show_sidebar_tab():
+    """Click the sidebar's "Modal Deform" tab (3.4 has no Python access to the active tab): the
+    fourth tab of a factory-startup sidebar (Item, Tool, View, Modal Deform) at the right edge."""
+    window, area, _ = view3d()
+    sidebar = next(r for r in area.regions if r.type == "UI")
+    x, y = sidebar.x + sidebar.width - 10, sidebar.y + sidebar.height - 182
+    window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x, y=y)
+    window.event_simulate(type="LEFTMOUSE", value="PRESS", x=x, y=y)
+    window.event_simulate(type="LEFTMOUSE", value="RELEASE", x=x, y=y)
+
+
+def wait_until(condition, seconds):
+    """Yield to Blender until condition() holds; fail after `seconds`."""
+    start = time.time()
+    while not condition():
+        assert time.time() - start < seconds, f"timed out after {seconds} s"
+        yield 0.1
+
+
+def steps():
+    addon_utils.enable("modal_deform", default_set=True)
+    from modal_deform import ops_pose, posing
+
+    # Scene: Suzanne (2 subdivision levels, 7,958 vertices) seen from the front, sidebar open.
+    for obj in list(bpy.data.objects):
+        bpy.data.objects.remove(obj)
+    with override():
+        bpy.ops.mesh.primitive_monkey_add()
+        obj = bpy.context.object
+        modifier = obj.modifiers.new("Subdivision", "SUBSURF")
+        modifier.levels = 2
+        bpy.ops.object.modifier_apply(modifier=modifier.name)
+        bpy.ops.object.shade_smooth()
+    settings = obj.modal_deform
+    settings.ghost = 500
+
+    # Bake as the button does: on a thread, with progress; Esc cancels and changes nothing.
+    def baking():
+        return any(thread.name == "modal_deform bake" for thread in threading.enumerate())
+
+    window, _, region = view3d()
+    with override():
+        assert bpy.ops.modal_deform.bake("INVOKE_DEFAULT") == {"RUNNING_MODAL"}
+    yield 0.3
+    assert baking(), "the bake is not running on its thread"
+    window.event_simulate(type="ESC", value="PRESS", x=region.x + 10, y=region.y + 10)
+    window.event_simulate(type="ESC", value="RELEASE", x=region.x + 10, y=region.y + 10)
+    yield from wait_until(lambda: not baking(), 60)
+    yield 0.5  # the operator's next timer event ends it
+    assert obj.modal_deform.basis is None and not any(p.name.startswith(".Modal") for p in bpy.data.palettes)
+    say("bake cancelled with Esc: nothing changed")
+
+    # Undo takes a bake back (the bake's datablock and status go with it); redo brings it again.
+    with override():
+        bpy.ops.ed.undo_push(message="Before bake")
+        # Called from Python an operator pushes an undo step only when asked (third argument).
+        assert bpy.ops.modal_deform.bake("EXEC_DEFAULT", True) == {"FINISHED"}
+        assert bpy.data.objects["Suzanne"].modal_deform.basis is not None
+        bpy.ops.ed.undo()
+    yield 0.2
+    assert bpy.data.objects["Suzanne"].modal_deform.basis is None, "undo did not take the bake back"
+    with override():
+        bpy.ops.ed.redo()
+    yield 0.2
+    obj = bpy.data.objects["Suzanne"]  # undo re-reads the data: earlier references are gone
+    settings = obj.modal_deform
+    assert settings.basis is not None, "redo did not bring the bake back"
+    say("bake, undo, redo: ok")
+
+    # A handle on the top of the head (Edit Mode selection -> vertex group + Empty), the chin pinned.
+    V = base_positions(obj)
+    rest = V.copy()
+    for mask, pinned in ((V[:, 2] > 0.55, False), (V[:, 2] < -0.55, True)):
+        obj.data.polygons.foreach_set("select", np.zeros(len(obj.data.polygons), bool))
+        obj.data.edges.foreach_set("select", np.zeros(len(obj.data.edges), bool))
+        obj.data.vertices.foreach_set("select", mask)
+        with override():
+            bpy.context.view_layer.objects.active = obj
+            bpy.ops.object.mode_set(mode="EDIT")
+            assert bpy.ops.modal_deform.add_handle() == {"FINISHED"}
+            bpy.ops.object.mode_set(mode="OBJECT")
+        if pinned:
+            settings.handles[-1].controller = None
+    top = settings.handles[0]
+    controller = top.controller
+    group = np.flatnonzero(V[:, 2] > 0.55)
+
+    window, area, region = view3d()
+    with override():
+        bpy.ops.view3d.view_axis(type="FRONT")
+        bpy.ops.view3d.view_all()
+        area.spaces.active.show_region_ui = True
+    yield 0.5
+
+    # Start posing the way the Pose button does, select the controller, grab it: G, move, click.
+    with override():
+        assert bpy.ops.modal_deform.pose("INVOKE_DEFAULT") == {"RUNNING_MODAL"}
+        for o in bpy.context.view_layer.objects:
+            o.select_set(False)
+        controller.select_set(True)
+        bpy.context.view_layer.objects.active = controller
+    yield 0.3
+    assert ops_pose._running is not None
+    x, y = region.x + region.width // 2, region.y + region.height // 2
+    window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x, y=y)
+    yield 0.1
+    window.event_simulate(type="G", value="PRESS", x=x, y=y)
+    window.event_simulate(type="G", value="RELEASE", x=x, y=y)
+    yield 0.2
+    for i in range(1, 11):
+        window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x + 12 * i, y=y + 6 * i)
+        yield 0.05
+    window.event_simulate(type="LEFTMOUSE", value="PRESS", x=x + 120, y=y + 60)
+    window.event_simulate(type="LEFTMOUSE", value="RELEASE", x=x + 120, y=y + 60)
+    yield 0.2
+    moved = np.array(controller.matrix_world.translation) - np.array(obj.matrix_world @ Vector(rest[group].mean(axis=0)))
+    assert np.linalg.norm(moved) > 0.1, f"the grab did not move the controller ({moved})"
+    say("controller moved by", np.round(moved, 3).tolist())
+
+    # The timer solves until converged, writing the shape key; the mesh follows the controller.
+    yield from wait_until(lambda: ops_pose._running.pose.stats["converged"], 30)
+    pose = key_positions(obj, posing.POSE_KEY)
+    followed = pose[group].mean(axis=0) - rest[group].mean(axis=0)
+    assert np.linalg.norm(followed - moved) < 0.05 * np.linalg.norm(moved), (followed, moved)
+    assert base_positions(obj).tobytes() == rest.tobytes(), "posing wrote to the base mesh"
+    say("mesh followed by", np.round(followed, 3).tolist(), "at", f"{ops_pose._running.tick_ms:.1f} ms per update")
+    show_sidebar_tab()
+    yield 0.5
+    screenshot("pose.png")
+
+    # Esc: the mesh is as it was (Suzanne had no shape keys).
+    window.event_simulate(type="ESC", value="PRESS", x=x, y=y)
+    window.event_simulate(type="ESC", value="RELEASE", x=x, y=y)
+    yield 0.3
+    assert ops_pose._running is None, "Esc did not end the pose"
+    assert obj.data.shape_keys is None, "Esc left shape keys behind"
+    assert base_positions(obj).tobytes() == rest.tobytes()
+    say("Esc restored the mesh")
+
+    # The Solve operator at convergence gives the pose the interactive one converged to.
+    with override():
+        assert bpy.ops.modal_deform.solve(tolerance=1e-8) == {"FINISHED"}
+    solved = key_positions(obj, posing.POSE_KEY)
+    difference = np.abs(solved - pose).max() / np.ptp(rest, axis=0).max()
+    assert difference < 5e-3, f"solve and interactive pose differ by {difference:.2%} of the size"
+    say(f"solve equals the interactive pose within {difference:.1e} of the size")
+    yield 0.5
+    screenshot("solved.png")
+
+
+def drive(generator=steps()):
+    try:
+        delay = next(generator)
+        return delay
+    except StopIteration:
+        finish(True)
+    except Exception:
+        say(traceback.format_exc())
+        finish(False)
+    return None
+
+
+def finish(ok):
+    with open(os.path.join(output, "result.json"), "w") as f:
+        json.dump({"ok": ok, "log": log}, f, indent=1)
+    bpy.ops.wm.quit_blender()
+
+
+bpy.app.timers.register(drive, first_interval=0.5)
