@@ -60,8 +60,8 @@ def run(quick=False):
                                  "energy_gap": (E - E_full) / E_full})
                     errors.append(rows[-1]["rms_error"])
                     if (modes, derivatives) == RENDERED_SIZE and pose.name in RENDERED.get(name, ()):
-                        arrays = rendered.setdefault((name, pose.name), {"F": shape.F, "rest": shape.V,
-                                                                         "full": reference})
+                        arrays = rendered.setdefault((name, pose.name), {"F": shape.F, "rest": shape.V, "full": reference,
+                                                                         "view": shape.view})
                         arrays["derivatives" if kind == "modal derivatives" else "linear"] = X
                 print(f"  {name} ({modes}, {derivatives}) {kind}: mean RMS error {np.mean(errors):.2e}", flush=True)
     MESHES.mkdir(parents=True, exist_ok=True)
