@@ -21,6 +21,7 @@ RIGID = 6
 #: with the basis of RENDERED_SIZE.
 RENDERED = {"bar": ("bend_large", "twist"), "cylinder": ("bend_large", "bend_twist")}
 RENDERED_SIZE = (15, 52)
+LAPLACIAN_FRAMES = 20
 QUICK_SIZES = {"bar": dict(nx=4, nz=30), "cylinder": dict(around=16, along=20), "bumpy_plane": dict(n=40)}
 
 
@@ -33,6 +34,14 @@ def pose_reduced(basis, shape, pose):
             if solver.solve(20, 1e-10)["converged"]:
                 break
     return solver.positions().astype(np.float64)
+
+
+def meshes_for_renders(shape, pose, reference):
+    """What render_figures.py and the Laplacian Deform comparison (blender_pose.py) read: the mesh,
+    the camera's view direction, the handles and the pose's transforms in LAPLACIAN_FRAMES steps."""
+    steps = [pose.at(k / LAPLACIAN_FRAMES) for k in range(1, LAPLACIAN_FRAMES + 1)]
+    return {"shape": shape.name, "pose": pose.name, "F": shape.F, "rest": shape.V, "full": reference,
+            "view": shape.view, "handle0": shape.handles[0], "handle1": shape.handles[1], "transforms": steps}
 
 
 def run(quick=False):
@@ -60,8 +69,7 @@ def run(quick=False):
                                  "energy_gap": (E - E_full) / E_full})
                     errors.append(rows[-1]["rms_error"])
                     if (modes, derivatives) == RENDERED_SIZE and pose.name in RENDERED.get(name, ()):
-                        arrays = rendered.setdefault((name, pose.name), {"F": shape.F, "rest": shape.V, "full": reference,
-                                                                         "view": shape.view})
+                        arrays = rendered.setdefault((name, pose.name), meshes_for_renders(shape, pose, reference))
                         arrays["derivatives" if kind == "modal derivatives" else "linear"] = X
                 print(f"  {name} ({modes}, {derivatives}) {kind}: mean RMS error {np.mean(errors):.2e}", flush=True)
     MESHES.mkdir(parents=True, exist_ok=True)

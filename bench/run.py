@@ -55,7 +55,8 @@ def blender(quick):
     with tempfile.TemporaryDirectory() as folder:
         out = pathlib.Path(folder) / "blender_pose.json"
         extra = ["--updates", "3", "--quick"] if quick else []
-        subprocess.run(BLENDER + [str(common.ROOT / "bench" / "blender_pose.py"), "--", "--output", str(out), *extra],
+        subprocess.run(BLENDER + [str(common.ROOT / "bench" / "blender_pose.py"), "--", "--output", str(out),
+                                  "--shapes", str(common.MESHES), *extra],
                        check=True, cwd=common.ROOT)
         raw = json.loads(out.read_text())
     return raw.pop("parameters"), raw
