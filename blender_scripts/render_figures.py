@@ -1,12 +1,12 @@
-"""Render posed meshes side by side with Cycles on the CPU: the benchmark's figures.
+"""Render a rest mesh and its poses side by side with Cycles on the CPU: the benchmark's figures.
 
     blender -b --factory-startup --python blender_scripts/render_figures.py -- \\
         --meshes bench/results/tmp/meshes --output docs/figures [--samples 16] [--width 360]
 
 Each MESHES/<name>.npz holds F (m, 3), rest (n, 3), view (3,) (the direction the camera looks
 along) and posed positions (n, 3) under any of the keys "full", "derivatives", "linear",
-"laplacian"; it becomes OUTPUT/render_<name>.png with those present in that order, left to right,
-one colour each, all seen by the same camera (framing every variant).
+"laplacian"; it becomes OUTPUT/render_<name>.png: the rest mesh, then those present in that
+order, left to right, one colour each, all seen by the same camera (framing every variant).
 """
 import argparse
 import math
@@ -21,9 +21,9 @@ from mathutils import Vector
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from rendering import render, side_by_side, stage  # noqa: E402
 
-#: Variant: RGB base colour (grey for the reference, blue for ours, orange for linear modes,
-#: red for Laplacian Deform).
-VARIANTS = {"full": (0.6, 0.6, 0.6), "derivatives": (0.25, 0.45, 0.8), "linear": (0.85, 0.5, 0.15),
+#: Variant: RGB base colour (white for the rest shape, grey for the reference, blue for ours,
+#: orange for linear modes, red for Laplacian Deform).
+VARIANTS = {"rest": (0.9, 0.9, 0.9), "full": (0.6, 0.6, 0.6), "derivatives": (0.25, 0.45, 0.8), "linear": (0.85, 0.5, 0.15),
             "laplacian": (0.75, 0.2, 0.2)}
 
 
@@ -62,7 +62,7 @@ def framing(points, view, lens, aspect):
     centre = 0.5 * (points.min(axis=0) + points.max(axis=0))
     radius = np.linalg.norm(points - centre, axis=1).max()
     half_angle = math.atan(18.0 / lens) * min(1.0, aspect)  # the 36 mm sensor's narrower half-width
-    distance = 1.05 * radius / math.sin(half_angle)
+    distance = 0.95 * radius / math.sin(half_angle)  # the bounding sphere is loose: 0.95 still frames
     view = np.asarray(view, float) / np.linalg.norm(view)
     return Vector(centre), Vector(centre - distance * view)
 

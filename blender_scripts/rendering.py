@@ -3,27 +3,27 @@
 
 Run inside Blender (imports bpy); the scripts put this folder on sys.path.
 """
-import math
-
 import bpy
 import numpy as np
 from mathutils import Vector
 
 
 def stage(target, eye, lens=50, samples=16, resolution=(480, 270)):
-    """Camera at `eye` looking at `target` (world units), a sun, a dim grey world, Cycles on the
-    CPU with `samples` samples per pixel and no denoiser, PNG output of `resolution` pixels."""
+    """Camera at `eye` looking at `target` (world units), a sun from above the camera (so that the
+    side facing the camera is lit), a dim grey world, Cycles on the CPU with `samples` samples per
+    pixel and no denoiser, PNG output of `resolution` pixels."""
     scene = bpy.context.scene
     camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
     scene.collection.objects.link(camera)
     camera.location = eye
-    camera.rotation_euler = (Vector(target) - Vector(eye)).to_track_quat("-Z", "Y").to_euler()
+    view = (Vector(target) - Vector(eye)).normalized()
+    camera.rotation_euler = view.to_track_quat("-Z", "Y").to_euler()
     camera.data.lens = lens
     camera.data.clip_end = 10 * (Vector(target) - Vector(eye)).length
     scene.camera = camera
     sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
     sun.data.energy = 4.0
-    sun.rotation_euler = (math.radians(50), math.radians(10), math.radians(30))
+    sun.rotation_euler = (view + Vector((0.3, 0.3, -0.8))).to_track_quat("-Z", "Y").to_euler()
     scene.collection.objects.link(sun)
     world = bpy.data.worlds.new("World")
     world.color = (0.05, 0.05, 0.06)
