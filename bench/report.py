@@ -53,7 +53,7 @@ def section_table1(result):
     paper = result["parameters"]["paper"]
     out = ["## Table 1: timings (paper Table 1)", "",
            "Per model, basis and ghost: ms per BFGS iteration (mean over a 60-frame pose of up to 10 iterations a "
-           "frame, `solve()` alone), ms to map q to the fine mesh (`positions()` into a float32 buffer, best of 20), "
+           "frame, `solve()` alone), ms to map q to the fine mesh (`positions()` into a float32 buffer, median of 20), "
            "ms for a full update (new transforms, 10 iterations, map; median of 20) and the bake in seconds. "
            "Each model is baked once per dimension with a 1k ghost; other ghost sizes reuse that basis with a ghost "
            "rebuilt by `mdc.ghost_mesh` + `mdc.restrict_to_ghost` (the bake's own steps), so the bake time "

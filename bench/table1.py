@@ -12,6 +12,7 @@ import numpy as np
 
 import modal_deform.core as mdc
 import shapes
+from common import median_ms
 
 #: Dimension = modes (the 6 rigid motions included) + modal derivatives: the paper's 67 = 20 + 47
 #: and 130 = 20 + 110 (here 25 + 105: 14 non-rigid modes have only 105 pairs). A floppy mesh's
@@ -47,7 +48,7 @@ def time_posing(basis, shape):
         iterations += stats["iterations"]
         solve_ms += stats["ms"]
     out = np.empty((basis.num_vertices, 3), np.float32)
-    map_ms = min(_ms(lambda: solver.positions(out)) for _ in range(20))
+    map_ms = median_ms(lambda: solver.positions(out), 20)
     # A full update as the add-on does per tick: new transforms, 10 iterations, map. The handle
     # keeps moving (back towards rest) so that every update has work to do.
     update_ms, update_iterations = [], []
@@ -60,12 +61,6 @@ def time_posing(basis, shape):
     return {"ms_per_iteration": solve_ms / max(iterations, 1), "iterations_per_frame": iterations / FRAMES,
             "ms_map": map_ms, "ms_update": float(np.median(update_ms)),
             "update_iterations": float(np.median(update_iterations))}
-
-
-def _ms(function):
-    start = time.perf_counter()
-    function()
-    return 1e3 * (time.perf_counter() - start)
 
 
 def run(quick=False):
