@@ -3,8 +3,8 @@ with modal derivatives and with linear modes only (paper Figs. 5 and 12).
 
 For each shape, basis size (modes, derivatives) and pose: the reduced solver run to convergence
 through the pose's frames, against mdc.solve_full (Newton on the fine mesh, same objective).
-The ghost is the mesh itself (bumpy plane: 10k of its 40k vertices), so that the error is the
-basis's. A linear-only basis has modes + derivatives vibration modes and no derivatives.
+The ghost is the mesh itself, so that the error is the basis's. (The bumpy plane is left out: its
+full solves and 300-dimensional bases on 40k vertices take longer than the suite's budget.) A linear-only basis has modes + derivatives vibration modes and no derivatives.
 Reported: vertex RMS error relative to the bounding-box diagonal, and the relative gap of the
 shells energy, (E(reduced) - E(full)) / E(full), in the normalised frame.
 """
@@ -17,12 +17,14 @@ from common import MESHES, rms_error
 #: The paper's (vibration modes, modal derivatives); the bake's modes count the 6 rigid motions on top.
 SIZES = ((8, 6), (10, 20), (15, 52), (20, 110), (30, 270))
 RIGID = 6
+TOLERANCE = 1e-8
 #: Poses kept as meshes (bench/results/tmp/meshes/, not committed) for the side-by-side renders,
 #: with the basis of RENDERED_SIZE.
 RENDERED = {"bar": ("bend_large", "twist"), "cylinder": ("bend_large", "bend_twist")}
 RENDERED_SIZE = (15, 52)
 LAPLACIAN_FRAMES = 20
-QUICK_SIZES = {"bar": dict(nx=4, nz=30), "cylinder": dict(around=16, along=20), "bumpy_plane": dict(n=40)}
+SHAPES = ("bar", "cylinder")
+QUICK_SIZES = {"bar": dict(nx=4, nz=30), "cylinder": dict(around=16, along=20)}
 
 
 def pose_reduced(basis, shape, pose):
@@ -31,7 +33,7 @@ def pose_reduced(basis, shape, pose):
     for frame in range(1, pose.frames + 1):
         solver.set_transforms(pose.at(frame / pose.frames))
         for _ in range(50):
-            if solver.solve(20, 1e-10)["converged"]:
+            if solver.solve(20, TOLERANCE)["converged"]:
                 break
     return solver.positions().astype(np.float64)
 
@@ -45,7 +47,7 @@ def meshes_for_renders(shape, pose, reference):
 
 
 def run(quick=False):
-    names = ("bar", "cylinder") if quick else ("bar", "cylinder", "bumpy_plane")
+    names = SHAPES
     sizes = SIZES[:3] if quick else SIZES
     rows, poses, rendered = [], {}, {}
     for name in names:
@@ -53,7 +55,7 @@ def run(quick=False):
         poses[name] = [(p.name, p.description) for p in shape.poses]
         energy = mdc.DiscreteShells(shape.V, shape.F)  # the shapes are normalised already
         full = {pose.name: mdc.solve_full(shape.V, shape.F, shape.handles, pose.at(1.0)) for pose in shape.poses}
-        ghost = 10000 if name == "bumpy_plane" else len(shape.V)
+        ghost = len(shape.V)
         for modes, derivatives in sizes:
             bases = {"modal derivatives": mdc.bake(shape.V, shape.F, RIGID + modes, derivatives, ghost=ghost),
                      "linear modes": mdc.bake(shape.V, shape.F, RIGID + modes + derivatives, 0, ghost=ghost)}
@@ -75,6 +77,6 @@ def run(quick=False):
     MESHES.mkdir(parents=True, exist_ok=True)
     for (name, pose), arrays in rendered.items():
         np.savez(MESHES / f"{name}_{pose}.npz", **arrays)
-    parameters = {"shapes": names, "sizes": sizes, "stiffness": mdc.solve.STIFFNESS, "tolerance": 1e-10,
+    parameters = {"shapes": names, "sizes": sizes, "stiffness": mdc.solve.STIFFNESS, "tolerance": TOLERANCE,
                   "poses": poses, "rendered": {"size": RENDERED_SIZE, "poses": RENDERED}}
     return parameters, {"rows": rows}

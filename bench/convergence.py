@@ -7,7 +7,8 @@ rest, four ways on the same reduced problem (paper Fig. 7):
 - BFGS, cold start: the same solver with the identity as initial inverse Hessian;
 - steepest descent.
 
-Newton and steepest descent use SciPy's strong-Wolfe line search on ReducedSolver.objective;
+Newton and steepest descent use SciPy's strong-Wolfe line search on ReducedSolver.objective
+(halving the step to sufficient decrease where it finds no Wolfe step);
 the BFGS runs are the solver itself, one iteration per call (its state carries over).
 """
 import numpy as np
@@ -17,7 +18,7 @@ import modal_deform.core as mdc
 import shapes
 
 ITERATIONS = 60
-CASES = (("bar", "bend_large"), ("cylinder", "bend_twist"))
+CASES = (("bar", "bend"), ("cylinder", "bend_twist"), ("bar", "bend_large"))
 DIMENSION = (20, 47)  # modes (rigid motions included) and derivatives: 67 dimensions
 
 
@@ -54,19 +55,23 @@ class Problem:
 
 
 def descend(problem, direction):
-    """Objective after each of ITERATIONS line-searched steps along direction(q, gradient)."""
+    """Objective after each of up to ITERATIONS line-searched steps along direction(q, gradient),
+    and the gradient norm at the end."""
     q = np.zeros(problem.solver.dimension)
     value, gradient = problem.solver.objective(q)
     trace = [value]
     for _ in range(ITERATIONS):
         p = direction(q, gradient)
         step, *_ = scipy.optimize.line_search(problem.value, problem.gradient, q, p, gradient, value, c2=0.9)
+        if step is None:  # no Wolfe step found: backtrack to sufficient decrease alone (Armijo)
+            step = next((a for a in 0.5 ** np.arange(40) if problem.value(q + a * p) <= value + 1e-4 * a * (gradient @ p)),
+                        None)
         if step is None:  # no decrease left at this precision
             break
         q = q + step * p
         value, gradient = problem.solver.objective(q)
         trace.append(value)
-    return trace
+    return trace, float(np.linalg.norm(gradient))
 
 
 def newton_direction(problem):
@@ -86,13 +91,14 @@ def newton_direction(problem):
 def bfgs(basis, shape, transforms, warm):
     solver = mdc.ReducedSolver(basis, shape.handles, warm_start=warm)
     solver.set_transforms(transforms)
-    trace = [solver.objective(solver.q)[0]]
+    value, gradient = solver.objective(solver.q)
+    trace = [value]
     for _ in range(ITERATIONS):
         stats = solver.solve(1, 1e-15)
         if stats["iterations"] == 0:
             break
         trace.append(stats["energy"])
-    return trace
+    return trace, float(np.linalg.norm(solver.objective(solver.q)[1]))
 
 
 def run(quick=False):
@@ -103,13 +109,14 @@ def run(quick=False):
         basis = mdc.bake(shape.V, shape.F, *DIMENSION, ghost=1000)
         transforms = shape.pose(pose_name).at(1.0)
         problem = Problem(basis, shape, transforms)
-        traces = {"Newton": descend(problem, newton_direction(problem)),
-                  "BFGS, warm start": bfgs(basis, shape, transforms, True),
-                  "BFGS, cold start": bfgs(basis, shape, transforms, False),
-                  "steepest descent": descend(problem, lambda q, gradient: -gradient)}
+        runs = {"Newton": descend(problem, newton_direction(problem)),
+                "BFGS, warm start": bfgs(basis, shape, transforms, True),
+                "BFGS, cold start": bfgs(basis, shape, transforms, False),
+                "steepest descent": descend(problem, lambda q, gradient: -gradient)}
+        traces = {method: trace for method, (trace, _) in runs.items()}
         cases.append({"shape": name, "pose": pose_name, "vertices": len(shape.V), "dimension": basis.dimension,
                       "ghost": len(basis.ghost_vertices), "minimum": min(min(t) for t in traces.values()),
-                      "traces": traces})
+                      "traces": traces, "final_gradient_norms": {method: norm for method, (_, norm) in runs.items()}})
         print(f"  {name} {pose_name}: " + ", ".join(f"{k} {len(t) - 1} it -> {t[-1]:.6g}" for k, t in traces.items()),
               flush=True)
     parameters = {"cases": CASES, "modes_derivatives": DIMENSION, "iterations": ITERATIONS,
