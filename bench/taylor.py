@@ -20,7 +20,7 @@ from table1 import with_ghost
 SHAPE, POSE = "bumpy_plane", "bend"
 DIMENSION = (20, 47)
 GHOSTS = (1000, 5000, 10000)
-LINE = np.linspace(-0.25, 1.75, 81)
+LINE = np.linspace(-0.25, 1.75, 201)
 
 
 def objective_along(basis, shape, transforms, direction):
