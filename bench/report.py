@@ -85,8 +85,11 @@ def section_table1(result):
                   if r2["model"] == r1["model"] and r2["dimension"] == r1["dimension"] and r2["ghost_target"] == 2500]
         if growth:
             out += ["", f"From a 1k to a 2.5k ghost the time per iteration on {paper['model']} grows "
-                    f"{min(growth):.0f}–{max(growth):.0f}x, far more than the 2.5x the ghost's size explains; "
-                    "not investigated here (the add-on's default ghost is 1k)."]
+                    f"{min(growth):.0f}–{max(growth):.0f}x, far more than the 2.5x the ghost's size explains. "
+                    "It coincides with the shells energy going parallel (OpenMP from 20,000 terms, "
+                    "`DiscreteShells::kParallelElements`, about a 2.5k-vertex ghost): on this oversubscribed 2-core "
+                    "machine (load average 6–8) threads that wait for each other lose their cores. Not investigated "
+                    "further; the add-on's default ghost is 1k."]
         out += ["", targets_table1(rows, paper["model"])]
     out += ["", provenance(result)]
     return "\n".join(out)
