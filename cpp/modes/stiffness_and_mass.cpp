@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "util/errors.h"
 
@@ -16,12 +18,10 @@ constexpr double kOrthonormalTolerance = 1e-8;
 // ‖K z‖ ≤ kKernelTolerance ‖K‖₁ ‖z‖ for each column z of a kernel basis.
 constexpr double kKernelTolerance = 1e-8;
 
-// K(row, col), zero when not stored; columns hold sorted row indices.
-double entry(const SparseMatrix& K, int row, int col) {
-  const int* begin = K.innerIndexPtr() + K.outerIndexPtr()[col];
-  const int* end = K.isCompressed() ? K.innerIndexPtr() + K.outerIndexPtr()[col + 1] : begin + K.innerNonZeroPtr()[col];
-  const int* it = std::lower_bound(begin, end, row);
-  return it != end && *it == row ? K.valuePtr()[it - K.innerIndexPtr()] : 0.0;
+// Entries [begin, end) of column `col` in K's index and value arrays; rows come sorted.
+std::pair<int, int> column_range(const SparseMatrix& K, int col) {
+  const int begin = K.outerIndexPtr()[col];
+  return {begin, K.isCompressed() ? K.outerIndexPtr()[col + 1] : begin + K.innerNonZeroPtr()[col]};
 }
 
 }  // namespace
@@ -45,13 +45,39 @@ void validate_stiffness_and_mass(const SparseMatrix& K, const VectorRef& mass) {
       largest = std::max(largest, std::abs(it.value()));
     }
   }
-  for (int j = 0; j < K.outerSize(); ++j)
-    for (SparseMatrix::InnerIterator it(K, j); it; ++it) {
-      const int i = static_cast<int>(it.row());
-      if (i != j && std::abs(it.value() - entry(K, j, i)) > kSymmetryTolerance * largest)
-        throw InputError(message("K is not symmetric: K(", i, ", ", j, ") = ", it.value(), " but K(", j, ", ", i,
-                                 ") = ", entry(K, j, i)));
+  // Each pair once, in one pass over K (a lookup per entry took 0.3 s on a 100k-vertex mesh, and
+  // the bake checks K twice): the partner K(j, i) of an entry K(i, j) below the diagonal is the
+  // next entry above the diagonal of column i not yet paired, as columns j come in ascending
+  // order and so do the rows of column i. An entry above the diagonal that no entry below pairs
+  // with is compared with the 0 its missing partner holds.
+  const double tolerance = kSymmetryTolerance * largest;
+  const int* rows = K.innerIndexPtr();
+  const double* values = K.valuePtr();
+  const auto asymmetric = [&](int i, int j, double value, double partner) {
+    return InputError(message("K is not symmetric: K(", i, ", ", j, ") = ", value, " but K(", j, ", ", i, ") = ",
+                              partner));
+  };
+  std::vector<int> unpaired(static_cast<size_t>(K.outerSize()));  // per column, its first entry not yet paired
+  for (int c = 0; c < K.outerSize(); ++c) unpaired[static_cast<size_t>(c)] = column_range(K, c).first;
+  // Checks the entries of column c above the diagonal with rows below `row` and moves past them.
+  const auto check_unpaired = [&](int c, int row) {
+    int& p = unpaired[static_cast<size_t>(c)];
+    for (const int end = column_range(K, c).second; p < end && rows[p] < std::min(row, c); ++p)
+      if (std::abs(values[p]) > tolerance) throw asymmetric(rows[p], c, values[p], 0.0);
+  };
+  for (int j = 0; j < K.outerSize(); ++j) {
+    const auto [begin, end] = column_range(K, j);
+    for (int p = begin; p < end; ++p) {
+      const int i = rows[p];
+      if (i <= j) continue;
+      check_unpaired(i, j);
+      int& q = unpaired[static_cast<size_t>(i)];
+      double partner = 0;
+      if (q < column_range(K, i).second && rows[q] == j) partner = values[q++];
+      if (std::abs(values[p] - partner) > tolerance) throw asymmetric(i, j, values[p], partner);
     }
+  }
+  for (int c = 0; c < K.outerSize(); ++c) check_unpaired(c, c);
 }
 
 Eigen::VectorXd dof_masses(const VectorRef& mass) { return mass.replicate(1, 3).transpose().reshaped(); }

@@ -8,6 +8,7 @@
 
 #include "energy/arap.h"
 #include "energy/discrete_shells.h"
+#include "linalg/blas_threads.h"
 #include "linalg/cholmod_llt.h"
 #include "mesh/mass.h"
 #include "mesh/mesh_check.h"
@@ -90,12 +91,15 @@ Modes flexible_modes(const SparseMatrix& K, const Eigen::VectorXd& mass, const E
 }
 
 // The ghost mesh, simplified on its own thread while the bake solves (edge collapse is serial,
-// and the eigensolver's solves leave a core idle). It reports nothing itself; when the bake stops
-// early, the destructor cancels it and waits, so nothing outlives the bake.
+// and the eigensolver's solves leave a core idle). Meanwhile the BLAS runs on one thread fewer,
+// so that its threads do not wait busily for a core the ghost holds (blas_threads.h). It reports
+// nothing itself; when the bake stops early, the destructor cancels it and waits, so nothing
+// outlives the bake.
 class GhostInBackground {
  public:
   GhostInBackground(const VerticesRef& V, const FacesRef& F, const Eigen::VectorXd& mass, int target)
-      : progress_([this](const std::string&, double) { return !stop_.load(); }),
+      : blas_(),
+        progress_([this](const std::string&, double) { return !stop_.load(); }),
         ghost_(std::async(std::launch::async,
                           [&V, &F, &mass, target, this] { return ghost_mesh(V, F, mass, target, &progress_); })) {}
   ~GhostInBackground() {
@@ -108,6 +112,7 @@ class GhostInBackground {
   Ghost get() { return ghost_.get(); }
 
  private:
+  BlasLeavesACore blas_;  // first in, last out: spans the thread's life
   std::atomic<bool> stop_{false};
   Progress progress_;
   std::future<Ghost> ghost_;

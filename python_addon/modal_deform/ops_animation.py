@@ -180,11 +180,4 @@ render without the add-on. Esc cancels"""
 CLASSES = (MODAL_DEFORM_OT_bake_animation,)
 
 
-def register():
-    for cls in CLASSES:
-        bpy.utils.register_class(cls)
-
-
-def unregister():
-    for cls in reversed(CLASSES):
-        bpy.utils.unregister_class(cls)
+register, unregister = bpy.utils.register_classes_factory(CLASSES)

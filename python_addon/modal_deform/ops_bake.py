@@ -178,11 +178,4 @@ class MODAL_DEFORM_OT_clear_basis(bpy.types.Operator):
 CLASSES = (MODAL_DEFORM_OT_bake, MODAL_DEFORM_OT_clear_basis)
 
 
-def register():
-    for cls in CLASSES:
-        bpy.utils.register_class(cls)
-
-
-def unregister():
-    for cls in reversed(CLASSES):
-        bpy.utils.unregister_class(cls)
+register, unregister = bpy.utils.register_classes_factory(CLASSES)

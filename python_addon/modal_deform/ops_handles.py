@@ -89,11 +89,4 @@ class MODAL_DEFORM_OT_remove_handle(bpy.types.Operator):
 CLASSES = (MODAL_DEFORM_OT_add_handle, MODAL_DEFORM_OT_remove_handle)
 
 
-def register():
-    for cls in CLASSES:
-        bpy.utils.register_class(cls)
-
-
-def unregister():
-    for cls in reversed(CLASSES):
-        bpy.utils.unregister_class(cls)
+register, unregister = bpy.utils.register_classes_factory(CLASSES)

@@ -193,11 +193,4 @@ CLASSES = (MODAL_DEFORM_OT_pose, MODAL_DEFORM_OT_pose_end, MODAL_DEFORM_MT_pose,
            MODAL_DEFORM_OT_reset)
 
 
-def register():
-    for cls in CLASSES:
-        bpy.utils.register_class(cls)
-
-
-def unregister():
-    for cls in reversed(CLASSES):
-        bpy.utils.unregister_class(cls)
+register, unregister = bpy.utils.register_classes_factory(CLASSES)

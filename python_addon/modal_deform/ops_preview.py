@@ -76,11 +76,4 @@ class MODAL_DEFORM_OT_preview_mode(bpy.types.Operator):
 CLASSES = (MODAL_DEFORM_OT_preview_mode,)
 
 
-def register():
-    for cls in CLASSES:
-        bpy.utils.register_class(cls)
-
-
-def unregister():
-    for cls in reversed(CLASSES):
-        bpy.utils.unregister_class(cls)
+register, unregister = bpy.utils.register_classes_factory(CLASSES)

@@ -118,13 +118,14 @@ class ModalDeformSettings(bpy.types.PropertyGroup):
 CLASSES = (ModalDeformHandle, ModalDeformBakeStatus, ModalDeformSettings)
 
 
+_register_classes, _unregister_classes = bpy.utils.register_classes_factory(CLASSES)
+
+
 def register():
-    for cls in CLASSES:
-        bpy.utils.register_class(cls)
+    _register_classes()
     bpy.types.Object.modal_deform = PointerProperty(type=ModalDeformSettings)
 
 
 def unregister():
     del bpy.types.Object.modal_deform
-    for cls in reversed(CLASSES):
-        bpy.utils.unregister_class(cls)
+    _unregister_classes()

@@ -159,11 +159,4 @@ CLASSES = (MODAL_DEFORM_UL_handles, VIEW3D_PT_modal_deform, VIEW3D_PT_modal_defo
            VIEW3D_PT_modal_deform_handles, VIEW3D_PT_modal_deform_pose, VIEW3D_PT_modal_deform_preview)
 
 
-def register():
-    for cls in CLASSES:
-        bpy.utils.register_class(cls)
-
-
-def unregister():
-    for cls in reversed(CLASSES):
-        bpy.utils.unregister_class(cls)
+register, unregister = bpy.utils.register_classes_factory(CLASSES)

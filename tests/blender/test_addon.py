@@ -1,9 +1,12 @@
 """The add-on in headless Blender: bake, store, reload, solve, stale data, animation, cancel."""
 import pathlib
+import subprocess
 
 import pytest
 
-SHARED_MESHES = pathlib.Path(__file__).resolve().parents[2].parent / "shared" / "meshes"
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+SHARED_MESHES = ROOT.parent / "shared" / "meshes"
+BLENDER_SCRIPTS = ROOT / "blender_scripts"
 
 
 @pytest.mark.parametrize("mesh", ["suzanne", "dragon"])
@@ -32,3 +35,21 @@ def test_cancelled_or_failed_bake_leaves_the_object_unchanged(run_blender):
 
 def test_basis_follows_append_and_link(run_blender):
     assert "APPEND_LINK_OK" in run_blender("append_link.py").stdout
+
+
+def test_headless_bake_and_pose_scripts(run_blender, tmp_path):
+    run_blender("bake_and_save.py", "suzanne")
+    baked = run_blender(BLENDER_SCRIPTS / "bake.py", "--object", "Suzanne", "--modes", "12", "--derivatives", "10",
+                        "--ghost", "300", "--output", tmp_path / "rebaked.blend", blend=tmp_path / "baked.blend")
+    assert "baked Suzanne: 22 dimensions, ghost 300 vertices" in baked.stdout, baked.stdout[-2000:]
+    run_blender(BLENDER_SCRIPTS / "pose.py", "--object", "Suzanne", "--output", tmp_path / "posed.blend",
+                blend=tmp_path / "rebaked.blend")
+    assert "HEADLESS_POSE_OK 22" in run_blender("check_headless_pose.py", blend=tmp_path / "posed.blend").stdout
+
+
+def test_headless_script_names_a_missing_object(tmp_path):
+    command = ["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python",
+               str(BLENDER_SCRIPTS / "bake.py"), "--", "--object", "Nope"]
+    result = subprocess.run(command, capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    assert result.returncode == 1
+    assert "--object: no mesh object named 'Nope'" in result.stdout + result.stderr

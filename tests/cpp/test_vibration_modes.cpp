@@ -162,5 +162,34 @@ TEST(VibrationModes, RejectsBadInput) {
   EXPECT_THROW(vibration_modes(indefinite, mass, 4), NumericalError);
 }
 
+// Every asymmetry is found, whichever triangle holds it and whether its partner is stored, and
+// the message names the pair; explicit zeros without a partner are symmetric.
+TEST(VibrationModes, SymmetryCheckPairsEveryEntry) {
+  const TriangleMesh mesh = jittered_bar(1, 1, 2, 0.05);
+  const Eigen::VectorXd mass = lumped_mass(mesh.V, mesh.F);
+  const SparseMatrix K = spring_network_hessian(mesh.V, mesh.F);
+  const int last = static_cast<int>(K.rows()) - 1;
+  ASSERT_EQ(K.coeff(0, last), 0.0);  // the bar's two ends are not coupled
+  validate_stiffness_and_mass(K, mass);
+  for (const auto& [i, j] : std::vector<std::pair<int, int>>{{0, last}, {last, 0}, {4, 2}, {2, 4}, {last, last - 1}}) {
+    SparseMatrix changed = K;
+    changed.coeffRef(i, j) += 1.0;
+    for (SparseMatrix matrix : {changed, SparseMatrix(changed.transpose())}) {
+      matrix.makeCompressed();
+      testing::expect_input_error([&] { validate_stiffness_and_mass(matrix, mass); }, "not symmetric");
+    }
+    changed.coeffRef(j, i) += 1.0;  // symmetric again
+    validate_stiffness_and_mass(changed, mass);
+  }
+  SparseMatrix zeros = K;
+  zeros.coeffRef(0, last) = 0.0;  // stored, no partner
+  zeros.coeffRef(last - 2, 1) = 0.0;
+  validate_stiffness_and_mass(zeros, mass);
+  zeros.coeffRef(last - 2, 1) = 1e-3;
+  testing::expect_input_error([&] { validate_stiffness_and_mass(zeros, mass); },
+                              "K(" + std::to_string(last - 2) + ", 1) = 0.001 but K(1, " + std::to_string(last - 2) +
+                                  ") = 0");
+}
+
 }  // namespace
 }  // namespace modal_deform
