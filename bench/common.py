@@ -25,10 +25,12 @@ def machine():
 
 
 def commit():
-    """The checked-out commit, with "+dirty" when the work tree differs from it."""
+    """The checked-out commit, with "+dirty" when the work tree differs from it (outside the
+    benchmark's own outputs, which a run rewrites as it goes)."""
     def git(*args):
         return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True).stdout.strip()
-    dirty = git("status", "--porcelain", "--untracked-files=no")
+    dirty = git("status", "--porcelain", "--untracked-files=no", "--", ".", ":!bench/results", ":!docs/benchmarks.md",
+                ":!docs/figures")
     return git("rev-parse", "HEAD") + ("+dirty" if dirty else "")
 
 
