@@ -1,7 +1,7 @@
 # Modal Deform — build, test and run everything from a fresh Debian machine (as root).
 #   make demo    install what is missing, build, bake and pose Suzanne headless -> out/demo.{blend,png}
 #   make test    install, build, run the C++, Python and Blender tests
-#   make bench   benchmarks (JSON in bench/results/, tables printed and in docs/benchmarks.md)
+#   make bench   benchmarks (JSON in bench/results/, report and figures in docs/benchmarks.md, docs/figures/)
 #   make sanitize  C++ and Python tests under AddressSanitizer + UBSan (build-sanitize/)
 #   make fuzz      libFuzzer targets, FUZZ_SECONDS each (build-fuzz/; docs/robustness.md)
 
@@ -20,7 +20,7 @@ PACKAGES := cmake g++ make pkg-config \
 
 BLENDER_TEST := $(BLENDER) -b --factory-startup --python-exit-code 1
 
-.PHONY: all deps build test test-cpp test-python test-blender test-gui demo bench addon clean sanitize fuzz
+.PHONY: all deps build test test-cpp test-python test-blender test-gui demo bench bench-smoke addon clean sanitize fuzz
 
 all: build
 
@@ -60,9 +60,11 @@ demo: build
 	$(BLENDER_TEST) --python blender_scripts/demo.py -- --output out
 
 bench: build
-	@mkdir -p bench/results
-	$(BUILD_DIR)/bench/modal_deform_bench --benchmark_out=bench/results/native.json --benchmark_out_format=json
-	$(BLENDER_TEST) --python bench/blender_pose.py -- --output bench/results/blender_pose.json
+	PYTHONPATH=python_addon $(PYTHON) bench/run.py
+
+# Every experiment at tiny sizes (about a minute): results in bench/results/tmp/, no report.
+bench-smoke: build
+	PYTHONPATH=python_addon $(PYTHON) bench/run.py --quick
 
 # dist/modal_deform-<version>.zip: the add-on folder with the compiled extension, for Blender's installer.
 addon: build

@@ -1,8 +1,12 @@
 """Posing in headless Blender: time per update on dragon_vrip_res2 (100k vertices) at 67 and 130
 dimensions, Blender's Laplacian Deform on a subdivided Suzanne of similar size, basis load time,
-.blend size, and what storing the basis on the Object would cost every update.
+.blend size, and what storing the basis on the Object would cost every update. With --shapes, also
+Laplacian Deform against Modal Deform on the benchmark's shapes and handles (the accuracy
+experiment's meshes): time per update, shells energy and error against the full solve; the
+Laplacian result is added to each mesh file for the renders.
 
-    blender -b --factory-startup --python bench/blender_pose.py -- --output bench/results/blender_pose.json
+    blender -b --factory-startup --python bench/blender_pose.py -- --output bench/results/blender_pose.json \
+        [--shapes bench/results/tmp/meshes] [--quick]
 
 One update is what the Pose operator does per timer tick, each step timed: controller matrices →
 set_transforms → 10 BFGS iterations → positions(out=float32) → shape key foreach_set →
@@ -34,6 +38,8 @@ def arguments():
     parser.add_argument("--output", default="bench/results/blender_pose.json")
     parser.add_argument("--updates", type=int, default=30, help="pose updates timed per basis")
     parser.add_argument("--laplacian-updates", type=int, default=3, help="Laplacian Deform updates timed")
+    parser.add_argument("--shapes", help="folder of .npz meshes (bench/accuracy.py) to compare Laplacian Deform on")
+    parser.add_argument("--quick", action="store_true", help="dragon_vrip_res4 and a coarser Suzanne (smoke test)")
     return parser.parse_args(argv)
 
 
@@ -47,10 +53,13 @@ def milliseconds(start):
     return 1e3 * (time.perf_counter() - start)
 
 
-def dragon():
+def dragon(name):
     from modal_deform import core as mdc
-    V, F = mdc.read_mesh(MESHES / "dragon_vrip_res2.ply.gz")
-    mesh = bpy.data.meshes.new("Dragon")
+    return mesh_object("Dragon", *mdc.read_mesh(MESHES / f"{name}.ply.gz"))
+
+
+def mesh_object(name, V, F):
+    mesh = bpy.data.meshes.new(name)
     mesh.vertices.add(len(V))
     mesh.vertices.foreach_set("co", V.astype(np.float32).ravel())
     mesh.loops.add(F.size)
@@ -59,7 +68,7 @@ def dragon():
     mesh.polygons.foreach_set("loop_start", np.arange(0, F.size, 3, dtype=np.int32))
     mesh.polygons.foreach_set("loop_total", np.full(len(F), 3, np.int32))
     mesh.update(calc_edges=True)
-    obj = bpy.data.objects.new("Dragon", mesh)
+    obj = bpy.data.objects.new(name, mesh)
     bpy.context.scene.collection.objects.link(obj)
     bpy.context.view_layer.objects.active = obj
     return obj
@@ -188,14 +197,36 @@ def components(mesh):
         label = updated
 
 
-def laplacian_deform(updates):
-    """Blender's Laplacian Deform on Suzanne at 4 subdivision levels: bind time and time per update
+def bind_laplacian(obj, anchors, moving):
+    """Blender's Laplacian Deform on obj with the vertices `anchors` held and `moving` (among them)
+    carried by a hook to an Empty at the origin (its matrix_world is then the handle's transform).
+    Returns the Empty and the bind time in seconds."""
+    group = obj.vertex_groups.new(name="Anchors")
+    group.add(np.asarray(anchors).tolist(), 1.0, "REPLACE")
+    group = obj.vertex_groups.new(name="Moving")
+    group.add(np.asarray(moving).tolist(), 1.0, "REPLACE")
+    empty = bpy.data.objects.new("Hook", None)
+    bpy.context.scene.collection.objects.link(empty)
+    hook = obj.modifiers.new("Hook", "HOOK")
+    hook.object, hook.vertex_group = empty, "Moving"
+    laplacian = obj.modifiers.new("LaplacianDeform", "LAPLACIANDEFORM")
+    laplacian.vertex_group = "Anchors"
+    bpy.context.view_layer.update()
+    t = time.perf_counter()
+    with bpy.context.temp_override(object=obj, active_object=obj):
+        bpy.ops.object.laplaciandeform_bind(modifier=laplacian.name)
+    bpy.context.view_layer.update()
+    return empty, time.perf_counter() - t
+
+
+def laplacian_deform(updates, subdivisions):
+    """Blender's Laplacian Deform on Suzanne at `subdivisions` levels: bind time and time per update
     (1 iteration, the modifier's default) with a hook moving the top anchors."""
     clear_scene()
     bpy.ops.mesh.primitive_monkey_add()
     obj = bpy.context.object
     subdivision = obj.modifiers.new("Subdivision", "SUBSURF")
-    subdivision.levels = 4
+    subdivision.levels = subdivisions
     bpy.ops.object.modifier_apply(modifier=subdivision.name)
     V = np.empty(3 * len(obj.data.vertices), np.float32)
     obj.data.vertices.foreach_get("co", V)
@@ -204,22 +235,8 @@ def laplacian_deform(updates):
     # Every connected component needs an anchor, or the modifier finds no solution: the eyes too.
     label = components(obj.data)
     eyes = np.flatnonzero(label != label[top[0]])
-    anchors = obj.vertex_groups.new(name="Anchors")
-    anchors.add(np.concatenate([top, bottom, eyes]).tolist(), 1.0, "REPLACE")
-    moving = obj.vertex_groups.new(name="Top")
-    moving.add(top.tolist(), 1.0, "REPLACE")
-    empty = bpy.data.objects.new("Hook", None)
-    bpy.context.scene.collection.objects.link(empty)
-    hook = obj.modifiers.new("Hook", "HOOK")
-    hook.object, hook.vertex_group = empty, "Top"
-    laplacian = obj.modifiers.new("LaplacianDeform", "LAPLACIANDEFORM")
-    laplacian.vertex_group = "Anchors"
-    bpy.context.view_layer.update()
-    t = time.perf_counter()
-    with bpy.context.temp_override(object=obj, active_object=obj):
-        bpy.ops.object.laplaciandeform_bind(modifier=laplacian.name)
-    bpy.context.view_layer.update()
-    bind = time.perf_counter() - t
+    anchors = np.concatenate([top, bottom, eyes])
+    empty, bind = bind_laplacian(obj, anchors, top)
     times = []
     for i in range(updates):
         empty.location = (0.02 * (i + 1), 0.0, 0.01 * (i + 1))
@@ -228,9 +245,56 @@ def laplacian_deform(updates):
         times.append(milliseconds(t))
     # Failing, the modifier passes the hooked mesh through: vertices away from the anchors stay.
     free = np.ones(len(V), bool)
-    free[np.concatenate([top, bottom, eyes])] = False
+    free[anchors] = False
     solved = bool(np.abs(evaluated_positions(obj)[free] - V[free]).max() > 0)
     return {"vertices": len(V), "bind_s": bind, "update_ms": float(np.median(times)), "solved": solved}
+
+
+def laplacian_on_shapes(folder):
+    """Laplacian Deform and Modal Deform (67 dimensions, 1k ghost, 10 iterations per update) on each
+    mesh file's shape, handles and pose (handle 0 held, handle 1 moved through the pose's steps):
+    ms per update, and shells energy and RMS error against the full solve of the final pose."""
+    from modal_deform import core as mdc
+    sys.path.insert(0, str(ROOT / "bench"))
+    from common import rms_error
+    rows = []
+    for path in sorted(pathlib.Path(folder).glob("*.npz")):
+        data = dict(np.load(path))
+        V, F, steps = data["rest"], data["F"], data["transforms"]
+        clear_scene()
+        obj = mesh_object("Shape", V, F)
+        empty, bind = bind_laplacian(obj, np.concatenate([data["handle0"], data["handle1"]]), data["handle1"])
+        laplacian_ms = []
+        for transforms in steps:
+            empty.matrix_world = Matrix(transforms[1].tolist())
+            t = time.perf_counter()
+            bpy.context.view_layer.update()
+            laplacian_ms.append(milliseconds(t))
+        data["laplacian"] = evaluated_positions(obj).astype(np.float64)
+
+        solver = mdc.ReducedSolver(mdc.bake(V, F, 20, 47, ghost=1000), [data["handle0"], data["handle1"]])
+        out = np.empty(V.shape, np.float32)
+        ours_ms = []
+        for transforms in steps:
+            t = time.perf_counter()
+            solver.set_transforms(transforms)
+            solver.solve(10, 1e-6)
+            solver.positions(out)
+            ours_ms.append(milliseconds(t))
+        while not solver.solve(50, 1e-10)["converged"]:
+            pass
+        ours = solver.positions().astype(np.float64)
+        energy = mdc.DiscreteShells(V, F)
+        rows.append({"shape": str(data["shape"]), "pose": str(data["pose"]), "vertices": len(V),
+                     "laplacian_bind_s": bind, "laplacian_update_ms": float(np.median(laplacian_ms)),
+                     "ours_update_ms": float(np.median(ours_ms)), "energy_full": energy.value(data["full"]),
+                     "energy_ours": energy.value(ours), "energy_laplacian": energy.value(data["laplacian"]),
+                     "rms_ours": rms_error(ours, data["full"]), "rms_laplacian": rms_error(data["laplacian"], data["full"])})
+        np.savez(path, **data)
+        print(f"{rows[-1]['shape']} {rows[-1]['pose']}: Laplacian {rows[-1]['laplacian_update_ms']:.1f} ms, energy "
+              f"{rows[-1]['energy_laplacian']:.4g}; ours {rows[-1]['ours_update_ms']:.2f} ms, energy "
+              f"{rows[-1]['energy_ours']:.4g}; full {rows[-1]['energy_full']:.4g}", flush=True)
+    return rows
 
 
 def evaluated_positions(obj):
@@ -246,7 +310,8 @@ def main():
     args = arguments()
     addon_utils.enable("modal_deform", default_set=True)
     clear_scene()
-    obj = dragon()
+    mesh = "dragon_vrip_res4" if args.quick else "dragon_vrip_res2"
+    obj = dragon(mesh)
     V = np.empty(3 * len(obj.data.vertices), np.float32)
     obj.data.vertices.foreach_get("co", V)
     V = V.reshape(-1, 3)
@@ -254,7 +319,7 @@ def main():
     low, high = np.quantile(V[:, axis], [0.05, 0.95])
     moving = add_handle(obj, V[:, axis] > high)
     add_handle(obj, V[:, axis] < low).controller = None
-    results = {"mesh": "dragon_vrip_res2", "vertices": len(V), "bases": {}}
+    results = {"mesh": mesh, "vertices": len(V), "bases": {}}
     # dragon_vrip_res2 has 6 floppy zero modes on top of the modes asked for: 16 + 6 + 45 = 67 and
     # 20 + 6 + 104 = 130 dimensions (bench_solve.cpp bakes the same).
     for modes, derivatives in ((16, 45), (20, 104)):
@@ -271,9 +336,14 @@ def main():
               f"({figures['iterations']:.0f} iterations)", flush=True)
     with tempfile.TemporaryDirectory() as folder:
         results["storage"] = storage_figures(obj, folder)
-    results["laplacian_deform"] = laplacian_deform(args.laplacian_updates)
+    results["laplacian_deform"] = laplacian_deform(args.laplacian_updates, 2 if args.quick else 4)
+    if args.shapes:
+        results["shapes"] = laplacian_on_shapes(args.shapes)
+    results["parameters"] = {"mesh": mesh, "updates": args.updates, "laplacian_updates": args.laplacian_updates,
+                             "suzanne_subdivisions": 2 if args.quick else 4, "shapes": args.shapes,
+                             "bases": "(16, 45) and (20, 104) modes, derivatives; 1k ghost"}
 
-    print("\nPose update on dragon_vrip_res2 (100,250 vertices), headless, shared 2-core machine; ms, medians")
+    print(f"\nPose update on {mesh} ({len(V)} vertices), headless, shared 2-core machine; ms, medians")
     print(f"{'dims':>5} {'ctrl':>6} {'set':>6} {'solve':>6} {'map':>6} {'write':>6} {'tick':>6} {'eval':>6} "
           f"{'iters':>5} {'bake s':>7}")
     for dims, f in results["bases"].items():

@@ -18,6 +18,8 @@ import numpy as np
 from mathutils import Matrix, Vector
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "python_addon"))
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from rendering import render, side_by_side, stage  # noqa: E402
 
 
 def arguments():
@@ -71,52 +73,6 @@ def interactive_updates(obj, count):
     return times
 
 
-def stage(camera_target):
-    scene = bpy.context.scene
-    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-    scene.collection.objects.link(camera)
-    camera.location = (1.2, -6.8, 0.8)
-    direction = camera_target - camera.location
-    camera.rotation_euler = direction.to_track_quat("-Z", "Y").to_euler()
-    camera.data.lens = 50
-    scene.camera = camera
-    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
-    sun.data.energy = 4.0
-    sun.rotation_euler = (math.radians(50), math.radians(10), math.radians(30))
-    scene.collection.objects.link(sun)
-    world = bpy.data.worlds.new("World")
-    world.color = (0.05, 0.05, 0.06)
-    world.use_nodes = True
-    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.6
-    scene.world = world
-    scene.render.engine = "CYCLES"
-    scene.cycles.device = "CPU"
-    scene.cycles.samples = 16
-    scene.cycles.use_denoising = False
-    scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = 480, 270, 100
-    scene.render.image_settings.file_format = "PNG"
-
-
-def render(path):
-    bpy.context.scene.render.filepath = str(path)
-    bpy.ops.render.render(write_still=True)
-    image = bpy.data.images.load(str(path))
-    pixels = np.empty(image.size[0] * image.size[1] * 4, np.float32)
-    image.pixels.foreach_get(pixels)
-    bpy.data.images.remove(image)
-    return pixels.reshape(270, 480, 4)
-
-
-def side_by_side(left, right, path):
-    both = np.concatenate([left, right], axis=1)
-    image = bpy.data.images.new("demo", both.shape[1], both.shape[0], alpha=True)
-    image.pixels.foreach_set(both.ravel())
-    image.filepath_raw = str(path)
-    image.file_format = "PNG"
-    image.save()
-    bpy.data.images.remove(image)
-
-
 def main():
     args = arguments()
     addon_utils.enable("modal_deform", default_set=True)
@@ -150,15 +106,14 @@ def main():
           f"budget {suzanne.modal_deform.budget:.0f} ms for the solver)")
     assert bpy.ops.modal_deform.solve() == {"FINISHED"}
 
-    stage(suzanne.matrix_world.translation + Vector((0.15, 0.0, 0.0)))
-    bpy.context.scene.cycles.samples = args.samples
+    stage(suzanne.matrix_world.translation + Vector((0.15, 0.0, 0.0)), eye=(1.2, -6.8, 0.8), samples=args.samples)
     key = suzanne.data.shape_keys.key_blocks[posing.POSE_KEY]
     start = time.perf_counter()
     key.value = 0.0
     before = render(output / "demo_before.png")
     key.value = 1.0
     after = render(output / "demo_after.png")
-    side_by_side(before, after, output / "demo.png")
+    side_by_side([before, after], output / "demo.png")
     print(f"rendered {output / 'demo.png'} in {time.perf_counter() - start:.1f} s")
 
     bpy.context.view_layer.objects.active = suzanne

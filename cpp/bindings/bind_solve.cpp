@@ -11,6 +11,7 @@
 #include "bindings/bindings.h"
 #include "solve/full_solver.h"
 #include "solve/reduced_solver.h"
+#include "util/errors.h"
 
 namespace py = pybind11;
 
@@ -30,13 +31,13 @@ Handles to_handles(const std::vector<Eigen::VectorXi>& arrays) {
 void bind_solve(py::module_& m) {
   py::class_<ReducedSolver>(m, "ReducedSolver")
       .def(py::init([](const Basis& basis, const std::vector<Eigen::VectorXi>& handles, const VectorRef& weights,
-                       double stiffness, const std::string& energy) {
+                       double stiffness, const std::string& energy, bool warm_start) {
              py::gil_scoped_release release;
              return std::make_unique<ReducedSolver>(basis, to_handles(handles), weights, stiffness,
-                                                    energy_kind(energy));
+                                                    energy_kind(energy), warm_start);
            }),
            py::arg("basis"), py::arg("handles"), py::arg("weights"), py::arg("stiffness"), py::arg("energy"),
-           py::keep_alive<1, 2>())
+           py::arg("warm_start"), py::keep_alive<1, 2>())
       .def("set_transforms", &ReducedSolver::set_transforms, py::arg("transforms"))
       .def(
           "solve",
@@ -52,6 +53,20 @@ void bind_solve(py::module_& m) {
           },
           py::arg("max_iterations"), py::arg("tolerance"))
       .def("reset", &ReducedSolver::reset)
+      .def(
+          "objective",
+          [](ReducedSolver& solver, const Eigen::VectorXd& q) {
+            if (q.size() != solver.dimension())
+              throw InputError(message("q: expected ", solver.dimension(), " reduced coordinates, got ", q.size()));
+            Eigen::VectorXd gradient(q.size());
+            double value;
+            {
+              py::gil_scoped_release release;
+              value = solver.objective(q, gradient);
+            }
+            return py::make_tuple(value, std::move(gradient));
+          },
+          py::arg("q"))
       .def("positions", &ReducedSolver::positions, py::arg("out").noconvert(), py::call_guard<py::gil_scoped_release>())
       .def_property_readonly("q", [](const ReducedSolver& solver) { return Eigen::VectorXd(solver.q()); })
       .def_property_readonly("dimension", &ReducedSolver::dimension)

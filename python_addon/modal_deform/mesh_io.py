@@ -2,6 +2,8 @@
 
 Positions are the base mesh's (``vertices.co``), the rest state every bake and pose starts from.
 """
+import ctypes
+
 import numpy as np
 
 
@@ -83,7 +85,20 @@ def remove_shape_keys(obj, names):
 
 
 def write_shape_key(mesh, block, co):
-    """Write float32 positions (#V by 3 or 3#V, C order) into a shape key of `mesh` and tag it for
-    redraw. A C-contiguous float32 buffer is what foreach_set copies in one memcpy."""
-    block.data.foreach_set("co", co.reshape(-1))
+    """Write float32 positions (#V by 3 or 3#V) into the shape key `block` of `mesh` and tag it for
+    redraw.
+
+    A mesh's shape key keeps its positions as one contiguous float[3] array per key, which
+    ``block.data[0]`` points at. Copying into it directly takes 0.05 ms for 126k vertices where
+    ``foreach_set`` takes 5.5 ms (it goes through RNA item by item): a tenth of the pose's frame
+    budget. The length is checked against the mesh every time, and the address read anew, so a
+    key reallocated since (undo, edit) is never written through an old pointer.
+    """
+    co = np.asarray(co, np.float32).reshape(-1, 3)
+    count = len(block.data)
+    if count != len(co) or count != len(mesh.vertices) or block.id_data != mesh.shape_keys:
+        raise ValueError(f"shape key '{block.name}' has {count} points for {len(co)} positions: the mesh changed")
+    if count:
+        address = block.data[0].as_pointer()
+        np.copyto(np.ctypeslib.as_array((ctypes.c_float * (3 * count)).from_address(address)).reshape(count, 3), co)
     mesh.update()

@@ -152,6 +152,35 @@ def test_state_persists_across_solves(tube, tube_basis):
     assert np.array_equal(once.q, twice.q)
 
 
+def test_objective_is_what_the_solver_minimises(tube, tube_basis):
+    _, _, handles, transforms = tube
+    solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0)
+    solver.set_transforms(transforms)
+    stats = solver.solve(3, tolerance=1e-14)
+    q = solver.q
+    value, gradient = solver.objective(q)
+    assert value == pytest.approx(stats["energy"], rel=1e-12)
+    assert np.linalg.norm(gradient) == pytest.approx(stats["gradient_norm"], rel=1e-9)
+    assert np.array_equal(solver.q, q)  # evaluating leaves the state alone
+    i = int(np.argmax(np.abs(gradient)))
+    step = 1e-4 * np.eye(len(q))[i]
+    centred = (solver.objective(q + step)[0] - solver.objective(q - step)[0]) / 2e-4
+    assert centred == pytest.approx(gradient[i], rel=1e-6)
+    with pytest.raises(ValueError, match="q"):
+        solver.objective(q[:-1])
+
+
+def test_warm_start_saves_iterations(tube, tube_basis):
+    _, _, handles, transforms = tube
+    counts = {}
+    for warm in (True, False):
+        solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0, warm_start=warm)
+        solver.set_transforms(transforms)
+        counts[warm] = sum(solver.solve(20, tolerance=1e-10)["iterations"] for _ in range(50))
+        assert solver.solve(20, tolerance=1e-10)["converged"]
+    assert counts[True] < counts[False]
+
+
 def test_arap_objective_in_the_shells_basis(tube, tube_basis):
     V, F, handles, transforms = tube
     solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0, energy="arap")

@@ -78,18 +78,19 @@ class ReducedSolver:
     ``basis``: from ``mdc.bake`` (kept alive by the solver). ``handles``: list of vertex index
     arrays; ``weights``: one per handle (default 1); ``stiffness``: μ > 0; ``energy``: "shells"
     (with the basis's material weights) or "arap". The solver starts at rest with every handle at
-    its rest position; the inverse Hessian's warm start is computed here, once per handle set.
+    its rest position; the inverse Hessian's warm start is computed here, once per handle set
+    (``warm_start=False`` starts BFGS from the identity instead, for comparison).
     Long calls release the GIL; one solver must not be used from two threads at once.
     """
 
-    def __init__(self, basis, handles, stiffness=STIFFNESS, weights=None, energy="shells"):
+    def __init__(self, basis, handles, stiffness=STIFFNESS, weights=None, energy="shells", warm_start=True):
         if not isinstance(basis, Basis):
             raise ValueError(f"basis: expected a modal_deform.core.Basis (from bake or Basis.from_arrays), "
                              f"got {type(basis).__name__}")
         native_basis = basis._native
         handles = _handles(handles)
         self._native = _native.ReducedSolver(native_basis, handles, _weights(weights, len(handles)),
-                                             _stiffness(stiffness), str(energy))
+                                             _stiffness(stiffness), str(energy), bool(warm_start))
         self._basis = basis
 
     @property
@@ -126,6 +127,11 @@ class ReducedSolver:
         except TypeError:
             raise ValueError(f"max_iterations: expected an integer, got {max_iterations!r}") from None
         return self._native.solve(max_iterations, _arrays.number(tolerance, "tolerance"))
+
+    def objective(self, q):
+        """The objective f(q) (ghost energy plus handle term, normalised frame) and its gradient
+        (r,) at any q (r,), for the current transforms; the solver's state is left alone."""
+        return self._native.objective(_arrays.values(q, "q", self.dimension))
 
     def reset(self):
         """Back to rest (q = 0) and the initial inverse Hessian; the transforms stay."""

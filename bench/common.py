@@ -1,0 +1,72 @@
+"""What every benchmark experiment shares: the machine and commit it ran on, timing, and its
+results file bench/results/<experiment>.json (parameters and figures, read by bench/report.py)."""
+import json
+import os
+import pathlib
+import platform
+import subprocess
+import time
+
+import numpy as np
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+RESULTS = ROOT / "bench" / "results"
+#: Posed meshes passed from one experiment to the next (accuracy -> blender -> renders); not committed.
+MESHES = ROOT / "bench" / "results" / "tmp" / "meshes"
+
+
+def machine():
+    """CPU model, cores, memory and uname of this machine."""
+    cpu = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo") if line.startswith("model name")),
+               platform.processor())
+    memory_kb = next(int(line.split()[1]) for line in open("/proc/meminfo") if line.startswith("MemTotal"))
+    return {"cpu": cpu, "cores": os.cpu_count(), "memory_gb": round(memory_kb / 2**20, 1),
+            "uname": " ".join(platform.uname()), "load_average": os.getloadavg()}
+
+
+def commit():
+    """The checked-out commit, with "+dirty" when the work tree differs from it (outside the
+    benchmark's own outputs, which a run rewrites as it goes)."""
+    def git(*args):
+        return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True).stdout.strip()
+    dirty = git("status", "--porcelain", "--untracked-files=no", "--", ".", ":!bench/results", ":!docs/benchmarks.md",
+                ":!docs/figures")
+    return git("rev-parse", "HEAD") + ("+dirty" if dirty else "")
+
+
+def write(experiment, command, parameters, figures, seconds):
+    """bench/results/<experiment>.json: machine, commit, the command that made it, parameters,
+    figures and the experiment's wall time."""
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    record = {"experiment": experiment, "command": command, "machine": machine(), "commit": commit(),
+              "date": time.strftime("%Y-%m-%d %H:%M:%S %Z"), "seconds": round(seconds, 1),
+              "parameters": parameters, "figures": figures}
+    path = RESULTS / f"{experiment}.json"
+    path.write_text(json.dumps(record, indent=1, default=_plain) + "\n")
+    return path
+
+
+def _plain(value):
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
+
+
+def median_ms(function, repeats):
+    """Median wall time of `repeats` calls of function(), milliseconds."""
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        function()
+        times.append(1e3 * (time.perf_counter() - start))
+    return float(np.median(times))
+
+
+def rms_error(X, reference):
+    """Vertex RMS distance between X and reference (n, 3), relative to the reference's bounding-box
+    diagonal."""
+    X, reference = np.asarray(X, np.float64), np.asarray(reference, np.float64)
+    diagonal = np.linalg.norm(np.ptp(reference, axis=0))
+    return float(np.sqrt(np.mean(np.sum((X - reference) ** 2, axis=1))) / diagonal)

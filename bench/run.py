@@ -1,0 +1,101 @@
+"""`make bench`: every benchmark experiment, then the report docs/benchmarks.md.
+
+    PYTHONPATH=python_addon /usr/bin/python3 bench/run.py [--quick] [--only NAME ...] [--report-only]
+
+Experiments (each writes bench/results/<name>.json: machine, commit, command, parameters, figures):
+  native       the Google Benchmark binary (build/bench/modal_deform_bench): energies, ghost,
+               CHOLMOD, modes, full solves (its bake, BFGS and positions benchmarks are left
+               out: table1 measures them on the same dragon)
+  table1       Table 1 analogue (bench/table1.py)
+  accuracy     Fig. 5/12 analogue (bench/accuracy.py)
+  convergence  Fig. 7 analogue (bench/convergence.py)
+  taylor       Fig. 9 analogue (bench/taylor.py)
+  blender      the add-on's pose update in headless Blender and Blender's Laplacian Deform
+               (bench/blender_pose.py)
+  renders      Cycles renders of the accuracy experiment's bar and cylinder poses
+               (blender_scripts/render_figures.py; needs accuracy's meshes from the same run)
+--quick runs tiny sizes (the smoke test): results go to bench/results/tmp/, the report is not
+written. The report alone is regenerated from the JSON with --report-only (or bench/report.py).
+"""
+import argparse
+import importlib
+import json
+import pathlib
+import subprocess
+import sys
+import tempfile
+import time
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import common  # noqa: E402
+import report  # noqa: E402
+
+PYTHON_EXPERIMENTS = ("table1", "accuracy", "convergence", "taylor")
+EXPERIMENTS = ("native",) + PYTHON_EXPERIMENTS + ("blender", "renders")
+NATIVE_IN_TABLE1 = "BM_Bake|BM_BfgsIteration|BM_Positions"
+BLENDER = ["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python"]
+
+
+def command(name):
+    return f"make bench  (alone: PYTHONPATH=python_addon /usr/bin/python3 bench/run.py --only {name})"
+
+
+def native(quick):
+    binary = common.ROOT / "build" / "bench" / "modal_deform_bench"
+    with tempfile.TemporaryDirectory() as folder:
+        out = pathlib.Path(folder) / "native.json"
+        # The dragon's bake, BFGS iterations and positions are measured by table1 at the same sizes.
+        arguments = [str(binary), f"--benchmark_out={out}", "--benchmark_out_format=json",
+                     "--benchmark_filter=BM_Shells|BM_LumpedMass" if quick else f"--benchmark_filter=-{NATIVE_IN_TABLE1}"]
+        subprocess.run(arguments, check=True)
+        raw = json.loads(out.read_text())
+    return {"binary": str(binary.relative_to(common.ROOT)), "filter": arguments[3:],
+            "context": raw["context"]}, {"benchmarks": raw["benchmarks"]}
+
+
+def blender(quick):
+    with tempfile.TemporaryDirectory() as folder:
+        out = pathlib.Path(folder) / "blender_pose.json"
+        extra = ["--updates", "3", "--quick"] if quick else []
+        subprocess.run(BLENDER + [str(common.ROOT / "bench" / "blender_pose.py"), "--", "--output", str(out),
+                                  "--shapes", str(common.MESHES), *extra],
+                       check=True, cwd=common.ROOT)
+        raw = json.loads(out.read_text())
+    return raw.pop("parameters"), raw
+
+
+def renders(quick):
+    folder = common.RESULTS / "renders" if quick else common.ROOT / "docs" / "figures"
+    arguments = ["--meshes", str(common.MESHES), "--output", str(folder)] + (["--samples", "4", "--width", "160"] if quick else [])
+    subprocess.run(BLENDER + [str(common.ROOT / "blender_scripts" / "render_figures.py"), "--", *arguments],
+                   check=True, cwd=common.ROOT)
+    images = sorted(str(p.relative_to(common.ROOT)) for p in folder.glob("render_*.png"))
+    return {"meshes": "accuracy experiment, bench/results/tmp/meshes", "arguments": arguments}, {"images": images}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--quick", action="store_true", help="tiny sizes, results in bench/results/tmp/, no report")
+    parser.add_argument("--only", nargs="+", choices=EXPERIMENTS, help="run only these experiments")
+    parser.add_argument("--report-only", action="store_true", help="write docs/benchmarks.md from the JSON and stop")
+    args = parser.parse_args()
+    if args.quick:
+        common.RESULTS = common.RESULTS / "tmp"
+    if not args.report_only:
+        start_all = time.perf_counter()
+        for name in args.only or EXPERIMENTS:
+            print(f"== {name}", flush=True)
+            start = time.perf_counter()
+            if name in PYTHON_EXPERIMENTS:
+                parameters, figures = importlib.import_module(name).run(quick=args.quick)
+            else:
+                parameters, figures = globals()[name](args.quick)
+            path = common.write(name, command(name), parameters, figures, time.perf_counter() - start)
+            print(f"   {time.perf_counter() - start:.0f} s -> {path.relative_to(common.ROOT)}", flush=True)
+        print(f"all experiments: {time.perf_counter() - start_all:.0f} s", flush=True)
+    if not args.quick:
+        print(f"wrote {report.write().relative_to(common.ROOT)}")
+
+
+if __name__ == "__main__":
+    main()
