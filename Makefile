@@ -2,6 +2,8 @@
 #   make demo    install what is missing, build, bake and pose Suzanne headless -> out/demo.{blend,png}
 #   make test    install, build, run the C++, Python and Blender tests
 #   make bench   benchmarks (JSON in bench/results/, report and figures in docs/benchmarks.md, docs/figures/)
+#   make sanitize  C++ and Python tests under AddressSanitizer + UBSan (build-sanitize/)
+#   make fuzz      libFuzzer targets, FUZZ_SECONDS each (build-fuzz/; docs/robustness.md)
 
 PYTHON      := /usr/bin/python3
 BLENDER     := blender
@@ -18,7 +20,7 @@ PACKAGES := cmake g++ make pkg-config \
 
 BLENDER_TEST := $(BLENDER) -b --factory-startup --python-exit-code 1
 
-.PHONY: all deps build test test-cpp test-python test-blender test-gui demo bench bench-smoke addon clean
+.PHONY: all deps build test test-cpp test-python test-blender test-gui demo bench bench-smoke addon clean sanitize fuzz
 
 all: build
 
@@ -68,5 +70,47 @@ bench-smoke: build
 addon: build
 	$(PYTHON) python_addon/package.py dist
 
+# Checked builds: -O2 with assertions on (no NDEBUG: Eigen's index checks, libstdc++'s checked
+# containers) under AddressSanitizer and UndefinedBehaviorSanitizer.
+SANITIZE_DIR ?= build-sanitize
+FUZZ_DIR     ?= build-fuzz
+FUZZ_SECONDS ?= 60
+FUZZ_TARGETS := mesh_entry_points bake_and_pose stored_basis
+CHECKED_FLAGS := -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g -D_GLIBCXX_ASSERTIONS" \
+	-DMODAL_DEFORM_BENCH=OFF
+# CPython is not instrumented: the ASan runtime must be loaded before it (LD_PRELOAD), and its
+# allocations at exit are not leaks to report. libstdc++ is preloaded too: loaded later (with the
+# extension), ASan's __cxa_throw interceptor finds no real function and aborts at the first throw.
+SANITIZE_ENV := ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+
+# The extension goes into its own copy of the package (links to the Python sources), so the
+# sanitized build never replaces python_addon/modal_deform/_native*.so.
+sanitize: deps
+	@mkdir -p $(SANITIZE_DIR)/python_addon/modal_deform
+	@for f in python_addon/modal_deform/*; do case $$f in *_native*.so|*__pycache__) ;; \
+		*) ln -sfn $(CURDIR)/$$f $(SANITIZE_DIR)/python_addon/modal_deform/ ;; esac; done
+	@cmake -S . -B $(SANITIZE_DIR) $(CHECKED_FLAGS) -DMODAL_DEFORM_SANITIZE=ON -DPython_EXECUTABLE=$(PYTHON) \
+		-DMODAL_DEFORM_EXTENSION_DIR=$(CURDIR)/$(SANITIZE_DIR)/python_addon/modal_deform > $(SANITIZE_DIR)/configure.log 2>&1 \
+		|| (cat $(SANITIZE_DIR)/configure.log; exit 1)
+	@cmake --build $(SANITIZE_DIR) -j $(JOBS)
+	cd $(SANITIZE_DIR) && $(SANITIZE_ENV) ctest --output-on-failure -j $(JOBS)
+	$(SANITIZE_ENV) LD_PRELOAD="$$($(CXX) -print-file-name=libasan.so) $$($(CXX) -print-file-name=libstdc++.so)" \
+		PYTHONPATH=$(SANITIZE_DIR)/python_addon \
+		$(PYTHON) -m pytest -q -p no:cacheprovider tests/python
+
+# libFuzzer comes with Debian's clang (its runtime in libclang-rt-14-dev); only this target needs it.
+fuzz: PACKAGES += clang libclang-rt-14-dev
+# Each target runs FUZZ_SECONDS from its seeds (tests/fuzz/corpus/<target>/, read only) and what
+# earlier runs found ($(FUZZ_DIR)/corpus/<target>/); a failing input is written to
+# $(FUZZ_DIR)/crash-<target>-*.
+fuzz: deps
+	@mkdir -p $(FUZZ_DIR)
+	@cmake -S . -B $(FUZZ_DIR) $(CHECKED_FLAGS) -DCMAKE_CXX_COMPILER=clang++ -DMODAL_DEFORM_FUZZ=ON \
+		> $(FUZZ_DIR)/configure.log 2>&1 || (cat $(FUZZ_DIR)/configure.log; exit 1)
+	@cmake --build $(FUZZ_DIR) -j $(JOBS)
+	@for t in $(FUZZ_TARGETS); do mkdir -p $(FUZZ_DIR)/corpus/$$t; \
+		$(FUZZ_DIR)/tests/fuzz/fuzz_$$t -max_total_time=$(FUZZ_SECONDS) -timeout=20 -rss_limit_mb=4096 \
+			-artifact_prefix=$(FUZZ_DIR)/crash-$$t- $(FUZZ_DIR)/corpus/$$t tests/fuzz/corpus/$$t || exit 1; done
+
 clean:
-	rm -rf $(BUILD_DIR) out dist python_addon/modal_deform/_native*.so
+	rm -rf $(BUILD_DIR) $(SANITIZE_DIR) $(FUZZ_DIR) out dist python_addon/modal_deform/_native*.so

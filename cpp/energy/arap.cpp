@@ -20,8 +20,9 @@ namespace {
 // it when the second thread is descheduled (every call waits for it at the barrier).
 constexpr int kParallelVertices = 8192;
 
-// Eigenvalues of f_ωω below this fraction of its largest are treated as zero (pseudo-inverse):
-// a cell whose edges are collinear can spin about their line at no cost.
+// Eigenvalues of f_ωω below this fraction of its largest, or of its value at rest, are treated as
+// zero (pseudo-inverse): a cell whose edges are collinear can spin about their line at no cost,
+// and one collapsed far below its rest size would give f_xω f_ωω⁻¹ f_ωx beyond double range.
 constexpr double kSingularRotationRatio = 1e-10;
 
 // The best rotation of a cell from its covariance S = U Σ Vᵀ (S&A eq. 6): R = V Uᵀ maximises
@@ -178,7 +179,12 @@ void Arap::rotation_factors(int i, const VectorRef& x, Eigen::Matrix3d* out) con
   const CellRotation fit = best_rotation(covariance(i, x));
   const Eigen::Vector3d& s = fit.signed_singular_values;
   const Eigen::Vector3d eigenvalues = 2 * (Eigen::Vector3d::Constant(s.sum()) - s);
-  const double cutoff = kSingularRotationRatio * eigenvalues.maxCoeff();
+  // At rest Σs = tr P = Σ_j w_j ‖ē_j‖², so f_ωω's eigenvalues are about twice that.
+  double rest_size = 0;
+  for (int e = cell_offsets_[i]; e < cell_offsets_[i + 1]; ++e)
+    rest_size += std::abs(cell_weights_[e]) *
+                 (rest_.segment<3>(3 * i) - rest_.segment<3>(3 * cell_neighbors_[e])).squaredNorm();
+  const double cutoff = kSingularRotationRatio * std::max(eigenvalues.maxCoeff(), 2 * rest_size);
   Eigen::Vector3d scale;
   for (int k = 0; k < 3; ++k) scale[k] = eigenvalues[k] > cutoff ? std::sqrt(1.0 / eigenvalues[k]) : 0.0;
   const Eigen::Matrix3d scaled_Ut = scale.asDiagonal() * fit.U.transpose();

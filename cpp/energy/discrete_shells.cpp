@@ -9,8 +9,10 @@
 #include "energy/dual.h"
 #include "mesh/mesh_check.h"
 #include "mesh/mesh_topology.h"
+#include "mesh/normalization.h"
 #include "util/errors.h"
 #include "util/require_positions.h"
+#include "util/require_weight.h"
 
 namespace modal_deform {
 namespace {
@@ -197,11 +199,6 @@ void term_hessian(const Response& q, const double* gradient, const double* hessi
     for (int d = 0; d < c; ++d) full[c * M + d] = full[d * M + c] = 0.5 * (full[c * M + d] + full[d * M + c]);
 }
 
-// y: 3n positions or displacements, named like validate_mesh names V.
-void require_weight(double weight, const char* name) {
-  if (!(std::isfinite(weight) && weight >= 0))
-    throw InputError(message(name, ": expected a finite weight >= 0, got ", weight));
-}
 
 template <typename Term>
 void add_vertex_pairs(const std::vector<Term>& terms, std::vector<std::array<int, 2>>& pairs) {
@@ -241,18 +238,21 @@ DiscreteShells::DiscreteShells(const VerticesRef& V, const FacesRef& F, double b
   const double* x = rest_.data();
   const int n = static_cast<int>(V.rows());
   const MeshTopology topology = build_topology(V, F);
+  // Elements below kCollapse of the mesh's extent have no terms: their derivatives would grow
+  // as inverse powers of their size, out of double range.
+  const double tiny = kCollapse * bounding_box_extent(V);
   std::vector<char> degenerate(F.rows());
-  for (int f = 0; f < F.rows(); ++f) degenerate[f] = is_degenerate_face(V, F, f);
+  for (int f = 0; f < F.rows(); ++f)
+    degenerate[f] = is_degenerate_face(V, F, f) || ((V.row(F(f, 1)) - V.row(F(f, 0))).norm() <= tiny &&
+                                                    (V.row(F(f, 2)) - V.row(F(f, 0))).norm() <= tiny);
 
   // The rest quantities come from the same code as the deformed ones, so at rest s = s̄ exactly.
-  double longest = 0;
-  for (const auto& [a, b] : topology.edges) longest = std::max(longest, (V.row(b) - V.row(a)).norm());
   for (const auto& [a, b] : topology.edges) {
     EdgeTerm term{{a, b}, 0, 0, 0};
     double r[3];
     relative(term, x, r);
     const double length = EdgeLength::measure(EdgeLength::frame(r));
-    if (length <= kCollapse * longest) continue;
+    if (length <= tiny) continue;
     term.rest_length = length;
     term.weight = membrane / length;
     term.collapsed_length = kCollapse * length;

@@ -31,8 +31,9 @@
 //   (MeshTopology::hinges), each with its own θ̄ and Ā_e: the sheets meeting there bend as if
 //   welded pairwise. Boundary edges have no bending term.
 // - degenerate rest elements have no term, since their rest quantity or weight is undefined: a
-//   triangle for which is_degenerate_face holds has no area term, a hinge with such a triangle
-//   no bending term, and an edge no longer than 1e-12 times the longest rest edge no length
+//   triangle for which is_degenerate_face holds, or whose edges are no longer than 1e-12 times
+//   the mesh's extent (the longest side of its bounding box), has no area term, a hinge with
+//   such a triangle no bending term, and an edge no longer than 1e-12 times the extent no length
 //   term. Vertices in no term (unreferenced ones, those only in degenerate faces) get zero
 //   gradient entries and zero (but present) diagonal Hessian blocks.
 // - a deformed element that collapses (edge length, triangle area or, for a hinge, either

@@ -6,17 +6,20 @@
 #include <functional>
 #include <set>
 
+#include "mesh/normalization.h"
 #include "util/errors.h"
+#include "util/require_positions.h"
 
 namespace modal_deform {
 
 void validate_mesh(const VerticesRef& V, const FacesRef& F) {
   if (V.rows() == 0) throw InputError("V: the mesh has no vertices");
   if (F.rows() == 0) throw InputError("F: the mesh has no faces");
-  for (Eigen::Index i = 0; i < V.rows(); ++i)
-    if (!V.row(i).allFinite())
-      throw InputError(message("V[", i, "]: vertex ", i, " has a non-finite coordinate (", V(i, 0), ", ",
-                               V(i, 1), ", ", V(i, 2), ")"));
+  require_positions(flatten(V), 3 * V.rows(), "V");
+  const double extent = bounding_box_extent(V);
+  if (!(extent >= kMinExtent))
+    throw InputError(message("V: the mesh's extent (the longest side of its bounding box) is ", extent,
+                             "; the core needs at least ", kMinExtent, ": scale the mesh up"));
   for (Eigen::Index f = 0; f < F.rows(); ++f)
     for (int k = 0; k < 3; ++k)
       if (F(f, k) < 0 || F(f, k) >= V.rows())
@@ -24,14 +27,19 @@ void validate_mesh(const VerticesRef& V, const FacesRef& F) {
                                  V.rows(), ")"));
 }
 
-bool is_degenerate_face(const VerticesRef& V, const FacesRef& F, int f) {
+double face_shape_ratio(const VerticesRef& V, const FacesRef& F, int f) {
   const int a = F(f, 0), b = F(f, 1), c = F(f, 2);
-  if (a == b || b == c || c == a) return true;
+  if (a == b || b == c || c == a) return 0;
   const Eigen::Vector3d ab = (V.row(b) - V.row(a)).transpose();
   const Eigen::Vector3d bc = (V.row(c) - V.row(b)).transpose();
   const Eigen::Vector3d ca = (V.row(a) - V.row(c)).transpose();
-  const double longest_squared = std::max({ab.squaredNorm(), bc.squaredNorm(), ca.squaredNorm()});
-  return ab.cross(-ca).norm() <= kDegenerateAreaRatio * longest_squared;
+  const double longest = std::max({ab.norm(), bc.norm(), ca.norm()});
+  if (!(longest > 0)) return 0;
+  return (ab / longest).cross(-ca / longest).norm();
+}
+
+bool is_degenerate_face(const VerticesRef& V, const FacesRef& F, int f) {
+  return face_shape_ratio(V, F, f) <= kDegenerateAreaRatio;
 }
 
 MeshReport check_mesh(const VerticesRef& V, const FacesRef& F) {

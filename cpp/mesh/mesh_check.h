@@ -9,14 +9,26 @@
 
 namespace modal_deform {
 
+// The smallest extent (longest side of the bounding box) of a usable mesh: the third derivatives
+// of the shells energy grow as the inverse cube of its elements' size, which must stay far from
+// overflow. A mesh whose vertices coincide has extent 0.
+constexpr double kMinExtent = 1e-12;
+
 // Throws InputError naming the first problem that makes (V, F) unusable: no vertices, no faces,
-// a non-finite coordinate (V[i]), or an index outside [0, #V) (F[f]).
+// a coordinate that is not finite or beyond kMaxCoordinate (V[i], require_positions), an extent
+// below kMinExtent, or an index outside [0, #V) (F[f]).
 void validate_mesh(const VerticesRef& V, const FacesRef& F);
 
 // Twice the area below which a face counts as degenerate, relative to its longest edge squared.
 constexpr double kDegenerateAreaRatio = 1e-12;
 
-// True when face f has repeated indices or (numerically) zero area.
+// Twice the area of face f over its longest edge squared: √3/2 for an equilateral triangle, about
+// the smallest angle (radians) for a thin one, 0 for repeated indices or coincident vertices.
+// Independent of the scale (no underflow for tiny faces).
+double face_shape_ratio(const VerticesRef& V, const FacesRef& F, int f);
+
+// True when face f has repeated indices or (numerically) zero area: face_shape_ratio at most
+// kDegenerateAreaRatio.
 bool is_degenerate_face(const VerticesRef& V, const FacesRef& F, int f);
 
 // Counts of each awkward feature with the first few offending indices (at most kExamples).

@@ -139,9 +139,22 @@ VibrationModes deflated_modes(const SparseMatrix& K, const VectorRef& mass, int 
   Eigen::VectorXd r(n), start(n);
   for (int d = 0; d < n; ++d) r[d] = m[d] * uniform(random);
   op.perform_op(r.data(), start.data());
-  eigs.init(start.data());
-  const Eigen::Index converged =
-      eigs.compute(Spectra::SortRule::LargestMagn, kMaxRestarts, kEigenTolerance, Spectra::SortRule::SmallestAlge);
+  Eigen::Index converged = 0;
+  try {
+    eigs.init(start.data());
+    converged =
+        eigs.compute(Spectra::SortRule::LargestMagn, kMaxRestarts, kEigenTolerance, Spectra::SortRule::SmallestAlge);
+  } catch (const NumericalError&) {
+    throw;
+  } catch (const Cancelled&) {
+    throw;
+  } catch (const std::runtime_error& e) {
+    // Spectra's own failures (e.g. "TridiagEigen: eigen decomposition failed"): seen when most of
+    // the mesh's motions cost no energy, so Lanczos meets one eigenvalue of huge multiplicity.
+    throw NumericalError(message("vibration modes: the eigensolver failed (", e.what(),
+                                 "); does the energy leave most motions free (a flat mesh under ARAP, a zero "
+                                 "weight)? Try the shells energy with positive weights, or fewer modes"));
+  }
   if (eigs.info() != Spectra::CompInfo::Successful)
     throw NumericalError(message("vibration modes: the eigensolver did not converge: ", converged, " of ", count,
                                  " eigenpairs after ", eigs.num_iterations(), " restarts and ", op.solves(),

@@ -126,7 +126,7 @@ Attachment attach(const VerticesRef& V, const FacesRef& F) {
   UnionFind sets(n);
   std::vector<bool> sound(static_cast<size_t>(m)), on_sound_face(static_cast<size_t>(n), false);
   for (int f = 0; f < m; ++f) {
-    sound[static_cast<size_t>(f)] = !is_degenerate_face(V, F, f);
+    sound[static_cast<size_t>(f)] = face_shape_ratio(V, F, f) > kMinSimulatedShape;
     if (!sound[static_cast<size_t>(f)]) continue;
     sets.unite(F(f, 0), F(f, 1));
     sets.unite(F(f, 0), F(f, 2));
@@ -136,7 +136,9 @@ Attachment attach(const VerticesRef& V, const FacesRef& F) {
   for (int f = 0; f < m; ++f)
     if (sound[static_cast<size_t>(f)]) root_area[static_cast<size_t>(sets.find(F(f, 0)))] += area[f];
   const double largest = *std::max_element(root_area.begin(), root_area.end());
-  if (!(largest > 0)) throw InputError("F: every face is degenerate; the mesh has no area to simulate");
+  if (!(largest > 0))
+    throw InputError(message("F: every face is degenerate or a sliver (twice its area below ", kMinSimulatedShape,
+                             " of its longest edge squared); the mesh has nothing to simulate"));
   const double threshold = kSimulatedAreaFraction * largest;
 
   Attachment result;

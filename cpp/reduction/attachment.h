@@ -4,13 +4,13 @@
 // unreferenced vertices, vertices whose faces have no area. The bake spends its modes only on
 // the simulated vertices; the others are attached and ride along.
 //
-// The rule. Components are taken over the non-degenerate faces (is_degenerate_face). A vertex is
-// simulated when it lies on a non-degenerate face of a component whose area is at least
-// kSimulatedAreaFraction (10%) of the largest component's area. Every other vertex is attached:
-// unreferenced vertices, vertices on degenerate faces only (they have no mass), and all vertices
-// of smaller components (scan debris; Suzanne's eyes, about 7% of her vertices each). The energy,
-// the mass and the eigenproblem use only the simulated submesh: the non-degenerate faces of the
-// simulated components.
+// The rule. Components are taken over the sound faces: neither degenerate nor slivers
+// (face_shape_ratio above kMinSimulatedShape). A vertex is simulated when it lies on a sound face
+// of a component whose area is at least kSimulatedAreaFraction (10%) of the largest component's
+// area. Every other vertex is attached: unreferenced vertices, vertices on degenerate faces or
+// slivers only, and all vertices of smaller components (scan debris; Suzanne's eyes, about 7% of
+// her vertices each). The energy, the mass and the eigenproblem use only the simulated submesh:
+// the sound faces of the simulated components.
 //
 // How attached vertices follow. An attached vertex moves with the affine motion of a tetrahedron
 // of four well-spread simulated vertices near it: its basis rows are Σ_k w_k (rows of anchor k),
@@ -34,6 +34,12 @@ namespace modal_deform {
 
 // Components with less area than this fraction of the largest one are attached.
 constexpr double kSimulatedAreaFraction = 0.1;
+// Faces thinner than this (face_shape_ratio: an angle below about 0.06°) are not simulated. The
+// bending stiffness of a sliver's hinges grows as the inverse square of its thinness (the inverse
+// cube when the sliver alone carries a vertex); measured on small grids, a sliver of 6e-5 threw
+// the eigensolver's shift, and one of 6e-6 made the lowest modes rounding noise (scan debris; the
+// shared dragons have one face below 1e-3 in 202k).
+constexpr double kMinSimulatedShape = 1e-3;
 
 struct Attachment {
   // Sorted indices of the simulated vertices (#S); submesh vertex s is fine vertex simulated[s].

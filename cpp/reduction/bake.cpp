@@ -21,6 +21,7 @@
 #include "reduction/ghost.h"
 #include "reduction/orthonormalize.h"
 #include "util/errors.h"
+#include "util/require_weight.h"
 #include "util/stopwatch.h"
 
 namespace modal_deform {
@@ -127,10 +128,8 @@ void check_options(const BakeOptions& o) {
   if (o.energy == "arap" && o.derivatives > 0)
     throw InputError(message("derivatives: the ARAP energy has no third derivative, so it has no modal derivatives; ",
                              "bake it with derivatives = 0, or use the shells energy (asked for ", o.derivatives, ")"));
-  if (!(std::isfinite(o.bending) && o.bending >= 0))
-    throw InputError(message("bending: expected a finite weight >= 0, got ", o.bending));
-  if (!(std::isfinite(o.membrane) && o.membrane >= 0))
-    throw InputError(message("membrane: expected a finite weight >= 0, got ", o.membrane));
+  require_weight(o.bending, "bending");
+  require_weight(o.membrane, "membrane");
 }
 
 }  // namespace

@@ -1,8 +1,13 @@
 #include "reduction/basis.h"
 
 #include <cmath>
+#include <limits>
 
+#include "mesh/mesh_check.h"
+#include "mesh/normalization.h"
 #include "util/errors.h"
+#include "util/require_positions.h"
+#include "util/require_weight.h"
 
 namespace modal_deform {
 namespace {
@@ -14,6 +19,15 @@ void require(bool condition, const std::string& what) {
 template <typename Matrix>
 void require_finite(const Matrix& matrix, const char* name) {
   require(matrix.allFinite(), message(name, " has non-finite entries"));
+}
+
+// Positions (#rows by 3) the energies take (require_positions), named as the basis's array.
+void require_coordinates(const RowMatrixX3d& positions, const char* name) {
+  try {
+    require_positions(flatten(positions), positions.size(), name);
+  } catch (const InputError& error) {
+    throw InputError(message("basis: ", error.what()));
+  }
 }
 
 }  // namespace
@@ -39,15 +53,20 @@ void validate_basis(const Basis& b) {
           message("ghost_vectors is ", b.ghost_vectors.rows(), " by ", b.ghost_vectors.cols(), ", expected ", 3 * g,
                   " by ", r));
   require(std::isfinite(b.scale) && b.scale > 0, message("scale ", b.scale, " is not a positive number"));
-  require(std::isfinite(b.bending) && b.bending >= 0 && std::isfinite(b.membrane) && b.membrane >= 0,
-          "energy weights must be finite and non-negative");
+  require(b.bending >= 0 && b.bending <= kMaxWeight && b.membrane >= 0 && b.membrane <= kMaxWeight,
+          message("energy weights must be in [0, ", kMaxWeight, "] (require_weight)"));
   require(b.num_dropped >= 0, "num_dropped is negative");
-  require_finite(b.rest, "rest");
+  require_coordinates(b.rest, "rest");
+  const double extent = bounding_box_extent(b.rest);
+  require(extent >= kMinExtent, message("rest has extent ", extent, ", below ", kMinExtent));
+  // The bake's scale is exactly normalizing_scale(rest): anything else was not baked for this mesh.
+  require(std::abs(b.scale * extent - kNormalizedExtent) <= 1e-12 * kNormalizedExtent,
+          message("scale ", b.scale, " does not scale rest (extent ", extent, ") to ", kNormalizedExtent));
   require_finite(b.mass, "mass");
   require((b.mass.array() >= 0).all(), "mass has negative entries");
   require_finite(b.vectors, "vectors");
   require_finite(b.eigenvalues, "eigenvalues");
-  require_finite(b.ghost_vertices, "ghost_vertices");
+  require_coordinates(b.ghost_vertices, "ghost_vertices");
   require_finite(b.ghost_vectors, "ghost_vectors");
   // The messages are formatted only for an offending entry: per entry they took 1.2 s at 100k vertices.
   for (Eigen::Index v = 0; v < n; ++v)
@@ -58,6 +77,28 @@ void validate_basis(const Basis& b) {
       if (b.ghost_faces(f, k) < 0 || b.ghost_faces(f, k) >= g)
         require(false, message("ghost_faces[", f, "] refers to ghost vertex ", b.ghost_faces(f, k), ", outside [0, ",
                                g, ")"));
+  // Ghost quantities are weighted means over the fine vertices: positions inside the fine bounding
+  // box, each vector entry within the largest of its column in `vectors` (float32 rounding aside).
+  const Eigen::RowVector3d low = b.rest.colwise().minCoeff(), high = b.rest.colwise().maxCoeff();
+  const double slack = 1e-9 * extent;
+  for (Eigen::Index i = 0; i < g; ++i)
+    if (!((b.ghost_vertices.row(i).array() >= low.array() - slack) &&
+          (b.ghost_vertices.row(i).array() <= high.array() + slack)).all())
+      require(false, message("ghost_vertices[", i, "] lies outside the bounding box of rest"));
+  // The solver evaluates the energy on the ghost in the normalised frame.
+  try {
+    validate_mesh(b.scale * b.ghost_vertices, b.ghost_faces);
+  } catch (const InputError& error) {
+    throw InputError(message("basis: ghost_vertices and ghost_faces (scaled) are not a usable mesh: ", error.what()));
+  }
+  const Eigen::VectorXf largest = b.vectors.cwiseAbs().colwise().maxCoeff().transpose();
+  for (Eigen::Index j = 0; j < r; ++j) {
+    Eigen::Index i = 0;
+    const double bound = 1.000001 * static_cast<double>(largest[j]) + std::numeric_limits<float>::min();
+    if (b.ghost_vectors.col(j).cwiseAbs().maxCoeff(&i) > bound)
+      require(false, message("ghost_vectors[", i, ", ", j, "] = ", b.ghost_vectors(i, j), " exceeds every entry of column ",
+                             j, " of vectors; it is not their restriction"));
+  }
 }
 
 }  // namespace modal_deform

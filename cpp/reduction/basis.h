@@ -48,7 +48,11 @@ struct Basis {
 
 // Throws InputError naming the first array that is missing, of the wrong shape, non-finite or
 // out of range, or inconsistent with the others. Stored bases are untrusted: a .blend may be
-// old, edited or hostile, and nothing may be read out of bounds after this passes.
+// old, edited or hostile, and nothing may be read out of bounds after this passes. Besides shapes,
+// counts and index ranges, what the bake guarantees is checked where it is cheap (O(#V r)):
+// coordinates within require_positions's range, scale = normalizing_scale(rest), ghost vertices
+// inside the bounding box of rest forming a usable mesh, and ghost vector entries no larger than
+// the largest entry of their column of vectors (they are weighted means of them).
 void validate_basis(const Basis& basis);
 
 }  // namespace modal_deform

@@ -6,14 +6,20 @@
 
 #include "linalg/cholmod_llt.h"
 #include "mesh/mass.h"
+#include "mesh/mesh_check.h"
 #include "mesh/normalization.h"
 #include "util/errors.h"
 #include "util/require_positions.h"
+#include "util/require_weight.h"
 
 namespace modal_deform {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+// The most load steps a solve takes: a handle moved farther than 10 diagonals moves by more than a
+// tenth of the diagonal per step (a move of 1e6 diagonals, a typo in a transform, would otherwise
+// take 1e7 steps and hang the caller).
+constexpr int kMaxLoadSteps = 100;
 
 // One handle vertex's share of the handle term: weight ‖y_vertex − target‖² (normalised frame).
 struct Pull {
@@ -64,11 +70,11 @@ Eigen::Matrix4d partial_transform(const Eigen::Matrix4d& T, const Eigen::Vector3
 FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handles& handles, const VectorRef& weights,
                            const Transforms& transforms, double stiffness, EnergyKind energy_kind, double bending,
                            double membrane, double tolerance, int max_iterations, const RowMatrixX3d* initial) {
+  validate_mesh(V, F);  // before the handles, which index into it
   const int n = static_cast<int>(V.rows());
   const Eigen::VectorXd handle_weights = checked_handle_weights(handles, weights, n);
   check_transforms(transforms, static_cast<int>(handles.size()));
-  if (!(std::isfinite(stiffness) && stiffness > 0))
-    throw InputError(message("stiffness: expected a finite value > 0, got ", stiffness));
+  require_stiffness(stiffness);
   if (!(tolerance > 0 && tolerance < 1))
     throw InputError(message("tolerance: expected a value in (0, 1), got ", tolerance));
   if (max_iterations < 0) throw InputError(message("max_iterations: expected at least 0, got ", max_iterations));
@@ -112,8 +118,8 @@ FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handle
       centres.push_back(c);
       const Eigen::AngleAxisd rotation(Eigen::Matrix3d(transforms[h].topLeftCorner<3, 3>()));
       const double move = (transforms[h].topLeftCorner<3, 3>() * c + transforms[h].topRightCorner<3, 1>() - c).norm();
-      steps = std::max({steps, static_cast<int>(std::ceil(std::abs(rotation.angle()) / (kPi / 6) - 1e-9)),
-                        static_cast<int>(std::ceil(move / (0.1 * diagonal) - 1e-9))});
+      const double wanted = std::max(std::abs(rotation.angle()) / (kPi / 6), move / (0.1 * diagonal));
+      steps = std::max(steps, static_cast<int>(std::ceil(std::min<double>(wanted - 1e-9, kMaxLoadSteps))));
     }
   }
 
@@ -162,7 +168,7 @@ FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handle
       bool decreased = false;
       for (int halving = 0; halving < 60 && slope < 0; ++halving, length /= 2) {
         y_trial = y + length * p;
-        if (!y_trial.allFinite()) continue;
+        if (!positions_in_range(y_trial)) continue;  // beyond what the energy takes: too long a step
         const double value_trial = objective(*energy, pulls, y_trial, gradient_trial);
         if (value_trial <= value + 1e-4 * length * slope ||
             (-length * slope < noise && value_trial <= value + noise && gradient_trial.norm() < gradient.norm())) {

@@ -11,7 +11,8 @@
 // Large motions are taken in load steps, as an animation would: the handles' transforms are
 // interpolated from the identity (each handle turning about its centre, the mean of its rest
 // vertices, by at most 30° per step, the centre moving by at most a tenth of the bounding-box
-// diagonal per step), and Newton converges at each step before the next. From rest, the first
+// diagonal per step, or by a hundredth of the move when it is longer than 10 diagonals: at most
+// 100 steps), and Newton converges at each step before the next. From rest, the first
 // Newton step is the linear elastic answer, which for a turned handle stretches the mesh
 // without bound; and a handle turned by 180° pulls its vertices straight through its axis.
 //

@@ -4,6 +4,8 @@
 #include <cmath>
 
 #include "util/errors.h"
+#include "util/require_positions.h"
+#include "util/require_weight.h"
 
 namespace modal_deform {
 
@@ -25,8 +27,8 @@ Eigen::VectorXd checked_handle_weights(const Handles& handles, const VectorRef& 
   if (weights.size() != count)
     throw InputError(message("weights: expected ", count, " values (one per handle), got ", weights.size()));
   for (int h = 0; h < count; ++h)
-    if (!std::isfinite(weights[h]) || weights[h] < 0)
-      throw InputError(message("weights[", h, "] = ", weights[h], " is not a finite number >= 0"));
+    if (!(weights[h] >= 0 && weights[h] <= kMaxWeight))
+      throw InputError(message("weights[", h, "] = ", weights[h], " is not a finite number in [0, ", kMaxWeight, "]"));
   return weights;
 }
 
@@ -44,6 +46,10 @@ void check_transforms(const Transforms& transforms, int num_handles) {
       throw InputError(message("transforms[", h, "]: the 3 by 3 block is not a rotation (max |RᵀR - I| = ", error,
                                "; scaling and shear are not rigid)"));
     if (R.determinant() < 0) throw InputError(message("transforms[", h, "]: the 3 by 3 block is a reflection"));
+    // Targets beyond the coordinates the energies take would make the objective overflow.
+    if (!positions_in_range(T.topRightCorner<3, 1>()))
+      throw InputError(message("transforms[", h, "]: the translation (", T(0, 3), ", ", T(1, 3), ", ", T(2, 3),
+                               ") is beyond ", kMaxCoordinate, " in a coordinate"));
   }
 }
 

@@ -35,12 +35,12 @@ using Transforms = std::vector<Eigen::Matrix4d>;  // per handle, a rigid transfo
 
 // Throws InputError naming the first problem: no handle, an empty handle, an index outside
 // [0, num_vertices), an index repeated within a handle, or weights (empty, or one per handle)
-// that are negative or not finite. Returns the weights, all 1 when `weights` is empty.
+// that are negative, not finite or above kMaxWeight (require_weight.h). Returns the weights, all 1 when `weights` is empty.
 Eigen::VectorXd checked_handle_weights(const Handles& handles, const VectorRef& weights, int num_vertices);
 
 // Throws InputError naming the first transform that is not rigid: not finite, a last row other
-// than (0, 0, 0, 1), a rotation block R with max |RᵀR − I| > 1e-5, or det R < 0 (a reflection);
-// or when there is not one transform per handle.
+// than (0, 0, 0, 1), a rotation block R with max |RᵀR − I| > 1e-5, det R < 0 (a reflection), or
+// a translation coordinate beyond kMaxCoordinate; or when there is not one transform per handle.
 void check_transforms(const Transforms& transforms, int num_handles);
 
 class HandleTerm {

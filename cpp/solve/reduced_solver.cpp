@@ -7,13 +7,14 @@
 #include <limits>
 
 #include "util/errors.h"
+#include "util/require_positions.h"
+#include "util/require_weight.h"
 
 namespace modal_deform {
 namespace {
 
 double checked_stiffness(double stiffness) {
-  if (!(std::isfinite(stiffness) && stiffness > 0))
-    throw InputError(message("stiffness: expected a finite value > 0, got ", stiffness));
+  require_stiffness(stiffness);
   return stiffness;
 }
 
@@ -97,7 +98,7 @@ void ReducedSolver::reset() {
 double ReducedSolver::objective(const Eigen::VectorXd& q, Eigen::VectorXd& gradient) {
   ghost_x_.noalias() = ghost_vectors_ * q;
   ghost_x_ += ghost_rest_;
-  if (!ghost_x_.allFinite()) return std::numeric_limits<double>::infinity();
+  if (!positions_in_range(ghost_x_)) return std::numeric_limits<double>::infinity();
   const double energy = energy_->value_and_gradient(ghost_x_, ghost_gradient_);
   gradient.noalias() = ghost_vectors_.transpose() * ghost_gradient_;
   const double handles = handle_term_.value_and_gradient(q, handle_gradient_);

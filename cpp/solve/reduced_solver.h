@@ -65,7 +65,8 @@ class ReducedSolver {
   // `out`. Rows are split over threads in blocks; throws InputError for a wrong size.
   void positions(Eigen::Ref<Eigen::VectorXf> out) const;
 
-  // f(q) with ∇f(q) (r) written into `gradient`; +inf where the ghost positions overflow.
+  // f(q) with ∇f(q) (r) written into `gradient`; +inf where a ghost coordinate leaves the range
+  // the energies take (kMaxCoordinate).
   double objective(const Eigen::VectorXd& q, Eigen::VectorXd& gradient);
 
   const Eigen::VectorXd& q() const { return bfgs_.x(); }

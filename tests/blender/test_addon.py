@@ -29,6 +29,10 @@ def test_quads_ngons_and_mode_preview(run_blender):
     assert "NGONS_OK" in run_blender("quads_ngons_preview.py").stdout
 
 
+def test_damaged_stored_basis_is_refused_with_a_message(run_blender):
+    assert "DAMAGED_OK" in run_blender("damaged_basis.py").stdout
+
+
 def test_cancelled_or_failed_bake_leaves_the_object_unchanged(run_blender):
     assert "CANCEL_OK" in run_blender("cancel_bake.py").stdout
 

@@ -171,6 +171,19 @@ TEST(Arap, ZeroAtRestAndAfterRigidMotions) {
   }
 }
 
+// Regression (fuzz_mesh_entry_points): a triangle scaled by 5e-324 (collapsed to denormals) gave
+// f_ωω eigenvalues too small to invert and an infinite Hessian; so did any cell collapsed far
+// below its rest size.
+TEST(Arap, HessianOfACollapsedMeshIsFinite) {
+  const TriangleMesh triangle = mesh_from_buffers({0, 0, -1.984375, 1, 0, 0, 0, 1, 0}, {0, 2, 1});
+  const Arap energy(triangle.V, triangle.F);
+  for (double scale : {5e-324, 1e-300, 1e-160, 0.0}) {
+    const Eigen::VectorXd x = scale * energy.rest();
+    const SparseMatrix H = energy.hessian(x);
+    EXPECT_TRUE(Eigen::Map<const Eigen::VectorXd>(H.valuePtr(), H.nonZeros()).allFinite()) << scale;
+  }
+}
+
 TEST(Arap, MirrorImageCostsMoreThanAStretch) {
   // Without the reflection fix each cell would fit its mirror image exactly (E = 0).
   for (const auto& [name, mesh] : test_shapes()) {

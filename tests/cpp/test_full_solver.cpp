@@ -9,6 +9,7 @@
 #include "solve/full_solver.h"
 #include "solve/reduced_solver.h"
 #include "test_posing.h"
+#include "test_support.h"
 #include "util/errors.h"
 
 namespace modal_deform {
@@ -140,6 +141,38 @@ TEST(SolveFull, UnreferencedVerticesStayAtRest) {
                                             1e3, EnergyKind::kShells, 1.0, 1.0, 1e-10, 100);
   EXPECT_TRUE(result.converged);
   EXPECT_LE((result.positions.row(loose) - tube.mesh.V.row(loose)).norm(), 1e-14);
+}
+
+// Regression (robustness corpus): a handle moved a million diagonals took 1e7 load steps, and a
+// move beyond 2^31 tenths of the diagonal overflowed the step count.
+TEST(SolveFull, AFarMoveTakesAtMostAHundredLoadSteps) {
+  const TriangleMesh mesh = grid(3, 3, 1.0, 1.0);
+  for (double distance : {1e6, 1e12}) {
+    const Transforms far = {rigid_transform({0, 0, 1}, 0.3, {0, 0, 0}, {distance, 0, 0})};
+    const FullSolveResult result =
+        solve_full(mesh.V, mesh.F, {{0, 5}}, Eigen::VectorXd(), far, 1e3, EnergyKind::kShells, 1, 1, 1e-6, 3);
+    EXPECT_EQ(result.steps, 100);
+    EXPECT_TRUE(result.positions.allFinite());
+  }
+}
+
+// Regression (robustness corpus): a bad mesh is named before the handles that index into it.
+TEST(SolveFull, TheMeshIsCheckedBeforeTheHandles) {
+  const TriangleMesh mesh = grid(3, 3, 1.0, 1.0);
+  RowMatrixX3d V = mesh.V;
+  V(4, 1) = std::nan("");
+  testing::expect_input_error(
+      [&] {
+        solve_full(V, mesh.F, {{0}}, Eigen::VectorXd(), {Eigen::Matrix4d::Identity()}, 1e3, EnergyKind::kShells, 1, 1,
+                   1e-6, 3);
+      },
+      "V[4]");
+  testing::expect_input_error(
+      [&] {
+        solve_full(RowMatrixX3d(0, 3), RowMatrixX3i(0, 3), {{0}}, Eigen::VectorXd(), {Eigen::Matrix4d::Identity()}, 1e3,
+                   EnergyKind::kShells, 1, 1, 1e-6, 3);
+      },
+      "V: the mesh has no vertices");
 }
 
 TEST(SolveFull, BadInputIsRefused) {

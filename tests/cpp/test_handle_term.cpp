@@ -147,5 +147,16 @@ TEST(HandleTerm, TransformsMustBeRigid) {
   expect_input_error([&] { check_transforms({nan}, 1); }, "non-finite");
 }
 
+// Regression (fuzz_bake_and_pose): a translation of -1.7e308 passed, and the full solve returned
+// an infinite energy. Translations are held to the coordinates the energies take.
+TEST(HandleTerm, TranslationsBeyondTheCoordinateRangeAreRefused) {
+  Eigen::Matrix4d far = Eigen::Matrix4d::Identity();
+  far(1, 3) = -1.7e308;
+  expect_input_error([&] { check_transforms({Eigen::Matrix4d::Identity(), far}, 2); },
+                     "transforms[1]: the translation (0, -1.7e+308, 0) is beyond 1e+15");
+  far(1, 3) = -1e15;
+  EXPECT_NO_THROW(check_transforms({far}, 1));
+}
+
 }  // namespace
 }  // namespace modal_deform

@@ -7,9 +7,18 @@ finiteness) are checked by the native core, which must refuse bad data on its ow
 import numpy as np
 
 
+def reals(x, name):
+    """x as a float64 array; a ValueError naming `name` for anything that is not real numbers
+    (strings, objects, complex values, None)."""
+    x = np.asarray(x)
+    if x.dtype.kind not in "biuf":
+        raise ValueError(f"{name}: expected real numbers, got dtype {x.dtype}")
+    return np.ascontiguousarray(x, dtype=np.float64)
+
+
 def vertices(V, name="V"):
     """(n, 3) float64, C order."""
-    V = np.ascontiguousarray(V, dtype=np.float64)
+    V = reals(V, name)
     if V.ndim != 2 or V.shape[1] != 3:
         raise ValueError(f"{name}: expected an (n, 3) array of positions, got shape {V.shape}")
     return V
@@ -29,7 +38,7 @@ def faces(F, name="F"):
 
 def positions(X, num_vertices, name="X"):
     """Flat (3n,) float64 view of an (n, 3) or (3n,) array of positions or displacements."""
-    X = np.ascontiguousarray(X, dtype=np.float64)
+    X = reals(X, name)
     if X.shape not in ((num_vertices, 3), (3 * num_vertices,)):
         raise ValueError(
             f"{name}: expected shape ({num_vertices}, 3) or ({3 * num_vertices},), got {X.shape}")
@@ -38,7 +47,7 @@ def positions(X, num_vertices, name="X"):
 
 def values(x, name, length=None):
     """(length,) float64, C order."""
-    x = np.ascontiguousarray(x, dtype=np.float64)
+    x = reals(x, name)
     if x.ndim != 1 or (length is not None and x.shape[0] != length):
         expected = f"({length},)" if length is not None else "a 1-d array"
         raise ValueError(f"{name}: expected {expected}, got shape {x.shape}")
@@ -60,9 +69,19 @@ def labels(x, length, name="labels"):
 def columns(X, rows, name):
     """(rows, k) float64 in Fortran order, the native core's column-major layout; a (rows,)
     vector becomes one column."""
-    X = np.asarray(X, dtype=np.float64)
+    X = reals(X, name)
     if X.ndim == 1:
         X = X[:, None]
     if X.ndim != 2 or X.shape[0] != rows:
         raise ValueError(f"{name}: expected shape ({rows}, k), got {X.shape}")
     return np.asfortranarray(X)
+
+
+def number(x, name):
+    """A float from a real number (Python or numpy); a ValueError naming `name` otherwise."""
+    if isinstance(x, (str, bytes)):
+        raise ValueError(f"{name}: expected a number, got {x!r}")
+    try:
+        return float(x)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: expected a number, got {x!r}") from None

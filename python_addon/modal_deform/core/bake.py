@@ -167,7 +167,8 @@ def bake(V, F, modes=20, derivatives=52, ghost=1000, energy="shells", bending=1.
     if progress is not None and not callable(progress):
         raise ValueError(f"progress: expected a callable progress(stage, fraction) or None, got {progress!r}")
     native = _native.bake(V, F, _count(modes, "modes", 1), _count(derivatives, "derivatives", 0),
-                          _count(ghost, "ghost", 4), energy, float(bending), float(membrane), progress)
+                          _count(ghost, "ghost", 4), energy, _arrays.number(bending, "bending"),
+                          _arrays.number(membrane, "membrane"), progress)
     basis = Basis(native)
     if basis.num_floppy:
         warnings.warn(f"the mesh is floppy: it has {basis.num_floppy} zero modes besides its rigid motions "

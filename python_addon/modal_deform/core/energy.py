@@ -63,7 +63,8 @@ class DiscreteShells(_Energy):
 
     def __init__(self, V, F, bending=1.0, membrane=1.0):
         super().__init__(
-            _native.DiscreteShells(_arrays.vertices(V), _arrays.faces(F), float(bending), float(membrane)))
+            _native.DiscreteShells(_arrays.vertices(V), _arrays.faces(F), _arrays.number(bending, "bending"),
+                                 _arrays.number(membrane, "membrane")))
 
     @property
     def term_counts(self):

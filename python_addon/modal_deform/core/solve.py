@@ -17,6 +17,7 @@ import numpy as np
 
 from .. import _native
 from . import _arrays
+from .bake import Basis
 
 #: The default handle stiffness μ: stiff enough that handles land within a small fraction of a
 #: percent of the model's size in the test poses, soft enough to keep BFGS well conditioned.
@@ -49,7 +50,7 @@ def _handles(handles):
 
 def _transforms(transforms, count):
     """One (4, 4) float64 matrix per handle (rigidity is checked natively)."""
-    transforms = [np.asarray(T, dtype=np.float64) for T in transforms]
+    transforms = [_arrays.reals(T, f"transforms[{h}]") for h, T in enumerate(transforms)]
     if len(transforms) != count:
         raise ValueError(f"transforms: expected {count} (one per handle), got {len(transforms)}")
     for h, T in enumerate(transforms):
@@ -65,7 +66,7 @@ def _weights(weights, count):
 
 
 def _stiffness(stiffness):
-    stiffness = float(stiffness)
+    stiffness = _arrays.number(stiffness, "stiffness")
     if not (np.isfinite(stiffness) and stiffness > 0):
         raise ValueError(f"stiffness: expected a finite value > 0, got {stiffness}")
     return stiffness
@@ -83,6 +84,9 @@ class ReducedSolver:
     """
 
     def __init__(self, basis, handles, stiffness=STIFFNESS, weights=None, energy="shells", warm_start=True):
+        if not isinstance(basis, Basis):
+            raise ValueError(f"basis: expected a modal_deform.core.Basis (from bake or Basis.from_arrays), "
+                             f"got {type(basis).__name__}")
         native_basis = basis._native
         handles = _handles(handles)
         self._native = _native.ReducedSolver(native_basis, handles, _weights(weights, len(handles)),
@@ -122,7 +126,7 @@ class ReducedSolver:
             max_iterations = operator.index(max_iterations)
         except TypeError:
             raise ValueError(f"max_iterations: expected an integer, got {max_iterations!r}") from None
-        return self._native.solve(max_iterations, float(tolerance))
+        return self._native.solve(max_iterations, _arrays.number(tolerance, "tolerance"))
 
     def objective(self, q):
         """The objective f(q) (ghost energy plus handle term, normalised frame) and its gradient
@@ -173,7 +177,8 @@ def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, ene
     except TypeError:
         raise ValueError(f"max_iterations: expected an integer, got {max_iterations!r}") from None
     X, stats = _native.solve_full(V, F, handles, _transforms(transforms, len(handles)), _weights(weights, len(handles)),
-                                  _stiffness(stiffness), str(energy), float(bending), float(membrane),
-                                  float(tolerance), max_iterations,
+                                  _stiffness(stiffness), str(energy), _arrays.number(bending, "bending"),
+                                  _arrays.number(membrane, "membrane"), _arrays.number(tolerance, "tolerance"),
+                                  max_iterations,
                                   None if initial is None else _arrays.vertices(initial, "initial"))
     return (X, stats) if return_stats else X
