@@ -29,6 +29,8 @@ from mathutils import Matrix
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "python_addon"))
+sys.path.insert(0, str(ROOT / "blender_scripts"))
+from headless import add_handle  # noqa: E402 (found through the line above)
 MESHES = ROOT.parent / "shared" / "meshes"
 
 
@@ -72,17 +74,6 @@ def mesh_object(name, V, F):
     bpy.context.scene.collection.objects.link(obj)
     bpy.context.view_layer.objects.active = obj
     return obj
-
-
-def add_handle(obj, mask):
-    mesh = obj.data
-    mesh.polygons.foreach_set("select", np.zeros(len(mesh.polygons), bool))
-    mesh.edges.foreach_set("select", np.zeros(len(mesh.edges), bool))
-    mesh.vertices.foreach_set("select", mask)
-    bpy.ops.object.mode_set(mode="EDIT")
-    bpy.ops.modal_deform.add_handle()
-    bpy.ops.object.mode_set(mode="OBJECT")
-    return obj.modal_deform.handles[-1]
 
 
 def time_updates(obj, controller, updates):

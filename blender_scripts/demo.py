@@ -19,6 +19,7 @@ from mathutils import Matrix, Vector
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "python_addon"))
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from headless import add_handle  # noqa: E402
 from rendering import render, side_by_side, stage  # noqa: E402
 
 
@@ -41,18 +42,6 @@ def subdivided_suzanne(levels):
     bpy.ops.object.modifier_apply(modifier=modifier.name)
     bpy.ops.object.shade_smooth()
     return suzanne
-
-
-def add_handle(obj, mask):
-    """A handle of the vertices in `mask`, made as an artist does: select them, Add Handle."""
-    mesh = obj.data
-    mesh.polygons.foreach_set("select", np.zeros(len(mesh.polygons), bool))
-    mesh.edges.foreach_set("select", np.zeros(len(mesh.edges), bool))
-    mesh.vertices.foreach_set("select", mask)
-    bpy.ops.object.mode_set(mode="EDIT")
-    bpy.ops.modal_deform.add_handle()
-    bpy.ops.object.mode_set(mode="OBJECT")
-    return obj.modal_deform.handles[-1]
 
 
 def interactive_updates(obj, count):

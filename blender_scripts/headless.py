@@ -5,9 +5,9 @@ import sys
 
 import addon_utils
 import bpy
+import numpy as np
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "python_addon"))
+ADDON_PARENT = pathlib.Path(__file__).resolve().parents[1] / "python_addon"
 
 
 def argument_parser(doc):
@@ -24,7 +24,9 @@ def parse(parser):
 
 
 def active_mesh_object(name):
-    """Enable the add-on and make the mesh object `name` active; exit with the reason if there is none."""
+    """Enable the add-on (from this source tree unless Blender has it installed) and make the mesh
+    object `name` active; exit with the reason if there is none."""
+    sys.path.append(str(ADDON_PARENT))
     addon_utils.enable("modal_deform", default_set=True)
     obj = bpy.data.objects.get(name)
     if obj is None or obj.type != "MESH":
@@ -46,3 +48,19 @@ def save(output):
     if not path:
         sys.exit("--output: the opened file has no path to save to")
     bpy.ops.wm.save_as_mainfile(filepath=str(pathlib.Path(path).resolve()))
+
+
+def add_handle(obj, mask):
+    """A handle of obj's vertices in the boolean `mask`, made as an artist does: select them in Edit
+    Mode, Add Handle (a vertex group and an Empty at their centre). Returns the handle."""
+    bpy.context.view_layer.objects.active = obj
+    mesh = obj.data
+    mesh.polygons.foreach_set("select", np.zeros(len(mesh.polygons), bool))
+    mesh.edges.foreach_set("select", np.zeros(len(mesh.edges), bool))
+    mesh.vertices.foreach_set("select", mask)
+    bpy.ops.object.mode_set(mode="EDIT")
+    result = bpy.ops.modal_deform.add_handle()
+    bpy.ops.object.mode_set(mode="OBJECT")
+    if result != {"FINISHED"}:
+        raise RuntimeError(f"Add Handle on {obj.name!r} did not finish: {result}")
+    return obj.modal_deform.handles[-1]

@@ -6,6 +6,10 @@ import addon_utils
 import bpy
 import numpy as np
 
+# Handles are made as the demo and the benchmark make them (select, Add Handle).
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "..", "blender_scripts"))
+from headless import add_handle  # noqa: E402,F401 (the scripts call support.add_handle; no side effect)
+
 
 def enable_addon():
     """Enable modal_deform from the source tree (ADDON_PATH) and return its package."""
@@ -45,20 +49,6 @@ def key_positions(obj, name):
     co = np.empty(3 * len(block.data), np.float32)
     block.data.foreach_get("co", co)
     return co.reshape(-1, 3)
-
-
-def add_handle(obj, mask):
-    """Add a handle from the vertices in the boolean mask, through the Edit Mode operator."""
-    bpy.context.view_layer.objects.active = obj
-    mesh = obj.data
-    mesh.polygons.foreach_set("select", np.zeros(len(mesh.polygons), bool))
-    mesh.edges.foreach_set("select", np.zeros(len(mesh.edges), bool))
-    mesh.vertices.foreach_set("select", mask)
-    bpy.ops.object.mode_set(mode="EDIT")
-    result = bpy.ops.modal_deform.add_handle()
-    bpy.ops.object.mode_set(mode="OBJECT")
-    assert result == {"FINISHED"}, result
-    return obj.modal_deform.handles[-1]
 
 
 def stored_bases():
