@@ -193,4 +193,13 @@ CLASSES = (MODAL_DEFORM_OT_pose, MODAL_DEFORM_OT_pose_end, MODAL_DEFORM_MT_pose,
            MODAL_DEFORM_OT_reset)
 
 
-register, unregister = bpy.utils.register_classes_factory(CLASSES)
+register, _unregister_classes = bpy.utils.register_classes_factory(CLASSES)
+
+
+def unregister():
+    """Disabling the add-on mid-pose ends the pose as Esc does: Blender drops the modal handler of
+    an unregistered operator without calling it, which would leave its timer, header text and
+    half-made shape key behind."""
+    if _running is not None:
+        _running._end(bpy.context, "CANCEL")
+    _unregister_classes()

@@ -2,7 +2,8 @@
 
 Bake Suzanne, add a handle, start the Pose operator from the sidebar's context, grab the controller
 with a simulated G + mouse motion + click, let the timer solve, check the mesh followed; Esc
-restores the mesh; the converged pose equals the Solve operator's; undo takes a bake back.
+restores the mesh; the converged pose equals the Solve operator's; undo takes a bake back;
+disabling the add-on mid-pose restores as Esc does.
 Each step runs from bpy.app.timers so Blender handles the simulated events in between.
 Writes OUTPUT/result.json ({"ok": bool, "log": [...]}) and screenshots, then quits.
 """
@@ -208,6 +209,20 @@ def steps():
     say(f"solve equals the interactive pose within {difference:.1e} of the size")
     yield 0.5
     screenshot("solved.png")
+
+    # Disabling the add-on while posing ends the pose as Esc does (Solve's key was there before).
+    before = key_positions(obj, posing.POSE_KEY).tobytes()
+    with override():
+        assert bpy.ops.modal_deform.pose("INVOKE_DEFAULT") == {"RUNNING_MODAL"}
+    controller.location.z += 0.3
+    yield 0.5
+    assert key_positions(obj, posing.POSE_KEY).tobytes() != before, "the pose did not follow the controller"
+    addon_utils.disable("modal_deform", default_set=True)
+    assert ops_pose._running is None, "disabling the add-on left the pose running"
+    assert key_positions(obj, posing.POSE_KEY).tobytes() == before, "disabling did not restore the shape key"
+    assert base_positions(obj).tobytes() == rest.tobytes()
+    yield 0.5
+    say("disabling the add-on mid-pose restored the shape key")
 
 
 def drive(generator=steps()):
