@@ -210,6 +210,41 @@ def steps():
     yield 0.5
     screenshot("solved.png")
 
+    # Saving while posing writes a consistent file: the base mesh as it was, the pose key, the basis.
+    with override():
+        bpy.ops.ed.undo_push(message="Solved")
+        # Started from Python, an operator records its undo step only when asked (third argument).
+        assert bpy.ops.modal_deform.pose("INVOKE_DEFAULT", True) == {"RUNNING_MODAL"}
+    controller.location.x -= 0.2
+    yield 0.5
+    saved = os.path.join(output, "saved_while_posing.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=saved, copy=True)
+    posed = key_positions(obj, posing.POSE_KEY)
+    with bpy.data.libraries.load(saved) as (data_from, data_to):
+        data_to.objects = [obj.name]
+    copy = data_to.objects[0]
+    assert base_positions(copy).tobytes() == rest.tobytes(), "the saved base mesh is not the rest mesh"
+    assert np.abs(key_positions(copy, posing.POSE_KEY) - posed).max() < 0.05, "the saved pose is not the pose"
+    assert copy.modal_deform.basis is not None and copy.modal_deform.status.dimension == settings.status.dimension
+    bpy.data.objects.remove(copy)
+
+    # Enter applies; Ctrl+Z takes the applied pose back.
+    before = key_positions(obj, posing.POSE_KEY).tobytes()
+    window.event_simulate(type="RET", value="PRESS", x=x, y=y)
+    window.event_simulate(type="RET", value="RELEASE", x=x, y=y)
+    yield 0.3
+    assert ops_pose._running is None, "Enter did not end the pose"
+    assert key_positions(obj, posing.POSE_KEY).tobytes() != key_positions(obj, "Basis").tobytes()
+    window.event_simulate(type="Z", value="PRESS", x=x, y=y, ctrl=True)
+    window.event_simulate(type="Z", value="RELEASE", x=x, y=y, ctrl=True)
+    yield 0.5
+    obj = bpy.data.objects["Suzanne"]  # undo re-reads the data
+    controller = obj.modal_deform.handles[0].controller
+    assert base_positions(obj).tobytes() == rest.tobytes()
+    undone = key_positions(obj, posing.POSE_KEY).tobytes()
+    assert undone == solved.tobytes(), "Ctrl+Z did not take the applied pose back to the solved one"
+    say("saving while posing wrote a consistent file; Enter applied and Ctrl+Z took it back")
+
     # Disabling the add-on while posing ends the pose as Esc does (Solve's key was there before).
     before = key_positions(obj, posing.POSE_KEY).tobytes()
     with override():
