@@ -4,6 +4,8 @@ Each function returns an array the native core takes without a copy (C order, th
 and raises ValueError naming the argument when the input cannot be one. Contents (index ranges,
 finiteness) are checked by the native core, which must refuse bad data on its own anyway.
 """
+import operator
+
 import numpy as np
 
 
@@ -85,3 +87,12 @@ def number(x, name):
         return float(x)
     except (TypeError, ValueError):
         raise ValueError(f"{name}: expected a number, got {x!r}") from None
+
+
+def integer(x, name):
+    """An int from an integer (Python or numpy, not a float or bool-like string); a ValueError
+    naming `name` otherwise."""
+    try:
+        return operator.index(x)
+    except TypeError:
+        raise ValueError(f"{name}: expected an integer, got {x!r}") from None

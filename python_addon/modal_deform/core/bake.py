@@ -10,7 +10,6 @@ Scan debris (components with less than 10% of the largest one's area), unreferen
 vertices without mass are not simulated: they follow the affine motion of nearby simulated
 vertices, so they move rigidly with the mesh.
 """
-import operator
 import warnings
 
 import numpy as np
@@ -136,10 +135,7 @@ class Basis:
 
 
 def _count(value, name, minimum):
-    try:
-        value = operator.index(value)
-    except TypeError:
-        raise ValueError(f"{name}: expected an integer, got {value!r}") from None
+    value = _arrays.integer(value, name)
     if value < minimum:
         raise ValueError(f"{name}: expected at least {minimum}, got {value}")
     return min(value, np.iinfo(np.int32).max)

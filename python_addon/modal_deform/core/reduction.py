@@ -3,7 +3,6 @@
 Each fine vertex collapses onto one ghost vertex; a ghost quantity is the lumped-mass-weighted
 mean of the fine quantity over the vertices collapsed onto it (paper section 5).
 """
-import operator
 
 import numpy as np
 
@@ -24,10 +23,7 @@ def ghost_mesh(V, F, vertices=1000, progress=None):
     False raises ``Cancelled``.
     """
     V, F = _arrays.vertices(V), _arrays.faces(F)
-    try:
-        vertices = operator.index(vertices)
-    except TypeError:
-        raise ValueError(f"vertices: expected an integer, got {vertices!r}") from None
+    vertices = _arrays.integer(vertices, "vertices")
     if vertices < 4:
         raise ValueError(f"vertices: a ghost needs at least 4 vertices, got {vertices}")
     if progress is not None and not callable(progress):

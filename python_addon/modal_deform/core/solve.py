@@ -11,8 +11,6 @@ belong to several handles (its pulls add up, so it settles between their targets
 their weights), but not twice to one. Vertices without mass (in no triangle) pull with zero
 weight.
 """
-import operator
-
 import numpy as np
 
 from .. import _native
@@ -122,11 +120,8 @@ class ReducedSolver:
         {"iterations", "energy" (the objective), "converged", "ms", "evaluations",
         "gradient_norm"}. q and the inverse Hessian carry over to the next call.
         """
-        try:
-            max_iterations = operator.index(max_iterations)
-        except TypeError:
-            raise ValueError(f"max_iterations: expected an integer, got {max_iterations!r}") from None
-        return self._native.solve(max_iterations, _arrays.number(tolerance, "tolerance"))
+        return self._native.solve(_arrays.integer(max_iterations, "max_iterations"),
+                                  _arrays.number(tolerance, "tolerance"))
 
     def objective(self, q):
         """The objective f(q) (ghost energy plus handle term, normalised frame) and its gradient
@@ -172,10 +167,7 @@ def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, ene
     """
     V, F = _arrays.vertices(V), _arrays.faces(F)
     handles = _handles(handles)
-    try:
-        max_iterations = operator.index(max_iterations)
-    except TypeError:
-        raise ValueError(f"max_iterations: expected an integer, got {max_iterations!r}") from None
+    max_iterations = _arrays.integer(max_iterations, "max_iterations")
     X, stats = _native.solve_full(V, F, handles, _transforms(transforms, len(handles)), _weights(weights, len(handles)),
                                   _stiffness(stiffness), str(energy), _arrays.number(bending, "bending"),
                                   _arrays.number(membrane, "membrane"), _arrays.number(tolerance, "tolerance"),
