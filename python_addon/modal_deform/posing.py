@@ -92,7 +92,7 @@ class ShapeKeyState:
         mesh_io.remove_shape_keys(obj, self.created)
         if self.co is not None:
             block = obj.data.shape_keys.key_blocks[self.name]
-            block.data.foreach_set("co", self.co)
+            mesh_io.write_shape_key(obj.data, block, self.co)
             block.value, block.mute = self.value, self.mute
         obj.active_shape_key_index = self.active_index
         obj.show_only_shape_key = self.show_only
