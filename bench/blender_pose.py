@@ -171,23 +171,6 @@ def storage_figures(obj, folder):
     return figures
 
 
-def components(mesh):
-    """Connected-component label of each vertex (the smallest vertex index in it)."""
-    edges = np.empty(2 * len(mesh.edges), np.int32)
-    mesh.edges.foreach_get("vertices", edges)
-    a, b = edges.reshape(-1, 2).T
-    label = np.arange(len(mesh.vertices))
-    while True:
-        low = np.minimum(label[a], label[b])
-        updated = label.copy()
-        np.minimum.at(updated, a, low)
-        np.minimum.at(updated, b, low)
-        updated = updated[updated]  # jump to the label's label: halves the remaining distance
-        if np.array_equal(updated, label):
-            return label
-        label = updated
-
-
 def bind_laplacian(obj, anchors, moving):
     """Blender's Laplacian Deform on obj with the vertices `anchors` held and `moving` (among them)
     carried by a hook to an Empty at the origin (its matrix_world is then the handle's transform).
@@ -224,7 +207,8 @@ def laplacian_deform(updates, subdivisions):
     V = V.reshape(-1, 3)
     top, bottom = np.flatnonzero(V[:, 2] > 0.6), np.flatnonzero(V[:, 2] < -0.55)
     # Every connected component needs an anchor, or the modifier finds no solution: the eyes too.
-    label = components(obj.data)
+    from modal_deform import core as mdc, mesh_io
+    label = mdc.check(V, mesh_io.triangles(obj.data))["vertex_component"]
     eyes = np.flatnonzero(label != label[top[0]])
     anchors = np.concatenate([top, bottom, eyes])
     empty, bind = bind_laplacian(obj, anchors, top)

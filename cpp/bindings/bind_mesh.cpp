@@ -22,6 +22,10 @@ py::dict report_to_dict(const MeshReport& report) {
   out["edges"] = report.num_edges;
   out["components"] = report.num_components;
   out["component_sizes"] = report.component_sizes;
+  out["vertex_component"] =
+      Eigen::Map<const Eigen::VectorXi>(report.vertex_component.data(),
+                                        static_cast<Eigen::Index>(report.vertex_component.size()))
+          .eval();
   for (const auto& finding : report.findings)
     out[finding.name.c_str()] = py::dict(py::arg("count") = finding.count, py::arg("first") = finding.examples);
   return out;

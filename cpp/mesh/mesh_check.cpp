@@ -50,6 +50,7 @@ MeshReport check_mesh(const VerticesRef& V, const FacesRef& F) {
   report.num_faces = static_cast<int>(F.rows());
   report.num_edges = static_cast<int>(topology.edges.size());
   report.num_components = topology.num_components;
+  report.vertex_component = topology.vertex_component;
   report.component_sizes.assign(topology.num_components, 0);
   for (int c : topology.vertex_component)
     if (c >= 0) ++report.component_sizes[c];

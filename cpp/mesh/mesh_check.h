@@ -41,6 +41,7 @@ struct MeshReport {
   };
   int num_vertices = 0, num_faces = 0, num_edges = 0, num_components = 0;
   std::vector<int> component_sizes;  // vertices per component, largest first
+  std::vector<int> vertex_component;  // per vertex: its component, -1 when in no face
   std::vector<Finding> findings;     // boundary_edges, nonmanifold_edges, ... in a fixed order
 };
 

@@ -14,6 +14,9 @@ def test_check_reports_the_dragon_defects(shared_mesh):
     assert report["unreferenced_vertices"]["count"] == 2
     assert len(report["unreferenced_vertices"]["first"]) == 2
     assert sum(report["component_sizes"]) == 5205 - 2
+    labels = report["vertex_component"]
+    assert labels.shape == (5205,) and np.count_nonzero(labels == -1) == 2
+    assert sorted(np.bincount(labels[labels >= 0]), reverse=True) == report["component_sizes"]
 
 
 def test_mass_sums_to_area(shared_mesh):

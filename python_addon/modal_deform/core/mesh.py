@@ -7,7 +7,8 @@ def check(V, F):
     """Report what is awkward about the triangle mesh (V, F).
 
     Returns a dict with counts (``vertices``, ``faces``, ``edges``, ``components``,
-    ``component_sizes``, largest first) and, for each of ``boundary_edges``,
+    ``component_sizes``, largest first), ``vertex_component`` ((n,) int32: each vertex's connected
+    component, -1 for a vertex in no face) and, for each of ``boundary_edges``,
     ``nonmanifold_edges``, ``nonmanifold_vertices``, ``unreferenced_vertices``,
     ``degenerate_faces`` and ``duplicate_faces``, a dict ``{"count": int, "first": [indices]}``.
     Raises ValueError for a mesh nothing can be computed on (no faces, a non-finite coordinate,
