@@ -46,9 +46,12 @@ def provenance(result):
             f"end {m['load_average'][0]:.1f}{SHARED if m['load_average'][0] > m['cores'] + 0.5 else ''}.*")
 
 
-def figure(name):
+def save_figure(fig, name):
+    """docs/figures/<name>.png, laid out tight, and the figure closed."""
     FIGURES.mkdir(parents=True, exist_ok=True)
-    return FIGURES / f"{name}.png"
+    fig.tight_layout()
+    fig.savefig(FIGURES / f"{name}.png", dpi=110)
+    plt.close(fig)
 
 
 def section_table1(result):
@@ -156,9 +159,7 @@ def section_accuracy(result):
     axes[0].set(xlabel="basis dimension", ylabel="vertex RMS error / bbox diagonal", title="position error")
     axes[1].set(xlabel="basis dimension", ylabel="(E_reduced − E_full) / E_full", title="energy gap")
     axes[0].legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(figure("accuracy"), dpi=110)
-    plt.close(fig)
+    save_figure(fig, "accuracy")
     out += [""]
     for name in names:
         ratios = []
@@ -207,9 +208,7 @@ def section_convergence(result):
         ax.set(title=f"{case['shape']} ({case['vertices']} vertices), {case['pose']}", xlabel="iteration",
                ylabel="f(q_k) − f*")
         ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(figure("convergence"), dpi=110)
-    plt.close(fig)
+    save_figure(fig, "convergence")
     out.append(table(["case", "method", "iterations run", "final objective", "final gradient norm",
                       "iterations to within 1e-6 (relative) of the lowest"], rows))
     out += ["", "![convergence](figures/convergence.png)", "", provenance(result)]
@@ -238,9 +237,7 @@ def section_taylor(result):
     axes[0].set(xlabel="t", ylabel="shells energy", title="deformation energy along t q*")
     axes[1].set(xlabel="t", ylabel="energy + handle term", title="objective near t = 1 (minima marked)")
     axes[0].legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(figure("taylor"), dpi=110)
-    plt.close(fig)
+    save_figure(fig, "taylor")
     out += ["", "![taylor](figures/taylor.png)", "", provenance(result)]
     return "\n".join(out)
 
