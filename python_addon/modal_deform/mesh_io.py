@@ -56,15 +56,21 @@ def selected_vertices(mesh):
     return np.flatnonzero(selected).astype(np.int32)
 
 
+def ensure_reference_key(obj):
+    """Give a mesh without shape keys its "Basis" reference key (the rest positions); returns the
+    names of the keys created here (none when it had one)."""
+    if obj.data.shape_keys is not None:
+        return []
+    obj.shape_key_add(name="Basis", from_mix=False)
+    return [obj.data.shape_keys.reference_key.name]
+
+
 def shape_key(obj, name):
     """The shape key `name` of obj, created (after a "Basis" key when the mesh has none) if needed.
 
     Returns (key block, names of the keys created here) so a caller can take them away again.
     """
-    created = []
-    if obj.data.shape_keys is None:
-        obj.shape_key_add(name="Basis", from_mix=False)
-        created.append(obj.data.shape_keys.key_blocks[0].name)
+    created = ensure_reference_key(obj)
     block = obj.data.shape_keys.key_blocks.get(name)
     if block is None:
         block = obj.shape_key_add(name=name, from_mix=False)

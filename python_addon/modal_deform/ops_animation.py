@@ -40,8 +40,7 @@ class AnimationJob:
         self.pose.follow_controllers()
         if not self.pose.converge()["converged"]:
             self.unconverged += 1
-        if self.obj.data.shape_keys is None:
-            self.obj.shape_key_add(name="Basis", from_mix=False)
+        mesh_io.ensure_reference_key(self.obj)
         block = self.obj.shape_key_add(name=frame_key_name(frame), from_mix=False)
         block.value = 0.0
         self.created.append((frame, block.name))
