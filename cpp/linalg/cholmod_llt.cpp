@@ -226,10 +226,17 @@ void CholmodLLT::factorize_lower(SparseMatrix lower, double min_rcond) {
 }
 
 Eigen::MatrixXd CholmodLLT::solve(const Eigen::Ref<const Eigen::MatrixXd>& B) {
+  Eigen::MatrixXd X(B.rows(), B.cols());
+  solve(B, X);
+  return X;
+}
+
+void CholmodLLT::solve(const Eigen::Ref<const Eigen::MatrixXd>& B, Eigen::Ref<Eigen::MatrixXd> X) {
   if (!factorized_) throw std::logic_error("CholmodLLT::solve: no successful factorisation to solve with");
   if (B.rows() != rows()) throw InputError(message("B: expected ", rows(), " rows, got ", B.rows()));
-  Eigen::MatrixXd X(B.rows(), B.cols());
-  if (B.cols() == 0) return X;
+  if (X.rows() != B.rows() || X.cols() != B.cols())
+    throw InputError(message("X: expected ", B.rows(), " by ", B.cols(), ", got ", X.rows(), " by ", X.cols()));
+  if (B.cols() == 0) return;
   cholmod_dense rhs{};
   rhs.nrow = static_cast<size_t>(B.rows());
   rhs.ncol = static_cast<size_t>(B.cols());
@@ -245,7 +252,6 @@ Eigen::MatrixXd CholmodLLT::solve(const Eigen::Ref<const Eigen::MatrixXd>& B) {
   const auto* x = static_cast<const double*>(c.solution->x);
   for (Eigen::Index j = 0; j < X.cols(); ++j)
     X.col(j) = Eigen::Map<const Eigen::VectorXd>(x + j * c.solution->d, X.rows());
-  return X;
 }
 
 }  // namespace modal_deform

@@ -44,8 +44,10 @@ class CholmodLLT {
   void factorize(const SparseMatrix& A);
 
   // X = (A + diag(shift))⁻¹ B for a rows() by k block of right-hand sides (k = 1 for a vector).
-  // A block is much faster than k single solves.
+  // A block is much faster than k single solves. The second form writes into X, of B's size, so
+  // that a caller solving again reuses its memory.
   Eigen::MatrixXd solve(const Eigen::Ref<const Eigen::MatrixXd>& B);
+  void solve(const Eigen::Ref<const Eigen::MatrixXd>& B, Eigen::Ref<Eigen::MatrixXd> X);
 
   int rows() const;
   // CHOLMOD's cheap estimate of the reciprocal condition number, (min Lᵢᵢ / max Lᵢᵢ)².

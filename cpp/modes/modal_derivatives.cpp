@@ -69,17 +69,10 @@ std::vector<int> pins_for(const SparseMatrix& K, const Kernel& kernel) {
   return pins;
 }
 
-// K X, columns in parallel (Eigen's sparse products run on one thread here).
-Eigen::MatrixXd product(const SparseMatrix& K, const Eigen::MatrixXd& X) {
-  Eigen::MatrixXd KX(K.rows(), X.cols());
-#pragma omp parallel for schedule(dynamic)
-  for (Eigen::Index j = 0; j < X.cols(); ++j) KX.col(j).noalias() = K * X.col(j);
-  return KX;
-}
-
-// Ψ (3n by p) with K Ψ = P B and Zᵀ M Ψ = 0, block by block: solve(P B, report) maps a block
-// of P B to its solution (any kernel part is removed here), whose residuals are then checked;
-// report(part) tells the bar what part of the block is done.
+// Ψ (3n by p) with K Ψ = P B and Zᵀ M Ψ = 0, block by block: solve(P B, X, report) writes the
+// solution of a block of P B into X (any kernel part is removed here), whose residuals are then
+// checked; report(part) tells the bar what part of the block is done. The blocks reuse their
+// buffers: at 100k vertices each is 113 MB, and fresh memory costs page faults.
 template <typename Solve>
 Eigen::MatrixXd solve_by_blocks(const SparseMatrix& K, const VectorRef& mass, const Kernel& kernel,
                                 const Eigen::Ref<const Eigen::MatrixXd>& B, Solve&& solve, Progress* progress) {
@@ -91,25 +84,26 @@ Eigen::MatrixXd solve_by_blocks(const SparseMatrix& K, const VectorRef& mass, co
   const Eigen::LLT<Eigen::MatrixXd> gram(Z.transpose() * Z);
   const Eigen::MatrixXd MZ = m.asDiagonal() * Z;
   const double norm_K = norm_1(K);
-  Eigen::MatrixXd Psi(n, B.cols());
+  Eigen::MatrixXd Psi(n, B.cols()), PB;
   for (Eigen::Index first = 0; first < B.cols(); first += kBlockColumns) {
     const Eigen::Index width = std::min(kBlockColumns, B.cols() - first);
-    Eigen::MatrixXd PB = B.middleCols(first, width);
+    PB = B.middleCols(first, width);
     for (Eigen::Index d = 0; d < n; ++d)
       if (decoupled[static_cast<size_t>(d)]) PB.row(d).setZero();
     if (Z.cols()) PB -= Z * gram.solve(Z.transpose() * PB);
-    Eigen::MatrixXd X = solve(PB, [&](double part) {
+    auto X = Psi.middleCols(first, width);
+    solve(PB, X, [&](double part) {
       if (progress) progress->report("derivative solves", (static_cast<double>(first) + part * width) / B.cols());
     });
     if (Z.cols()) X -= Z * (MZ.transpose() * X);
-    const Eigen::MatrixXd residual = product(K, X) - PB;
+    const Eigen::VectorXd rhs_norms = PB.colwise().norm();
+    add_product(K, X, -1.0, PB);  // PB becomes the residual P B − K X
     for (Eigen::Index j = 0; j < width; ++j) {
-      const double bound = kResidualTolerance * (norm_K * X.col(j).norm() + PB.col(j).norm());
-      if (!(residual.col(j).norm() <= bound))
-        throw NumericalError(message("solve_in_range: column ", first + j, " has residual ", residual.col(j).norm(),
+      const double bound = kResidualTolerance * (norm_K * X.col(j).norm() + rhs_norms[j]);
+      if (!(PB.col(j).norm() <= bound))
+        throw NumericalError(message("solve_in_range: column ", first + j, " has residual ", PB.col(j).norm(),
                                      ", above ", bound, "; does Z span the kernel of K?"));
     }
-    Psi.middleCols(first, width) = X;
     if (progress) progress->report("derivative solves", static_cast<double>(first + width) / B.cols());
   }
   return Psi;
@@ -145,7 +139,8 @@ Eigen::MatrixXd solve_with_pins(const SparseMatrix& K, const VectorRef& mass, co
                                  "kernel of K? ", e.what()));
   }
   return solve_by_blocks(
-      K, mass, kernel, B, [&](const Eigen::MatrixXd& PB, const auto&) { return llt.solve(PB); }, progress);
+      K, mass, kernel, B,
+      [&](const Eigen::MatrixXd& PB, Eigen::Ref<Eigen::MatrixXd> X, const auto&) { llt.solve(PB, X); }, progress);
 }
 
 }  // namespace
@@ -227,27 +222,33 @@ Eigen::MatrixXd solve_in_range_shifted(const SparseMatrix& K, const VectorRef& m
                              eigenvalues.maxCoeff(), ": ", steps, " refinement steps would be needed"));
   const Eigen::VectorXd m = dof_masses(mass);
   const Eigen::MatrixXd MZ = m.asDiagonal() * kernel.Z;
-  // One step: X = (K − σM)⁻¹ R less its kernel part, corrected on the known pairs by w. What it
+  // One step: X += (K − σM)⁻¹ R less its kernel part, corrected on the known pairs by w. What it
   // leaves of R needs no product with K: K (K − σM)⁻¹ R = R + σM (K − σM)⁻¹ R, K Z = 0 and
-  // K Φ = M Φ Λ, so R − K X = −σ M (K − σM)⁻¹ R − M Φ Λ w.
-  const auto step = [&](const Eigen::MatrixXd& R, Eigen::MatrixXd& X, Eigen::MatrixXd& left) {
-    const Eigen::MatrixXd Y = shifted.solve(R);
+  // K Φ = M Φ Λ, so R − K X = −σ M (K − σM)⁻¹ R − M Φ Λ w, which overwrites R unless `last`.
+  // Each product is a statement of its own: nested in one expression, Eigen evaluated
+  // M (σY − ΦΛw) coefficient by coefficient, which took as long as the solve.
+  Eigen::MatrixXd R, Y;
+  const auto step = [&](Eigen::Ref<Eigen::MatrixXd> X, bool last) {
+    Y.resize(R.rows(), R.cols());  // allocates once: the size stays
+    shifted.solve(R, Y);
     const Eigen::MatrixXd w = correction.asDiagonal() * (modes.transpose() * R);
-    X.noalias() += Y;
+    X += Y;
     if (kernel.Z.cols()) X.noalias() -= kernel.Z * (MZ.transpose() * Y);
     X.noalias() += modes * w;
-    left = m.asDiagonal() * ((-sigma) * Y - modes * (eigenvalues.asDiagonal() * w));
+    if (last) return;
+    R = (-sigma) * Y;
+    R.noalias() -= modes * (eigenvalues.asDiagonal() * w);
+    R.array().colwise() *= m.array();
   };
   return solve_by_blocks(
       K, mass, kernel, B,
-      [&](const Eigen::MatrixXd& PB, const auto& report) {
-        Eigen::MatrixXd X = Eigen::MatrixXd::Zero(PB.rows(), PB.cols()), left;
-        step(PB, X, left);
-        for (int k = 1; k < steps; ++k) {
-          report(static_cast<double>(k) / steps);
-          step(Eigen::MatrixXd(left), X, left);
+      [&](const Eigen::MatrixXd& PB, Eigen::Ref<Eigen::MatrixXd> X, const auto& report) {
+        X.setZero();
+        R = PB;
+        for (int k = 0; k < steps; ++k) {
+          if (k > 0) report(static_cast<double>(k) / steps);
+          step(X, k + 1 == steps);
         }
-        return X;
       },
       progress);
 }

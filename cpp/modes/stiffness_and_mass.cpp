@@ -5,6 +5,8 @@
 #include <utility>
 #include <vector>
 
+#include <omp.h>
+
 #include "util/errors.h"
 
 namespace modal_deform {
@@ -25,6 +27,24 @@ std::pair<int, int> column_range(const SparseMatrix& K, int col) {
 }
 
 }  // namespace
+
+void add_product(const SparseMatrix& K, const Eigen::Ref<const Eigen::MatrixXd>& X, double scale,
+                 Eigen::Ref<Eigen::MatrixXd> out) {
+  // One block of columns per thread: each streams K once for all its columns, where a product
+  // per column would stream K once per column.
+  const auto blocks = std::min<Eigen::Index>(omp_get_max_threads(), X.cols());
+#pragma omp parallel for schedule(static)
+  for (Eigen::Index b = 0; b < blocks; ++b) {
+    const Eigen::Index first = X.cols() * b / blocks, last = X.cols() * (b + 1) / blocks;
+    out.middleCols(first, last - first).noalias() += scale * (K * X.middleCols(first, last - first));
+  }
+}
+
+Eigen::MatrixXd multiply(const SparseMatrix& K, const Eigen::Ref<const Eigen::MatrixXd>& X) {
+  Eigen::MatrixXd KX = Eigen::MatrixXd::Zero(K.rows(), X.cols());
+  add_product(K, X, 1.0, KX);
+  return KX;
+}
 
 void validate_stiffness_and_mass(const SparseMatrix& K, const VectorRef& mass) {
   const Eigen::Index n = mass.size();
@@ -116,7 +136,7 @@ Eigen::MatrixXd checked_kernel_basis(const SparseMatrix& K, const VectorRef& mas
   if (Z.cols() &&
       (gram - Eigen::MatrixXd::Identity(Z.cols(), Z.cols())).cwiseAbs().maxCoeff(&i, &j) > kOrthonormalTolerance)
     throw InputError(message("Z: expected M-orthonormal columns, but (Z^T M Z)(", i, ", ", j, ") = ", gram(i, j)));
-  const Eigen::MatrixXd KZ = K * basis;
+  const Eigen::MatrixXd KZ = multiply(K, basis);
   const double norm_K = norm_1(K);
   for (Eigen::Index k = 0; k < Z.cols(); ++k) {
     const double relative = KZ.col(k).norm() / (norm_K * basis.col(k).norm());

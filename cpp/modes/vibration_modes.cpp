@@ -164,7 +164,7 @@ VibrationModes deflated_modes(const SparseMatrix& K, const VectorRef& mass, int 
   // vector keeps a trace of rough rounding error that K amplifies into a large residual, and one
   // more solve damps it by λ / λ_max.
   Eigen::MatrixXd Y = op.solve(m.asDiagonal() * eigs.eigenvectors());
-  const Eigen::MatrixXd KY = K * Y;
+  const Eigen::MatrixXd KY = multiply(K, Y);
   const Eigen::MatrixXd reduced_K = Y.transpose() * KY;
   const Eigen::MatrixXd reduced_M = Y.transpose() * (m.asDiagonal() * Y);
   Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> ritz(0.5 * (reduced_K + reduced_K.transpose()),
