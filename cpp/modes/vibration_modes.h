@@ -14,6 +14,9 @@ struct VibrationModes {
   // ‖K φ − λ M φ‖ in the M⁻¹-norm per mode (count, units of λ): some eigenvalue of the pencil
   // lies within it of the reported one.
   Eigen::VectorXd residuals;
+  // The residual each mode must stay within: 1e-6 of (|λ| + the largest λ computed), plus a
+  // rounding floor for λ = 0 (count, units of λ).
+  Eigen::VectorXd tolerances;
   double shift = 0;  // σ of the shift-invert transform
   int solves = 0;    // solves with the factor of K − σM
 };
@@ -33,9 +36,16 @@ VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int
 // deform with, and lets the shift sit closer to the flexible modes.
 // `factor`, when given, is the CholmodLLT (3 DOFs per node) that K − σM is factored in, and holds
 // that factor afterwards (σ = VibrationModes::shift): the bake's derivative solves reuse it
-// (solve_in_range_shifted).
+// (solve_in_range_shifted). With ResidualCheck::kReport a mode above its tolerance is returned
+// rather than thrown, for a caller that can do better (the bake deflates the zero modes found
+// and solves again).
+enum class ResidualCheck { kThrow, kReport };
 VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int count,
                                const Eigen::Ref<const Eigen::MatrixXd>& Z, Progress* progress = nullptr,
-                               CholmodLLT* factor = nullptr);
+                               CholmodLLT* factor = nullptr, ResidualCheck check = ResidualCheck::kThrow);
+
+// Throws NumericalError, naming the mode, when a mode in [first, last) has a residual above its
+// tolerance.
+void require_accurate(const VibrationModes& modes, int first, int last);
 
 }  // namespace modal_deform

@@ -48,7 +48,10 @@ struct Modes {
 
 // Asks Lanczos for kZeroModeAllowance modes more than `flexible`, which covers the zero modes of
 // the scans measured (3 to 9) at the price of a few solves; a mesh with more is solved again with
-// the zero modes found deflated, until the flexible modes are complete.
+// the zero modes found deflated, until the flexible modes are complete. So is a mesh whose
+// flexible modes miss their residual tolerance next to zero modes (two cones joined at their
+// apex: with the zero modes in K, their transformed eigenvalue 1/|σ| is about 1e10 times the
+// others', which are left to rounding).
 Modes flexible_modes(const SparseMatrix& K, const Eigen::VectorXd& mass, const Eigen::MatrixXd& rigid, int flexible,
                      Progress& progress, CholmodLLT& factor) {
   const double zero = kZeroEigenvalue * K.diagonal().sum() / (3 * mass.sum());
@@ -64,14 +67,22 @@ Modes flexible_modes(const SparseMatrix& K, const Eigen::VectorXd& mass, const E
       throw InputError(message("modes: the simulated mesh has only ", free - known,
                                " degrees of freedom besides its rigid motions and ", known,
                                " zero modes; ask for fewer modes"));
-    const VibrationModes modes = vibration_modes(K, mass, count, kernel, &progress, &factor);
+    const VibrationModes modes =
+        vibration_modes(K, mass, count, kernel, &progress, &factor, ResidualCheck::kReport);
     int found = 0;
     while (found < count && modes.eigenvalues[found] < zero) ++found;
+    // The zero modes are deflated next, and the flexible ones go into the basis: both must be
+    // accurate. Those past them only correct the derivative solves, which check their residuals.
+    const int wanted = std::min(count, found + flexible);
+    const auto within = (modes.residuals.array() <= modes.tolerances.array()).eval();
+    require_accurate(modes, 0, found);
+    if (found == 0) require_accurate(modes, 0, wanted);  // nothing to deflate: no second try
+    const bool accurate = within.segment(found, wanted - found).all();
     for (int i = 0; i < found; ++i) {
       zero_modes.push_back(modes.modes.col(i));
       zero_values.push_back(modes.eigenvalues[i]);
     }
-    if (count - found >= flexible) {
+    if (accurate && count - found >= flexible) {
       result.num_zero = static_cast<int>(zero_modes.size());
       result.eigenvalues.resize(result.num_zero + flexible);
       result.vectors.resize(K.rows(), result.num_zero + flexible);
@@ -82,8 +93,11 @@ Modes flexible_modes(const SparseMatrix& K, const Eigen::VectorXd& mass, const E
       result.eigenvalues.tail(flexible) = modes.eigenvalues.segment(found, flexible);
       result.vectors.rightCols(flexible) = modes.modes.middleCols(found, flexible);
       result.shift = modes.shift;
-      result.known_eigenvalues = modes.eigenvalues.tail(count - found);
-      result.known_vectors = modes.modes.rightCols(count - found);
+      std::vector<Eigen::Index> known_pairs;
+      for (int i = found; i < count; ++i)
+        if (within[i]) known_pairs.push_back(i);
+      result.known_eigenvalues = modes.eigenvalues(known_pairs);
+      result.known_vectors = modes.modes(Eigen::all, known_pairs);
       return result;
     }
     kernel.conservativeResize(Eigen::NoChange, kernel.cols() + found);

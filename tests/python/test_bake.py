@@ -48,6 +48,23 @@ def test_eigenvalues_and_residuals_match_scipy_eigh(two_tubes, tubes_basis):
     assert np.sqrt((residual ** 2 / m[:, None]).sum(axis=0)).max() < 1e-6 * reference[-1]
 
 
+def test_zero_modes_beside_the_flexible_ones_are_deflated_and_solved_again():
+    """Two cones joined at their apex: their relative rotation gives 3 zero modes, whose
+    transformed eigenvalue swamps the others' in one Lanczos run (once a residual failure)."""
+    V, F = [[0.0, 0.0, 0.0]], []
+    for side in (1.0, -1.0):
+        ring = len(V)
+        V += [[np.cos(a), np.sin(a), side] for a in np.linspace(0, 2 * np.pi, 5, endpoint=False)]
+        F += [[0, ring + k, ring + (k + 1) % 5] for k in range(5)]
+    V, F = np.array(V), np.array(F)
+    with pytest.warns(UserWarning, match="3 zero modes"):
+        basis = mdc.bake(V, F, modes=10, derivatives=5, ghost=11)
+    K, m, _ = normalised_pencil(V, F)
+    reference = scipy.linalg.eigh(K, np.diag(m), eigvals_only=True)
+    assert basis.num_rigid == 6 and basis.num_floppy == 3
+    np.testing.assert_allclose(basis.eigenvalues[9:], reference[9:13], rtol=1e-8)
+
+
 def test_basis_is_m_orthonormal_with_the_rigid_motions_first(two_tubes, tubes_basis):
     V, F = two_tubes
     basis = tubes_basis
