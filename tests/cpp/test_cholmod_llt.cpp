@@ -95,6 +95,24 @@ TEST(CholmodLLT, BlockSolveEqualsColumnSolves) {
   const Eigen::MatrixXd tall = random_block(2 * A.rows(), 5, 5);
   const Eigen::MatrixXd top = tall.topRows(A.rows());
   EXPECT_LT(relative_error(llt.solve(tall.topRows(A.rows())), llt.solve(top)), 1e-15);
+  // Into a caller's buffer, a view included: the same solution; a buffer of another size is refused.
+  Eigen::MatrixXd into = Eigen::MatrixXd::Zero(A.rows(), 70);
+  llt.solve(B, into.middleCols(3, 64));
+  EXPECT_EQ(into.middleCols(3, 64), X);
+  EXPECT_EQ(into.leftCols(3).norm() + into.rightCols(3).norm(), 0.0);
+  Eigen::MatrixXd wrong(A.rows(), 63);
+  EXPECT_THROW(llt.solve(B, wrong), InputError);
+}
+
+TEST(SparseProducts, BlockedByThreadMatchEigens) {
+  const SparseMatrix A = bunny_stiffness_plus_mass();
+  const Eigen::MatrixXd X = random_block(A.rows(), 7, 6);
+  const Eigen::MatrixXd expected = A * X;
+  EXPECT_LT(relative_error(multiply(A, X), expected), 1e-15);
+  Eigen::MatrixXd out = X;
+  add_product(A, X, -2.0, out);
+  EXPECT_LT(relative_error(out, X - 2.0 * expected), 1e-15);
+  EXPECT_EQ(multiply(A, Eigen::MatrixXd(A.rows(), 0)).cols(), 0);
 }
 
 TEST(CholmodLLT, ShiftedFactorizationsReuseOrRedoTheAnalysis) {

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <string>
 
 #include "mesh/mass.h"
 #include "mesh/mesh_topology.h"
@@ -101,6 +102,27 @@ TEST(VibrationModes, DeflatingTheRigidMotionsLeavesTheFlexibleModes) {
   // Z must be M-orthonormal, and count leaves room for the deflated kernel.
   EXPECT_THROW(vibration_modes(K, mass, 8, 2 * Z), InputError);
   EXPECT_THROW(vibration_modes(K, mass, static_cast<int>(K.rows()) - 12, Z), InputError);
+}
+
+TEST(VibrationModes, ReportedResidualsAreCheckedOnRequest) {
+  const TriangleMesh mesh = two_boxes();
+  const Eigen::VectorXd mass = lumped_mass(mesh.V, mesh.F);
+  const SparseMatrix K = spring_network_hessian(mesh.V, mesh.F);
+  const std::vector<int> labels = build_topology(mesh.V, mesh.F).vertex_component;
+  const Eigen::MatrixXd Z = rigid_motions(
+      mesh.V, Eigen::Map<const Eigen::VectorXi>(labels.data(), static_cast<Eigen::Index>(labels.size())), mass);
+  VibrationModes modes = vibration_modes(K, mass, 8, Z, nullptr, nullptr, ResidualCheck::kReport);
+  ASSERT_EQ(modes.tolerances.size(), 8);
+  EXPECT_TRUE((modes.residuals.array() <= modes.tolerances.array()).all());
+  EXPECT_TRUE((modes.tolerances.array() > 0).all());
+  modes.residuals[2] = 2 * modes.tolerances[2];
+  EXPECT_NO_THROW(require_accurate(modes, 3, 8));
+  try {
+    require_accurate(modes, 0, 8);
+    ADD_FAILURE() << "no exception";
+  } catch (const NumericalError& e) {
+    EXPECT_NE(std::string(e.what()).find("mode 2 ("), std::string::npos) << e.what();
+  }
 }
 
 TEST(VibrationModes, UnreferencedVertexStaysStill) {
