@@ -91,10 +91,12 @@ Eigen::MatrixXd solve_by_blocks(const SparseMatrix& K, const VectorRef& mass, co
     for (Eigen::Index d = 0; d < n; ++d)
       if (decoupled[static_cast<size_t>(d)]) PB.row(d).setZero();
     if (Z.cols()) PB -= Z * gram.solve(Z.transpose() * PB);
-    auto X = Psi.middleCols(first, width);
-    solve(PB, X, [&](double part) {
+    const auto report = [&](double part) {
       if (progress) progress->report("derivative solves", (static_cast<double>(first) + part * width) / B.cols());
-    });
+    };
+    auto X = Psi.middleCols(first, width);
+    solve(PB, X, report);
+    report(1.0);  // the check below takes a product with K, as long as a step
     if (Z.cols()) X -= Z * (MZ.transpose() * X);
     const Eigen::VectorXd rhs_norms = PB.colwise().norm();
     add_product(K, X, -1.0, PB);  // PB becomes the residual P B − K X
@@ -104,7 +106,6 @@ Eigen::MatrixXd solve_by_blocks(const SparseMatrix& K, const VectorRef& mass, co
         throw NumericalError(message("solve_in_range: column ", first + j, " has residual ", PB.col(j).norm(),
                                      ", above ", bound, "; does Z span the kernel of K?"));
     }
-    if (progress) progress->report("derivative solves", static_cast<double>(first + width) / B.cols());
   }
   return Psi;
 }
