@@ -12,14 +12,18 @@
 
 namespace modal_deform {
 
+void require_vertices(const VerticesRef& V, const char* name) {
+  require_positions(flatten(V), 3 * V.rows(), name);
+  const double extent = bounding_box_extent(V);
+  if (!(extent >= kMinExtent))
+    throw InputError(message(name, ": the mesh's extent (the longest side of its bounding box) is ", extent,
+                             "; the core needs at least ", kMinExtent, ": scale the mesh up"));
+}
+
 void validate_mesh(const VerticesRef& V, const FacesRef& F) {
   if (V.rows() == 0) throw InputError("V: the mesh has no vertices");
   if (F.rows() == 0) throw InputError("F: the mesh has no faces");
-  require_positions(flatten(V), 3 * V.rows(), "V");
-  const double extent = bounding_box_extent(V);
-  if (!(extent >= kMinExtent))
-    throw InputError(message("V: the mesh's extent (the longest side of its bounding box) is ", extent,
-                             "; the core needs at least ", kMinExtent, ": scale the mesh up"));
+  require_vertices(V, "V");
   for (Eigen::Index f = 0; f < F.rows(); ++f)
     for (int k = 0; k < 3; ++k)
       if (F(f, k) < 0 || F(f, k) >= V.rows())

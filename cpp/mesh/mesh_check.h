@@ -14,9 +14,12 @@ namespace modal_deform {
 // overflow. A mesh whose vertices coincide has extent 0.
 constexpr double kMinExtent = 1e-12;
 
+// Throws InputError, naming the array `name`, when a coordinate of V is not finite or beyond
+// kMaxCoordinate (name[i], require_positions) or its extent is below kMinExtent.
+void require_vertices(const VerticesRef& V, const char* name);
+
 // Throws InputError naming the first problem that makes (V, F) unusable: no vertices, no faces,
-// a coordinate that is not finite or beyond kMaxCoordinate (V[i], require_positions), an extent
-// below kMinExtent, or an index outside [0, #V) (F[f]).
+// V failing require_vertices, or an index outside [0, #V) (F[f]).
 void validate_mesh(const VerticesRef& V, const FacesRef& F);
 
 // Twice the area below which a face counts as degenerate, relative to its longest edge squared.

@@ -152,6 +152,9 @@ def corruptions(arrays):
     yield "mass", changed(mass=-arrays["mass"])
     yield "scale", changed(scale=np.array(0.0))
     yield "scale", changed(scale=np.array(np.nan))
+    yield "bending", changed(bending=np.array(-1.0))
+    yield "membrane", changed(membrane=np.array(np.inf))
+    yield "rest", changed(rest=arrays["rest"] * 1e-200)
     for bad in (-1, g, 2 ** 31 - 1):
         ghost_map = arrays["ghost_map"].copy()
         ghost_map[n // 2] = bad
