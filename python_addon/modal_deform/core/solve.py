@@ -63,13 +63,6 @@ def _weights(weights, count):
     return _arrays.values(weights, "weights", count)
 
 
-def _stiffness(stiffness):
-    stiffness = _arrays.number(stiffness, "stiffness")
-    if not (np.isfinite(stiffness) and stiffness > 0):
-        raise ValueError(f"stiffness: expected a finite value > 0, got {stiffness}")
-    return stiffness
-
-
 class ReducedSolver:
     """BFGS in a baked basis: x = x̄ + U q, energy on the ghost, handles exact on the fine mesh.
 
@@ -88,7 +81,7 @@ class ReducedSolver:
         native_basis = basis._native
         handles = _handles(handles)
         self._native = _native.ReducedSolver(native_basis, handles, _weights(weights, len(handles)),
-                                             _stiffness(stiffness), str(energy), bool(warm_start))
+                                             _arrays.number(stiffness, "stiffness"), str(energy), bool(warm_start))
         self._basis = basis
 
     @property
@@ -169,7 +162,7 @@ def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, ene
     handles = _handles(handles)
     max_iterations = _arrays.integer(max_iterations, "max_iterations")
     X, stats = _native.solve_full(V, F, handles, _transforms(transforms, len(handles)), _weights(weights, len(handles)),
-                                  _stiffness(stiffness), str(energy), _arrays.number(bending, "bending"),
+                                  _arrays.number(stiffness, "stiffness"), str(energy), _arrays.number(bending, "bending"),
                                   _arrays.number(membrane, "membrane"), _arrays.number(tolerance, "tolerance"),
                                   max_iterations,
                                   None if initial is None else _arrays.vertices(initial, "initial"))
