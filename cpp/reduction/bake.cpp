@@ -56,12 +56,10 @@ Modes flexible_modes(const SparseMatrix& K, const Eigen::VectorXd& mass, const E
                      Progress& progress, CholmodLLT& factor) {
   const double zero = kZeroEigenvalue * K.diagonal().sum() / (3 * mass.sum());
   const auto free = static_cast<int>(K.rows() - rigid.cols());
-  Eigen::MatrixXd kernel = rigid;
-  Modes result;
-  std::vector<Eigen::VectorXd> zero_modes;
+  Eigen::MatrixXd kernel = rigid;  // the rigid motions, then the zero modes found so far
   std::vector<double> zero_values;
   for (;;) {
-    const int known = static_cast<int>(zero_modes.size());
+    const int known = static_cast<int>(zero_values.size());
     const int count = std::min(flexible + kZeroModeAllowance, free - known - 1);
     if (count < flexible)
       throw InputError(message("modes: the simulated mesh has only ", free - known,
@@ -77,20 +75,18 @@ Modes flexible_modes(const SparseMatrix& K, const Eigen::VectorXd& mass, const E
     const auto within = (modes.residuals.array() <= modes.tolerances.array()).eval();
     require_accurate(modes, 0, found);
     if (found == 0) require_accurate(modes, 0, wanted);  // nothing to deflate: no second try
-    const bool accurate = within.segment(found, wanted - found).all();
-    for (int i = 0; i < found; ++i) {
-      zero_modes.push_back(modes.modes.col(i));
-      zero_values.push_back(modes.eigenvalues[i]);
-    }
-    if (accurate && count - found >= flexible) {
-      result.num_zero = static_cast<int>(zero_modes.size());
+    kernel.conservativeResize(Eigen::NoChange, kernel.cols() + found);
+    kernel.rightCols(found) = modes.modes.leftCols(found);
+    zero_values.insert(zero_values.end(), modes.eigenvalues.data(), modes.eigenvalues.data() + found);
+    if (within.segment(found, wanted - found).all() && count - found >= flexible) {
+      Modes result;
+      result.num_zero = static_cast<int>(zero_values.size());
       result.eigenvalues.resize(result.num_zero + flexible);
-      result.vectors.resize(K.rows(), result.num_zero + flexible);
-      for (int i = 0; i < result.num_zero; ++i) {
-        result.eigenvalues[i] = zero_values[static_cast<size_t>(i)];
-        result.vectors.col(i) = zero_modes[static_cast<size_t>(i)];
-      }
+      result.eigenvalues.head(result.num_zero) =
+          Eigen::Map<const Eigen::VectorXd>(zero_values.data(), result.num_zero);
       result.eigenvalues.tail(flexible) = modes.eigenvalues.segment(found, flexible);
+      result.vectors.resize(K.rows(), result.num_zero + flexible);
+      result.vectors.leftCols(result.num_zero) = kernel.rightCols(result.num_zero);
       result.vectors.rightCols(flexible) = modes.modes.middleCols(found, flexible);
       result.shift = modes.shift;
       std::vector<Eigen::Index> known_pairs;
@@ -100,8 +96,6 @@ Modes flexible_modes(const SparseMatrix& K, const Eigen::VectorXd& mass, const E
       result.known_vectors = modes.modes(Eigen::all, known_pairs);
       return result;
     }
-    kernel.conservativeResize(Eigen::NoChange, kernel.cols() + found);
-    kernel.rightCols(found) = modes.modes.leftCols(found);
   }
 }
 
