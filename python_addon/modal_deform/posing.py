@@ -2,7 +2,7 @@
 result into a shape key. Shared by the interactive pose, the solve and the animation bake.
 
 Per update: controller matrices → set_transforms → solve (within a time budget) →
-positions(out=preallocated float32) → shape key foreach_set → mesh.update().
+positions(out=preallocated float32) → shape key (mesh_io.write_shape_key) → mesh.update().
 """
 import time
 

@@ -123,22 +123,21 @@ def scaled(factor):
     return lambda: (factor * grid()[0], grid()[1])
 
 
-def with_value(row, column, value):
+def with_entry(array, row, column, value):
+    """The grid with one entry of V (array 0) or F (array 1) replaced."""
     def make():
-        V, F = grid()
-        V = V.copy()
-        V[row, column] = value
-        return V, F
+        arrays = [a.copy() for a in grid()]
+        arrays[array][row, column] = value
+        return tuple(arrays)
     return make
+
+
+def with_value(row, column, value):
+    return with_entry(0, row, column, value)
 
 
 def with_index(row, column, value):
-    def make():
-        V, F = grid()
-        F = F.copy()
-        F[row, column] = value
-        return V, F
-    return make
+    return with_entry(1, row, column, value)
 
 
 def flipped(every):
