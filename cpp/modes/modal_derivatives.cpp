@@ -146,18 +146,43 @@ Eigen::MatrixXd solve_with_pins(const SparseMatrix& K, const VectorRef& mass, co
 
 }  // namespace
 
-std::vector<std::array<int, 2>> derivative_pairs(int num_modes, int count) {
-  const long long available = static_cast<long long>(std::max(num_modes, 0)) * (num_modes + 1) / 2;
-  if (count < 0 || count > available)
-    throw InputError(message("count: ", num_modes, " modes have ", available, " pairs, asked for ", count));
-  std::vector<std::array<int, 2>> pairs;
-  pairs.reserve(static_cast<size_t>(count));
-  for (int j = 0; j < num_modes; ++j)
-    for (int i = 0; i <= j; ++i) {
-      if (static_cast<int>(pairs.size()) == count) return pairs;
-      pairs.push_back({i, j});
+std::vector<std::array<int, 2>> derivative_pairs(const std::vector<std::vector<int>>& components, int count) {
+  const auto share_a_component = [](const std::vector<int>& a, const std::vector<int>& b) {
+    for (size_t i = 0, j = 0; i < a.size() && j < b.size();) {
+      if (a[i] == b[j]) return true;
+      a[i] < b[j] ? ++i : ++j;
     }
+    return false;
+  };
+  if (count < 0) throw InputError(message("derivatives: expected 0 or more, got ", count));
+  std::vector<std::array<int, 2>> pairs;
+  const auto k = static_cast<int>(components.size());
+  for (int j = 0; j < k && static_cast<int>(pairs.size()) < count; ++j)
+    for (int i = 0; i <= j && static_cast<int>(pairs.size()) < count; ++i)
+      if (share_a_component(components[static_cast<size_t>(i)], components[static_cast<size_t>(j)]))
+        pairs.push_back({i, j});
+  if (static_cast<int>(pairs.size()) < count)
+    throw InputError(message("derivatives: ", count, " asked for, but the ", k,
+                             " modes that have derivatives (all but the translations and zero modes) give only ",
+                             pairs.size(), " pairs; ask for more modes or fewer derivatives"));
   return pairs;
+}
+
+std::vector<std::vector<int>> components_moved(const Eigen::Ref<const Eigen::MatrixXd>& Phi,
+                                               const Eigen::Ref<const Eigen::VectorXi>& component) {
+  if (Phi.rows() != 3 * component.size())
+    throw InputError(message("Phi: expected ", 3 * component.size(), " rows (3 per labelled vertex), got ", Phi.rows()));
+  if (component.size() > 0 && component.minCoeff() < 0)
+    throw InputError(message("component: expected labels >= 0, got ", component.minCoeff()));
+  const int c = component.size() > 0 ? component.maxCoeff() + 1 : 0;
+  std::vector<std::vector<int>> moved(static_cast<size_t>(Phi.cols()));
+  for (Eigen::Index col = 0; col < Phi.cols(); ++col) {
+    Eigen::VectorXd norm = Eigen::VectorXd::Zero(c);
+    for (Eigen::Index v = 0; v < component.size(); ++v) norm[component[v]] += Phi.col(col).segment<3>(3 * v).squaredNorm();
+    for (int k = 0; k < c; ++k)
+      if (norm[k] > 1e-12 * norm.sum()) moved[static_cast<size_t>(col)].push_back(k);
+  }
+  return moved;
 }
 
 std::vector<int> kernel_pins(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z) {

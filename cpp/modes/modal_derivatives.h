@@ -1,5 +1,10 @@
 // Modal derivatives, the paper's eq. 13: K ψᵢⱼ = ∇³E(x̄)(φᵢ, φⱼ), solved generically in (K, M) for
 // a block of right-hand sides, and the order in which the pairs (i, j) enter the basis.
+//
+// Which modes pair (paper §4): all but the translations, whose derivatives vanish. A linearised
+// rotation r = W x̄ pairs too: ∇³E(x̄)(r, φ) = (W K − K W) φ, so its derivative with a mode is, up to
+// a part ∝ λ, −W φ, that mode rotated (what the far end of a bent bar needs), and with another
+// rotation −W_a W_b x̄, the second-order term of the rotation.
 #pragma once
 
 #include <array>
@@ -12,10 +17,19 @@ namespace modal_deform {
 
 class CholmodLLT;
 
-// The first `count` pairs (i, j), i ≤ j < num_modes, of non-rigid modes in the paper's order
-// (two loops, so that pairs of low eigenvalues come first): (0,0), (0,1), (1,1), (0,2), (1,2),
-// (2,2), (0,3), ... Throws InputError when count exceeds num_modes (num_modes + 1) / 2.
-std::vector<std::array<int, 2>> derivative_pairs(int num_modes, int count);
+// The first `count` pairs (i, j), i ≤ j, of modes ordered by eigenvalue (lowest first), in the
+// paper's order (two loops, so that pairs of low eigenvalues come first): (0,0), (0,1), (1,1),
+// (0,2), (1,2), (2,2), (0,3), ... Pairs of modes that move no component in common (the rotations of
+// two components) are left out: the energy couples the vertices of one component only, so their
+// derivative is zero. components[i]: the components mode i moves, ascending (components_moved).
+// Throws InputError naming "derivatives" when count is negative or exceeds the pairs there are.
+std::vector<std::array<int, 2>> derivative_pairs(const std::vector<std::vector<int>>& components, int count);
+
+// The components each column of Phi (3n by k, interleaved) moves: those holding more than 1e-12
+// of its squared norm. component: n labels in [0, c). Throws InputError for mismatched sizes or a
+// label outside [0, c).
+std::vector<std::vector<int>> components_moved(const Eigen::Ref<const Eigen::MatrixXd>& Phi,
+                                               const Eigen::Ref<const Eigen::VectorXi>& component);
 
 // The DOFs to pin so that K plus a stiffness at them is definite: in each connected component of
 // K's graph, as many DOFs as Z has rank there, chosen by column-pivoted QR of Z's rows (for rigid

@@ -227,16 +227,16 @@ Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, 
   const int num_zero = modes.num_zero;
   basis.num_floppy = num_zero;
 
-  // 4. Modal derivatives of the pairs of modes that are neither rigid nor zero.
+  // 4. Modal derivatives of the pairs of modes other than the translations and zero modes: the
+  // linearised rotations of each component (λ = 0, so first), then the flexible modes.
   Eigen::MatrixXd derivatives(3 * S, options.derivatives);
   if (options.derivatives > 0) {
-    const long long available = static_cast<long long>(flexible) * (flexible + 1) / 2;
-    if (options.derivatives > available)
-      throw InputError(message("derivatives: ", options.derivatives, " asked for, but the ", flexible,
-                               " vibration modes besides the rigid motions have only ", available,
-                               " pairs; ask for more modes or fewer derivatives"));
-    const std::vector<std::array<int, 2>> pairs = derivative_pairs(flexible, options.derivatives);
-    const auto phi = modes.vectors.rightCols(flexible);
+    const int paired_rotations = options.rotation_pairs ? 3 * attachment.num_components : 0;
+    Eigen::MatrixXd phi(3 * S, paired_rotations + flexible);
+    for (int r = 0; r < paired_rotations; ++r) phi.col(r) = rigid.col(6 * (r / 3) + 3 + r % 3);
+    phi.rightCols(flexible) = modes.vectors.rightCols(flexible);
+    const std::vector<std::array<int, 2>> pairs =
+        derivative_pairs(components_moved(phi, attachment.component), options.derivatives);
     {
       const Stopwatch stopwatch(time["third derivatives"]);
       for (size_t first = 0; first < pairs.size(); first += kPairsPerPass) {

@@ -5,7 +5,7 @@
 //      frame (longest bounding-box edge 10).
 //   2. Simulated vertices (attachment.h): components with less than 10% of the largest one's
 //      area, unreferenced vertices and vertices without mass are attached, not simulated; they
-//      follow the affine motion of four simulated vertices near them.
+//      follow the affine motion fitted to the simulated surface around them.
 //   3. K = ∇²E(x̄) of the simulated submesh, M lumped. The rigid motions of its components come
 //      first (analytic, M-orthonormal, 6 per component); the vibration modes are the lowest
 //      eigenpairs M-orthogonal to them (deflation). A floppy mesh (flaps at non-manifold
@@ -13,7 +13,8 @@
 //      λ < kZeroEigenvalue tr K/tr M: they come on top of `modes` (a scan's count of mechanisms is
 //      not known before the bake, and each would take the place of a deformation mode), stay in
 //      the basis after the rigid motions (Basis::num_floppy) and join the kernel for step 4.
-//   4. Modal derivatives (eq. 13) for the pairs of the remaining modes in the paper's order:
+//   4. Modal derivatives (eq. 13) for the pairs of the modes other than translations and zero
+//      modes (the linearised rotations and the flexible modes), in the paper's order:
 //      right-hand sides ∇³E(x̄)(φᵢ, φⱼ) (third_batch), solved in the range of K against the
 //      kernel [rigid motions, zero modes] with the eigensolver's factor of K − σM, corrected on
 //      the eigenpairs found and refined (solve_in_range_shifted): one CHOLMOD factorisation in
@@ -54,6 +55,9 @@ struct BakeOptions {
   std::string energy = "shells";  // "shells", or "arap" with derivatives = 0
   double bending = 1.0;           // shells: α (finite, ≥ 0)
   double membrane = 1.0;          // shells: β (finite, ≥ 0)
+  // Derivatives of pairs with the linearised rotations too (the paper's rule), or of pairs of
+  // flexible modes only (false; needs more modes for as many derivatives).
+  bool rotation_pairs = true;
 };
 
 // The reduced space of (V #V by 3, F #F by 3, any length unit) per the pipeline above: a Basis in

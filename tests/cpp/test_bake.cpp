@@ -110,17 +110,23 @@ TEST(Bake, BasisSpansTheModalDerivativesOfEquation13) {
   const Eigen::VectorXd mass = s * s * lumped_mass(mesh.V, mesh.F);
   const Eigen::MatrixXd Z = rigid_motions(X, Eigen::VectorXi::Zero(X.rows()), mass);
   const VibrationModes modes = vibration_modes(K, mass, 6, Z);
-  const std::vector<std::array<int, 2>> pairs = derivative_pairs(6, 12), swapped = [&] {
-    std::vector<std::array<int, 2>> p;
-    for (const auto& [i, j] : pairs) p.push_back({j, i});
-    return p;
-  }();
-  const Eigen::MatrixXd B = shells.third_batch(shells.rest(), modes.modes, pairs);
+  // The paper's pairs: the three rotations first (λ = 0), then the six flexible modes.
+  Eigen::MatrixXd phi(K.rows(), 9);
+  phi << Z.rightCols(3), modes.modes;
+  const std::vector<std::array<int, 2>> pairs =
+      derivative_pairs(components_moved(phi, Eigen::VectorXi::Zero(X.rows())), 12),
+                                        swapped = [&] {
+                                          std::vector<std::array<int, 2>> p;
+                                          for (const auto& [i, j] : pairs) p.push_back({j, i});
+                                          return p;
+                                        }();
+  EXPECT_EQ(pairs[6], (std::array<int, 2>{0, 3}));  // a rotation with the lowest mode
+  const Eigen::MatrixXd B = shells.third_batch(shells.rest(), phi, pairs);
   const Eigen::MatrixXd Psi = solve_in_range(K, mass, Z, B);
   // Other pins: the last DOFs of a 3-2-1 set at the far corner instead of QR's choice.
   const int far = static_cast<int>(X.rows()) - 1, near = far - 1, side = far - 11;
   const Eigen::MatrixXd Psi_swapped =
-      solve_in_range(K, mass, Z, shells.third_batch(shells.rest(), modes.modes, swapped),
+      solve_in_range(K, mass, Z, shells.third_batch(shells.rest(), phi, swapped),
                      std::vector<int>{3 * far, 3 * far + 1, 3 * far + 2, 3 * near + 1, 3 * near + 2, 3 * side + 2});
   EXPECT_LT((Psi - Psi_swapped).norm(), 1e-8 * Psi.norm());
   const Eigen::MatrixXd PB = B - Z * (Z.transpose() * Z).ldlt().solve(Z.transpose() * B);
@@ -144,6 +150,47 @@ TEST(Bake, BasisSpansTheModalDerivativesOfEquation13) {
     const Eigen::VectorXd psi = Psi.col(c);
     const Eigen::VectorXd outside = psi - U * (U.transpose() * m.cwiseProduct(psi));
     EXPECT_LT(std::sqrt(outside.dot(m.cwiseProduct(outside)) / psi.dot(m.cwiseProduct(psi))), 1e-4) << "pair " << c;
+  }
+}
+
+// Why the rotations pair (paper §4): E is invariant under rotations R, so ∇²E(R x̄) = R ∇²E(x̄) Rᵀ;
+// differentiated along a linearised rotation r = W x̄ (W: ω × per vertex), ∇³E(x̄)(r, u) = (W K − K W) u.
+// Hence the right-hand side of a rotation with a mode φ is λ W M φ − K W φ (its derivative is φ
+// rotated, −W φ, up to a part ∝ λ), and with another rotation −K W_a W_b x̄.
+TEST(Bake, RotationsDerivativesAreTheModesRotated) {
+  const TriangleMesh mesh = bumpy_plane(8, 1.0, 3, 0.2);
+  const RowMatrixX3d X = normalizing_scale(mesh.V) * mesh.V;
+  const DiscreteShells shells(X, mesh.F);
+  const SparseMatrix K = shells.hessian(shells.rest());
+  const Eigen::VectorXd mass = lumped_mass(X, mesh.F);
+  const Eigen::MatrixXd Z = rigid_motions(X, Eigen::VectorXi::Zero(X.rows()), mass);
+  const VibrationModes modes = vibration_modes(K, mass, 2, Z);
+  const Eigen::RowVector3d centre = (mass.transpose() * X) / mass.sum();
+  const RowMatrixX3d P = X.rowwise() - centre;
+  // W u = ω × u at every vertex, ω the axis (times rate) of rotation column c of Z: Z_c = ω × p.
+  const auto turn = [&](int c, const Eigen::VectorXd& u) {
+    Eigen::MatrixXd cross(3 * P.rows(), 3);
+    for (Eigen::Index v = 0; v < P.rows(); ++v)
+      cross.middleRows<3>(3 * v) << 0, P(v, 2), -P(v, 1), -P(v, 2), 0, P(v, 0), P(v, 1), -P(v, 0), 0;
+    const Eigen::Vector3d omega = cross.colPivHouseholderQr().solve(Z.col(c));
+    EXPECT_LT((cross * omega - Z.col(c)).norm(), 1e-10 * Z.col(c).norm());
+    Eigen::VectorXd out(u.size());
+    for (Eigen::Index v = 0; v < P.rows(); ++v) out.segment<3>(3 * v) = omega.cross(u.segment<3>(3 * v));
+    return out;
+  };
+  const Eigen::VectorXd p = Eigen::Map<const Eigen::VectorXd>(RowMatrixX3d(P).data(), P.size());
+  const Eigen::VectorXd m = dof_masses(mass);
+  for (int a = 3; a < 6; ++a) {
+    for (int b = 3; b < 6; ++b) {
+      const Eigen::VectorXd expected = -(K * turn(a, turn(b, p)));
+      EXPECT_LT((shells.third(shells.rest(), Z.col(a), Z.col(b)) - expected).norm(), 1e-8 * K.norm()) << a << b;
+    }
+    for (int i = 0; i < 2; ++i) {
+      const Eigen::VectorXd phi = modes.modes.col(i);
+      const Eigen::VectorXd expected =
+          modes.eigenvalues[i] * turn(a, m.cwiseProduct(phi)) - K * turn(a, phi);
+      EXPECT_LT((shells.third(shells.rest(), Z.col(a), phi) - expected).norm(), 1e-8 * expected.norm()) << a << i;
+    }
   }
 }
 
@@ -233,7 +280,7 @@ TEST(Bake, RefusesBadOptionsNamingThem) {
   options.modes = 12;  // two tubes: 12 rigid motions
   expect_refused(two, options, "modes:");
   options = {};
-  options.derivatives = 106;  // 14 flexible modes: 105 pairs
+  options.derivatives = 154;  // 3 rotations and 14 flexible modes: 153 pairs
   expect_refused(tube, options, "derivatives:");
   options = {};
   options.energy = "arap";
@@ -297,7 +344,7 @@ TEST(Bake, FloppyDragonKeepsItsZeroModesOnTopWithoutDerivatives) {
   EXPECT_LT(identity_error(normalised_gram(basis)), 1e-4);
   // The bar moves often enough to cancel within a second (measured here on a shared machine).
   EXPECT_LT(*std::max_element(gaps.begin(), gaps.end()), 1.0);
-  options.derivatives = 106;  // 14 modes neither rigid nor zero: 105 pairs
+  options.derivatives = 154;  // 3 rotations and 14 modes neither rigid nor zero: 153 pairs
   expect_refused(dragon, options, "derivatives:");
 }
 

@@ -77,13 +77,42 @@ std::vector<int> random_pins(const Problem& p, unsigned seed) {
 }
 
 TEST(DerivativePairs, FollowThePapersOrder) {
+  const auto one_component = [](int k) { return std::vector<std::vector<int>>(static_cast<size_t>(k), {0}); };
   const std::vector<std::array<int, 2>> expected{{0, 0}, {0, 1}, {1, 1}, {0, 2}, {1, 2}, {2, 2}};
-  EXPECT_EQ(derivative_pairs(3, 6), expected);
-  EXPECT_EQ(derivative_pairs(5, 4), (std::vector<std::array<int, 2>>(expected.begin(), expected.begin() + 4)));
-  EXPECT_EQ(derivative_pairs(15, 120).size(), 120u);
-  EXPECT_TRUE(derivative_pairs(4, 0).empty());
-  EXPECT_THROW(derivative_pairs(3, 7), InputError);
-  EXPECT_THROW(derivative_pairs(3, -1), InputError);
+  EXPECT_EQ(derivative_pairs(one_component(3), 6), expected);
+  EXPECT_EQ(derivative_pairs(one_component(5), 4),
+            (std::vector<std::array<int, 2>>(expected.begin(), expected.begin() + 4)));
+  EXPECT_EQ(derivative_pairs(one_component(15), 120).size(), 120u);
+  EXPECT_TRUE(derivative_pairs(one_component(4), 0).empty());
+  EXPECT_THROW(derivative_pairs(one_component(3), 7), InputError);
+  EXPECT_THROW(derivative_pairs(one_component(3), -1), InputError);
+}
+
+TEST(DerivativePairs, LeaveOutModesOfDifferentComponents) {
+  // A rotation of component 0, one of component 1, a mode moving both, a mode of component 1.
+  const std::vector<std::vector<int>> components{{0}, {1}, {0, 1}, {1}};
+  const std::vector<std::array<int, 2>> expected{{0, 0}, {1, 1}, {0, 2}, {1, 2}, {2, 2}, {1, 3}, {2, 3}, {3, 3}};
+  EXPECT_EQ(derivative_pairs(components, 8), expected);
+  try {
+    derivative_pairs(components, 9);
+    ADD_FAILURE() << "9 pairs accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("derivatives: 9 asked for, but the 4 modes"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("only 8 pairs"), std::string::npos) << e.what();
+  }
+}
+
+TEST(DerivativePairs, ComponentsMovedAreThoseCarryingTheMode) {
+  const Problem p = two_boxes();
+  const Eigen::VectorXi labels = p.labels.head(p.labels.size() - 1);  // without the unreferenced vertex
+  const Eigen::MatrixXd Z = p.Z.topRows(3 * labels.size());
+  Eigen::MatrixXd Phi(Z.rows(), 3);
+  Phi << Z.col(3), Z.col(9), Z.col(4) + Z.col(10);
+  Phi(0, 1) += 1e-9;  // rounding on component 0 does not count for a mode of component 1
+  const std::vector<std::vector<int>> expected{{0}, {1}, {0, 1}};
+  EXPECT_EQ(components_moved(Phi, labels), expected);
+  EXPECT_THROW(components_moved(Phi.topRows(3), labels), InputError);
+  EXPECT_THROW(components_moved(Phi, -labels), InputError);
 }
 
 TEST(KernelPins, PinSixWellChosenDofsPerComponent) {

@@ -179,6 +179,22 @@ def test_from_arrays_refuses_every_corruption_naming_the_array(tubes_basis):
     mdc.Basis.from_arrays(arrays)  # the original still loads
 
 
+def test_the_papers_pairs_give_its_67_dimensions(two_tubes):
+    """All modes but the translations pair (paper §4): with 15 modes, 3 rotations and 9 flexible
+    modes give 78 pairs, so 52 derivatives make its 67-dimensional basis; pairs of flexible modes
+    only (rotation_pairs=False, the rule before) are 45. Rotations of two components do not pair
+    (their derivative is zero), so two tubes drop no column."""
+    tube = mdc.cylinder(14, 6, 0.5, 2.0)
+    basis = mdc.bake(*tube, modes=15, derivatives=52, ghost=60)
+    assert (basis.dimension, basis.num_dropped) == (67, 0)
+    with pytest.raises(ValueError, match="derivatives: 52 asked for, but the 9 modes .* only 45 pairs"):
+        mdc.bake(*tube, modes=15, derivatives=52, ghost=60, rotation_pairs=False)
+    assert mdc.bake(*tube, modes=21, derivatives=52, ghost=60, rotation_pairs=False).dimension == 73
+    with pytest.raises(ValueError, match="rotation_pairs: expected True or False"):
+        mdc.bake(*tube, rotation_pairs="yes")
+    assert mdc.bake(*two_tubes, modes=18, derivatives=20, ghost=60).num_dropped == 0
+
+
 def test_bad_options_raise_value_error_naming_them(two_tubes):
     V, F = two_tubes
     for kwargs, name in [({"modes": 12}, "modes"), ({"derivatives": 500}, "derivatives"),

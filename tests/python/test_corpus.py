@@ -336,7 +336,7 @@ def test_third_derivative_refuses_bad_directions():
 OPTIONS = {
     "more modes than degrees of freedom": (ONE_TRIANGLE, {"modes": 9}, Refused(r"modes: .*ask for fewer than 9")),
     "modes not above the rigid motions": ((grid()), {"modes": 6}, Refused(r"modes: 6 modes are not more than the 6")),
-    "derivatives beyond the pairs": (grid(), {"modes": 8, "derivatives": 4}, Refused(r"derivatives: 4 asked for")),
+    "derivatives beyond the pairs": (grid(), {"modes": 8, "derivatives": 16}, Refused(r"derivatives: 16 asked for")),
     "ghost larger than the mesh": (grid(), {"modes": 8, "ghost": 10**6}, WORKS),
     "ghost below 4": (grid(), {"ghost": 3}, Refused(r"ghost: expected at least 4")),
     "NaN bending": (grid(), {"bending": np.nan}, Refused(r"bending: expected a finite weight")),

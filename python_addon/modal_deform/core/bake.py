@@ -141,11 +141,21 @@ def _count(value, name, minimum):
     return min(value, np.iinfo(np.int32).max)
 
 
-def bake(V, F, modes=20, derivatives=52, ghost=1000, energy="shells", bending=1.0, membrane=1.0, progress=None):
+def _flag(value, name):
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name}: expected True or False, got {value!r}")
+    return bool(value)
+
+
+def bake(V, F, modes=20, derivatives=52, ghost=1000, energy="shells", bending=1.0, membrane=1.0, progress=None,
+         rotation_pairs=True):
     """Bake the reduced space of the triangle mesh (V (n, 3), F (m, 3)) for posing.
 
     modes: vibration modes, the rigid motions of the simulated components (6 each) included;
-    derivatives: modal derivatives (pairs of non-rigid modes, low eigenvalues first); ghost: the
+    derivatives: modal derivatives of pairs of modes, low eigenvalues first, in the paper's rule: all
+    modes but the translations and zero modes pair, the linearised rotations included, so that
+    ``modes=15, derivatives=52`` is the paper's 67-dimensional basis (``rotation_pairs=False``:
+    pairs of flexible modes only, the rule before; it needs more modes); ghost: the
     ghost's target vertex count (at least 4; the mesh itself when it has fewer vertices);
     energy: "shells" (discrete shells with weights ``bending`` and ``membrane``) or "arap" (only
     with derivatives=0: ARAP has no third derivative). ``progress(stage, fraction)`` is called
@@ -164,7 +174,7 @@ def bake(V, F, modes=20, derivatives=52, ghost=1000, energy="shells", bending=1.
         raise ValueError(f"progress: expected a callable progress(stage, fraction) or None, got {progress!r}")
     native = _native.bake(V, F, _count(modes, "modes", 1), _count(derivatives, "derivatives", 0),
                           _count(ghost, "ghost", 4), energy, _arrays.number(bending, "bending"),
-                          _arrays.number(membrane, "membrane"), progress)
+                          _arrays.number(membrane, "membrane"), _flag(rotation_pairs, "rotation_pairs"), progress)
     basis = Basis(native)
     if basis.num_floppy:
         warnings.warn(f"the mesh is floppy: it has {basis.num_floppy} zero modes besides its rigid motions "
