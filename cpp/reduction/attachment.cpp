@@ -1,6 +1,7 @@
 #include "reduction/attachment.h"
 
-#include <Eigen/LU>
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 
@@ -12,25 +13,31 @@
 namespace modal_deform {
 namespace {
 
-// The neighbourhood of an attached group holds at least this many simulated vertices.
+// The region a group follows reaches this many times the group's radius (or its distance to the
+// nearest simulated vertex, when larger) from its centre, and holds at least kMinNeighbours
+// simulated vertices.
+constexpr double kRegionReach = 1.5;
 constexpr int kMinNeighbours = 16;
-// A fourth anchor less than this fraction of the first edge's length off the plane of the other
-// three makes a flat tetrahedron: its weights would amplify noise, so the triangle rule applies.
+// A region thinner (its least principal extent) than this fraction of its largest extent is flat:
+// the normal column of its affine fit is ill-determined, so it grows (header).
 constexpr double kMinThickness = 0.1;
-// A third anchor this close to the line of the first two (relative to their distance) means the
-// neighbourhood is collinear: it grows.
+// A region whose second principal extent is this small relative to its largest lies on a line: it
+// grows.
 constexpr double kCollinear = 1e-6;
 
-// Vertices that follow one set of anchors: an attached component, or a single attached vertex.
+// Vertices that follow one region: an attached component, or a single attached vertex.
 struct Group {
   std::vector<int> vertices;
 };
 
-// Anchors (submesh indices) and the 3 by 3 weights of each follower of `group`, appended to
-// `followers`. P: #S by 3 simulated positions.
-void follow(const VerticesRef& V, const RowMatrixX3d& P, const Group& group,
-            std::vector<Attachment::Follower>& followers) {
+// The region `group` follows and the least-squares affine fit to it (header). P: #S by 3
+// simulated positions, mass: their vertex masses (the fit's weights, so that it averages over the
+// surface rather than over its sampling).
+Attachment::Follower follow(const VerticesRef& V, const RowMatrixX3d& P, const Eigen::VectorXd& mass,
+                            const Group& group) {
   const auto S = static_cast<int>(P.rows());
+  Attachment::Follower follower;
+  follower.vertices = group.vertices;
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   for (int v : group.vertices) centre += V.row(v).transpose();
   centre /= static_cast<double>(group.vertices.size());
@@ -38,80 +45,55 @@ void follow(const VerticesRef& V, const RowMatrixX3d& P, const Group& group,
   for (int v : group.vertices) radius = std::max(radius, (V.row(v).transpose() - centre).norm());
 
   const Eigen::VectorXd distance = (P.rowwise() - centre.transpose()).rowwise().norm();
-  int nearest = 0;
-  distance.minCoeff(&nearest);
   std::vector<double> sorted(distance.data(), distance.data() + S);
   const int k = std::min(kMinNeighbours, S) - 1;
   std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
-  double reach = std::max(2 * (distance[nearest] + radius), sorted[static_cast<size_t>(k)]);
+  double reach = std::max(kRegionReach * std::max(radius, distance.minCoeff()), sorted[static_cast<size_t>(k)]);
 
-  std::array<int, 4> anchor{nearest, nearest, nearest, nearest};
-  double length = 0, height = 0;
+  // The region: its principal axes (ascending extent) from the mass-weighted covariance.
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> axes;
+  Eigen::RowVector3d mean;
+  bool flat = false;
   for (;;) {
-    std::vector<int> near;
+    follower.anchors.clear();
     for (int s = 0; s < S; ++s)
-      if (distance[s] <= reach) near.push_back(s);
-    const Eigen::Vector3d a1 = P.row(nearest).transpose();
-    // The farthest from the first, the farthest from their line, the farthest from their plane.
-    length = 0;
-    for (int s : near)
-      if ((P.row(s).transpose() - a1).norm() > length) length = (P.row(s).transpose() - a1).norm(), anchor[1] = s;
-    const Eigen::Vector3d e = (P.row(anchor[1]).transpose() - a1).normalized();
-    double off_line = 0;
-    for (int s : near) {
-      const Eigen::Vector3d d = P.row(s).transpose() - a1;
-      const double h = (d - d.dot(e) * e).norm();
-      if (h > off_line) off_line = h, anchor[2] = s;
-    }
-    if (length > 0 && off_line > kCollinear * length) {
-      const Eigen::Vector3d normal = e.cross(P.row(anchor[2]).transpose() - a1).normalized();
-      height = 0;
-      for (int s : near) {
-        const double h = std::abs(normal.dot(P.row(s).transpose() - a1));
-        if (h > height) height = h, anchor[3] = s;
-      }
-      break;
-    }
-    if (static_cast<int>(near.size()) == S)
+      if (distance[s] <= reach) follower.anchors.push_back(s);
+    const Eigen::VectorXd w = mass(follower.anchors);
+    const RowMatrixX3d A = P(follower.anchors, Eigen::all);
+    mean = (w.transpose() * A) / w.sum();
+    const RowMatrixX3d centred = A.rowwise() - mean;
+    axes.compute(centred.transpose() * w.asDiagonal() * centred / w.sum());
+    const bool collinear = axes.eigenvalues()[1] <= kCollinear * kCollinear * axes.eigenvalues()[2];
+    flat = axes.eigenvalues()[0] < kMinThickness * kMinThickness * axes.eigenvalues()[2];
+    const bool everything = static_cast<int>(follower.anchors.size()) == S;
+    if (collinear && everything)
       throw NumericalError(message("attachment: the simulated vertices around attached vertex ", group.vertices[0],
-                                   " are collinear; no tetrahedron or triangle can carry it"));
+                                   " are collinear; no affine motion can be fitted to them"));
+    if (!collinear && (!flat || everything)) break;
     reach *= 2;
   }
 
-  const Eigen::Vector3d a1 = P.row(anchor[0]).transpose();
-  const Eigen::Vector3d d2 = P.row(anchor[1]).transpose() - a1, d3 = P.row(anchor[2]).transpose() - a1;
-  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-  if (height >= kMinThickness * length) {
-    // Affine coordinates in the tetrahedron: p − a1 = β2 d2 + β3 d3 + β4 d4.
-    Eigen::Matrix3d edges;
-    edges << d2, d3, P.row(anchor[3]).transpose() - a1;
-    const Eigen::PartialPivLU<Eigen::Matrix3d> lu(edges);
-    for (int v : group.vertices) {
-      const Eigen::Vector3d beta = lu.solve(V.row(v).transpose() - a1);
-      followers.push_back({v, anchor, {(1 - beta.sum()) * I, beta[0] * I, beta[1] * I, beta[2] * I}});
-    }
-    return;
-  }
-  // Flat: p − a1 = a d2 + b d3 + h n. In-plane motion is affine; the normal turns as under the
-  // linearised rotation A with A d2 = u2 − u1, A d3 = u3 − u1: for a skew A, (A n)·v = −n·(A v)
-  // for every in-plane v, so A n = −d2* nᵀ(u2 − u1) − d3* nᵀ(u3 − u1) with the dual basis
-  // d2*, d3* of (d2, d3) in the plane.
-  const Eigen::Vector3d normal = d2.cross(d3).normalized();
-  Eigen::Matrix<double, 3, 2> D;
-  D << d2, d3;
-  const Eigen::Matrix2d gram_inverse = (D.transpose() * D).inverse();
-  const Eigen::Matrix<double, 3, 2> dual = D * gram_inverse;
-  const Eigen::Matrix3d turn2 = dual.col(0) * normal.transpose(), turn3 = dual.col(1) * normal.transpose();
-  anchor[3] = anchor[0];
-  for (int v : group.vertices) {
-    const Eigen::Vector3d p = V.row(v).transpose() - a1;
-    const double h = normal.dot(p);
-    const Eigen::Vector2d ab = gram_inverse * (D.transpose() * p);
-    followers.push_back({v,
-                         anchor,
-                         {(1 - ab.sum()) * I + h * (turn2 + turn3), ab[0] * I - h * turn2, ab[1] * I - h * turn3,
-                          Eigen::Matrix3d::Zero()}});
-  }
+  // About the region's mean (in the plane of a flat region, so that t is the displacement there):
+  // weighted least squares u_k ≈ t + A y_k (y_k = anchor k − mean) over the fitted directions
+  // (all three, or the plane's two): [t; A e] = Σ_k G⁻¹ w_k [1; y_k·e] u_k. So t = Σ alpha_k u_k
+  // and A = Σ_k u_k beta_kᵀ on those directions; on a flat region A n = −Σ_i e_i (n·A e_i), the
+  // skew completion (what a linearised rotation of the plane does to its normal).
+  const Eigen::MatrixXd directions = flat ? Eigen::MatrixXd(axes.eigenvectors().rightCols(2)) : Eigen::MatrixXd::Identity(3, 3);
+  follower.normal = flat ? Eigen::Vector3d(axes.eigenvectors().col(0)) : Eigen::Vector3d::Zero();
+  const auto K = static_cast<Eigen::Index>(follower.anchors.size());
+  Eigen::MatrixXd design(1 + directions.cols(), K);  // column k: [1; y_k·e]
+  design.row(0).setOnes();
+  design.bottomRows(directions.cols()) =
+      directions.transpose() * (P(follower.anchors, Eigen::all).rowwise() - mean).transpose();
+  const Eigen::VectorXd w = mass(follower.anchors);
+  const Eigen::MatrixXd gram = design * w.asDiagonal() * design.transpose();
+  const Eigen::MatrixXd solved = gram.ldlt().solve(design * w.asDiagonal());  // column k: G⁻¹ w_k [1; y_k·e]
+  follower.offsets.resize(static_cast<Eigen::Index>(group.vertices.size()), 3);
+  for (size_t i = 0; i < group.vertices.size(); ++i)
+    follower.offsets.row(static_cast<Eigen::Index>(i)) = V.row(group.vertices[i]) - mean;
+  follower.alpha = solved.row(0).transpose();
+  follower.beta = (directions * solved.bottomRows(directions.cols())).transpose();
+  return follower;
 }
 
 }  // namespace
@@ -177,9 +159,8 @@ Attachment attach(const VerticesRef& V, const FacesRef& F) {
 
   RowMatrixX3d P(static_cast<Eigen::Index>(result.simulated.size()), 3);
   for (size_t s = 0; s < result.simulated.size(); ++s) P.row(static_cast<Eigen::Index>(s)) = V.row(result.simulated[s]);
-  for (const Group& group : groups) follow(V, P, group, result.followers);
-  std::sort(result.followers.begin(), result.followers.end(),
-            [](const Attachment::Follower& a, const Attachment::Follower& b) { return a.vertex < b.vertex; });
+  const Eigen::VectorXd mass = lumped_mass(V, F)(result.simulated);
+  for (const Group& group : groups) result.followers.push_back(follow(V, P, mass, group));
   return result;
 }
 
@@ -194,11 +175,20 @@ Eigen::MatrixXd extend_to_attached(const Attachment& attachment, const Eigen::Re
     for (Eigen::Index s = 0; s < S; ++s)
       out.col(j).segment<3>(3 * attachment.simulated[static_cast<size_t>(s)]) = U.col(j).segment<3>(3 * s);
     for (const Attachment::Follower& follower : attachment.followers) {
-      Eigen::Vector3d row = Eigen::Vector3d::Zero();
-      for (int k = 0; k < 4; ++k)
-        row += follower.weights[static_cast<size_t>(k)] *
-               U.col(j).segment<3>(3 * follower.anchors[static_cast<size_t>(k)]);
-      out.col(j).segment<3>(3 * follower.vertex) = row;
+      // The fitted affine displacement t + A y of this column (header).
+      Eigen::Vector3d t = Eigen::Vector3d::Zero(), turn = Eigen::Vector3d::Zero();
+      Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+      for (size_t k = 0; k < follower.anchors.size(); ++k) {
+        const Eigen::Vector3d u = U.col(j).segment<3>(3 * follower.anchors[k]);
+        const Eigen::Vector3d beta = follower.beta.row(static_cast<Eigen::Index>(k)).transpose();
+        t += follower.alpha[static_cast<Eigen::Index>(k)] * u;
+        A += u * beta.transpose();
+        turn += beta * follower.normal.dot(u);
+      }
+      A -= turn * follower.normal.transpose();
+      for (size_t i = 0; i < follower.vertices.size(); ++i)
+        out.col(j).segment<3>(3 * follower.vertices[i]) =
+            t + A * follower.offsets.row(static_cast<Eigen::Index>(i)).transpose();
     }
   }
   return out;

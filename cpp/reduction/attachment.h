@@ -12,17 +12,19 @@
 // her vertices each). The energy, the mass and the eigenproblem use only the simulated submesh:
 // the sound faces of the simulated components.
 //
-// How attached vertices follow. An attached vertex moves with the affine motion of a tetrahedron
-// of four well-spread simulated vertices near it: its basis rows are Σ_k w_k (rows of anchor k),
-// with w its affine (barycentric) coordinates in the tetrahedron, so every affine motion of the
-// anchors, rigid motions included, carries over exactly: handles can still move the whole mesh
-// rigidly, and the eyes follow the head. All vertices of one attached component share one
-// tetrahedron, chosen around the component's centroid among the simulated vertices within about
-// twice its radius plus its distance to them, so the component moves as one affine body with the
-// part of the mesh beside it. Where those simulated vertices are nearly coplanar (a flat sheet),
-// the tetrahedron flattens to a triangle: in-plane motion is interpolated affinely and the offset
-// along the normal turns with the triangle as a linearised rotation, so every linearised rigid
-// motion (what the rigid columns of the basis are) is still reproduced exactly.
+// How attached vertices follow. The vertices of one attached component (or a single attached
+// vertex) move as one affine body with the surface around them: their displacement is the affine
+// field t + A (p − m) fitted by mass-weighted least squares to the displacements of the simulated
+// vertices nearby, m their mean. The region: the simulated vertices within 1.5 times the
+// component's radius from its centre, grown until it holds at least 16 vertices and is not flat
+// (thinner than a tenth of its extent). Every affine motion of that region, rigid motions
+// included, carries over exactly; a region that deforms is followed on average, so an eye stays
+// in its socket rather than following four far-apart vertices. A flat region could not tell how
+// its normal turns under a large rotation, hence the growing. Only when the whole simulated mesh
+// is flat (a sheet) is the fit affine in its plane, the normal turning as the plane does (the
+// skew completion of A): every linearised rigid motion, which is what the rigid columns of the
+// basis are, is still reproduced exactly. The fit is linear in the displacements, so it applies
+// to each basis vector (x = x̄ + U q stays linear).
 #pragma once
 
 #include <array>
@@ -51,19 +53,23 @@ struct Attachment {
   RowMatrixX3i faces;
   Eigen::VectorXi component;
   int num_components = 0;
-  // An attached vertex's displacement is Σ_k weights[k] · (displacement of submesh vertex
-  // anchors[k]), weights 3 by 3 (a multiple of the identity for a tetrahedron).
+  // A group of attached vertices and the region it follows: the displacement of vertex p is
+  // Σ_k [(alpha[k] + beta[k]·y) I − (normal·y) beta[k] normalᵀ] u_k, y = p − m, u_k the
+  // displacement of submesh vertex anchors[k] (the least-squares affine fit, flat or not).
   struct Follower {
-    int vertex;
-    std::array<int, 4> anchors;
-    std::array<Eigen::Matrix3d, 4> weights;
+    std::vector<int> vertices;  // fine vertex indices, ascending
+    RowMatrixX3d offsets;       // y of each vertex: its rest position minus the region's mean m
+    std::vector<int> anchors;   // submesh indices of the region
+    Eigen::VectorXd alpha;      // #anchors
+    RowMatrixX3d beta;          // #anchors by 3
+    Eigen::Vector3d normal;     // the flat region's normal, zero when the region is not flat
   };
-  std::vector<Follower> followers;  // one per attached vertex, in vertex order
+  std::vector<Follower> followers;  // one per group, in the order of their first vertex
   int num_attached_components = 0;  // components attached as a whole
 };
 
 // The simulated submesh of (V #V by 3, F #F by 3) and how the other vertices follow it (rule
-// above). Any length unit: the weights are dimensionless. Throws InputError for a mesh
+// above). Any length unit (the fit scales with the mesh). Throws InputError for a mesh
 // validate_mesh refuses or one whose faces are all degenerate (nothing to simulate).
 Attachment attach(const VerticesRef& V, const FacesRef& F);
 

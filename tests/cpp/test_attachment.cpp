@@ -43,12 +43,16 @@ TEST(Attachment, SmallComponentsFollowTheMeshAffinely) {
   ASSERT_EQ(static_cast<int>(attachment.simulated.size()), head);
   EXPECT_EQ(attachment.num_components, 1);
   EXPECT_EQ(attachment.num_attached_components, 2);
-  EXPECT_EQ(attachment.followers.size(), static_cast<size_t>(mesh.V.rows() - head));
+  ASSERT_EQ(attachment.followers.size(), 2u);  // one per eye
+  EXPECT_EQ(attachment.followers[0].vertices.size() + attachment.followers[1].vertices.size(),
+            static_cast<size_t>(mesh.V.rows() - head));
   for (int s = 0; s < head; ++s) EXPECT_EQ(attachment.simulated[static_cast<size_t>(s)], s);
   EXPECT_EQ(attachment.faces.rows(), 6 * 6 * 6 * 2);
-  // The eyes are boxes in front of the head: far from flat around them, so tetrahedra.
-  for (const auto& follower : attachment.followers)
-    EXPECT_TRUE(follower.weights[3].isApprox(follower.weights[3](0, 0) * Eigen::Matrix3d::Identity()));
+  // The eyes sit in front of a corner region of the head: not flat, and at least 16 vertices.
+  for (const auto& follower : attachment.followers) {
+    EXPECT_EQ(follower.normal, Eigen::Vector3d::Zero());
+    EXPECT_GE(follower.anchors.size(), 16u);
+  }
   const Eigen::Matrix3d A = (Eigen::Matrix3d() << 0.3, -0.2, 0.1, 0.05, -0.4, 0.2, 0.7, 0.1, 0.0).finished();
   EXPECT_LT(extension_error(attachment, mesh.V, A, Eigen::Vector3d(1, -2, 0.5)), 1e-12);
   EXPECT_LT(extension_error(attachment, mesh.V, skew(Eigen::Vector3d(0.2, -1, 0.4)), Eigen::Vector3d(0, 0, 1)), 1e-12);
@@ -62,9 +66,9 @@ TEST(Attachment, DebrisOverAFlatSheetTurnsWithIt) {
   speck.V.col(2).setConstant(0.3);
   const TriangleMesh mesh = side_by_side(sheet, speck, Eigen::RowVector3d(0.2, -0.1, 0.0));
   const Attachment attachment = attach(mesh.V, mesh.F);
-  ASSERT_EQ(attachment.followers.size(), 4u);
-  EXPECT_FALSE(attachment.followers[0].weights[0].isApprox(attachment.followers[0].weights[0](0, 0) *
-                                                           Eigen::Matrix3d::Identity()));
+  ASSERT_EQ(attachment.followers.size(), 1u);
+  EXPECT_EQ(attachment.followers[0].vertices.size(), 4u);
+  EXPECT_NEAR(std::abs(attachment.followers[0].normal.z()), 1.0, 1e-12);
   EXPECT_LT(extension_error(attachment, mesh.V, skew(Eigen::Vector3d(0.5, 0.3, -0.2)), Eigen::Vector3d(1, 2, 3)),
             1e-12);
   const Eigen::Matrix3d in_plane = (Eigen::Matrix3d() << 0.3, -0.2, 0, 0.5, 0.1, 0, 0, 0, 0).finished();
@@ -83,8 +87,8 @@ TEST(Attachment, UnreferencedAndMasslessVerticesAreAttached) {
   const Attachment attachment = attach(mesh.V, mesh.F);
   EXPECT_EQ(static_cast<int>(attachment.simulated.size()), n);
   ASSERT_EQ(attachment.followers.size(), 2u);
-  EXPECT_EQ(attachment.followers[0].vertex, n);
-  EXPECT_EQ(attachment.followers[1].vertex, n + 1);
+  EXPECT_EQ(attachment.followers[0].vertices, std::vector<int>{n});
+  EXPECT_EQ(attachment.followers[1].vertices, std::vector<int>{n + 1});
   EXPECT_EQ(attachment.submesh_index[n], -1);
   EXPECT_EQ(attachment.faces.rows(), mesh.F.rows() - 1);  // the degenerate face is not simulated
   EXPECT_LT(extension_error(attachment, mesh.V, skew(Eigen::Vector3d(1, 2, 3)), Eigen::Vector3d(-1, 0, 1)), 1e-12);
