@@ -1,4 +1,6 @@
-"""The main job, headless: bake Suzanne (~31k vertices), pose it with two handles, render before/after.
+"""The main job, headless: bake Suzanne (~31k vertices), pose it strongly with two handles (the top
+of the head turned by 30 and bent sideways by 25 degrees against the held chin: a pose with large
+rotations, what modal derivatives are for), render before/after.
 
     blender -b --factory-startup --python blender_scripts/demo.py -- --output out
 
@@ -23,12 +25,17 @@ from headless import add_handle  # noqa: E402
 from rendering import render, side_by_side, stage  # noqa: E402
 
 
+#: The pose: the top of the head turned about the vertical and then bent sideways (degrees).
+TURN, BEND = 30, 25
+
+
 def arguments():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--output", default="out", help="folder for demo.png and demo.blend")
     parser.add_argument("--subdivisions", type=int, default=3, help="Catmull-Clark levels (3: ~31k vertices)")
     parser.add_argument("--samples", type=int, default=16, help="Cycles samples per pixel")
+    parser.add_argument("--width", type=int, default=800, help="width of each of the two pictures, pixels")
     return parser.parse_args(argv)
 
 
@@ -81,13 +88,14 @@ def main():
     print(f"bake: {time.perf_counter() - start:.1f} s ({status.dimension} dimensions, ghost {status.ghost_vertices} "
           f"vertices)")
 
-    # Handles: the top of the head, tilted to the side; the chin, pulled down and forward.
-    head = add_handle(suzanne, V[:, 2] > 0.6)
-    chin = add_handle(suzanne, (V[:, 2] < -0.55) & (V[:, 1] < -0.3))
-    head_empty, chin_empty = head.controller, chin.controller
-    head_empty.matrix_world = (Matrix.Translation((0.25, 0.0, 0.05)) @ head_empty.matrix_world
-                               @ Matrix.Rotation(math.radians(-15), 4, "Y"))
-    chin_empty.location += Vector((0.0, -0.15, -0.2))  # in Suzanne's space: Add Handle parents the Empty
+    # Handles: the top of the head, turned about the vertical and bent sideways about the head's
+    # centre; the chin, held where it is (its Empty is not moved).
+    head = add_handle(suzanne, V[:, 2] > 0.4)
+    add_handle(suzanne, (V[:, 2] < -0.55) & (V[:, 1] < -0.3))
+    turn = Matrix.Rotation(math.radians(BEND), 4, "Y") @ Matrix.Rotation(math.radians(TURN), 4, "Z")
+    centre = suzanne.matrix_world.translation
+    head.controller.matrix_world = (Matrix.Translation(centre) @ turn @ Matrix.Translation(-centre)
+                                    @ head.controller.matrix_world)
     bpy.context.view_layer.update()
 
     times = interactive_updates(suzanne, 30)
@@ -95,7 +103,8 @@ def main():
           f"budget {suzanne.modal_deform.budget:.0f} ms for the solver)")
     assert bpy.ops.modal_deform.solve() == {"FINISHED"}
 
-    stage(suzanne.matrix_world.translation + Vector((0.15, 0.0, 0.0)), eye=(1.2, -6.8, 0.8), samples=args.samples)
+    stage(suzanne.matrix_world.translation + Vector((0.1, 0.0, 0.05)), eye=(1.0, -6.0, 0.8), lens=70,
+          samples=args.samples, resolution=(args.width, args.width * 3 // 4))
     key = suzanne.data.shape_keys.key_blocks[posing.POSE_KEY]
     start = time.perf_counter()
     key.value = 0.0
