@@ -2,8 +2,8 @@
 
 Generated shapes in the style of Botsch & Sorkine's linear-deformation benchmarks ("On Linear
 Variational Surface Deformation Methods", 2008), scaled so that the longest bounding-box edge is
-10 (the paper's normalised frame), each with one handle set and five poses: the three classic
-motions (lift, bend, twist) and two larger ones. The shared scans (bunny, dragons) are read in
+10 (the paper's normalised frame), each with one handle set and five poses (the bar six): the three
+classic motions (lift, bend, twist) and larger ones. The shared scans (bunny, dragons) are read in
 place with a generic pose: one end held, the other pulled and turned.
 
 The generated shapes and their first poses mirror tests/cpp/test_posing_accuracy.cpp (bumpy plane
@@ -145,6 +145,7 @@ def bar(nx=12, nz=120):
     poses = _rod_poses(10.0, (0.5, 0.5), (
         ("lift", "far end shifted sideways by 2", 0, 0, 2.0, 3),
         ("bend", "bent by 90 deg", 90 * deg, 0, 0, 6),
+        ("bend_60", "bent by 60 deg", 60 * deg, 0, 0, 4),
         ("twist", "twisted by 90 deg", 0, 90 * deg, 0, 6),
         ("bend_large", "bent by 180 deg", 180 * deg, 0, 0, 6),
         ("twist_large", "twisted by 180 deg (the reference buckles)", 0, 180 * deg, 0, 6),
