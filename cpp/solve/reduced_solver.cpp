@@ -74,11 +74,11 @@ void ReducedSolver::set_transforms(const Transforms& transforms) {
   bfgs_.objective_changed(new_value - old_value, handle_gradient_);
 }
 
-ReducedSolveStats ReducedSolver::solve(int max_iterations, double tolerance) {
+ReducedSolveStats ReducedSolver::solve(int max_iterations, double tolerance, double budget_ms) {
   const auto start = std::chrono::steady_clock::now();
   const BfgsResult result =
       bfgs_.minimize([this](const Eigen::VectorXd& q, Eigen::VectorXd& gradient) { return objective(q, gradient); },
-                     max_iterations, tolerance);
+                     max_iterations, tolerance, budget_ms);
   q_float_ = q().cast<float>();
   ReducedSolveStats stats;
   stats.iterations = result.iterations;

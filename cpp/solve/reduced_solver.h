@@ -20,6 +20,7 @@
 // Not thread-safe: one solver per thread.
 #pragma once
 
+#include <limits>
 #include <memory>
 
 #include "energy/energy.h"
@@ -55,8 +56,10 @@ class ReducedSolver {
   // O(r) per handle; the next solve continues from the current q and inverse Hessian.
   void set_transforms(const Transforms& transforms);
 
-  // Up to max_iterations ≥ 0 BFGS iterations with stopping tolerance ε in (0, 1) (bfgs.h).
-  ReducedSolveStats solve(int max_iterations, double tolerance);
+  // Up to max_iterations ≥ 0 BFGS iterations with stopping tolerance ε in (0, 1), none begun after
+  // budget_ms milliseconds (Bfgs::minimize): a pose tick calls it once per frame.
+  ReducedSolveStats solve(int max_iterations, double tolerance,
+                          double budget_ms = std::numeric_limits<double>::infinity());
 
   // Back to rest (q = 0) and the initial inverse Hessian; the transforms stay.
   void reset();

@@ -117,6 +117,20 @@ def test_reduced_solver_poses_close_to_the_full_solve(tube, tube_basis):
     assert np.sqrt(np.mean(np.sum((X - reference) ** 2, axis=1))) < 0.02 * diagonal
 
 
+def test_a_time_budget_ends_a_solve_after_one_iteration(tube, tube_basis):
+    _, _, handles, transforms = tube
+    solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0)
+    solver.set_transforms(transforms)
+    for _ in range(3):
+        assert solver.solve(max_iterations=1000, budget_ms=1e-9)["iterations"] == 1
+    assert solver.solve(max_iterations=4, budget_ms=6e4)["iterations"] == 4
+    for budget in [0, -1.0, float("nan")]:
+        with pytest.raises(ValueError, match="budget_ms"):
+            solver.solve(budget_ms=budget)
+    with pytest.raises(ValueError, match="budget_ms"):
+        solver.solve(budget_ms="5")
+
+
 def test_positions_fill_the_callers_buffer(tube, tube_basis):
     _, _, handles, transforms = tube
     solver = mdc.ReducedSolver(tube_basis, handles)

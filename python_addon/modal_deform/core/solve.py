@@ -106,15 +106,18 @@ class ReducedSolver:
         """
         self._native.set_transforms(_transforms(transforms, self._native.num_handles))
 
-    def solve(self, max_iterations=10, tolerance=1e-6):
+    def solve(self, max_iterations=10, tolerance=1e-6, budget_ms=None):
         """Up to ``max_iterations`` BFGS iterations from the current state.
 
-        Stops early when the Gill–Murray–Wright test holds (paper eq. 14, tolerance ε). Returns
+        Stops early when the Gill–Murray–Wright test holds (paper eq. 14, tolerance ε), and begins
+        no iteration once ``budget_ms`` milliseconds (> 0; None: no limit) have passed: a frame's
+        share of time (the iteration under way is finished, so a call always progresses). Returns
         {"iterations", "energy" (the objective), "converged", "ms", "evaluations",
         "gradient_norm"}. q and the inverse Hessian carry over to the next call.
         """
         return self._native.solve(_arrays.integer(max_iterations, "max_iterations"),
-                                  _arrays.number(tolerance, "tolerance"))
+                                  _arrays.number(tolerance, "tolerance"),
+                                  float("inf") if budget_ms is None else _arrays.number(budget_ms, "budget_ms"))
 
     def objective(self, q):
         """The objective f(q) (ghost energy plus handle term, normalised frame) and its gradient
