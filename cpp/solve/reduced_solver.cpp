@@ -38,9 +38,10 @@ ReducedSolver::ReducedSolver(const Basis& basis, const Handles& handles, const V
           make_energy(energy, basis.scale * basis.ghost_vertices, basis.ghost_faces, basis.bending, basis.membrane)),
       ghost_rest_(basis.scale * flatten(basis.ghost_vertices)),
       ghost_vectors_(basis.scale * basis.ghost_vectors),
-      handle_term_(basis.rest, basis.mass, basis.vectors, handles,
-                   checked_handle_weights(handles, weights, basis.num_vertices()),
-                   checked_stiffness(stiffness) * std::pow(basis.scale, 4)) {
+      handle_term_(HandleTerm(basis.rest, basis.mass, handles,
+                              checked_handle_weights(handles, weights, basis.num_vertices()),
+                              checked_stiffness(stiffness) * std::pow(basis.scale, 4)),
+                   basis.vectors) {
   const Eigen::Index r = basis.dimension();
   if (warm_start) {
     const SparseMatrix K = energy_->hessian(ghost_rest_);

@@ -82,7 +82,7 @@ class ReducedSolver {
   std::unique_ptr<Energy> energy_;  // of the ghost, normalised frame
   Eigen::VectorXd ghost_rest_;      // s x̄_s (3g)
   Eigen::MatrixXd ghost_vectors_;   // s U_s (3g by r)
-  HandleTerm handle_term_;
+  ReducedHandleTerm handle_term_;
   Eigen::MatrixXd initial_inverse_hessian_;
   Bfgs bfgs_;
   Eigen::VectorXf q_float_;  // q for positions()
