@@ -63,6 +63,28 @@ def _weights(weights, count):
     return _arrays.values(weights, "weights", count)
 
 
+def nearest_rigid(matrix, centre):
+    """The rigid 4x4 transform closest to ``matrix`` (4x4, e.g. a scaled or sheared controller's)
+    that takes ``centre`` (3,) where ``matrix`` does: what the solvers take for a handle.
+
+    Rotation: the orthogonal polar factor of the 3x3 part (U Vᵀ of its SVD, a reflection turned
+    into a rotation); translation: chosen so the handle's centre lands on matrix @ centre.
+    """
+    M = _arrays.reals(matrix, "matrix")
+    if M.shape != (4, 4):
+        raise ValueError(f"matrix: expected a 4x4 matrix, got shape {M.shape}")
+    centre = _arrays.values(centre, "centre", 3)
+    A = M[:3, :3]
+    U, _, Vt = np.linalg.svd(A)
+    if np.linalg.det(U @ Vt) < 0:
+        U[:, 2] = -U[:, 2]
+    R = U @ Vt
+    T = np.eye(4)
+    T[:3, :3] = R
+    T[:3, 3] = A @ centre + M[:3, 3] - R @ centre
+    return T
+
+
 class ReducedSolver:
     """BFGS in a baked basis: x = x̄ + U q, energy on the ghost, handles exact on the fine mesh.
 
