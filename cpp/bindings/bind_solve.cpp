@@ -41,17 +41,17 @@ void bind_solve(py::module_& m) {
       .def("set_transforms", &ReducedSolver::set_transforms, py::arg("transforms"))
       .def(
           "solve",
-          [](ReducedSolver& solver, int max_iterations, double tolerance) {
+          [](ReducedSolver& solver, int max_iterations, double tolerance, double budget_ms) {
             ReducedSolveStats stats;
             {
               py::gil_scoped_release release;
-              stats = solver.solve(max_iterations, tolerance);
+              stats = solver.solve(max_iterations, tolerance, budget_ms);
             }
             return py::dict(py::arg("iterations") = stats.iterations, py::arg("energy") = stats.energy,
                             py::arg("converged") = stats.converged, py::arg("ms") = stats.milliseconds,
                             py::arg("evaluations") = stats.evaluations, py::arg("gradient_norm") = stats.gradient_norm);
           },
-          py::arg("max_iterations"), py::arg("tolerance"))
+          py::arg("max_iterations"), py::arg("tolerance"), py::arg("budget_ms"))
       .def("reset", &ReducedSolver::reset)
       .def(
           "objective",

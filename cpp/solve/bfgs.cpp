@@ -1,5 +1,6 @@
 #include "solve/bfgs.h"
 
+#include <chrono>
 #include <cmath>
 
 #include "util/errors.h"
@@ -29,10 +30,16 @@ void Bfgs::objective_changed(double value_change, const VectorRef& gradient_chan
 
 void Bfgs::objective_changed() { evaluated_ = converged_ = false; }
 
-BfgsResult Bfgs::minimize(const Objective& objective, int max_iterations, double tolerance) {
+BfgsResult Bfgs::minimize(const Objective& objective, int max_iterations, double tolerance, double budget_ms) {
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point start = Clock::now();
   if (max_iterations < 0) throw InputError(message("max_iterations: expected at least 0, got ", max_iterations));
   if (!(tolerance > 0 && tolerance < 1))
     throw InputError(message("tolerance: expected a value in (0, 1), got ", tolerance));
+  if (!(budget_ms > 0)) throw InputError(message("budget_ms: expected a time > 0 (or infinity), got ", budget_ms));
+  const auto within_budget = [&] {
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count() < budget_ms;
+  };
   BfgsResult result;
   if (!evaluated_) {
     value_ = objective(x_, gradient_);
@@ -41,7 +48,7 @@ BfgsResult Bfgs::minimize(const Objective& objective, int max_iterations, double
     evaluated_ = true;
   }
   const double sqrt_tolerance = std::sqrt(tolerance), cbrt_tolerance = std::cbrt(tolerance);
-  while (!converged_ && result.iterations < max_iterations) {
+  while (!converged_ && result.iterations < max_iterations && (result.iterations == 0 || within_budget())) {
     if (gradient_.norm() <= tolerance * (1 + std::abs(value_))) {
       converged_ = true;
       break;

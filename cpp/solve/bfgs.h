@@ -16,6 +16,8 @@
 // until the objective changes.
 #pragma once
 
+#include <limits>
+
 #include "solve/line_search.h"
 #include "util/types.h"
 
@@ -38,13 +40,17 @@ class Bfgs {
   // The objective changed in an unknown way: f and ∇f are evaluated again by the next minimize.
   void objective_changed();
 
-  // Up to max_iterations ≥ 0 BFGS steps with the stopping test above (tolerance ε in (0, 1)).
+  // Up to max_iterations ≥ 0 BFGS steps with the stopping test above (tolerance ε in (0, 1)),
+  // and none begun once `budget_ms` milliseconds (> 0; infinity for no limit) have passed since the
+  // call began: an interactive frame's share of time. The step under way when the budget runs out
+  // is finished, so every call with max_iterations ≥ 1 makes progress.
   // Each step searches along p = −H∇f; H takes the BFGS update (N&W eq. 6.17) when the step's
   // curvature yᵀs is positive, as the Wolfe conditions ensure. When p is not a descent direction
   // or the line search finds no decrease, H restarts from H0 once; a second failure ends the
   // call unconverged (the objective cannot be decreased at this precision). Throws
   // NumericalError when f is not finite at the current x.
-  BfgsResult minimize(const Objective& objective, int max_iterations, double tolerance);
+  BfgsResult minimize(const Objective& objective, int max_iterations, double tolerance,
+                      double budget_ms = std::numeric_limits<double>::infinity());
 
   const Eigen::VectorXd& x() const { return x_; }
   const Eigen::MatrixXd& inverse_hessian() const { return H_; }

@@ -21,36 +21,17 @@ constexpr double kPi = 3.14159265358979323846;
 // take 1e7 steps and hang the caller).
 constexpr int kMaxLoadSteps = 100;
 
-// One handle vertex's share of the handle term: weight ‖y_vertex − target‖² (normalised frame).
-struct Pull {
-  int vertex;
-  double weight;
-  Eigen::Vector3d target;
-};
-
-// F(y) = E(y) + Σ pulls, with ∇F(y) written into `gradient`.
-double objective(const Energy& energy, const std::vector<Pull>& pulls, const Eigen::VectorXd& y,
+// F(y) = E(y) + E_C(y), with ∇F(y) written into `gradient`.
+double objective(const Energy& energy, const HandleTerm& handle_term, const Eigen::VectorXd& y,
                  Eigen::VectorXd& gradient) {
-  double value = energy.value_and_gradient(y, gradient);
-  for (const Pull& pull : pulls) {
-    const Eigen::Vector3d d = y.segment<3>(3 * pull.vertex) - pull.target;
-    value += pull.weight * d.squaredNorm();
-    gradient.segment<3>(3 * pull.vertex) += 2 * pull.weight * d;
-  }
-  return value;
+  const double value = energy.value_and_gradient(y, gradient);
+  return value + handle_term.add_value_and_gradient(y, gradient);
 }
 
-// The pulls of every handle vertex towards its target under `transforms` (normalised frame).
-std::vector<Pull> pulls_towards(const Transforms& transforms, const Handles& handles, const Eigen::VectorXd& weights,
-                                const VerticesRef& V, const Eigen::VectorXd& mass, double s, double stiffness) {
-  std::vector<Pull> pulls;
-  for (size_t h = 0; h < handles.size(); ++h) {
-    const Eigen::Matrix3d R = transforms[h].topLeftCorner<3, 3>();
-    const Eigen::Vector3d t = transforms[h].topRightCorner<3, 1>();
-    for (int v : handles[h])
-      pulls.push_back({v, stiffness * weights[h] * s * s * mass[v], s * (R * V.row(v).transpose() + t)});
-  }
-  return pulls;
+// Transforms of mesh units as transforms of the normalised frame y = s x.
+Transforms normalised(Transforms transforms, double s) {
+  for (Eigen::Matrix4d& T : transforms) T.topRightCorner<3, 1>() *= s;
+  return transforms;
 }
 
 // T a fraction `t` of the way from the identity: the rotation by t times its angle about the
@@ -84,11 +65,9 @@ FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handle
   const std::unique_ptr<Energy> energy = make_energy(energy_kind, rest, F, bending, membrane);
   const Eigen::VectorXd mass = lumped_mass(V, F);
 
-  // The handle term's Hessian: constant and diagonal.
-  Eigen::VectorXd handle_diagonal = Eigen::VectorXd::Zero(3 * n);
-  for (size_t h = 0; h < handles.size(); ++h)
-    for (int v : handles[h])
-      handle_diagonal.segment<3>(3 * v).array() += 2 * stiffness * handle_weights[h] * s * s * mass[v];
+  // E_C in the normalised frame: masses s²m, coefficient μ. Its Hessian is constant and diagonal.
+  HandleTerm handle_term(rest, s * s * mass, handles, handle_weights, stiffness);
+  const Eigen::VectorXd handle_diagonal = handle_term.hessian_diagonal(n);
   // D of the Hessian modification, and a fixed diagonal for the coordinates of vertices in no
   // energy term and no handle (no mass, zero Hessian block): nothing moves them.
   Eigen::VectorXd y = flatten(rest);
@@ -126,12 +105,12 @@ FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handle
   FullSolveResult result;
   result.steps = steps;
   Eigen::VectorXd gradient(3 * n), y_trial(3 * n), gradient_trial(3 * n), shift(3 * n), p(3 * n);
-  std::vector<Pull> pulls = pulls_towards(transforms, handles, handle_weights, V, mass, s, stiffness);
-  double value = objective(*energy, pulls, y, gradient);
+  handle_term.set_transforms(normalised(transforms, s));
+  double value = objective(*energy, handle_term, y, gradient);
   result.gradient_scale = gradient.norm();
   if (initial) {
     y = s * flatten(*initial);
-    objective(*energy, pulls, y, gradient);
+    objective(*energy, handle_term, y, gradient);
     result.gradient_scale = std::max(result.gradient_scale, gradient.norm());
   }
   const double target = tolerance * result.gradient_scale;
@@ -143,8 +122,8 @@ FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handle
     if (step < steps)
       for (size_t h = 0; h < handles.size(); ++h)
         partial[h] = partial_transform(transforms[h], centres[h], double(step) / steps);
-    pulls = pulls_towards(partial, handles, handle_weights, V, mass, s, stiffness);
-    value = objective(*energy, pulls, y, gradient);
+    handle_term.set_transforms(normalised(partial, s));
+    value = objective(*energy, handle_term, y, gradient);
     for (int iteration = 0; iteration < max_iterations && gradient.norm() > target; ++iteration) {
       const SparseMatrix H = energy->hessian(y);
       tau = tau / 10 >= tau_min ? tau / 10 : 0;
@@ -169,7 +148,7 @@ FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handle
       for (int halving = 0; halving < 60 && slope < 0; ++halving, length /= 2) {
         y_trial = y + length * p;
         if (!positions_in_range(y_trial)) continue;  // beyond what the energy takes: too long a step
-        const double value_trial = objective(*energy, pulls, y_trial, gradient_trial);
+        const double value_trial = objective(*energy, handle_term, y_trial, gradient_trial);
         if (value_trial <= value + 1e-4 * length * slope ||
             (-length * slope < noise && value_trial <= value + noise && gradient_trial.norm() < gradient.norm())) {
           decreased = true;

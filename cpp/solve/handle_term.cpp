@@ -53,65 +53,95 @@ void check_transforms(const Transforms& transforms, int num_handles) {
   }
 }
 
-HandleTerm::HandleTerm(const VerticesRef& rest, const VectorRef& mass, const Eigen::Ref<const RowMatrixXf>& U,
-                       const Handles& handles, const VectorRef& weights, double coefficient) {
-  const int n = static_cast<int>(rest.rows());
+HandleTerm::HandleTerm(const VerticesRef& rest, const VectorRef& mass, const Handles& handles,
+                       const VectorRef& weights, double coefficient) {
+  for (size_t h = 0; h < handles.size(); ++h) {
+    std::vector<Member>& members = members_.emplace_back();
+    for (int v : handles[h]) members.push_back({v, coefficient * weights[h] * mass[v], rest.row(v).transpose()});
+    std::vector<Eigen::Vector3d>& targets = targets_.emplace_back();
+    for (const Member& member : members) targets.push_back(member.rest);
+  }
+}
+
+void HandleTerm::set_transforms(const Transforms& transforms) {
+  for (size_t h = 0; h < members_.size(); ++h) {
+    const Eigen::Matrix3d R = transforms[h].topLeftCorner<3, 3>();
+    const Eigen::Vector3d t = transforms[h].topRightCorner<3, 1>();
+    for (size_t k = 0; k < members_[h].size(); ++k) targets_[h][k] = R * members_[h][k].rest + t;
+  }
+}
+
+double HandleTerm::add_value_and_gradient(const VectorRef& x, Eigen::Ref<Eigen::VectorXd> gradient) const {
+  double value = 0;
+  for (size_t h = 0; h < members_.size(); ++h)
+    for (size_t k = 0; k < members_[h].size(); ++k) {
+      const Member& member = members_[h][k];
+      const Eigen::Vector3d d = x.segment<3>(3 * member.vertex) - targets_[h][k];
+      value += member.weight * d.squaredNorm();
+      gradient.segment<3>(3 * member.vertex) += 2 * member.weight * d;
+    }
+  return value;
+}
+
+Eigen::VectorXd HandleTerm::hessian_diagonal(int num_vertices) const {
+  Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(3 * num_vertices);
+  for (const std::vector<Member>& members : members_)
+    for (const Member& member : members) diagonal.segment<3>(3 * member.vertex).array() += 2 * member.weight;
+  return diagonal;
+}
+
+ReducedHandleTerm::ReducedHandleTerm(const HandleTerm& term, const Eigen::Ref<const RowMatrixXf>& U) {
   const Eigen::Index r = U.cols();
-  // A = Σ_i ω_i U_iᵀU_i with ω_i = coefficient Σ_{h∋i} w_h m_i: rank updates with the gathered
-  // rows √ω_i U_i, a block of vertices at a time (bounded memory for a handle of any size).
-  Eigen::VectorXd omega = Eigen::VectorXd::Zero(n);
-  for (size_t h = 0; h < handles.size(); ++h)
-    for (int v : handles[h]) omega[v] += coefficient * weights[h] * mass[v];
-  std::vector<int> members;
-  for (int v = 0; v < n; ++v)
-    if (omega[v] > 0) members.push_back(v);
+  // A = Σ_i ω_i U_iᵀU_i with ω_i = Σ_{h∋i} c w_h m_i: rank updates with the gathered rows √ω_i U_i,
+  // a block of vertices at a time (bounded memory for a handle of any size).
+  std::vector<double> omega(static_cast<size_t>(U.rows() / 3), 0.0);
+  for (const std::vector<HandleTerm::Member>& members : term.members())
+    for (const HandleTerm::Member& member : members) omega[static_cast<size_t>(member.vertex)] += member.weight;
+  std::vector<int> pulled;
+  for (size_t v = 0; v < omega.size(); ++v)
+    if (omega[v] > 0) pulled.push_back(static_cast<int>(v));
   constexpr size_t kBlock = 1024;
   A_ = Eigen::MatrixXd::Zero(r, r);
   Eigen::MatrixXd G(3 * kBlock, r);
-  for (size_t begin = 0; begin < members.size(); begin += kBlock) {
-    const size_t count = std::min(kBlock, members.size() - begin);
+  for (size_t begin = 0; begin < pulled.size(); begin += kBlock) {
+    const size_t count = std::min(kBlock, pulled.size() - begin);
     for (size_t k = 0; k < count; ++k) {
-      const int v = members[begin + k];
-      G.middleRows<3>(3 * k) = std::sqrt(omega[v]) * U.middleRows<3>(3 * v).cast<double>();
+      const int v = pulled[begin + k];
+      G.middleRows<3>(3 * k) = std::sqrt(omega[static_cast<size_t>(v)]) * U.middleRows<3>(3 * v).cast<double>();
     }
     A_.selfadjointView<Eigen::Lower>().rankUpdate(G.topRows(3 * count).transpose());
   }
   A_.triangularView<Eigen::StrictlyUpper>() = A_.transpose();
 
-  for (size_t h = 0; h < handles.size(); ++h) {
-    const double scale = coefficient * weights[h];
+  for (const std::vector<HandleTerm::Member>& members : term.members()) {
     Handle handle;
     handle.mass = 0;
     handle.centroid.setZero();
-    for (int v : handles[h]) {
-      handle.mass += mass[v];
-      handle.centroid += mass[v] * rest.row(v).transpose();
+    for (const HandleTerm::Member& member : members) {
+      handle.mass += member.weight;
+      handle.centroid += member.weight * member.rest;
     }
-    // Without mass the term is zero and any centre will do.
-    handle.centroid =
-        handle.mass > 0 ? Eigen::Vector3d(handle.centroid / handle.mass) : Eigen::Vector3d(rest.row(handles[h][0]));
+    // Without weight the term is zero and any centre will do.
+    handle.centroid = handle.mass > 0 ? Eigen::Vector3d(handle.centroid / handle.mass) : members.front().rest;
     handle.second_moment.setZero();
     handle.coefficients = Eigen::MatrixXd::Zero(r, 12);
-    for (int v : handles[h]) {
-      const Eigen::Vector3d offset = rest.row(v).transpose() - handle.centroid;
-      handle.second_moment += mass[v] * offset * offset.transpose();
+    for (const HandleTerm::Member& member : members) {
+      const Eigen::Vector3d offset = member.rest - handle.centroid;
+      handle.second_moment += member.weight * offset * offset.transpose();
       for (int a = 0; a < 3; ++a) {
-        const Eigen::VectorXd row = U.row(3 * v + a).transpose().cast<double>();
-        for (int c = 0; c < 3; ++c) handle.coefficients.col(3 * a + c) += mass[v] * offset[c] * row;
-        handle.coefficients.col(9 + a) += mass[v] * row;
+        const Eigen::VectorXd row = U.row(3 * member.vertex + a).transpose().cast<double>();
+        for (int c = 0; c < 3; ++c) handle.coefficients.col(3 * a + c) += member.weight * offset[c] * row;
+        handle.coefficients.col(9 + a) += member.weight * row;
       }
     }
-    handle.mass *= scale;
-    handle.second_moment *= scale;
-    handle.coefficients *= scale;
     handles_.push_back(std::move(handle));
   }
   b_ = Eigen::VectorXd::Zero(r);
 }
 
-void HandleTerm::set_transforms(const Transforms& transforms) {
+void ReducedHandleTerm::set_transforms(const Transforms& transforms) {
   b_.setZero();
-  c_ = 0;
+  e_ = 0;
   Eigen::Matrix<double, 12, 1> parameters;
   for (size_t h = 0; h < handles_.size(); ++h) {
     const Handle& handle = handles_[h];
@@ -122,13 +152,13 @@ void HandleTerm::set_transforms(const Transforms& transforms) {
       for (int c = 0; c < 3; ++c) parameters[3 * a + c] = D(a, c);
     parameters.tail<3>() = e;
     b_.noalias() += handle.coefficients * parameters;
-    c_ += (D * handle.second_moment * D.transpose()).trace() + handle.mass * e.squaredNorm();
+    e_ += (D * handle.second_moment * D.transpose()).trace() + handle.mass * e.squaredNorm();
   }
 }
 
-double HandleTerm::value_and_gradient(const VectorRef& q, Eigen::Ref<Eigen::VectorXd> gradient) const {
+double ReducedHandleTerm::value_and_gradient(const VectorRef& q, Eigen::Ref<Eigen::VectorXd> gradient) const {
   gradient.noalias() = A_ * q;
-  const double value = q.dot(gradient) + 2 * b_.dot(q) + c_;
+  const double value = q.dot(gradient) + 2 * b_.dot(q) + e_;
   gradient = 2 * (gradient + b_);
   return value;
 }

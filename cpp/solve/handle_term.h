@@ -1,22 +1,24 @@
-// Handles and the handle term of the posing objective (paper section 5, E_C), in reduced
-// coordinates.
+// Handles and the handle term of the posing objective (paper section 5, E_C): on the fine mesh
+// for the full solve, and restricted to the reduced coordinates for the reduced solver.
 //
 // A handle is a set of fine vertices that follows a rigid transform T_h = [R_h t_h; 0 0 0 1] of
-// its rest positions (mesh units), with a weight w_h ≥ 0. In the normalised frame (scale s,
-// normalization.h) the term is
+// its rest positions, with a weight w_h ≥ 0. With a coefficient c (μs⁴ for mesh units in the
+// normalised frame, normalization.h; μ for positions already normalised) the term is
 //
-//   E_C(q) = μ Σ_h w_h Σ_{i∈h} s²m_i ‖s (x̄_i + U_i q − R_h x̄_i − t_h)‖²
-//          = qᵀ A q + 2 bᵀ q + c,
+//   E_C(x) = c Σ_h w_h Σ_{i∈h} m_i ‖x_i − R_h x̄_i − t_h‖²                    (HandleTerm)
 //
-// with m_i the fine lumped masses (mesh units, so s²m_i is the normalised mass) and U_i the
-// 3 by r rows of vertex i. A = μs⁴ Σ_h w_h Σ_i m_i U_iᵀU_i depends only on the handle set; with
-// x̄_i = c_h + r_i about the handle's mass centroid c_h, D_h = I − R_h and e_h = D_h c_h − t_h,
+// with m_i the lumped masses. Restricted to x = x̄ + U q (U_i the 3 by r rows of vertex i),
 //
-//   b = μs⁴ Σ_h w_h (C_h vec(D_h) + T_h e_h),   c = μs⁴ Σ_h w_h (tr(D_h S_h D_hᵀ) + M_h ‖e_h‖²),
+//   E_C(q) = qᵀ A q + 2 bᵀ q + e                                            (ReducedHandleTerm)
+//
+// A = c Σ_h w_h Σ_i m_i U_iᵀU_i depends only on the handle set; with x̄_i = k_h + r_i about the
+// handle's mass centroid k_h, D_h = I − R_h and e_h = D_h k_h − t_h,
+//
+//   b = c Σ_h w_h (C_h vec(D_h) + T_h e_h),   e = c Σ_h w_h (tr(D_h S_h D_hᵀ) + M_h ‖e_h‖²),
 //
 // where C_h = Σ_i m_i U_iᵀ ⊗ r_iᵀ (r by 9), T_h = Σ_i m_i U_iᵀ (r by 3), S_h = Σ_i m_i r_i r_iᵀ and
 // M_h = Σ_i m_i are computed once. Moving handles then costs O(r) per handle, and evaluating the
-// term O(r²), whatever the number of handle vertices. (Centring keeps c exact when the mesh lies
+// term O(r²), whatever the number of handle vertices. (Centring keeps e exact when the mesh lies
 // far from the origin: no large terms cancel.)
 //
 // A vertex may belong to several handles: its terms add, so it settles between their targets in
@@ -43,12 +45,41 @@ Eigen::VectorXd checked_handle_weights(const Handles& handles, const VectorRef& 
 // a translation coordinate beyond kMaxCoordinate; or when there is not one transform per handle.
 void check_transforms(const Transforms& transforms, int num_handles);
 
+// E_C on the fine mesh: the full solve's handle term, and what ReducedHandleTerm restricts.
 class HandleTerm {
  public:
-  // rest: #V by 3 and mass: #V (mesh units); U: 3#V by r (x = x̄ + U q); coefficient: μs⁴.
-  // The handles must pass checked_handle_weights. Transforms start at the identity.
-  HandleTerm(const VerticesRef& rest, const VectorRef& mass, const Eigen::Ref<const RowMatrixXf>& U,
-             const Handles& handles, const VectorRef& weights, double coefficient);
+  // One handle vertex: its rest position and its share c w_h m_i of the term.
+  struct Member {
+    int vertex;
+    double weight;
+    Eigen::Vector3d rest;
+  };
+
+  // rest: #V by 3 and mass: #V; coefficient: c. The handles must pass checked_handle_weights.
+  // Transforms start at the identity.
+  HandleTerm(const VerticesRef& rest, const VectorRef& mass, const Handles& handles, const VectorRef& weights,
+             double coefficient);
+
+  // One transform per handle (check_transforms first), in the units of `rest`.
+  void set_transforms(const Transforms& transforms);
+
+  // E_C(x) for positions x (3#V, interleaved), with ∇E_C(x) added to `gradient` (3#V).
+  double add_value_and_gradient(const VectorRef& x, Eigen::Ref<Eigen::VectorXd> gradient) const;
+  // The diagonal of ∇²E_C (3#V), constant: 2 c Σ_{h∋i} w_h m_i for each coordinate of vertex i.
+  Eigen::VectorXd hessian_diagonal(int num_vertices) const;
+
+  const std::vector<std::vector<Member>>& members() const { return members_; }
+
+ private:
+  std::vector<std::vector<Member>> members_;     // per handle
+  std::vector<std::vector<Eigen::Vector3d>> targets_;  // per handle and member: T_h x̄_i
+};
+
+// E_C restricted to x = x̄ + U q, in O(r²) per evaluation.
+class ReducedHandleTerm {
+ public:
+  // U: 3#V by r, the basis x = x̄ + U q of the fine term's mesh.
+  ReducedHandleTerm(const HandleTerm& term, const Eigen::Ref<const RowMatrixXf>& U);
 
   // One transform per handle (check_transforms first).
   void set_transforms(const Transforms& transforms);
@@ -70,7 +101,7 @@ class HandleTerm {
   std::vector<Handle> handles_;  // coefficient and weights folded in
   Eigen::MatrixXd A_;
   Eigen::VectorXd b_;
-  double c_ = 0;
+  double e_ = 0;
 };
 
 }  // namespace modal_deform

@@ -38,9 +38,10 @@ ReducedSolver::ReducedSolver(const Basis& basis, const Handles& handles, const V
           make_energy(energy, basis.scale * basis.ghost_vertices, basis.ghost_faces, basis.bending, basis.membrane)),
       ghost_rest_(basis.scale * flatten(basis.ghost_vertices)),
       ghost_vectors_(basis.scale * basis.ghost_vectors),
-      handle_term_(basis.rest, basis.mass, basis.vectors, handles,
-                   checked_handle_weights(handles, weights, basis.num_vertices()),
-                   checked_stiffness(stiffness) * std::pow(basis.scale, 4)) {
+      handle_term_(HandleTerm(basis.rest, basis.mass, handles,
+                              checked_handle_weights(handles, weights, basis.num_vertices()),
+                              checked_stiffness(stiffness) * std::pow(basis.scale, 4)),
+                   basis.vectors) {
   const Eigen::Index r = basis.dimension();
   if (warm_start) {
     const SparseMatrix K = energy_->hessian(ghost_rest_);
@@ -74,11 +75,11 @@ void ReducedSolver::set_transforms(const Transforms& transforms) {
   bfgs_.objective_changed(new_value - old_value, handle_gradient_);
 }
 
-ReducedSolveStats ReducedSolver::solve(int max_iterations, double tolerance) {
+ReducedSolveStats ReducedSolver::solve(int max_iterations, double tolerance, double budget_ms) {
   const auto start = std::chrono::steady_clock::now();
   const BfgsResult result =
       bfgs_.minimize([this](const Eigen::VectorXd& q, Eigen::VectorXd& gradient) { return objective(q, gradient); },
-                     max_iterations, tolerance);
+                     max_iterations, tolerance, budget_ms);
   q_float_ = q().cast<float>();
   ReducedSolveStats stats;
   stats.iterations = result.iterations;

@@ -20,6 +20,7 @@
 // Not thread-safe: one solver per thread.
 #pragma once
 
+#include <limits>
 #include <memory>
 
 #include "energy/energy.h"
@@ -55,8 +56,10 @@ class ReducedSolver {
   // O(r) per handle; the next solve continues from the current q and inverse Hessian.
   void set_transforms(const Transforms& transforms);
 
-  // Up to max_iterations ≥ 0 BFGS iterations with stopping tolerance ε in (0, 1) (bfgs.h).
-  ReducedSolveStats solve(int max_iterations, double tolerance);
+  // Up to max_iterations ≥ 0 BFGS iterations with stopping tolerance ε in (0, 1), none begun after
+  // budget_ms milliseconds (Bfgs::minimize): a pose tick calls it once per frame.
+  ReducedSolveStats solve(int max_iterations, double tolerance,
+                          double budget_ms = std::numeric_limits<double>::infinity());
 
   // Back to rest (q = 0) and the initial inverse Hessian; the transforms stay.
   void reset();
@@ -79,7 +82,7 @@ class ReducedSolver {
   std::unique_ptr<Energy> energy_;  // of the ghost, normalised frame
   Eigen::VectorXd ghost_rest_;      // s x̄_s (3g)
   Eigen::MatrixXd ghost_vectors_;   // s U_s (3g by r)
-  HandleTerm handle_term_;
+  ReducedHandleTerm handle_term_;
   Eigen::MatrixXd initial_inverse_hessian_;
   Bfgs bfgs_;
   Eigen::VectorXf q_float_;  // q for positions()

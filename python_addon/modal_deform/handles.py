@@ -11,6 +11,7 @@ import collections
 import numpy as np
 from mathutils import Matrix
 
+from . import core as mdc
 from . import mesh_io
 
 Handle = collections.namedtuple("Handle", "name indices weight controller bind_inverse centre")
@@ -89,24 +90,6 @@ def resolve(obj, scene, rest):
     return handles, warnings
 
 
-def rigid(matrix, centre):
-    """The rigid 4x4 transform closest to `matrix` (4x4) that takes `centre` where `matrix` does.
-
-    Rotation: the orthogonal polar factor of the 3x3 part (U Vᵀ of its SVD, a reflection turned
-    into a rotation); translation: chosen so the handle's centre lands on matrix @ centre.
-    """
-    M = np.asarray(matrix, dtype=np.float64)
-    A = M[:3, :3]
-    U, _, Vt = np.linalg.svd(A)
-    if np.linalg.det(U @ Vt) < 0:
-        U[:, 2] = -U[:, 2]
-    R = U @ Vt
-    T = np.eye(4)
-    T[:3, :3] = R
-    T[:3, 3] = A @ centre + M[:3, 3] - R @ centre
-    return T
-
-
 def transforms(obj, handles):
     """One rigid 4x4 float64 transform per handle of its rest positions (object space), from where
     its controller is now."""
@@ -117,7 +100,7 @@ def transforms(obj, handles):
             result.append(np.eye(4))
         else:
             relative = world_inverse @ handle.controller.matrix_world @ handle.bind_inverse
-            result.append(rigid(relative, handle.centre))
+            result.append(mdc.nearest_rigid(relative, handle.centre))
     return result
 
 

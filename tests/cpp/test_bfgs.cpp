@@ -5,6 +5,7 @@
 
 #include "solve/bfgs.h"
 #include "solve/line_search.h"
+#include "util/errors.h"
 
 namespace modal_deform {
 namespace {
@@ -177,6 +178,24 @@ TEST(Bfgs, StatePersistsAcrossCalls) {
   EXPECT_EQ(first.evaluations + second.evaluations, ten.evaluations);
   EXPECT_EQ(once.x(), twice.x());
   EXPECT_EQ(once.inverse_hessian(), twice.inverse_hessian());
+}
+
+// A spent budget stops the call after the step under way; the state is the same as after that
+// many steps without a budget, so the next call continues seamlessly.
+TEST(Bfgs, ATimeBudgetEndsTheCallAfterItsFirstStep) {
+  Bfgs budgeted, unlimited;
+  budgeted.start(rosenbrock_start(6), Eigen::MatrixXd::Identity(6, 6));
+  unlimited.start(rosenbrock_start(6), Eigen::MatrixXd::Identity(6, 6));
+  for (int call = 0; call < 3; ++call) {
+    const BfgsResult result = budgeted.minimize(rosenbrock, 100, 1e-12, 1e-9);
+    EXPECT_EQ(result.iterations, 1);
+  }
+  unlimited.minimize(rosenbrock, 3, 1e-12);
+  EXPECT_EQ(budgeted.x(), unlimited.x());
+  // A generous budget leaves the iteration count to max_iterations.
+  EXPECT_EQ(budgeted.minimize(rosenbrock, 5, 1e-12, 6e4).iterations, 5);
+  for (double budget : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN()})
+    EXPECT_THROW(budgeted.minimize(rosenbrock, 1, 1e-12, budget), InputError) << budget;
 }
 
 TEST(Bfgs, TheExactInverseHessianSolvesAQuadraticInOneStep) {

@@ -29,6 +29,12 @@ double direct_handle_term(const RowMatrixX3d& rest, const Eigen::VectorXd& mass,
   return sum;
 }
 
+// The reduced term of `setup`-like arguments: the fine term restricted to x̄ + U q.
+ReducedHandleTerm reduced(const RowMatrixX3d& rest, const Eigen::VectorXd& mass, const RowMatrixXf& U,
+                          const Handles& handles, const Eigen::VectorXd& weights, double coefficient) {
+  return ReducedHandleTerm(HandleTerm(rest, mass, handles, weights, coefficient), U);
+}
+
 struct Handled {
   RowMatrixX3d rest;
   Eigen::VectorXd mass;
@@ -49,9 +55,9 @@ struct Handled {
   }
 };
 
-TEST(HandleTerm, EqualsTheSumOverHandleVertices) {
+TEST(ReducedHandleTerm, EqualsTheSumOverHandleVertices) {
   const Handled setup;
-  HandleTerm term(setup.rest, setup.mass, setup.U, setup.handles, setup.weights, setup.coefficient);
+  ReducedHandleTerm term = reduced(setup.rest, setup.mass, setup.U, setup.handles, setup.weights, setup.coefficient);
   term.set_transforms(setup.transforms);
   for (int trial = 0; trial < 3; ++trial) {
     const Eigen::VectorXd q = 10 * Eigen::VectorXd::Random(5);
@@ -79,7 +85,41 @@ TEST(HandleTerm, EqualsTheSumOverHandleVertices) {
   }
 }
 
-TEST(HandleTerm, LargeHandlesAreSummedInBlocks) {
+// The fine term is the same sum at any positions x; its gradient is exact (the term is quadratic)
+// and its Hessian diagonal is 2 c w m per coordinate; it adds to the gradient it is given.
+TEST(HandleTerm, OnTheFineMeshEqualsTheSumAndItsDerivatives) {
+  const Handled setup;
+  HandleTerm term(setup.rest, setup.mass, setup.handles, setup.weights, setup.coefficient);
+  term.set_transforms(setup.transforms);
+  const Eigen::VectorXd q = 10 * Eigen::VectorXd::Random(5);
+  const Eigen::VectorXd x = flatten(setup.rest) + setup.U.cast<double>() * q;
+  const double expected = direct_handle_term(setup.rest, setup.mass, setup.U, setup.handles, setup.weights,
+                                             setup.transforms, setup.coefficient, q);
+  const Eigen::VectorXd offset = Eigen::VectorXd::Random(36);
+  Eigen::VectorXd gradient = offset;
+  EXPECT_NEAR(term.add_value_and_gradient(x, gradient), expected, 1e-10 * expected);
+  gradient -= offset;
+  for (int j = 0; j < 36; ++j) {
+    const double h = 1e-2;
+    Eigen::VectorXd plus = x, minus = x, unused(36);
+    plus[j] += h;
+    minus[j] -= h;
+    const double fd = (term.add_value_and_gradient(plus, unused) - term.add_value_and_gradient(minus, unused)) / (2 * h);
+    EXPECT_NEAR(gradient[j], fd, 1e-6 * gradient.norm()) << "x[" << j << "]";
+  }
+  // Vertex 7 is in handles 0 and 1 (weights 1 and 0.5); vertex 1 in none.
+  const Eigen::VectorXd diagonal = term.hessian_diagonal(12);
+  EXPECT_NEAR(diagonal[21], 2 * setup.coefficient * 1.5 * setup.mass[7], 1e-12);
+  EXPECT_EQ(diagonal[3], 0.0);
+  // Restricted to x̄ + U q it is the reduced term.
+  ReducedHandleTerm restricted(term, setup.U);
+  restricted.set_transforms(setup.transforms);
+  Eigen::VectorXd reduced_gradient(5);
+  EXPECT_NEAR(restricted.value_and_gradient(q, reduced_gradient), expected, 1e-10 * expected);
+  EXPECT_LE((reduced_gradient - setup.U.cast<double>().transpose() * gradient).norm(), 1e-8 * gradient.norm());
+}
+
+TEST(ReducedHandleTerm, LargeHandlesAreSummedInBlocks) {
   std::srand(5);
   const int n = 2500;  // more vertices than one block of the Σ m UᵀU accumulation
   const RowMatrixX3d rest = RowMatrixX3d::Random(n, 3);
@@ -89,7 +129,7 @@ TEST(HandleTerm, LargeHandlesAreSummedInBlocks) {
   for (int v = 0; v < n; ++v) handles[0].push_back(v);
   const Eigen::VectorXd weights = Eigen::VectorXd::Ones(1);
   const Transforms transforms = {rigid_transform({0, 1, 1}, 1.2, {0, 0, 0}, {1, 0, 0})};
-  HandleTerm term(rest, mass, U, handles, weights, 2.0);
+  ReducedHandleTerm term = reduced(rest, mass, U, handles, weights, 2.0);
   term.set_transforms(transforms);
   const Eigen::VectorXd q = Eigen::Vector4d(0.3, -1, 2, 0.5);
   Eigen::VectorXd gradient(4);
@@ -97,9 +137,9 @@ TEST(HandleTerm, LargeHandlesAreSummedInBlocks) {
   EXPECT_NEAR(term.value_and_gradient(q, gradient), expected, 1e-10 * expected);
 }
 
-TEST(HandleTerm, ZeroAtRestWithIdentityTransformsAndPositiveAfterAMove) {
+TEST(ReducedHandleTerm, ZeroAtRestWithIdentityTransformsAndPositiveAfterAMove) {
   const Handled setup;
-  HandleTerm term(setup.rest, setup.mass, setup.U, setup.handles, setup.weights, setup.coefficient);
+  ReducedHandleTerm term = reduced(setup.rest, setup.mass, setup.U, setup.handles, setup.weights, setup.coefficient);
   Eigen::VectorXd gradient(5);
   EXPECT_EQ(term.value_and_gradient(Eigen::VectorXd::Zero(5), gradient), 0.0);
   EXPECT_EQ(gradient.norm(), 0.0);
@@ -109,7 +149,8 @@ TEST(HandleTerm, ZeroAtRestWithIdentityTransformsAndPositiveAfterAMove) {
   Transforms same(3, rigid_transform({0, 0, 1}, 0, {0, 0, 0}, {1, 2, 3}));
   RowMatrixXf translation = RowMatrixXf::Zero(36, 3);
   for (int v = 0; v < 12; ++v) translation.block<3, 3>(3 * v, 0).setIdentity();
-  HandleTerm translated(setup.rest, setup.mass, translation, setup.handles, setup.weights, setup.coefficient);
+  ReducedHandleTerm translated =
+      reduced(setup.rest, setup.mass, translation, setup.handles, setup.weights, setup.coefficient);
   translated.set_transforms(same);
   Eigen::VectorXd g3(3);
   EXPECT_NEAR(translated.value_and_gradient(Eigen::Vector3d(1, 2, 3), g3), 0.0, 1e-9);

@@ -117,6 +117,20 @@ def test_reduced_solver_poses_close_to_the_full_solve(tube, tube_basis):
     assert np.sqrt(np.mean(np.sum((X - reference) ** 2, axis=1))) < 0.02 * diagonal
 
 
+def test_a_time_budget_ends_a_solve_after_one_iteration(tube, tube_basis):
+    _, _, handles, transforms = tube
+    solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0)
+    solver.set_transforms(transforms)
+    for _ in range(3):
+        assert solver.solve(max_iterations=1000, budget_ms=1e-9)["iterations"] == 1
+    assert solver.solve(max_iterations=4, budget_ms=6e4)["iterations"] == 4
+    for budget in [0, -1.0, float("nan")]:
+        with pytest.raises(ValueError, match="budget_ms"):
+            solver.solve(budget_ms=budget)
+    with pytest.raises(ValueError, match="budget_ms"):
+        solver.solve(budget_ms="5")
+
+
 def test_positions_fill_the_callers_buffer(tube, tube_basis):
     _, _, handles, transforms = tube
     solver = mdc.ReducedSolver(tube_basis, handles)
@@ -212,3 +226,36 @@ def test_reduced_solver_refuses_bad_input(tube, tube_basis):
         solver.solve(max_iterations=-1)
     with pytest.raises(ValueError, match="tolerance"):
         solver.solve(tolerance=2.0)
+
+
+def _rotation(axis, angle):
+    """Rodrigues' rotation matrix (3x3) about a unit axis."""
+    axis = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+
+
+@pytest.mark.parametrize("distortion", [np.diag([2.0, 0.5, 1.5]), np.diag([-1.0, 1.0, 1.0]),
+                                        np.array([[1.0, 0.3, 0.0], [0.0, 1.0, 0.0], [0.0, 0.2, 1.0]])])
+def test_nearest_rigid_keeps_the_rotation_and_the_centre(distortion):
+    # Controllers may be scaled, sheared or mirrored: the handle gets the nearest rotation, and
+    # its centre goes where the controller's full matrix takes it.
+    centre = np.array([0.3, -0.2, 0.5])
+    rotation = _rotation([1.0, 2.0, 0.5], 0.4)
+    M = np.eye(4)
+    M[:3, :3] = rotation @ distortion
+    M[:3, 3] = [1.0, 2.0, 3.0]
+    T = mdc.nearest_rigid(M, centre)
+    R = T[:3, :3]
+    assert np.allclose(R.T @ R, np.eye(3), atol=1e-12) and abs(np.linalg.det(R) - 1) < 1e-12
+    assert np.allclose(R @ centre + T[:3, 3], M[:3, :3] @ centre + M[:3, 3], atol=1e-12)
+    assert np.array_equal(T[3], [0, 0, 0, 1])
+    if np.allclose(distortion, np.diag(np.diag(distortion))) and (np.diag(distortion) > 0).all():
+        assert np.allclose(R, rotation, atol=1e-12)  # a scale along the axes: the controller's own rotation
+
+
+def test_nearest_rigid_names_a_bad_argument():
+    with pytest.raises(ValueError, match="matrix: expected a 4x4"):
+        mdc.nearest_rigid(np.eye(3), np.zeros(3))
+    with pytest.raises(ValueError, match="centre"):
+        mdc.nearest_rigid(np.eye(4), np.zeros(2))

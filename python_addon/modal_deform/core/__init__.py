@@ -12,11 +12,11 @@ from .energy import Arap, DiscreteShells
 from .mesh import bar, bumpy_plane, check, cylinder, grid, mass, read_mesh
 from .modes import rigid_motions, solve_in_range, vibration_modes
 from .reduction import ghost_mesh, restrict_to_ghost
-from .solve import ReducedSolver, solve_full
+from .solve import ReducedSolver, nearest_rigid, solve_full
 
 __all__ = [
     "Arap", "Basis", "Cancelled", "DiscreteShells", "bake", "bar", "bumpy_plane", "check", "cylinder",
     "ghost_mesh", "grid", "mass", "read_mesh", "restrict_to_ghost", "rigid_motions", "solve_in_range",
     "vibration_modes",
 ]
-__all__ += ["ReducedSolver", "solve_full"]
+__all__ += ["ReducedSolver", "nearest_rigid", "solve_full"]

@@ -63,6 +63,28 @@ def _weights(weights, count):
     return _arrays.values(weights, "weights", count)
 
 
+def nearest_rigid(matrix, centre):
+    """The rigid 4x4 transform closest to ``matrix`` (4x4, e.g. a scaled or sheared controller's)
+    that takes ``centre`` (3,) where ``matrix`` does: what the solvers take for a handle.
+
+    Rotation: the orthogonal polar factor of the 3x3 part (U Vᵀ of its SVD, a reflection turned
+    into a rotation); translation: chosen so the handle's centre lands on matrix @ centre.
+    """
+    M = _arrays.reals(matrix, "matrix")
+    if M.shape != (4, 4):
+        raise ValueError(f"matrix: expected a 4x4 matrix, got shape {M.shape}")
+    centre = _arrays.values(centre, "centre", 3)
+    A = M[:3, :3]
+    U, _, Vt = np.linalg.svd(A)
+    if np.linalg.det(U @ Vt) < 0:
+        U[:, 2] = -U[:, 2]
+    R = U @ Vt
+    T = np.eye(4)
+    T[:3, :3] = R
+    T[:3, 3] = A @ centre + M[:3, 3] - R @ centre
+    return T
+
+
 class ReducedSolver:
     """BFGS in a baked basis: x = x̄ + U q, energy on the ghost, handles exact on the fine mesh.
 
@@ -106,15 +128,18 @@ class ReducedSolver:
         """
         self._native.set_transforms(_transforms(transforms, self._native.num_handles))
 
-    def solve(self, max_iterations=10, tolerance=1e-6):
+    def solve(self, max_iterations=10, tolerance=1e-6, budget_ms=None):
         """Up to ``max_iterations`` BFGS iterations from the current state.
 
-        Stops early when the Gill–Murray–Wright test holds (paper eq. 14, tolerance ε). Returns
+        Stops early when the Gill–Murray–Wright test holds (paper eq. 14, tolerance ε), and begins
+        no iteration once ``budget_ms`` milliseconds (> 0; None: no limit) have passed: a frame's
+        share of time (the iteration under way is finished, so a call always progresses). Returns
         {"iterations", "energy" (the objective), "converged", "ms", "evaluations",
         "gradient_norm"}. q and the inverse Hessian carry over to the next call.
         """
         return self._native.solve(_arrays.integer(max_iterations, "max_iterations"),
-                                  _arrays.number(tolerance, "tolerance"))
+                                  _arrays.number(tolerance, "tolerance"),
+                                  float("inf") if budget_ms is None else _arrays.number(budget_ms, "budget_ms"))
 
     def objective(self, q):
         """The objective f(q) (ghost energy plus handle term, normalised frame) and its gradient
