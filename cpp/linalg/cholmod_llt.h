@@ -35,7 +35,8 @@ class CholmodLLT {
   static constexpr double kSingularRcond = 1e-13;
 
   // Numeric factorisation of A + diag(shift) (shift: one value per row). Analyses A first when
-  // its pattern differs from the one analysed last. Throws InputError for a malformed A and
+  // its pattern differs from the one analysed last. Throws InputError for a malformed A,
+  // OutOfMemory when CHOLMOD runs out of memory (analysis, factorisation or solve), and
   // NumericalError, naming the row where the factorisation broke down, when the matrix is not
   // numerically positive definite, or when rcond() is below min_rcond. A caller that knows the
   // matrix is definite and wants it nearly singular (shift-invert) passes 0: on a scan with
@@ -54,6 +55,8 @@ class CholmodLLT {
   double rcond() const { return rcond_; }
   // Nonzeros of the factor L.
   double factor_nonzeros() const;
+  // Bytes the numeric factor takes, known from the symbolic analysis already (before factorize).
+  double factor_bytes() const;
   // Wall seconds spent in analyze and factorize since construction, solves excluded (the bake
   // reports factorisation apart from the stages that call it).
   double seconds() const { return seconds_; }
