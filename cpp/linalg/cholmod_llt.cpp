@@ -214,6 +214,7 @@ void CholmodLLT::factorize(const SparseMatrix& A, const VectorRef& shift, double
 void CholmodLLT::factorize_lower(SparseMatrix lower, double min_rcond) {
   const Stopwatch stopwatch(seconds_);
   factorized_ = false;
+  failed_row_ = -1;
   const bool new_pattern = !cholmod_->factor || !same_pattern(lower, lower_);
   lower_ = std::move(lower);
   if (new_pattern) analyze_lower();
@@ -223,6 +224,7 @@ void CholmodLLT::factorize_lower(SparseMatrix lower, double min_rcond) {
   if (cholmod_->common.status == CHOLMOD_NOT_POSDEF) {
     const int pivot = static_cast<int>(L->minor);
     const int row = static_cast<const int*>(L->Perm)[pivot];
+    failed_row_ = row;
     throw NumericalError(message("the matrix is not positive definite: the Cholesky factorisation breaks down at row ",
                                  row, " (pivot ", pivot + 1, " of ", rows(), " in CHOLMOD's ordering)"));
   }

@@ -53,6 +53,9 @@ class CholmodLLT {
   int rows() const;
   // CHOLMOD's cheap estimate of the reciprocal condition number, (min Lᵢᵢ / max Lᵢᵢ)².
   double rcond() const { return rcond_; }
+  // The row (in A's order) where the last factorisation found A not positive definite; -1 when
+  // it did not fail that way.
+  int failed_row() const { return failed_row_; }
   // Nonzeros of the factor L.
   double factor_nonzeros() const;
   // Bytes the numeric factor takes, known from the symbolic analysis already (before factorize).
@@ -70,6 +73,7 @@ class CholmodLLT {
   int dofs_per_node_;
   SparseMatrix lower_;  // lower triangle of A + diag(shift), the matrix CHOLMOD factors
   bool factorized_ = false;
+  int failed_row_ = -1;
   double rcond_ = 0;
   double seconds_ = 0;
 };

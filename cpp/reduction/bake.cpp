@@ -230,7 +230,15 @@ Basis bake_stages(const VerticesRef& V, const FacesRef& F, const BakeOptions& op
     const double factoring = factor.seconds();
     {
       const Stopwatch stopwatch(time["modes"]);
-      modes = flexible_modes(K, simulated_mass, rigid, flexible, progress, factor);
+      try {
+        modes = flexible_modes(K, simulated_mass, rigid, flexible, progress, factor);
+      } catch (const NumericalError& e) {
+        if (factor.failed_row() < 0) throw;
+        // Where: the fine vertex of the row the factorisation broke down at.
+        const int vertex = attachment.simulated[static_cast<size_t>(factor.failed_row() / 3)];
+        throw NumericalError(message(e.what(), "; that row is ", "xyz"[factor.failed_row() % 3], " of vertex ", vertex,
+                                     " at (", V(vertex, 0), ", ", V(vertex, 1), ", ", V(vertex, 2), ")"));
+      }
     }
     time["modes"] -= factor.seconds() - factoring;
   }
