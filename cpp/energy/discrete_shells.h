@@ -40,11 +40,12 @@
 //   is no stiffer at rest than kMaxStiffnessRatio times the same term on equilateral triangles
 //   (a hinge of the same edge length): its weight w is lowered to
 //   min(w, kMaxStiffnessRatio · k_equilateral / ‖∇s‖²). A hinge's stiffness w ‖∇θ‖² grows as the
-//   cube of its triangles' thinness (a sliver of shape ratio 1e-3 on a thin neighbour: 1e9 times
-//   an equilateral hinge's); those outliers, a discretisation artefact, not the surface's
-//   physics, leave K − σM's small pivots to rounding in the Cholesky factorisation (a raw scan's
-//   K − σM was not positive definite). Measured ratio to the equilateral stiffness: the bunny's
-//   largest hinge 46, dragon_vrip_res2's median 2.5, 99th percentile 210, largest 2.9e8.
+//   cube of its triangles' thinness (between two slivers of shape ratio 1e-3: about 3e8 times an
+//   equilateral hinge's). Those outliers, a discretisation artefact rather than the surface's
+//   physics, dominate tr K, which sets the eigensolver's shift (a grid with such sliver pairs
+//   failed its bake: the shift fell far below the modes), and they leave small pivots of K − σM
+//   to rounding. Measured ratio to the equilateral stiffness: the bunny's largest hinge 46,
+//   dragon_vrip_res2's median 2.5, 99th percentile 210, largest 2.9e8.
 // - a deformed element that collapses (edge length, triangle area or, for a hinge, either
 //   triangle's area below 1e-12 times its rest value) is not differentiable there: an edge or a
 //   triangle keeps its value but contributes no derivatives; a hinge has no angle at all and
