@@ -355,9 +355,28 @@ def section_native(result):
     return "\n".join(out)
 
 
+def section_raw_scan(result):
+    p = result["parameters"]
+    out = ["## Raw scans (issue 15)", "",
+           f"{p['mesh']} midpoint-subdivided {p['subdivisions']} time(s) and damaged by bench/raw_scans.py (every "
+           f"kind of scan damage), baked with {p['modes']} modes + {p['derivatives']} derivatives and a "
+           f"{p['ghost']}-vertex ghost, each seed in a fresh process. Targets: at most {p['targets']['seconds']:.0f} s "
+           f"within {p['targets']['peak_gb']:.0f} GB.", ""]
+    rows = []
+    for b in result["figures"]["bakes"]:
+        if b["ok"]:
+            rows.append([b["seed"], b["vertices"], b["components"], f"{b['seconds']:.1f}", f"{b['peak_gb']:.2f}",
+                         b["floppy"], "baked"])
+        else:
+            rows.append([b["seed"], b.get("vertices", ""), b.get("components", ""), "", "", "", b["error"]])
+    out.append(table(["seed", "vertices", "components", "bake s", "peak GB", "zero modes", "outcome"], rows))
+    out += ["", provenance(result)]
+    return "\n".join(out)
+
+
 SECTIONS = (("table1", section_table1), ("accuracy", section_accuracy), ("renders", section_renders),
             ("convergence", section_convergence), ("taylor", section_taylor), ("blender", section_blender),
-            ("native", section_native))
+            ("native", section_native), ("raw_scan", section_raw_scan))
 
 
 def write():

@@ -27,6 +27,11 @@ using shells::TriangleTerm;
 // Below this fraction of its rest size an element counts as collapsed (see the header).
 constexpr double kCollapse = kDegenerateAreaRatio;
 
+// Rest stiffness w ‖∇s‖² of a bending or area term on equilateral triangles (per unit α or β):
+// a hinge of edge ē, w = 2√3, ‖∇θ‖² = 16 / (3 ē²); a triangle, w ‖∇A‖² = Σ ē² / (4 Ā) = √3.
+double equilateral_hinge_stiffness(double edge_squared) { return 32 / (std::sqrt(3.0) * edge_squared); }
+constexpr double kEquilateralTriangleStiffness = 1.7320508075688772;
+
 template <typename Term>
 constexpr int kVerticesOf = Term::Quantity::kVertices;
 // A term's coordinates relative to its first vertex (shell_elements.h).
@@ -99,6 +104,22 @@ void to_vertices(const double* rel, double* full) {
       full[3 * m + i] = rel[3 * (m - 1) + i];
       full[i] -= rel[3 * (m - 1) + i];
     }
+}
+
+// ‖∇s‖² over all of a term's vertices (s of shell_elements.h at `frame`).
+template <typename Term>
+double squared_gradient_norm(const typename Term::Quantity::template Frame<double>& frame) {
+  constexpr int K = kVerticesOf<Term>;
+  double g[kDofsOf<Term>], full[3 * K];
+  Term::Quantity::gradient(frame, g);
+  to_vertices<K>(g, full);
+  return dot<3 * K>(full, full);
+}
+
+// The weight w of a term, lowered where needed so that its rest stiffness w ‖∇s‖² stays within
+// kMaxStiffnessRatio of `reference`, the stiffness of the same term on well-shaped triangles.
+double bounded_weight(double weight, double squared_gradient, double reference) {
+  return std::min(weight, kMaxStiffnessRatio * reference / squared_gradient);
 }
 
 // out[3v + i] += full[3m + i] for the term's vertices v = vertices[m] in `owned`.
@@ -267,7 +288,8 @@ DiscreteShells::DiscreteShells(const VerticesRef& V, const FacesRef& F, double b
     const auto frame = TriangleArea::frame(r);
     area[f] = TriangleArea::measure(frame);
     term.rest_area = area[f];
-    term.weight = membrane / area[f];
+    term.weight = bounded_weight(membrane / area[f], squared_gradient_norm<TriangleTerm>(frame),
+                                 membrane * kEquilateralTriangleStiffness);
     term.collapsed_norm = kCollapse * frame.norm;
     triangles_.terms.push_back(term);
   }
@@ -280,7 +302,8 @@ DiscreteShells::DiscreteShells(const VerticesRef& V, const FacesRef& F, double b
     const auto [cos_rest, sin_rest] = DihedralAngle::measure(frame);
     term.cos_rest = cos_rest;
     term.sin_rest = sin_rest;
-    term.weight = 3 * bending * frame.aa / (area[hinge.faces[0]] + area[hinge.faces[1]]);
+    term.weight = bounded_weight(3 * bending * frame.aa / (area[hinge.faces[0]] + area[hinge.faces[1]]),
+                                 squared_gradient_norm<HingeTerm>(frame), bending * equilateral_hinge_stiffness(frame.aa));
     term.collapsed_n1n1 = std::pow(kCollapse, 2) * frame.n1n1;
     term.collapsed_n2n2 = std::pow(kCollapse, 2) * frame.n2n2;
     hinges_.terms.push_back(term);

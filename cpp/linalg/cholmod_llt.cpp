@@ -132,10 +132,12 @@ struct CholmodLLT::Cholmod {
 
   void free_factor() { cholmod_free_factor(&factor, &common); }
 
-  // Throws NumericalError when the last call failed (negative status: out of memory, invalid).
+  // Throws when the last call failed (negative status): OutOfMemory for a lack of memory (or a
+  // problem too large for CHOLMOD's integers), NumericalError otherwise.
   void check(bool ok, const char* what) {
     if (ok && common.status >= CHOLMOD_OK) return;
-    if (common.status == CHOLMOD_OUT_OF_MEMORY) throw NumericalError(message("CHOLMOD ", what, ": out of memory"));
+    if (common.status == CHOLMOD_OUT_OF_MEMORY || common.status == CHOLMOD_TOO_LARGE)
+      throw OutOfMemory(message("CHOLMOD ", what, ": out of memory (", cholmod_message, ")"));
     throw NumericalError(message("CHOLMOD ", what, " failed: ", cholmod_message));
   }
 
@@ -172,6 +174,14 @@ double CholmodLLT::factor_nonzeros() const {
   return L->is_super ? static_cast<double>(L->xsize) : static_cast<double>(L->nzmax);
 }
 
+double CholmodLLT::factor_bytes() const {
+  const cholmod_factor* L = cholmod_->factor;
+  if (!L) return 0;
+  // Values, row indices, and the column (or supernode) arrays.
+  if (L->is_super) return 8.0 * L->xsize + 4.0 * L->ssize + 4.0 * 4 * L->nsuper;
+  return 12.0 * static_cast<double>(L->nzmax) + 4.0 * 4 * L->n;
+}
+
 void CholmodLLT::analyze(const SparseMatrix& A) {
   const Stopwatch stopwatch(seconds_);
   lower_ = lower_with_diagonal(A, nullptr);
@@ -204,6 +214,7 @@ void CholmodLLT::factorize(const SparseMatrix& A, const VectorRef& shift, double
 void CholmodLLT::factorize_lower(SparseMatrix lower, double min_rcond) {
   const Stopwatch stopwatch(seconds_);
   factorized_ = false;
+  failed_row_ = -1;
   const bool new_pattern = !cholmod_->factor || !same_pattern(lower, lower_);
   lower_ = std::move(lower);
   if (new_pattern) analyze_lower();
@@ -213,6 +224,7 @@ void CholmodLLT::factorize_lower(SparseMatrix lower, double min_rcond) {
   if (cholmod_->common.status == CHOLMOD_NOT_POSDEF) {
     const int pivot = static_cast<int>(L->minor);
     const int row = static_cast<const int*>(L->Perm)[pivot];
+    failed_row_ = row;
     throw NumericalError(message("the matrix is not positive definite: the Cholesky factorisation breaks down at row ",
                                  row, " (pivot ", pivot + 1, " of ", rows(), " in CHOLMOD's ordering)"));
   }

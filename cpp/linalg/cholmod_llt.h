@@ -35,7 +35,8 @@ class CholmodLLT {
   static constexpr double kSingularRcond = 1e-13;
 
   // Numeric factorisation of A + diag(shift) (shift: one value per row). Analyses A first when
-  // its pattern differs from the one analysed last. Throws InputError for a malformed A and
+  // its pattern differs from the one analysed last. Throws InputError for a malformed A,
+  // OutOfMemory when CHOLMOD runs out of memory (analysis, factorisation or solve), and
   // NumericalError, naming the row where the factorisation broke down, when the matrix is not
   // numerically positive definite, or when rcond() is below min_rcond. A caller that knows the
   // matrix is definite and wants it nearly singular (shift-invert) passes 0: on a scan with
@@ -52,8 +53,13 @@ class CholmodLLT {
   int rows() const;
   // CHOLMOD's cheap estimate of the reciprocal condition number, (min Lᵢᵢ / max Lᵢᵢ)².
   double rcond() const { return rcond_; }
+  // The row (in A's order) where the last factorisation found A not positive definite; -1 when
+  // it did not fail that way.
+  int failed_row() const { return failed_row_; }
   // Nonzeros of the factor L.
   double factor_nonzeros() const;
+  // Bytes the numeric factor takes, known from the symbolic analysis already (before factorize).
+  double factor_bytes() const;
   // Wall seconds spent in analyze and factorize since construction, solves excluded (the bake
   // reports factorisation apart from the stages that call it).
   double seconds() const { return seconds_; }
@@ -67,6 +73,7 @@ class CholmodLLT {
   int dofs_per_node_;
   SparseMatrix lower_;  // lower triangle of A + diag(shift), the matrix CHOLMOD factors
   bool factorized_ = false;
+  int failed_row_ = -1;
   double rcond_ = 0;
   double seconds_ = 0;
 };

@@ -5,6 +5,7 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <random>
+#include <string>
 
 #include "linalg/cholmod_llt.h"
 #include "modes/stiffness_and_mass.h"
@@ -58,6 +59,11 @@ class ShiftInvert {
   void set_shift(double sigma) {
     try {
       llt_.factorize(K_, decoupled_stiffness_ - sigma * dof_mass_, 0.0);
+    } catch (const OutOfMemory& e) {
+      const double bytes = llt_.factor_bytes();  // 0 when the analysis itself ran out
+      throw OutOfMemory(message("vibration modes: not enough memory to factor K - sigma M (", K_.rows(), " rows",
+                                bytes > 0 ? message(", a factor of ", bytes / 1e9, " GB") : std::string(),
+                                "): ", e.what()));
     } catch (const NumericalError& e) {
       throw NumericalError(message("vibration modes: K - sigma M with sigma = ", sigma,
                                    " cannot be factored; is K positive semidefinite? ", e.what()));
@@ -147,6 +153,8 @@ VibrationModes deflated_modes(const SparseMatrix& K, const VectorRef& mass, int 
   } catch (const NumericalError&) {
     throw;
   } catch (const Cancelled&) {
+    throw;
+  } catch (const OutOfMemory&) {
     throw;
   } catch (const std::runtime_error& e) {
     // Spectra's own failures (e.g. "TridiagEigen: eigen decomposition failed"): seen when most of

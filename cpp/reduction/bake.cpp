@@ -6,6 +6,7 @@
 #include <cmath>
 #include <future>
 #include <memory>
+#include <new>
 
 #include "energy/arap.h"
 #include "energy/discrete_shells.h"
@@ -18,6 +19,7 @@
 #include "modes/stiffness_and_mass.h"
 #include "modes/vibration_modes.h"
 #include "reduction/attachment.h"
+#include "reduction/bake_memory.h"
 #include "reduction/ghost.h"
 #include "reduction/orthonormalize.h"
 #include "util/errors.h"
@@ -146,9 +148,7 @@ void check_options(const BakeOptions& o) {
   require_weight(o.membrane, "membrane");
 }
 
-}  // namespace
-
-Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Progress& progress) {
+Basis bake_stages(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Progress& progress) {
   check_options(options);
   validate_mesh(V, F);
   Basis basis;
@@ -210,7 +210,17 @@ Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, 
     // reports nothing during either).
     GhostInBackground ghost(V, F, basis.mass, options.ghost);
     progress.report("factorisation", 0.0);
-    factor.analyze(K);
+    try {
+      factor.analyze(K);
+    } catch (const OutOfMemory& e) {
+      throw OutOfMemory(message("bake: not enough memory to order the stiffness matrix (", K.rows(), " rows, ",
+                                K.nonZeros(), " entries): ", e.what()));
+    }
+    // The factor's size is known now, before the numeric factorisation: refuse at once what
+    // cannot fit rather than fail half a minute later.
+    require_memory(estimate_bake_memory(V.rows(), S, static_cast<double>(K.nonZeros()), factor.factor_bytes(),
+                                        options.modes, options.derivatives),
+                   available_memory());
     progress.report("factorisation", 1.0);
     const Stopwatch stopwatch(time["ghost"]);
     coarse = ghost.get(progress);
@@ -220,7 +230,15 @@ Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, 
     const double factoring = factor.seconds();
     {
       const Stopwatch stopwatch(time["modes"]);
-      modes = flexible_modes(K, simulated_mass, rigid, flexible, progress, factor);
+      try {
+        modes = flexible_modes(K, simulated_mass, rigid, flexible, progress, factor);
+      } catch (const NumericalError& e) {
+        if (factor.failed_row() < 0) throw;
+        // Where: the fine vertex of the row the factorisation broke down at.
+        const int vertex = attachment.simulated[static_cast<size_t>(factor.failed_row() / 3)];
+        throw NumericalError(message(e.what(), "; that row is ", "xyz"[factor.failed_row() % 3], " of vertex ", vertex,
+                                     " at (", V(vertex, 0), ", ", V(vertex, 1), ", ", V(vertex, 2), ")"));
+      }
     }
     time["modes"] -= factor.seconds() - factoring;
   }
@@ -300,6 +318,18 @@ Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, 
   }
   validate_basis(basis);
   return basis;
+}
+
+}  // namespace
+
+Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Progress& progress) {
+  try {
+    return bake_stages(V, F, options, progress);
+  } catch (const std::bad_alloc&) {
+    throw OutOfMemory(message("bake: out of memory: an allocation failed (", available_memory() / 1e9,
+                              " GB still available); close other programs, bake fewer modes and derivatives, "
+                              "or decimate the mesh"));
+  }
 }
 
 }  // namespace modal_deform

@@ -65,6 +65,8 @@ struct BakeOptions {
 // columns. Throws InputError for a bad mesh or option (naming it), among them: modes not above the
 // rigid motions of the simulated components (6 each), more derivatives than pairs of the modes
 // that are neither rigid nor zero, "arap" with derivatives; NumericalError when a solver fails;
+// OutOfMemory when the memory the bake needs (bake_memory.h, estimated once CHOLMOD has analysed
+// K and before the numeric factorisation) is more than is available, or an allocation fails;
 // Cancelled when `progress` says stop.
 Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Progress& progress);
 

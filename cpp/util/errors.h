@@ -2,7 +2,7 @@
 //
 // InputError: the caller's data is wrong (becomes ValueError in Python); the message names the
 // argument and the first offending index. NumericalError: a solver failed on valid input
-// (becomes RuntimeError). Cancelled: a progress callback asked to stop (becomes mdc.Cancelled).
+// (becomes RuntimeError). OutOfMemory: not enough memory (becomes MemoryError). Cancelled: a progress callback asked to stop (becomes mdc.Cancelled).
 #pragma once
 
 #include <sstream>
@@ -16,6 +16,13 @@ struct InputError : std::invalid_argument {
 };
 
 struct NumericalError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Not enough memory for a step (CHOLMOD out of memory, an allocation refused, or the bake's
+// estimate above what is available): becomes mdc.OutOfMemoryError, a MemoryError. Kept apart from
+// NumericalError so that a lack of memory never reads as a matrix that is not positive definite.
+struct OutOfMemory : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 

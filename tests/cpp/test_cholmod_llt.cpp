@@ -147,10 +147,14 @@ TEST(CholmodLLT, IndefiniteMatrixThrowsWithoutPrinting) {
   } catch (const NumericalError& e) {
     EXPECT_NE(std::string(e.what()).find("not positive definite"), std::string::npos) << e.what();
   }
+  EXPECT_EQ(llt.failed_row(), 123);  // the bake names the vertex of that row
   EXPECT_EQ(::testing::internal::GetCapturedStdout(), "");
   EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
   // The failed factorisation is not used.
   EXPECT_THROW(llt.solve(Eigen::VectorXd::Ones(A.rows())), std::logic_error);
+  A.coeffRef(123, 123) = 100.0;
+  llt.factorize(A);
+  EXPECT_EQ(llt.failed_row(), -1);
 }
 
 TEST(CholmodLLT, SingularMatricesThrow) {

@@ -6,7 +6,7 @@ The pipeline, one module per stage: ``mesh`` (check, mass, test shapes), ``energ
 shells, ARAP), ``modes`` (vibration modes, rigid motions, modal-derivative solves), ``reduction``
 (the ghost), ``bake`` (the whole preprocess, mesh to Basis).
 """
-from .._native import Cancelled
+from .._native import Cancelled, OutOfMemoryError
 from .bake import Basis, bake
 from .energy import Arap, DiscreteShells
 from .mesh import bar, bumpy_plane, check, cylinder, grid, mass, read_mesh
@@ -15,7 +15,7 @@ from .reduction import ghost_mesh, restrict_to_ghost
 from .solve import ReducedSolver, nearest_rigid, solve_full
 
 __all__ = [
-    "Arap", "Basis", "Cancelled", "DiscreteShells", "bake", "bar", "bumpy_plane", "check", "cylinder",
+    "Arap", "Basis", "Cancelled", "DiscreteShells", "OutOfMemoryError", "bake", "bar", "bumpy_plane", "check", "cylinder",
     "ghost_mesh", "grid", "mass", "read_mesh", "restrict_to_ghost", "rigid_motions", "solve_in_range",
     "vibration_modes",
 ]
