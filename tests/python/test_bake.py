@@ -214,22 +214,33 @@ def floppy_dragon(shared_mesh):
     return shared_mesh("dragon_vrip_res4.ply.gz")
 
 
-def test_progress_is_frequent_and_a_floppy_mesh_warns(floppy_dragon):
+@pytest.fixture(scope="module")
+def floppy_bake(floppy_dragon):
+    """The floppy dragon's bake with its progress calls (time, stage, fraction), its warnings and
+    its duration: the unit for the promptness checks below (shares of a bake, not seconds, so a
+    loaded machine does not fail them)."""
     calls = []
+    start = time.perf_counter()
     with pytest.warns(UserWarning, match="floppy") as record:
         basis = mdc.bake(*floppy_dragon, modes=20, derivatives=15,
                          progress=lambda stage, fraction: calls.append((time.perf_counter(), stage, fraction)))
+    return basis, calls, record, time.perf_counter() - start
+
+
+def test_progress_is_frequent_and_a_floppy_mesh_warns(floppy_bake):
+    basis, calls, record, seconds = floppy_bake
     assert basis.num_floppy == 9 and basis.num_modes == 29 and basis.dimension + basis.num_dropped == 44
     assert "on top of the 20 modes" in str(record[0].message)
     times = np.array([t for t, _, _ in calls])
-    assert np.diff(times).max() < 1.0  # a shared 2-core machine: the bar moves at least every second
+    assert np.diff(times).max() < 0.3 * seconds  # the bar never stands still for long
     stages = [stage for _, stage, _ in calls]
     for stage in ("hessian", "modes", "third derivatives", "derivative solves", "orthonormalisation", "ghost"):
         assert stage in stages
     assert all(0.0 <= fraction <= 1.0 for _, _, fraction in calls)
 
 
-def test_cancel_stops_within_a_second(floppy_dragon):
+def test_cancel_stops_promptly(floppy_dragon, floppy_bake):
+    seconds = floppy_bake[3]
     for stop_at in ("modes", "derivative solves", "ghost"):
         asked = []
 
@@ -241,7 +252,7 @@ def test_cancel_stops_within_a_second(floppy_dragon):
 
         with pytest.raises(mdc.Cancelled):
             mdc.bake(*floppy_dragon, modes=20, derivatives=15, progress=progress)
-        assert len(asked) == 1 and time.perf_counter() - asked[0] < 1.0
+        assert len(asked) == 1 and time.perf_counter() - asked[0] < 0.3 * seconds, stop_at
 
 
 def test_an_exception_in_the_callback_propagates_as_itself(two_tubes):
