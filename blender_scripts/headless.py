@@ -1,5 +1,6 @@
 """What the headless scripts share: their arguments after "--", the object they work on, saving."""
 import argparse
+import importlib
 import pathlib
 import sys
 
@@ -23,11 +24,25 @@ def parse(parser):
     return parser.parse_args(sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else [])
 
 
+def enable_addon():
+    """Enable Modal Deform and return its package: the extension Blender installed (4.2+, module
+    bl_ext.<repository>.modal_deform) if there is one, else the add-on of this source tree."""
+    installed = sorted(m.__name__ for m in addon_utils.modules()
+                       if m.__name__.startswith("bl_ext.") and m.__name__.endswith(".modal_deform"))
+    if installed:
+        name = installed[0]
+    else:
+        name = "modal_deform"
+        sys.path.append(str(ADDON_PARENT))
+    if addon_utils.enable(name, default_set=True) is None:
+        raise RuntimeError(f"enabling the add-on {name} failed (see the messages above)")
+    return importlib.import_module(name)
+
+
 def active_mesh_object(name):
-    """Enable the add-on (from this source tree unless Blender has it installed) and make the mesh
-    object `name` active; exit with the reason if there is none."""
-    sys.path.append(str(ADDON_PARENT))
-    addon_utils.enable("modal_deform", default_set=True)
+    """Enable the add-on (enable_addon) and make the mesh object `name` active; exit with the reason
+    if there is none."""
+    enable_addon()
     obj = bpy.data.objects.get(name)
     if obj is None or obj.type != "MESH":
         sys.exit(f"--object: no mesh object named {name!r} in {bpy.data.filepath or 'the file'}")

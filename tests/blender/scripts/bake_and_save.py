@@ -11,8 +11,7 @@ import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 import support  # noqa: E402
 
-support.enable_addon()
-from modal_deform import core as mdc, storage  # noqa: E402
+mdc, storage = support.enable_addon("core", "storage")
 
 args = support.arguments()
 if args[0] == "suzanne":

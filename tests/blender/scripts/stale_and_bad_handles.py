@@ -7,8 +7,7 @@ import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 import support  # noqa: E402
 
-support.enable_addon()
-from modal_deform import handles, storage  # noqa: E402
+handles, storage = support.enable_addon("handles", "storage")
 from mathutils import Matrix, Vector  # noqa: E402
 
 obj = support.suzanne(1)
