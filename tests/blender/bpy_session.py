@@ -22,6 +22,7 @@ MODULE = "bl_ext.user_default.modal_deform"
 # inside Blender they must come from the extension's wheel, never from the machine.
 CORE_LIBRARIES = re.compile(r"lib(cholmod|amd|camd|colamd|ccolamd|suitesparseconfig|metis|openblas|blas|lapack|"
                             r"gfortran|quadmath|gomp)\b")
+PRIVATE_NAME = re.compile(r"-[0-9a-f]{8}\.")  # auditwheel's renaming: libcholmod-7426373e.so.3.0.14
 
 
 def install_extension(zip_path):
@@ -34,17 +35,18 @@ def install_extension(zip_path):
 
 
 def check_nothing_of_the_build_machine_is_used():
-    """The add-on and its compiled core come from the user folder Blender installed them into; no
-    library of the core is the machine's own (the build's -dev packages, /usr/lib)."""
-    user = os.path.realpath(os.environ["BLENDER_USER_RESOURCES"])
-    native = sys.modules[f"{MODULE}._native"]
-    for module in (sys.modules[MODULE], native):
-        assert os.path.realpath(module.__file__).startswith(user + os.sep), f"{module.__name__} from {module.__file__}"
+    """The add-on and its compiled core come from the user folder Blender installed them into, and
+    no library of the core is the machine's own (the -dev packages' /usr/lib/.../libcholmod.so.3 ...):
+    every one loaded has a wheel's private name (bpy's NumPy brings its own libgfortran, renamed)."""
+    user = os.path.realpath(os.environ["BLENDER_USER_RESOURCES"]) + os.sep
+    for module in (sys.modules[MODULE], sys.modules[f"{MODULE}._native"]):
+        assert os.path.realpath(module.__file__).startswith(user), f"{module.__name__} from {module.__file__}"
     mapped = {line.split(maxsplit=5)[5].strip() for line in open("/proc/self/maps") if len(line.split()) == 6}
     core = sorted(path for path in mapped if CORE_LIBRARIES.match(os.path.basename(path)))
-    foreign = [path for path in core if not os.path.realpath(path).startswith(user + os.sep)]
-    assert not foreign, f"the compiled core loaded libraries of this machine: {foreign}"
-    assert any("cholmod" in path for path in core), f"CHOLMOD is not loaded from the extension: {core}"
+    machine = [path for path in core if not PRIVATE_NAME.search(os.path.basename(path))]
+    assert not machine, f"the compiled core loaded libraries of this machine: {machine}"
+    cholmod = [path for path in core if "cholmod" in path]
+    assert cholmod and all(os.path.realpath(path).startswith(user) for path in cholmod), cholmod
 
 
 def main():
