@@ -5,6 +5,7 @@ import pathlib
 import sys
 
 import addon_utils
+import bmesh
 import bpy
 import numpy as np
 
@@ -69,11 +70,16 @@ def add_handle(obj, mask):
     """A handle of obj's vertices in the boolean `mask`, made as an artist does: select them in Edit
     Mode, Add Handle (a vertex group and an Empty at their centre). Returns the handle."""
     bpy.context.view_layer.objects.active = obj
-    mesh = obj.data
-    mesh.polygons.foreach_set("select", np.zeros(len(mesh.polygons), bool))
-    mesh.edges.foreach_set("select", np.zeros(len(mesh.edges), bool))
-    mesh.vertices.foreach_set("select", mask)
     bpy.ops.object.mode_set(mode="EDIT")
+    # Selected in Edit Mode: Blender 5.0.1 crashes setting MeshEdge.select (foreach_set or one by one)
+    # on a mesh made by from_pydata.
+    bpy.ops.mesh.select_all(action="DESELECT")
+    bm = bmesh.from_edit_mesh(obj.data)
+    bm.verts.ensure_lookup_table()
+    for index in np.flatnonzero(mask):
+        bm.verts[int(index)].select = True
+    bm.select_flush(True)
+    bmesh.update_edit_mesh(obj.data)
     result = bpy.ops.modal_deform.add_handle()
     bpy.ops.object.mode_set(mode="OBJECT")
     if result != {"FINISHED"}:
