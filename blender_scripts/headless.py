@@ -1,9 +1,11 @@
 """What the headless scripts share: their arguments after "--", the object they work on, saving."""
 import argparse
+import importlib
 import pathlib
 import sys
 
 import addon_utils
+import bmesh
 import bpy
 import numpy as np
 
@@ -23,11 +25,25 @@ def parse(parser):
     return parser.parse_args(sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else [])
 
 
+def enable_addon():
+    """Enable Modal Deform and return its package: the extension Blender installed (4.2+, module
+    bl_ext.<repository>.modal_deform) if there is one, else the add-on of this source tree."""
+    installed = sorted(m.__name__ for m in addon_utils.modules()
+                       if m.__name__.startswith("bl_ext.") and m.__name__.endswith(".modal_deform"))
+    if installed:
+        name = installed[0]
+    else:
+        name = "modal_deform"
+        sys.path.append(str(ADDON_PARENT))
+    if addon_utils.enable(name, default_set=True) is None:
+        raise RuntimeError(f"enabling the add-on {name} failed (see the messages above)")
+    return importlib.import_module(name)
+
+
 def active_mesh_object(name):
-    """Enable the add-on (from this source tree unless Blender has it installed) and make the mesh
-    object `name` active; exit with the reason if there is none."""
-    sys.path.append(str(ADDON_PARENT))
-    addon_utils.enable("modal_deform", default_set=True)
+    """Enable the add-on (enable_addon) and make the mesh object `name` active; exit with the reason
+    if there is none."""
+    enable_addon()
     obj = bpy.data.objects.get(name)
     if obj is None or obj.type != "MESH":
         sys.exit(f"--object: no mesh object named {name!r} in {bpy.data.filepath or 'the file'}")
@@ -54,11 +70,16 @@ def add_handle(obj, mask):
     """A handle of obj's vertices in the boolean `mask`, made as an artist does: select them in Edit
     Mode, Add Handle (a vertex group and an Empty at their centre). Returns the handle."""
     bpy.context.view_layer.objects.active = obj
-    mesh = obj.data
-    mesh.polygons.foreach_set("select", np.zeros(len(mesh.polygons), bool))
-    mesh.edges.foreach_set("select", np.zeros(len(mesh.edges), bool))
-    mesh.vertices.foreach_set("select", mask)
     bpy.ops.object.mode_set(mode="EDIT")
+    # Selected in Edit Mode: Blender 5.0.1 crashes setting MeshEdge.select (foreach_set or one by one)
+    # on a mesh made by from_pydata.
+    bpy.ops.mesh.select_all(action="DESELECT")
+    bm = bmesh.from_edit_mesh(obj.data)
+    bm.verts.ensure_lookup_table()
+    for index in np.flatnonzero(mask):
+        bm.verts[int(index)].select = True
+    bm.select_flush(True)
+    bmesh.update_edit_mesh(obj.data)
     result = bpy.ops.modal_deform.add_handle()
     bpy.ops.object.mode_set(mode="OBJECT")
     if result != {"FINISHED"}:

@@ -64,7 +64,7 @@ class AnimationJob:
             for f, value in ((frame - 1, 0.0), (frame, 1.0), (frame + 1, 0.0)):
                 block.value = value
                 block.keyframe_insert("value", frame=f)
-            curve = obj.data.shape_keys.animation_data.action.fcurves.find(block.path_from_id("value"))
+            curve = _fcurves(obj.data.shape_keys.animation_data).find(block.path_from_id("value"))
             for point in curve.keyframe_points:
                 point.interpolation = "CONSTANT"
         self.scene.frame_set(self.frame_before)
@@ -78,15 +78,27 @@ class AnimationJob:
         self.scene.frame_set(self.frame_before)
 
 
+def _fcurves(animation_data):
+    """The F-curves of an animation's action, None without one: on the action up to Blender 4.5, in
+    the channel bag of the assigned slot from 5.0 (layered actions; Action.fcurves is gone)."""
+    if animation_data is None or animation_data.action is None:
+        return None
+    if hasattr(animation_data.action, "fcurves"):
+        return animation_data.action.fcurves
+    from bpy_extras import anim_utils
+    channelbag = anim_utils.animdata_get_channelbag_for_assigned_slot(animation_data)
+    return None if channelbag is None else channelbag.fcurves
+
+
 def _remove_keys(obj, names):
     """Remove shape keys and the curves that animate them."""
     keys = obj.data.shape_keys
-    action = keys.animation_data.action if keys.animation_data else None
+    fcurves = _fcurves(keys.animation_data)
     for name in names:
-        if action is not None:
-            curve = action.fcurves.find(keys.key_blocks[name].path_from_id("value"))
+        if fcurves is not None:
+            curve = fcurves.find(keys.key_blocks[name].path_from_id("value"))
             if curve is not None:
-                action.fcurves.remove(curve)
+                fcurves.remove(curve)
     mesh_io.remove_shape_keys(obj, names)
 
 

@@ -1,7 +1,15 @@
-"""Headless Blender tests: each test runs one script in a fresh `blender -b --factory-startup`.
+"""Headless Blender tests: each test runs one script in a fresh Blender session.
 
-A script signals failure by raising (Blender then exits with code 1 via --python-exit-code).
-Scripts find the add-on through the ADDON_PATH environment variable.
+Which Blender: the environment variable BLENDER_PYTHON names the Python of a virtual environment
+holding `bpy` (Blender 4.2+ as a module; `make test-bpy-4.5`, `make test-bpy-5.0`); without it,
+the Blender app on PATH (Debian's 3.4.1; `make test-blender`).
+- App: `blender -b [file] --factory-startup --python-exit-code 1 --python SCRIPT -- ARGS`; the
+  scripts enable the add-on from the source tree (the ADDON_PATH environment variable).
+- bpy: bpy_session.py runs the script after installing the extension zip from dist/ (`make addon`)
+  with Blender's installer, in a session that sees neither the source tree's add-on nor the build
+  machine's libraries: no ADDON_PATH, PYTHONPATH unset, LD_LIBRARY_PATH empty, user folders in the
+  test's temporary folder.
+A script signals failure by raising (exit code 1).
 """
 import os
 import pathlib
@@ -11,21 +19,48 @@ import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SCRIPTS = pathlib.Path(__file__).resolve().parent / "scripts"
+BLENDER_PYTHON = os.environ.get("BLENDER_PYTHON")
+DIST = pathlib.Path(os.environ.get("MODAL_DEFORM_DIST", ROOT / "dist"))
+
+
+def built(pattern):
+    """The one file in dist/ matching `pattern` (made by `make addon`)."""
+    found = sorted(DIST.glob(pattern))
+    if len(found) != 1:
+        pytest.fail(f"{DIST}: expected one {pattern}, found {[p.name for p in found]}: run `make addon`")
+    return found[0]
+
+
+@pytest.fixture(scope="session")
+def extension_zip():
+    return built("modal_deform-*[0-9]-linux_x64.zip") if BLENDER_PYTHON else None
 
 
 @pytest.fixture
-def run_blender(tmp_path):
-    """run_blender("script.py", *args, blend=None, env=None) -> CompletedProcess; asserts exit code 0.
-    env: extra environment variables."""
+def run_blender(tmp_path, extension_zip):
+    """run_blender("script.py", *args, blend=None, env=None, addon=True, check=True) -> CompletedProcess.
+    env: extra environment variables; addon=False: under bpy, no extension is installed;
+    check: assert exit code 0."""
 
-    def run(script, *args, blend=None, timeout=600, env=None):
-        command = ["blender", "-b"]
-        if blend is not None:
-            command.append(str(blend))
-        command += ["--factory-startup", "--python-exit-code", "1", "--python", str(SCRIPTS / script), "--", *map(str, args)]
-        env = dict(os.environ, ADDON_PATH=str(ROOT / "python_addon"), TEST_TMP=str(tmp_path), **(env or {}))
-        result = subprocess.run(command, capture_output=True, text=True, timeout=timeout, env=env, cwd=tmp_path)
-        assert result.returncode == 0, f"{script} failed:\n{result.stdout[-4000:]}\n{result.stderr[-4000:]}"
+    def run(script, *args, blend=None, timeout=600, env=None, addon=True, check=True):
+        script = SCRIPTS / script
+        if BLENDER_PYTHON:
+            command = [BLENDER_PYTHON, str(pathlib.Path(__file__).with_name("bpy_session.py"))]
+            if addon:
+                command += ["--extension", str(extension_zip)]
+            if blend is not None:
+                command += ["--blend", str(blend)]
+            command += [str(script), "--", *map(str, args)]
+            base = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
+            base.update(LD_LIBRARY_PATH="", BLENDER_USER_RESOURCES=str(tmp_path / "blender_user"))
+        else:
+            command = ["blender", "-b"] + ([str(blend)] if blend is not None else [])
+            command += ["--factory-startup", "--python-exit-code", "1", "--python", str(script), "--", *map(str, args)]
+            base = dict(os.environ, ADDON_PATH=str(ROOT / "python_addon"))
+        environment = dict(base, TEST_TMP=str(tmp_path), **(env or {}))
+        result = subprocess.run(command, capture_output=True, text=True, timeout=timeout, env=environment, cwd=tmp_path)
+        if check:
+            assert result.returncode == 0, f"{script.name} failed:\n{result.stdout[-4000:]}\n{result.stderr[-4000:]}"
         return result
 
     return run

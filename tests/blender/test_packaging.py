@@ -1,20 +1,42 @@
-"""The zip: its manifest, and installing it in a fresh Blender (enable, disable, enable)."""
+"""The zips `make addon` writes into dist/: their layout and manifest, the shared objects inside them
+(nothing of the build machine), Blender's own validation, and installing each in a fresh Blender
+(the extension under bpy 4.2+, the legacy zip in the 3.4 app): enable, disable, enable."""
 import ast
+import glob
+import io
+import os
 import pathlib
+import re
+import subprocess
 import sys
 import tomllib
 import zipfile
 
 import pytest
+from conftest import BLENDER_PYTHON, built
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "python_addon"))
 import package  # noqa: E402
 
+# What a manylinux wheel may need from the system: the libraries of the manylinux policy (glibc's,
+# the C++ and GCC runtimes, zlib) that the core uses; everything else must be bundled in the zip.
+MANYLINUX = {"libc.so.6", "libm.so.6", "libstdc++.so.6", "libgcc_s.so.1", "libpthread.so.0", "libdl.so.2",
+             "librt.so.1", "ld-linux-x86-64.so.2", "libz.so.1"}
+
 
 @pytest.fixture(scope="module")
-def addon_zip(tmp_path_factory):
-    return package.build(tmp_path_factory.mktemp("dist"))
+def extension():
+    return built("modal_deform-*[0-9]-linux_x64.zip")
+
+
+@pytest.fixture(scope="module")
+def legacy():
+    return built("modal_deform-*-legacy-linux_x64.zip")
+
+
+def sources():
+    return {name for _, name in package.sources()}
 
 
 def bl_info():
@@ -23,18 +45,34 @@ def bl_info():
     return ast.literal_eval(node.value)
 
 
-def test_zip_holds_the_package_with_its_extension_and_manifest(addon_zip):
-    assert addon_zip.name == f"modal_deform-{package.version()}.zip"
-    names = zipfile.ZipFile(addon_zip).namelist()
-    assert all(name.startswith("modal_deform/") for name in names)
-    for required in ("modal_deform/__init__.py", "modal_deform/core/__init__.py", "modal_deform/blender_manifest.toml"):
-        assert required in names
-    assert any(name.startswith("modal_deform/_native") and name.endswith(".so") for name in names)
-    assert not any("__pycache__" in name for name in names)
+def zip_manifest(extension):
+    return tomllib.loads(zipfile.ZipFile(extension).read(package.MANIFEST).decode())
 
 
-def test_manifest_fields_and_version_match_bl_info():
-    manifest = tomllib.loads((package.PACKAGE / "blender_manifest.toml").read_text())
+def test_extension_zip_is_laid_out_as_blenders_extension_build(extension):
+    assert extension.name == f"modal_deform-{package.version()}-linux_x64.zip"
+    archive = zipfile.ZipFile(extension)
+    names = set(archive.namelist())
+    wheels = [name for name in names if name.startswith("wheels/")]
+    assert len(wheels) == 1 and re.fullmatch(r"wheels/modal_deform_native-[\d.]+-cp311-cp311-manylinux_2_\d+_x86_64"
+                                             r"(\.manylinux_2_\d+_x86_64)*\.whl", wheels[0]), wheels
+    assert archive.getinfo(wheels[0]).compress_type == zipfile.ZIP_STORED
+    assert names == sources() | {package.MANIFEST, wheels[0]}, "the package's files at the top, nothing else"
+    assert zip_manifest(extension)["wheels"] == [f"./{wheels[0]}"]
+
+
+def test_legacy_zip_holds_the_add_on_folder_with_the_wheels_core(legacy):
+    assert legacy.name == f"modal_deform-{package.version()}-legacy-linux_x64.zip"
+    names = set(zipfile.ZipFile(legacy).namelist())
+    native = {name for name in names if re.fullmatch(r"modal_deform/_native\.cpython-311-x86_64-linux-gnu\.so", name)}
+    libraries = {name for name in names if name.startswith("modal_deform/_native.libs/")}
+    assert len(native) == 1 and any("cholmod" in name for name in libraries), sorted(names)
+    assert names == {f"modal_deform/{name}" for name in sources()} | native | libraries
+    assert not any("__pycache__" in name or name.endswith(".toml") for name in names)
+
+
+def test_manifest_fields_and_version_match_bl_info(extension):
+    manifest = zip_manifest(extension)
     info = bl_info()
     assert manifest["schema_version"] == "1.0.0"
     assert manifest["id"] == "modal_deform" == package.PACKAGE.name
@@ -43,16 +81,72 @@ def test_manifest_fields_and_version_match_bl_info():
     assert manifest["type"] == "add-on"
     assert 0 < len(manifest["tagline"]) <= 64 and not manifest["tagline"].endswith(".")
     assert manifest["maintainer"]
-    assert tuple(map(int, manifest["blender_version_min"].split("."))) >= (4, 2, 0)
+    assert manifest["blender_version_min"] == "4.2.0"
     assert manifest["license"] == ["SPDX:GPL-3.0-or-later"]
     assert manifest["platforms"] == ["linux-x64"]
+    assert "permissions" not in manifest, "the add-on reads no files, uses no network, clipboard, camera or microphone"
     assert set(manifest) <= {"schema_version", "id", "version", "name", "tagline", "maintainer", "type", "tags",
                              "blender_version_min", "blender_version_max", "license", "platforms", "permissions",
-                             "website", "copyright", "wheels", "build"}
+                             "website", "copyright", "wheels"}
 
 
-def test_install_enable_disable_enable(run_blender, addon_zip, tmp_path):
-    user_scripts = tmp_path / "user_scripts"
-    result = run_blender("install_enable_disable.py", addon_zip, user_scripts,
-                         env={"BLENDER_USER_SCRIPTS": str(user_scripts)})
+def shared_objects(archive):
+    """(name, bytes) of every shared object in a zip, including those inside the wheels it holds."""
+    for name in archive.namelist():
+        if name.endswith(".whl"):
+            yield from ((f"{name}!{inner}", data) for inner, data in shared_objects(zipfile.ZipFile(
+                io.BytesIO(archive.read(name)))))
+        elif re.search(r"\.so(\.[\d.]+)?$", name):
+            yield name, archive.read(name)
+
+
+def readelf(data, tmp_path, *options):
+    path = tmp_path / "object.so"
+    path.write_bytes(data)
+    return subprocess.run(["readelf", "--wide", *options, str(path)], capture_output=True, text=True,
+                          check=True).stdout
+
+
+@pytest.mark.parametrize("which", ["extension", "legacy"])
+def test_shared_objects_need_only_manylinux_libraries_and_what_is_bundled(which, request, tmp_path):
+    """readelf -d of every shared object: each NEEDED library is in the manylinux set or in the zip
+    under a private (hashed) name, run paths stay inside the zip ($ORIGIN), and the compiled core
+    exports nothing but its module init (symbols hidden: nothing clashes with Blender's libraries)."""
+    objects = dict(shared_objects(zipfile.ZipFile(request.getfixturevalue(which))))
+    bundled = {os.path.basename(name) for name in objects}
+    # OpenBLAS's threaded build (libopenblasp: pthreads) and OpenMP, renamed: a reference BLAS or a
+    # lost OpenMP would cost the bake twice the time.
+    assert any(re.fullmatch(r"libopenblasp-r[\d.]+-[0-9a-f]{8}\.[\d.]+so", name) for name in bundled), bundled
+    assert any(re.fullmatch(r"libgomp-[0-9a-f]{8}\.so[.\d]*", name) for name in bundled), bundled
+    for name, data in objects.items():
+        dynamic = readelf(data, tmp_path, "-d")
+        needed = set(re.findall(r"\(NEEDED\)\s+Shared library: \[(.+?)\]", dynamic))
+        assert needed <= MANYLINUX | bundled, f"{name} needs {sorted(needed - MANYLINUX - bundled)}"
+        for path in re.findall(r"\((?:RPATH|RUNPATH)\)\s+Library (?:rpath|runpath): \[(.+?)\]", dynamic):
+            assert all(entry.startswith("$ORIGIN") for entry in path.split(":")), f"{name}: run path {path}"
+        if os.path.basename(name).startswith("_native"):
+            exported = re.findall(r"^\s*\d+:\s+\w+\s+\d+\s+\w+\s+GLOBAL\s+DEFAULT\s+\d+\s+(\S+)$",
+                                  readelf(data, tmp_path, "--dyn-syms"), re.MULTILINE)
+            assert exported == ["PyInit__native"], f"{name} exports {exported[:20]}"
+
+
+@pytest.mark.skipif(not BLENDER_PYTHON, reason="Blender's extension validator ships with bpy 4.2+")
+def test_blenders_validator_accepts_the_extension(extension):
+    validator = glob.glob(str(pathlib.Path(BLENDER_PYTHON).parents[1] / "lib" / "python3.*" / "site-packages" / "bpy"
+                              / "*" / "scripts" / "addons_core" / "bl_pkg" / "cli" / "blender_ext.py"))
+    assert len(validator) == 1, validator
+    result = subprocess.run([BLENDER_PYTHON, validator[0], "validate", str(extension)], capture_output=True, text=True)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "Success parsing TOML" in result.stdout, result.stdout
+
+
+def test_install_enable_disable_enable(run_blender, tmp_path):
+    """The extension under bpy (4.2+), the legacy zip in the Blender app (3.4)."""
+    if BLENDER_PYTHON:
+        zip_path, user_folder = built("modal_deform-*[0-9]-linux_x64.zip"), tmp_path / "blender_user"
+        env = {}
+    else:
+        zip_path, user_folder = built("modal_deform-*-legacy-linux_x64.zip"), tmp_path / "user_scripts"
+        env = {"BLENDER_USER_SCRIPTS": str(user_folder)}
+    result = run_blender("install_enable_disable.py", zip_path, user_folder, env=env, addon=False)
     assert "INSTALL_OK" in result.stdout

@@ -6,7 +6,6 @@ DOFs interleaved x0 y0 z0 x1 ...); mass holds the n vertex masses, M = diag(mass
 with neither mass nor stiffness (unreferenced vertices) stay zero in every result.
 """
 import numpy as np
-import scipy.sparse
 
 from .. import _native
 from . import _arrays
@@ -14,6 +13,7 @@ from . import _arrays
 
 def _stiffness(K):
     """K as a float64 csc matrix with sorted, unique indices (what the native core reads)."""
+    import scipy.sparse  # not at the top: Blender's own Python has NumPy but no SciPy
     if not scipy.sparse.issparse(K):
         raise ValueError(f"K: expected a scipy.sparse matrix, got {type(K).__name__}")
     K = scipy.sparse.csc_matrix(K, dtype=np.float64)

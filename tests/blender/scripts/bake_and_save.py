@@ -1,4 +1,4 @@
-"""Bake a mesh through the operator, add two handles, save the file and what a reload must find.
+"""Bake a mesh through the operator, add two handles, pose, save the file and what a reload must find.
 
 Arguments: suzanne | dragon PATH. Writes TEST_TMP/baked.blend, TEST_TMP/basis.npz (the basis as
 baked) and TEST_TMP/rest.npy (the base mesh's positions).
@@ -11,8 +11,7 @@ import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 import support  # noqa: E402
 
-support.enable_addon()
-from modal_deform import core as mdc, storage  # noqa: E402
+mdc, posing, storage = support.enable_addon("core", "posing", "storage")
 
 args = support.arguments()
 if args[0] == "suzanne":
@@ -33,6 +32,15 @@ low, high = np.quantile(V[:, axis], [0.1, 0.9])
 support.add_handle(obj, V[:, axis] > high)
 support.add_handle(obj, V[:, axis] < low)
 assert [h.controller is not None for h in settings.handles] == [True, True]
+# Posed before saving (the first controller moved sideways by 5% of the model's size), then the
+# controller put back: the file keeps the pose's shape key, the scripts reading it find rest handles.
+controller = settings.handles[0].controller
+start = controller.location.copy()
+controller.location[(axis + 1) % 3] += 0.05 * np.ptp(V, axis=0).max()
+bpy.context.view_layer.update()
+assert bpy.ops.modal_deform.solve() == {"FINISHED"}
+assert np.abs(support.key_positions(obj, posing.POSE_KEY) - V).max() > 0.01 * np.ptp(V, axis=0).max(), "no pose"
+controller.location = start
 
 np.savez(support.tmp("basis.npz"), **storage.load(obj).to_arrays())
 np.save(support.tmp("rest.npy"), support.positions(obj))

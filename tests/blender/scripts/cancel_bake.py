@@ -8,8 +8,7 @@ sys.path.insert(0, os.path.dirname(__file__))
 import bpy  # noqa: E402
 import support  # noqa: E402
 
-support.enable_addon()
-from modal_deform import ops_bake  # noqa: E402
+ops_bake = support.enable_addon("ops_bake")
 
 
 def cancelled_bake(obj):

@@ -8,8 +8,7 @@ import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 import support  # noqa: E402
 
-support.enable_addon()
-from modal_deform import posing  # noqa: E402
+posing = support.enable_addon("posing")
 
 obj = next(o for o in bpy.data.objects if o.type == "MESH")
 rest = np.load(support.tmp("rest.npy"))

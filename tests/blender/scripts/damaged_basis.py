@@ -24,14 +24,22 @@ def array(block, name):
     return np.frombuffer(value, dtype=value.typecode).copy()
 
 
+def replace(block, name, value):
+    """block[name] = value, dropping the old property first: Blender 4.5 and 5.0 copy a NumPy array
+    into an existing array property of the same type without resizing it (a shorter one is padded
+    with the old values, a longer one overruns the buffer)."""
+    del block[name]
+    block[name] = value
+
+
 def truncated(block):
-    block["vectors"] = array(block, "vectors")[:-7]
+    replace(block, "vectors", array(block, "vectors")[:-7])
 
 
 def resized(block):
     shapes = block["shapes"].to_dict()
     rows, columns = shapes["vectors"]
-    block["vectors"] = np.zeros((rows + 3) * columns, np.float32)
+    replace(block, "vectors", np.zeros((rows + 3) * columns, np.float32))
     shapes["vectors"] = [rows + 3, columns]
     block["shapes"] = shapes
 
@@ -39,13 +47,13 @@ def resized(block):
 def nan(block):
     ghost_vectors = array(block, "ghost_vectors")
     ghost_vectors[5] = np.nan
-    block["ghost_vectors"] = ghost_vectors
+    replace(block, "ghost_vectors", ghost_vectors)
 
 
 def out_of_range(block):
     ghost_map = array(block, "ghost_map")
     ghost_map[3] = 2**31 - 1
-    block["ghost_map"] = ghost_map
+    replace(block, "ghost_map", ghost_map)
 
 
 def missing(block):

@@ -2,12 +2,12 @@
 import os
 import sys
 
-import bpy
-import numpy as np
+sys.path.insert(0, os.path.dirname(__file__))
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+import support  # noqa: E402
 
-sys.path.insert(0, os.environ["ADDON_PATH"])
-import modal_deform.core as mdc  # noqa: E402
-
+mdc = support.enable_addon("core")
 bpy.ops.mesh.primitive_monkey_add()
 mesh = bpy.context.object.data
 V = np.empty(3 * len(mesh.vertices), np.float64)

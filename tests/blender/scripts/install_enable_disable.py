@@ -1,6 +1,9 @@
-"""Install the zip like Preferences > Add-ons > Install, then enable, disable, enable again: nothing
-may be left behind by disabling (classes, properties, handlers, timers), and the installed copy
-(not the source tree) bakes."""
+"""Install a zip as an artist does, then enable, disable, enable again: nothing may be left behind
+by disabling (classes, properties, handlers, timers), and the installed copy (not the source tree)
+bakes. Blender 4.2+: the extension zip with Blender's extension installer (module
+bl_ext.user_default.modal_deform); earlier: the legacy zip like Preferences > Add-ons > Install.
+
+Arguments: ZIP USER_FOLDER (where Blender installs into)."""
 import os
 import sys
 
@@ -9,16 +12,22 @@ import addon_utils  # noqa: E402
 import bpy  # noqa: E402
 import support  # noqa: E402
 
-zip_path, user_scripts = support.arguments()
+zip_path, user_folder = support.arguments()
 handlers = {name: len(getattr(bpy.app.handlers, name)) for name in ("depsgraph_update_post", "load_post")}
-assert "modal_deform" not in sys.modules
-assert bpy.ops.preferences.addon_install(filepath=zip_path) == {"FINISHED"}
+assert not any(name.endswith("modal_deform") for name in sys.modules)
+if bpy.app.version >= (4, 2, 0):
+    module_name = "bl_ext.user_default.modal_deform"
+    installed = bpy.ops.extensions.package_install_files(filepath=zip_path, repo="user_default", enable_on_install=False)
+else:
+    module_name = "modal_deform"
+    installed = bpy.ops.preferences.addon_install(filepath=zip_path)
+assert installed == {"FINISHED"}, installed
 
 
 def enable_and_bake():
-    module = addon_utils.enable("modal_deform", default_set=True, handle_error=None)
+    module = addon_utils.enable(module_name, default_set=True, handle_error=None)
     assert module is not None, "enabling failed"
-    assert os.path.realpath(module.__file__).startswith(os.path.realpath(user_scripts)), module.__file__
+    assert os.path.realpath(module.__file__).startswith(os.path.realpath(user_folder)), module.__file__
     assert hasattr(bpy.types.Object, "modal_deform") and hasattr(bpy.types, "VIEW3D_PT_modal_deform")
     obj = support.suzanne(0)
     obj.modal_deform.modes, obj.modal_deform.derivatives, obj.modal_deform.ghost = 10, 5, 100
@@ -27,7 +36,7 @@ def enable_and_bake():
 
 
 def disable():
-    addon_utils.disable("modal_deform", default_set=True)
+    addon_utils.disable(module_name, default_set=True)
     assert not hasattr(bpy.types.Object, "modal_deform")
     for name in ("VIEW3D_PT_modal_deform", "MODAL_DEFORM_UL_handles", "ModalDeformSettings"):
         assert not hasattr(bpy.types, name), f"{name} is still registered"

@@ -8,8 +8,7 @@ import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 import support  # noqa: E402
 
-support.enable_addon()
-from modal_deform import ops_preview, storage  # noqa: E402
+ops_preview, storage = support.enable_addon("ops_preview", "storage")
 
 # A closed tube: 24 x 20 quads around, and a 24-gon at each end.
 around, rings = 24, 21

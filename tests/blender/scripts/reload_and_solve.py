@@ -10,8 +10,7 @@ import numpy as np  # noqa: E402
 from mathutils import Matrix  # noqa: E402
 import support  # noqa: E402
 
-support.enable_addon()
-from modal_deform import handles, posing, storage  # noqa: E402
+handles, posing, storage = support.enable_addon("handles", "posing", "storage")
 
 obj = next(o for o in bpy.data.objects if o.type == "MESH")
 bpy.context.view_layer.objects.active = obj

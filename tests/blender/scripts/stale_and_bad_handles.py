@@ -6,8 +6,7 @@ sys.path.insert(0, os.path.dirname(__file__))
 import bpy  # noqa: E402
 import support  # noqa: E402
 
-support.enable_addon()
-from modal_deform import storage  # noqa: E402
+storage = support.enable_addon("storage")
 
 obj = support.suzanne(1)
 obj.modal_deform.modes, obj.modal_deform.derivatives, obj.modal_deform.ghost = 12, 10, 300

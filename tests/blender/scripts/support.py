@@ -1,4 +1,5 @@
 """Helpers shared by the headless test scripts (imported from the script's folder)."""
+import importlib
 import os
 import sys
 
@@ -8,16 +9,19 @@ import numpy as np
 
 # Handles are made as the demo and the benchmark make them (select, Add Handle).
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "..", "blender_scripts"))
+import headless  # noqa: E402
 from headless import add_handle  # noqa: E402,F401 (the scripts call support.add_handle; no side effect)
 
 
-def enable_addon():
-    """Enable modal_deform from the source tree (ADDON_PATH) and return its package."""
-    sys.path.insert(0, os.environ["ADDON_PATH"])
-    addon_utils.enable("modal_deform", default_set=True)
-    import modal_deform
+def enable_addon(*modules):
+    """Enable Modal Deform (the installed extension under bpy, else the source tree) and return the
+    add-on's modules named, e.g. enable_addon("core", "storage"); its package when none is named."""
+    package = headless.enable_addon()
     assert hasattr(bpy.types.Object, "modal_deform"), "the add-on did not register"
-    return modal_deform
+    if not modules:
+        return package
+    found = tuple(importlib.import_module(f"{package.__name__}.{name}") for name in modules)
+    return found[0] if len(found) == 1 else found
 
 
 def tmp(name):
