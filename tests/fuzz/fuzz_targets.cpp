@@ -22,8 +22,9 @@ namespace {
 
 [[noreturn]] void fail(const std::string& what) { throw Failure(what); }
 
-// Runs call(); true when it returned, false when it refused with InputError or NumericalError
-// (whose message must say something). Other exceptions propagate: they are failures.
+// Runs call(); true when it returned, false when it refused with InputError, NumericalError or
+// OutOfMemory (the bake's up-front memory estimate; whose message must say something). Other
+// exceptions propagate: they are failures.
 template <typename Call>
 bool runs(const char* what, Call&& call) {
   try {
@@ -33,6 +34,8 @@ bool runs(const char* what, Call&& call) {
     if (std::string(error.what()).empty()) fail(message(what, ": InputError without a message"));
   } catch (const NumericalError& error) {
     if (std::string(error.what()).empty()) fail(message(what, ": NumericalError without a message"));
+  } catch (const OutOfMemory& error) {
+    if (std::string(error.what()).empty()) fail(message(what, ": OutOfMemory without a message"));
   }
   return false;
 }
