@@ -3,10 +3,9 @@ import time
 
 import bpy
 
-from . import handles, mesh_io, posing, storage
-from .ops_bake import _mesh_poll
+from . import handles, mesh_io, posing
+from .ops_common import FAILURES, mesh_poll
 
-_FAILURES = (storage.NotReady, handles.HandleError, ValueError, RuntimeError)
 
 # The running interactive pose, so the right-click menu's items can end it.
 _running = None
@@ -19,14 +18,14 @@ keeps the pose, Esc restores the mesh as it was"""
     bl_label = "Pose"
     bl_options = {"REGISTER", "UNDO"}
 
-    poll = classmethod(_mesh_poll)
+    poll = classmethod(mesh_poll)
 
     def invoke(self, context, event):
         global _running
         obj = handles.owner(context.object)
         try:
             self.pose = posing.Pose(context, obj)
-        except _FAILURES as error:
+        except FAILURES as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         for warning in self.pose.warnings:
@@ -79,7 +78,7 @@ keeps the pose, Esc restores the mesh as it was"""
                 self.pose.step(obj.modal_deform.budget)
                 self.pose.write(self.block)
                 self.tick_ms = 1e3 * (time.perf_counter() - start)
-        except _FAILURES as error:  # e.g. a controller deleted while posing
+        except FAILURES as error:  # e.g. a controller deleted while posing
             self.report({"ERROR"}, str(error))
             return self._end(context, "CANCEL")
         stats = self.pose.stats
@@ -150,7 +149,7 @@ class MODAL_DEFORM_OT_solve(bpy.types.Operator):
                                        description="Stopping tolerance of the Gill-Murray-Wright test: smaller "
                                                    "solves more exactly and takes longer")
 
-    poll = classmethod(_mesh_poll)
+    poll = classmethod(mesh_poll)
 
     def execute(self, context):
         obj = handles.owner(context.object)
@@ -158,7 +157,7 @@ class MODAL_DEFORM_OT_solve(bpy.types.Operator):
             pose = posing.Pose(context, obj)
             pose.follow_controllers()
             stats = pose.converge(self.max_iterations, self.tolerance)
-        except _FAILURES as error:
+        except FAILURES as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         for warning in pose.warnings:
@@ -178,7 +177,7 @@ class MODAL_DEFORM_OT_reset(bpy.types.Operator):
     bl_label = "Reset Pose"
     bl_options = {"REGISTER", "UNDO"}
 
-    poll = classmethod(_mesh_poll)
+    poll = classmethod(mesh_poll)
 
     def execute(self, context):
         obj = handles.owner(context.object)

@@ -3,7 +3,7 @@ import bpy
 import numpy as np
 
 from . import handles, mesh_io, storage
-from .ops_bake import _mesh_poll
+from .ops_common import mesh_poll
 
 PREVIEW_KEY = "Modal Deform Preview"
 
@@ -55,7 +55,7 @@ class MODAL_DEFORM_OT_preview_mode(bpy.types.Operator):
     bl_label = "Preview Mode"
     bl_options = {"REGISTER", "UNDO"}
 
-    poll = classmethod(_mesh_poll)
+    poll = classmethod(mesh_poll)
 
     def execute(self, context):
         obj = handles.owner(context.object)

@@ -7,7 +7,7 @@ import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 import support  # noqa: E402
 
-ops_animation = support.enable_addon("ops_animation")
+jobs = support.enable_addon("jobs")
 obj = support.suzanne(1)
 obj.modal_deform.modes, obj.modal_deform.derivatives, obj.modal_deform.ghost = 15, 20, 400
 assert bpy.ops.modal_deform.bake() == {"FINISHED"}
@@ -27,7 +27,7 @@ assert names == ["Basis"] + [f"Modal Deform {f:04d}" for f in range(1, 11)], nam
 # Again: the keys of the first run are replaced, not added to.
 assert bpy.ops.modal_deform.bake_animation(frame_start=1, frame_end=10) == {"FINISHED"}
 assert [b.name for b in obj.data.shape_keys.key_blocks] == names
-assert len(ops_animation._fcurves(obj.data.shape_keys.animation_data)) == 10
+assert len(jobs.action_fcurves(obj.data.shape_keys.animation_data)) == 10
 for f in (1, 5, 10):
     np.save(support.tmp(f"frame{f}.npy"), support.key_positions(obj, f"Modal Deform {f:04d}"))
 np.save(support.tmp("rest.npy"), V)

@@ -8,12 +8,12 @@ sys.path.insert(0, os.path.dirname(__file__))
 import bpy  # noqa: E402
 import support  # noqa: E402
 
-ops_bake = support.enable_addon("ops_bake")
+jobs = support.enable_addon("jobs")
 
 
 def cancelled_bake(obj):
     before = support.mesh_state(obj)
-    job = ops_bake.BakeJob(obj)
+    job = jobs.BakeJob(obj)
     job.start()
     while job.stage == "starting" and not job.done:  # cancel once the native bake reports
         time.sleep(0.001)

@@ -1,0 +1,183 @@
+"""The work the long operators drive, apart from their Blender UI plumbing: a bake of the mesh on a
+thread (BakeJob) and an animation bake a frame at a time (AnimationJob). Both read the object when
+made and change it only in finish(); cancel() leaves it as it was.
+
+Bake animation writes one shape key per frame, keyed to show on its frame only, so the result plays
+back and renders without the add-on: frame f shows shape key "Modal Deform f" (value 1 at f, 0 at
+f - 1 and f + 1, constant interpolation). Each frame starts from the previous frame's solution (the
+solver keeps q and its inverse Hessian).
+"""
+import re
+import threading
+import time
+
+import bpy
+
+from . import core as mdc
+from . import mesh_io, posing, storage
+
+# The bake's stages in order (cpp/reduction/bake.h), for one bar over the whole bake.
+STAGES = ("attachment", "hessian", "factorisation", "modes", "third derivatives", "derivative solves",
+          "orthonormalisation", "assembly", "ghost")
+
+
+class BakeJob:
+    """One bake of obj's mesh as it is now, run by run() here or on a thread by start().
+
+    The mesh is read on the calling thread; the native bake releases the GIL, so Blender stays
+    responsive. cancel() makes the next progress report stop the bake (Cancelled).
+    """
+
+    def __init__(self, obj):
+        settings = obj.modal_deform
+        self.object_name = obj.name
+        self.energy = settings.energy
+        self.V = mesh_io.positions(obj.data)
+        self.F = mesh_io.triangles(obj.data)
+        self.fingerprint = storage.fingerprint(obj.data)
+        self.options = dict(modes=settings.modes, derivatives=settings.derivatives if self.energy == "SHELLS" else 0,
+                            ghost=settings.ghost, energy=self.energy.lower(), bending=settings.bending,
+                            membrane=settings.membrane)
+        self.stage, self.fraction = "starting", 0.0
+        self.basis = self.error = None
+        self.seconds = 0.0
+        self.cancelling = False
+        self._thread = None
+
+    def _progress(self, stage, fraction):
+        self.stage, self.fraction = stage, fraction
+        return not self.cancelling
+
+    @property
+    def overall(self):
+        """Fraction of the whole bake done, counting each stage alike (their costs vary by mesh)."""
+        if self.stage not in STAGES:
+            return 0.0
+        return (STAGES.index(self.stage) + self.fraction) / len(STAGES)
+
+    def run(self):
+        start = time.perf_counter()
+        try:
+            self.basis = mdc.bake(self.V, self.F, progress=self._progress, **self.options)
+        except Exception as error:  # reported on the main thread (Cancelled included)
+            self.error = error
+        self.seconds = time.perf_counter() - start
+
+    def start(self):
+        self._thread = threading.Thread(target=self.run, name="modal_deform bake", daemon=True)
+        self._thread.start()
+
+    def cancel(self):
+        self.cancelling = True
+
+    @property
+    def done(self):
+        return self._thread is None or not self._thread.is_alive()
+
+    def finish(self):
+        """Store the basis on the object (main thread). Returns (level, message) for a report."""
+        if isinstance(self.error, mdc.Cancelled):
+            return "WARNING", "Bake cancelled: nothing changed"
+        if self.error is not None:
+            return "ERROR", f"Bake failed: {self.error}"
+        obj = bpy.data.objects.get(self.object_name)
+        if obj is None or obj.type != "MESH" or storage.fingerprint(obj.data) != self.fingerprint:
+            return "WARNING", f"'{self.object_name}' changed during the bake: the result was discarded, bake again"
+        storage.store(obj, self.basis, self.fingerprint, self.seconds, self.energy)
+        basis = self.basis
+        message = (f"Baked '{obj.name}' in {self.seconds:.1f} s: {basis.dimension} dimensions, ghost "
+                   f"{len(basis.ghost_vertices)} vertices")
+        if basis.num_floppy:
+            message += (f"; {basis.num_floppy} zero modes besides the rigid motions (flaps at non-manifold edges "
+                        f"or vertices) came on top of the modes")
+        return "INFO", message
+
+
+_FRAME_KEY = re.compile(re.escape(posing.POSE_KEY) + r" -?\d{4,}")
+
+
+def frame_key_name(frame):
+    return f"{posing.POSE_KEY} {frame:04d}"
+
+
+class AnimationJob:
+    """Solves frames one at a time (step()); finish() or cancel() afterwards."""
+
+    def __init__(self, context, obj, frames):
+        self.pose = posing.Pose(context, obj)
+        self.obj, self.scene, self.frames = obj, context.scene, list(frames)
+        self.frame_before = self.scene.frame_current
+        self.done = 0
+        self.created = []  # (frame, key name as created: a new key may get a ".001" suffix)
+        self.basis_created = obj.data.shape_keys is None
+        self.unconverged = 0
+
+    def step(self):
+        """Solve the next frame into a new shape key; returns False when every frame is done."""
+        if self.done == len(self.frames):
+            return False
+        frame = self.frames[self.done]
+        self.scene.frame_set(frame)
+        self.pose.follow_controllers()
+        if not self.pose.converge()["converged"]:
+            self.unconverged += 1
+        mesh_io.ensure_reference_key(self.obj)
+        block = self.obj.shape_key_add(name=frame_key_name(frame), from_mix=False)
+        block.value = 0.0
+        self.created.append((frame, block.name))
+        self.pose.write(block)
+        self.done += 1
+        return True
+
+    def finish(self):
+        """Replace the keys of an earlier animation bake with the new ones and key their values."""
+        obj = self.obj
+        blocks = obj.data.shape_keys.key_blocks
+        new_names = {name for _, name in self.created}
+        old = [b.name for b in blocks if _FRAME_KEY.fullmatch(b.name) and b.name not in new_names]
+        _remove_keys(obj, old)
+        pose_block = blocks.get(posing.POSE_KEY)
+        if pose_block is not None:
+            pose_block.mute = True  # the frame keys take its place; it would add on top
+        for frame, name in self.created:
+            block = blocks[name]
+            block.name = frame_key_name(frame)
+            for f, value in ((frame - 1, 0.0), (frame, 1.0), (frame + 1, 0.0)):
+                block.value = value
+                block.keyframe_insert("value", frame=f)
+            curve = action_fcurves(obj.data.shape_keys.animation_data).find(block.path_from_id("value"))
+            for point in curve.keyframe_points:
+                point.interpolation = "CONSTANT"
+        self.scene.frame_set(self.frame_before)
+
+    def cancel(self):
+        """Take away everything this job added."""
+        names = [name for _, name in self.created]
+        if self.basis_created and self.obj.data.shape_keys is not None:
+            names.append(self.obj.data.shape_keys.reference_key.name)
+        mesh_io.remove_shape_keys(self.obj, names)
+        self.scene.frame_set(self.frame_before)
+
+
+def action_fcurves(animation_data):
+    """The F-curves of an animation's action, None without one: on the action up to Blender 4.5, in
+    the channel bag of the assigned slot from 5.0 (layered actions; Action.fcurves is gone)."""
+    if animation_data is None or animation_data.action is None:
+        return None
+    if hasattr(animation_data.action, "fcurves"):
+        return animation_data.action.fcurves
+    from bpy_extras import anim_utils
+    channelbag = anim_utils.animdata_get_channelbag_for_assigned_slot(animation_data)
+    return None if channelbag is None else channelbag.fcurves
+
+
+def _remove_keys(obj, names):
+    """Remove shape keys and the curves that animate them."""
+    keys = obj.data.shape_keys
+    fcurves = action_fcurves(keys.animation_data)
+    for name in names:
+        if fcurves is not None:
+            curve = fcurves.find(keys.key_blocks[name].path_from_id("value"))
+            if curve is not None:
+                fcurves.remove(curve)
+    mesh_io.remove_shape_keys(obj, names)
