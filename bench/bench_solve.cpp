@@ -52,7 +52,7 @@ const Basis& dragon_basis(int dimension) {
   if (bases.empty()) {
     const TriangleMesh mesh = read_mesh(MODAL_DEFORM_SHARED_MESHES "/dragon_vrip_res2.ply.gz");
     Progress quiet;
-    Basis full = bake(mesh.V, mesh.F, BakeOptions{20, 104, 1000, "shells", 1.0, 1.0}, quiet);
+    Basis full = bake(mesh.V, mesh.F, BakeOptions{20, 104, 1000, EnergyKind::kShells, 1.0, 1.0}, quiet);
     Basis prefix = full;
     prefix.vectors = full.vectors.leftCols(67);
     prefix.ghost_vectors = full.ghost_vectors.leftCols(67);

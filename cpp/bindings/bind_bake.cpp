@@ -70,7 +70,7 @@ void bind_bake(py::module_& m) {
       "bake",
       [](const VerticesRef& V, const FacesRef& F, int modes, int derivatives, int ghost, const std::string& energy,
          double bending, double membrane, bool rotation_pairs, const py::object& progress) {
-        const BakeOptions options{modes, derivatives, ghost, energy, bending, membrane, rotation_pairs};
+        const BakeOptions options{modes, derivatives, ghost, energy_kind(energy), bending, membrane, rotation_pairs};
         Progress reporter(python_progress(progress));
         py::gil_scoped_release release;
         return bake(V, F, options, reporter);

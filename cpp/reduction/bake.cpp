@@ -139,9 +139,7 @@ void check_options(const BakeOptions& o) {
   if (o.modes < 1) throw InputError(message("modes: expected at least 1, got ", o.modes));
   if (o.derivatives < 0) throw InputError(message("derivatives: expected 0 or more, got ", o.derivatives));
   if (o.ghost < 4) throw InputError(message("ghost: a ghost needs at least 4 vertices, got ", o.ghost));
-  if (o.energy != "shells" && o.energy != "arap")
-    throw InputError(message("energy: expected \"shells\" or \"arap\", got \"", o.energy, "\""));
-  if (o.energy == "arap" && o.derivatives > 0)
+  if (o.energy == EnergyKind::kArap && o.derivatives > 0)
     throw InputError(message("derivatives: the ARAP energy has no third derivative, so it has no modal derivatives; ",
                              "bake it with derivatives = 0, or use the shells energy (asked for ", o.derivatives, ")"));
   require_weight(o.bending, "bending");
@@ -192,7 +190,7 @@ Basis bake_stages(const VerticesRef& V, const FacesRef& F, const BakeOptions& op
   {
     const Stopwatch stopwatch(time["hessian"]);
     progress.report("hessian", 0.0);
-    if (options.energy == "shells") {
+    if (options.energy == EnergyKind::kShells) {
       shells = std::make_unique<DiscreteShells>(simulated_V, attachment.faces, options.bending, options.membrane);
       K = shells->hessian(shells->rest());
     } else {

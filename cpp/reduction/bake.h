@@ -36,6 +36,7 @@
 
 #include <string>
 
+#include "energy/make_energy.h"
 #include "reduction/basis.h"
 #include "util/progress.h"
 #include "util/types.h"
@@ -52,7 +53,7 @@ struct BakeOptions {
   int modes = 20;                 // vibration modes, rigid motions included
   int derivatives = 52;           // modal derivatives
   int ghost = 1000;               // ghost vertices to aim for (≥ 4; the mesh itself when ≥ #V)
-  std::string energy = "shells";  // "shells", or "arap" with derivatives = 0
+  EnergyKind energy = EnergyKind::kShells;  // or ARAP, with derivatives = 0
   double bending = 1.0;           // shells: α (finite, ≥ 0)
   double membrane = 1.0;          // shells: β (finite, ≥ 0)
   // Derivatives of pairs with the linearised rotations too (the paper's rule), or of pairs of

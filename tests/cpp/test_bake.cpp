@@ -31,7 +31,7 @@ using testing::shared_mesh;
 using testing::side_by_side;
 
 Basis bake_with(const TriangleMesh& mesh, int modes, int derivatives, int ghost = 1000,
-                const std::string& energy = "shells") {
+                EnergyKind energy = EnergyKind::kShells) {
   BakeOptions options;
   options.modes = modes;
   options.derivatives = derivatives;
@@ -258,7 +258,7 @@ TEST(Bake, GhostMapsEveryVertexAndKeepsRigidMotionsRigid) {
 }
 
 TEST(Bake, ArapWithoutDerivatives) {
-  const Basis basis = bake_with(bar(3, 3, 3, 1, 1, 1), 12, 0, 1000, "arap");
+  const Basis basis = bake_with(bar(3, 3, 3, 1, 1, 1), 12, 0, 1000, EnergyKind::kArap);
   EXPECT_EQ(basis.dimension(), 12);
   EXPECT_EQ(basis.num_rigid, 6);
   EXPECT_GT(basis.eigenvalues[6], 0);
@@ -284,10 +284,9 @@ TEST(Bake, RefusesBadOptionsNamingThem) {
   options.derivatives = 154;  // 3 rotations and 14 flexible modes: 153 pairs
   expect_refused(tube, options, "derivatives:");
   options = {};
-  options.energy = "arap";
+  options.energy = EnergyKind::kArap;
   expect_refused(tube, options, "derivatives:");
-  options.energy = "springs";
-  expect_refused(tube, options, "energy:");
+  EXPECT_THROW(energy_kind("springs"), InputError);  // names reach the bake through energy_kind
   options = {};
   options.ghost = 3;
   expect_refused(tube, options, "ghost:");

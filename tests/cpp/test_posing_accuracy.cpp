@@ -87,7 +87,7 @@ const Basis& basis(const std::string& mesh_name, const TriangleMesh& mesh, bool 
   if (it == cache.end()) {
     Progress quiet;
     const BakeOptions options{derivatives ? 15 : 67, derivatives ? 52 : 0, static_cast<int>(mesh.V.rows()),
-                              "shells", 1.0, 1.0};
+                              EnergyKind::kShells, 1.0, 1.0};
     it = cache.emplace(key, bake(mesh.V, mesh.F, options, quiet)).first;
   }
   return it->second;
@@ -265,7 +265,7 @@ TEST(PosingAccuracy, AttachedEyesStaySeatedInALargePose) {
     return Transforms{Eigen::Matrix4d::Identity(), rigid_transform({0, 1, 0}, t * 2 * kPi / 9, {1, 1, 0}, {0, 0, 0}) * turn};
   };
   Progress quiet;
-  const Basis basis = bake(mesh.V, mesh.F, {15, 52, 1000, "shells", 1.0, 1.0}, quiet);
+  const Basis basis = bake(mesh.V, mesh.F, {15, 52, 1000, EnergyKind::kShells, 1.0, 1.0}, quiet);
   ReducedSolver solver(basis, handles, Eigen::VectorXd(), kStiffness, EnergyKind::kShells);
   for (int step = 1; step <= 6; ++step) {
     solver.set_transforms(at(step / 6.0));

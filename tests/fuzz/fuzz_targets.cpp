@@ -191,8 +191,8 @@ void bake_and_pose(const std::uint8_t* data, std::size_t size) {
   options.derivatives = in.integer(0, 12);
   if (in.byte() == 255) options.derivatives -= 1;  // -1 reachable
   options.ghost = in.integer(3, 20);
-  options.energy = in.flag() ? "arap" : "shells";
-  if (options.energy == "arap" && in.byte() < 200) options.derivatives = 0;
+  options.energy = in.flag() ? EnergyKind::kArap : EnergyKind::kShells;
+  if (options.energy == EnergyKind::kArap && in.byte() < 200) options.derivatives = 0;
   options.bending = in.positive();
   options.membrane = in.positive();
   Progress progress;
