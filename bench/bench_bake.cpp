@@ -14,7 +14,7 @@
 #include <string>
 
 #include "mesh/read_mesh.h"
-#include "reduction/bake.h"
+#include "bake/bake.h"
 
 namespace modal_deform {
 namespace {

@@ -7,7 +7,7 @@
 
 #include "mesh/primitives.h"
 #include "mesh/read_mesh.h"
-#include "reduction/bake.h"
+#include "bake/bake.h"
 #include "solve/full_solver.h"
 #include "solve/reduced_solver.h"
 

@@ -8,7 +8,7 @@
 
 #include "bindings/bindings.h"
 #include "bindings/python_progress.h"
-#include "reduction/bake.h"
+#include "bake/bake.h"
 
 namespace py = pybind11;
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <vector>
 
-#include "reduction/edge_collapse.h"
+#include "mesh/edge_collapse.h"
 #include "util/errors.h"
 
 namespace modal_deform {

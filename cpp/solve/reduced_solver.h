@@ -25,7 +25,7 @@
 
 #include "energy/energy.h"
 #include "energy/make_energy.h"
-#include "reduction/basis.h"
+#include "basis/basis.h"
 #include "solve/bfgs.h"
 #include "solve/handle_term.h"
 

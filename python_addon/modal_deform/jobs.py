@@ -16,7 +16,7 @@ import bpy
 from . import core as mdc
 from . import mesh_io, posing, storage
 
-# The bake's stages in order (cpp/reduction/bake.h), for one bar over the whole bake.
+# The bake's stages in order (cpp/bake/bake.h), for one bar over the whole bake.
 STAGES = ("attachment", "hessian", "factorisation", "modes", "third derivatives", "derivative solves",
           "orthonormalisation", "assembly", "ghost")
 

@@ -15,7 +15,7 @@
 #include "modes/rigid_motions.h"
 #include "modes/stiffness_and_mass.h"
 #include "modes/vibration_modes.h"
-#include "reduction/bake.h"
+#include "bake/bake.h"
 #include "reduction/ghost.h"
 #include "test_bake_meshes.h"
 #include "test_support.h"

@@ -3,7 +3,7 @@
 #include <string>
 
 #include "linalg/cholmod_llt.h"
-#include "reduction/bake_memory.h"
+#include "bake/bake_memory.h"
 #include "stand_in_stiffness.h"
 #include "test_support.h"
 #include "util/errors.h"

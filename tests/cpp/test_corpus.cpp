@@ -18,7 +18,7 @@
 #include "mesh/normalization.h"
 #include "mesh/primitives.h"
 #include "reduction/attachment.h"
-#include "reduction/bake.h"
+#include "bake/bake.h"
 #include "reduction/ghost.h"
 #include "solve/full_solver.h"
 #include "solve/reduced_solver.h"

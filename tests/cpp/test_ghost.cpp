@@ -14,7 +14,7 @@
 #include "mesh/mesh_topology.h"
 #include "mesh/primitives.h"
 #include "mesh/union_find.h"
-#include "reduction/edge_collapse.h"
+#include "mesh/edge_collapse.h"
 #include "reduction/ghost.h"
 #include "test_support.h"
 #include "util/errors.h"

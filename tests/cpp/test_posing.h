@@ -11,7 +11,7 @@
 #include "mesh/mass.h"
 #include "mesh/normalization.h"
 #include "mesh/triangle_mesh.h"
-#include "reduction/basis.h"
+#include "basis/basis.h"
 #include "solve/handle_term.h"
 
 namespace modal_deform::testing {

@@ -20,7 +20,7 @@
 #include <string>
 
 #include "mesh/primitives.h"
-#include "reduction/bake.h"
+#include "bake/bake.h"
 #include "solve/full_solver.h"
 #include "solve/reduced_solver.h"
 #include "test_posing.h"

@@ -9,7 +9,7 @@
 #include "mesh/mass.h"
 #include "mesh/mesh_check.h"
 #include "mesh/normalization.h"
-#include "reduction/bake.h"
+#include "bake/bake.h"
 #include "reduction/ghost.h"
 #include "solve/full_solver.h"
 #include "solve/reduced_solver.h"

@@ -1,4 +1,4 @@
-#include "reduction/bake.h"
+#include "bake/bake.h"
 
 #include <algorithm>
 #include <atomic>
@@ -19,7 +19,7 @@
 #include "modes/stiffness_and_mass.h"
 #include "modes/vibration_modes.h"
 #include "reduction/attachment.h"
-#include "reduction/bake_memory.h"
+#include "bake/bake_memory.h"
 #include "reduction/ghost.h"
 #include "reduction/orthonormalize.h"
 #include "util/errors.h"

@@ -1,4 +1,4 @@
-#include "reduction/bake_memory.h"
+#include "bake/bake_memory.h"
 
 #include <sys/resource.h>
 #include <unistd.h>

@@ -1,4 +1,4 @@
-#include "reduction/edge_collapse.h"
+#include "mesh/edge_collapse.h"
 
 #include <algorithm>
 #include <array>

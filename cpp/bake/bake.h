@@ -37,7 +37,7 @@
 #include <string>
 
 #include "energy/make_energy.h"
-#include "reduction/basis.h"
+#include "basis/basis.h"
 #include "util/progress.h"
 #include "util/types.h"
 

@@ -1,4 +1,4 @@
-#include "reduction/basis.h"
+#include "basis/basis.h"
 
 #include <cmath>
 #include <limits>
