@@ -1,6 +1,5 @@
 """mdc.bake against dense scipy references, the Basis arrays and their storage round trip, and
 progress, cancel and errors from the callback."""
-import time
 
 import numpy as np
 import pytest
@@ -214,45 +213,33 @@ def floppy_dragon(shared_mesh):
     return shared_mesh("dragon_vrip_res4.ply.gz")
 
 
-@pytest.fixture(scope="module")
-def floppy_bake(floppy_dragon):
-    """The floppy dragon's bake with its progress calls (time, stage, fraction), its warnings and
-    its duration: the unit for the promptness checks below (shares of a bake, not seconds, so a
-    loaded machine does not fail them)."""
+def test_progress_is_frequent_and_a_floppy_mesh_warns(floppy_dragon):
     calls = []
-    start = time.perf_counter()
     with pytest.warns(UserWarning, match="floppy") as record:
         basis = mdc.bake(*floppy_dragon, modes=20, derivatives=15,
-                         progress=lambda stage, fraction: calls.append((time.perf_counter(), stage, fraction)))
-    return basis, calls, record, time.perf_counter() - start
-
-
-def test_progress_is_frequent_and_a_floppy_mesh_warns(floppy_bake):
-    basis, calls, record, seconds = floppy_bake
+                         progress=lambda stage, fraction: calls.append((stage, fraction)))
     assert basis.num_floppy == 9 and basis.num_modes == 29 and basis.dimension + basis.num_dropped == 44
     assert "on top of the 20 modes" in str(record[0].message)
-    times = np.array([t for t, _, _ in calls])
-    assert np.diff(times).max() < 0.3 * seconds  # the bar never stands still for long
-    stages = [stage for _, stage, _ in calls]
+    # The bar moves inside the eigensolve, the longest stage, not only at its ends.
+    assert sum(stage == "modes" and 0 < fraction < 1 for stage, fraction in calls) >= 3
+    stages = [stage for stage, _ in calls]
     for stage in ("hessian", "modes", "third derivatives", "derivative solves", "orthonormalisation", "ghost"):
         assert stage in stages
-    assert all(0.0 <= fraction <= 1.0 for _, _, fraction in calls)
+    assert all(0.0 <= fraction <= 1.0 for _, fraction in calls)
 
 
-def test_cancel_stops_promptly(floppy_dragon, floppy_bake):
-    seconds = floppy_bake[3]
+def test_cancel_stops_at_once(floppy_dragon):
+    # The first report after the callback says stop ends the bake: nothing is reported after it.
     for stop_at in ("modes", "derivative solves", "ghost"):
-        asked = []
+        calls = []
 
         def progress(stage, fraction):
-            if stage == stop_at:
-                asked.append(time.perf_counter())
-                return False
-            return True
+            calls.append(stage)
+            return stage != stop_at
 
         with pytest.raises(mdc.Cancelled):
             mdc.bake(*floppy_dragon, modes=20, derivatives=15, progress=progress)
-        assert len(asked) == 1 and time.perf_counter() - asked[0] < 0.3 * seconds, stop_at
+        assert calls.index(stop_at) == len(calls) - 1, (stop_at, calls[-5:])
 
 
 def test_an_exception_in_the_callback_propagates_as_itself(two_tubes):
