@@ -220,8 +220,8 @@ def test_progress_is_frequent_and_a_floppy_mesh_warns(floppy_dragon):
                          progress=lambda stage, fraction: calls.append((stage, fraction)))
     assert basis.num_floppy == 9 and basis.num_modes == 29 and basis.dimension + basis.num_dropped == 44
     assert "on top of the 20 modes" in str(record[0].message)
-    # The bar moves inside the eigensolve, the longest stage, not only at its ends.
-    assert sum(stage == "modes" and 0 < fraction < 1 for stage, fraction in calls) >= 3
+    # (That the eigensolve reports between its ends is tested natively, with no minimum interval
+    # between reports: here reports are at most every 0.1 s, so their count depends on the machine.)
     stages = [stage for stage, _ in calls]
     for stage in ("hessian", "modes", "third derivatives", "derivative solves", "orthonormalisation", "ghost"):
         assert stage in stages
