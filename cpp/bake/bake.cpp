@@ -7,7 +7,9 @@
 #include <future>
 #include <memory>
 #include <new>
+#include <type_traits>
 
+#include "bake/bake_memory.h"
 #include "energy/arap.h"
 #include "energy/discrete_shells.h"
 #include "linalg/cholmod_llt.h"
@@ -19,7 +21,6 @@
 #include "modes/stiffness_and_mass.h"
 #include "modes/vibration_modes.h"
 #include "reduction/attachment.h"
-#include "bake/bake_memory.h"
 #include "reduction/ghost.h"
 #include "reduction/orthonormalize.h"
 #include "util/errors.h"
@@ -146,174 +147,227 @@ void check_options(const BakeOptions& o) {
   require_weight(o.membrane, "membrane");
 }
 
-Basis bake_stages(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Progress& progress) {
-  check_options(options);
-  validate_mesh(V, F);
+// One stage of the bake: reported to the bar at its start and end, and its wall time added to
+// basis.timings[name] (a stage may run in parts). Returns what `work` returns.
+template <typename Work>
+auto stage(const char* name, Basis& basis, Progress& progress, Work&& work) {
+  const Stopwatch stopwatch(basis.timings[name]);
+  progress.report(name, 0.0);
+  if constexpr (std::is_void_v<std::invoke_result_t<Work>>) {
+    work();
+    progress.report(name, 1.0);
+  } else {
+    auto result = work();
+    progress.report(name, 1.0);
+    return result;
+  }
+}
+
+// 1. What the basis keeps of the input: the rest mesh, its masses and the normalising scale.
+Basis rest_state(const VerticesRef& V, const FacesRef& F, const BakeOptions& options) {
   Basis basis;
-  auto& time = basis.timings;
   basis.rest = V;
   basis.mass = lumped_mass(V, F);
   basis.scale = normalizing_scale(V);
   basis.bending = options.bending;
   basis.membrane = options.membrane;
-  const double scale = basis.scale;
+  return basis;
+}
 
-  // 2. The simulated submesh, in the normalised frame.
+// The simulated submesh in the normalised frame, and the modes asked of it.
+struct Simulated {
   Attachment attachment;
-  {
-    const Stopwatch stopwatch(time["attachment"]);
-    progress.report("attachment", 0.0);
-    attachment = attach(V, F);
-    progress.report("attachment", 1.0);
-  }
-  const auto S = static_cast<Eigen::Index>(attachment.simulated.size());
-  RowMatrixX3d simulated_V(S, 3);
-  Eigen::VectorXd simulated_mass(S);
+  RowMatrixX3d V;        // #S by 3
+  Eigen::VectorXd mass;  // #S
+  int num_rigid = 0;     // 6 per simulated component
+  int flexible = 0;      // modes besides the rigid motions
+  Eigen::Index size() const { return V.rows(); }
+};
+
+// 2. Which vertices are simulated and which follow them (attachment.h); refuses mode counts the
+// submesh cannot give.
+Simulated simulated_submesh(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Basis& basis,
+                            Progress& progress) {
+  Simulated sim;
+  sim.attachment = stage("attachment", basis, progress, [&] { return attach(V, F); });
+  const std::vector<int>& simulated = sim.attachment.simulated;
+  const auto S = static_cast<Eigen::Index>(simulated.size());
+  sim.V.resize(S, 3);
+  sim.mass.resize(S);
   for (Eigen::Index s = 0; s < S; ++s) {
-    simulated_V.row(s) = scale * V.row(attachment.simulated[static_cast<size_t>(s)]);
-    simulated_mass[s] = scale * scale * basis.mass[attachment.simulated[static_cast<size_t>(s)]];
+    sim.V.row(s) = basis.scale * V.row(simulated[static_cast<size_t>(s)]);
+    sim.mass[s] = basis.scale * basis.scale * basis.mass[simulated[static_cast<size_t>(s)]];
   }
-  const int num_rigid = 6 * attachment.num_components;
-  if (options.modes <= num_rigid)
-    throw InputError(message("modes: ", options.modes, " modes are not more than the ", num_rigid,
-                             " rigid motions of the mesh's ", attachment.num_components,
-                             " simulated components (6 each); ask for more than ", num_rigid));
-  const int flexible = options.modes - num_rigid;
-  if (flexible >= 3 * S - num_rigid)
-    throw InputError(message("modes: the simulated mesh has ", 3 * S - num_rigid,
+  const int components = sim.attachment.num_components;
+  sim.num_rigid = 6 * components;
+  if (options.modes <= sim.num_rigid)
+    throw InputError(message("modes: ", options.modes, " modes are not more than the ", sim.num_rigid,
+                             " rigid motions of the mesh's ", components,
+                             " simulated components (6 each); ask for more than ", sim.num_rigid));
+  sim.flexible = options.modes - sim.num_rigid;
+  if (sim.flexible >= 3 * S - sim.num_rigid)
+    throw InputError(message("modes: the simulated mesh has ", 3 * S - sim.num_rigid,
                              " degrees of freedom besides its rigid motions; ask for fewer than ", 3 * S,
                              " modes, got ", options.modes));
+  return sim;
+}
 
-  // 3. Stiffness and vibration modes.
-  std::unique_ptr<DiscreteShells> shells;
+// 3. K = ∇²E(x̄) of the submesh; the shells energy is kept for its third derivatives.
+struct Stiffness {
+  std::unique_ptr<DiscreteShells> shells;  // null for ARAP
   SparseMatrix K;
-  {
-    const Stopwatch stopwatch(time["hessian"]);
-    progress.report("hessian", 0.0);
+};
+
+Stiffness stiffness_at_rest(const Simulated& sim, const BakeOptions& options, Basis& basis, Progress& progress) {
+  return stage("hessian", basis, progress, [&] {
+    Stiffness stiffness;
     if (options.energy == EnergyKind::kShells) {
-      shells = std::make_unique<DiscreteShells>(simulated_V, attachment.faces, options.bending, options.membrane);
-      K = shells->hessian(shells->rest());
+      stiffness.shells = std::make_unique<DiscreteShells>(sim.V, sim.attachment.faces, options.bending, options.membrane);
+      stiffness.K = stiffness.shells->hessian(stiffness.shells->rest());
     } else {
-      const Arap arap(simulated_V, attachment.faces);
-      K = arap.hessian(arap.rest());
+      const Arap arap(sim.V, sim.attachment.faces);
+      stiffness.K = arap.hessian(arap.rest());
     }
-    progress.report("hessian", 1.0);
+    return stiffness;
+  });
+}
+
+// 4. CHOLMOD orders K while the ghost of the whole mesh is simplified beside it (stage 8 uses
+// it). Analysed here rather than inside the eigensolver's first factorisation, so the bar moves
+// between the two (CHOLMOD reports nothing during either), and so that the factor's size is known
+// before the numeric factorisation: what cannot fit is refused at once, not half a minute later.
+Ghost order_beside_the_ghost(const VerticesRef& V, const FacesRef& F, const Simulated& sim, const SparseMatrix& K,
+                             const BakeOptions& options, CholmodLLT& factor, Basis& basis, Progress& progress) {
+  GhostInBackground ghost(V, F, basis.mass, options.ghost);
+  progress.report("factorisation", 0.0);
+  try {
+    factor.analyze(K);
+  } catch (const OutOfMemory& e) {
+    throw OutOfMemory(message("bake: not enough memory to order the stiffness matrix (", K.rows(), " rows, ",
+                              K.nonZeros(), " entries): ", e.what()));
   }
-  const Eigen::MatrixXd rigid = rigid_motions(simulated_V, attachment.component, simulated_mass);
-  CholmodLLT factor(3);  // one factorisation for the modes and the derivative solves
-  Ghost coarse;
-  {
-    // 7, done now: the ghost of the whole mesh, while CHOLMOD orders K. Analysed here rather than
-    // inside the eigensolver's first factorisation, so the bar moves between the two (CHOLMOD
-    // reports nothing during either).
-    GhostInBackground ghost(V, F, basis.mass, options.ghost);
-    progress.report("factorisation", 0.0);
-    try {
-      factor.analyze(K);
-    } catch (const OutOfMemory& e) {
-      throw OutOfMemory(message("bake: not enough memory to order the stiffness matrix (", K.rows(), " rows, ",
-                                K.nonZeros(), " entries): ", e.what()));
-    }
-    // The factor's size is known now, before the numeric factorisation: refuse at once what
-    // cannot fit rather than fail half a minute later.
-    require_memory(estimate_bake_memory(V.rows(), S, static_cast<double>(K.nonZeros()), factor.factor_bytes(),
-                                        options.modes, options.derivatives),
-                   available_memory());
-    progress.report("factorisation", 1.0);
-    const Stopwatch stopwatch(time["ghost"]);
-    coarse = ghost.get(progress);
-  }
+  require_memory(estimate_bake_memory(V.rows(), sim.size(), static_cast<double>(K.nonZeros()), factor.factor_bytes(),
+                                      options.modes, options.derivatives),
+                 available_memory());
+  progress.report("factorisation", 1.0);
+  const Stopwatch stopwatch(basis.timings["ghost"]);  // the wait beyond the ordering
+  return ghost.get(progress);
+}
+
+// 5. The vibration modes (eigenvalue problem K φ = λ M φ), timed without the factorisations
+// (they are the "factorisation" stage). A breakdown names the fine vertex of the failing row.
+Modes vibration_stage(const VerticesRef& V, const Simulated& sim, const SparseMatrix& K, const Eigen::MatrixXd& rigid,
+                      CholmodLLT& factor, Basis& basis, Progress& progress) {
+  const double factoring = factor.seconds();
   Modes modes;
   {
-    const double factoring = factor.seconds();
-    {
-      const Stopwatch stopwatch(time["modes"]);
-      try {
-        modes = flexible_modes(K, simulated_mass, rigid, flexible, progress, factor);
-      } catch (const NumericalError& e) {
-        if (factor.failed_row() < 0) throw;
-        // Where: the fine vertex of the row the factorisation broke down at.
-        const int vertex = attachment.simulated[static_cast<size_t>(factor.failed_row() / 3)];
-        throw NumericalError(message(e.what(), "; that row is ", "xyz"[factor.failed_row() % 3], " of vertex ", vertex,
-                                     " at (", V(vertex, 0), ", ", V(vertex, 1), ", ", V(vertex, 2), ")"));
-      }
+    const Stopwatch stopwatch(basis.timings["modes"]);
+    try {
+      modes = flexible_modes(K, sim.mass, rigid, sim.flexible, progress, factor);
+    } catch (const NumericalError& e) {
+      if (factor.failed_row() < 0) throw;
+      const int vertex = sim.attachment.simulated[static_cast<size_t>(factor.failed_row() / 3)];
+      throw NumericalError(message(e.what(), "; that row is ", "xyz"[factor.failed_row() % 3], " of vertex ", vertex,
+                                   " at (", V(vertex, 0), ", ", V(vertex, 1), ", ", V(vertex, 2), ")"));
     }
-    time["modes"] -= factor.seconds() - factoring;
   }
-  const int num_zero = modes.num_zero;
-  basis.num_floppy = num_zero;
+  basis.timings["modes"] -= factor.seconds() - factoring;
+  return modes;
+}
 
-  // 4. Modal derivatives of the pairs of modes other than the translations and zero modes: the
-  // linearised rotations of each component (λ = 0, so first), then the flexible modes.
+// 6. Modal derivatives (paper eq. 9, ∇²E ψ_ij = −∇³E(φ_i, φ_j)) of the pairs of modes other than
+// the translations and zero modes: the linearised rotations of each component (λ = 0, so first),
+// then the flexible modes.
+Eigen::MatrixXd derivative_stage(const Simulated& sim, const Stiffness& stiffness, const Eigen::MatrixXd& rigid,
+                                 const Modes& modes, const BakeOptions& options, CholmodLLT& factor, Basis& basis,
+                                 Progress& progress) {
+  const Eigen::Index S = sim.size();
   Eigen::MatrixXd derivatives(3 * S, options.derivatives);
-  if (options.derivatives > 0) {
-    const int paired_rotations = options.rotation_pairs ? 3 * attachment.num_components : 0;
-    Eigen::MatrixXd phi(3 * S, paired_rotations + flexible);
-    for (int r = 0; r < paired_rotations; ++r) phi.col(r) = rigid.col(6 * (r / 3) + 3 + r % 3);
-    phi.rightCols(flexible) = modes.vectors.rightCols(flexible);
-    const std::vector<std::array<int, 2>> pairs =
-        derivative_pairs(components_moved(phi, attachment.component), options.derivatives);
-    {
-      const Stopwatch stopwatch(time["third derivatives"]);
-      for (size_t first = 0; first < pairs.size(); first += kPairsPerPass) {
-        progress.report("third derivatives", static_cast<double>(first) / pairs.size());
-        const size_t last = std::min(pairs.size(), first + kPairsPerPass);
-        derivatives.middleCols(static_cast<Eigen::Index>(first), static_cast<Eigen::Index>(last - first)) =
-            shells->third_batch(shells->rest(), phi, {pairs.begin() + first, pairs.begin() + last});
-      }
-      progress.report("third derivatives", 1.0);
+  if (options.derivatives == 0) return derivatives;
+  const int paired_rotations = options.rotation_pairs ? 3 * sim.attachment.num_components : 0;
+  Eigen::MatrixXd phi(3 * S, paired_rotations + sim.flexible);
+  for (int r = 0; r < paired_rotations; ++r) phi.col(r) = rigid.col(6 * (r / 3) + 3 + r % 3);
+  phi.rightCols(sim.flexible) = modes.vectors.rightCols(sim.flexible);
+  const std::vector<std::array<int, 2>> pairs =
+      derivative_pairs(components_moved(phi, sim.attachment.component), options.derivatives);
+  const DiscreteShells& shells = *stiffness.shells;
+  stage("third derivatives", basis, progress, [&] {
+    for (size_t first = 0; first < pairs.size(); first += kPairsPerPass) {
+      progress.report("third derivatives", static_cast<double>(first) / pairs.size());
+      const size_t last = std::min(pairs.size(), first + kPairsPerPass);
+      derivatives.middleCols(static_cast<Eigen::Index>(first), static_cast<Eigen::Index>(last - first)) =
+          shells.third_batch(shells.rest(), phi, {pairs.begin() + first, pairs.begin() + last});
     }
-    Eigen::MatrixXd kernel(3 * S, num_rigid + num_zero);
-    kernel.leftCols(num_rigid) = rigid;
-    kernel.rightCols(num_zero) = modes.vectors.leftCols(num_zero);
-    const Stopwatch stopwatch(time["derivative solves"]);
-    derivatives = solve_in_range_shifted(K, simulated_mass, kernel, derivatives, factor, modes.shift,
-                                         modes.known_eigenvalues, modes.known_vectors, &progress);
-  }
-  time["factorisation"] = factor.seconds();
+  });
+  const int num_zero = modes.num_zero;
+  Eigen::MatrixXd kernel(3 * S, sim.num_rigid + num_zero);
+  kernel.leftCols(sim.num_rigid) = rigid;
+  kernel.rightCols(num_zero) = modes.vectors.leftCols(num_zero);
+  const Stopwatch stopwatch(basis.timings["derivative solves"]);
+  return solve_in_range_shifted(stiffness.K, sim.mass, kernel, derivatives, factor, modes.shift,
+                                modes.known_eigenvalues, modes.known_vectors, &progress);
+}
 
-  // 5. [rigid motions, zero modes, modes, derivatives], M-orthonormal.
+// 7. [rigid motions, zero modes, modes, derivatives], M-orthonormal; derivatives that came out
+// dependent are dropped (basis.num_dropped).
+Eigen::MatrixXd orthonormal_basis(const Simulated& sim, const Eigen::MatrixXd& rigid, const Modes& modes,
+                                  Eigen::MatrixXd derivatives, const BakeOptions& options, Basis& basis,
+                                  Progress& progress) {
+  const int num_zero = modes.num_zero;
   const int leading = options.modes + num_zero;
-  Eigen::MatrixXd U(3 * S, leading + options.derivatives);
-  U.leftCols(num_rigid) = rigid;
-  U.middleCols(num_rigid, num_zero + flexible) = modes.vectors;
+  Eigen::MatrixXd U(3 * sim.size(), leading + options.derivatives);
+  U.leftCols(sim.num_rigid) = rigid;
+  U.middleCols(sim.num_rigid, num_zero + sim.flexible) = modes.vectors;
   U.rightCols(options.derivatives) = derivatives;
   derivatives.resize(0, 0);
   {
-    const Stopwatch stopwatch(time["orthonormalisation"]);
-    const std::vector<int> kept = orthonormalize(U, dof_masses(simulated_mass), kDependentTolerance, &progress);
+    const Stopwatch stopwatch(basis.timings["orthonormalisation"]);
+    const std::vector<int> kept = orthonormalize(U, dof_masses(sim.mass), kDependentTolerance, &progress);
     for (int j = 0; j < leading; ++j)
       if (j >= static_cast<int>(kept.size()) || kept[static_cast<size_t>(j)] != j)
         throw NumericalError(message("bake: column ", j, " of the rigid motions and modes came out dependent; ",
                                      "they are not M-orthonormal"));
   }
   basis.num_dropped = static_cast<int>(leading + options.derivatives - U.cols());
-  basis.num_rigid = num_rigid;
+  basis.num_rigid = sim.num_rigid;
+  basis.num_floppy = num_zero;
   basis.num_modes = leading;
   basis.eigenvalues = Eigen::VectorXd::Zero(leading);
-  basis.eigenvalues.tail(num_zero + flexible) = modes.eigenvalues;
+  basis.eigenvalues.tail(num_zero + sim.flexible) = modes.eigenvalues;
+  return U;
+}
 
-  // 6. Attached rows, mesh units, single precision.
-  {
-    const Stopwatch stopwatch(time["assembly"]);
-    progress.report("assembly", 0.0);
+// 8. The fine basis (attached rows added, mesh units, single precision) and the ghost's,
+// restricted from the double-precision one (rigid motions stay exact).
+void fine_and_ghost_vectors(Eigen::MatrixXd U, const Attachment& attachment, Ghost coarse, Basis& basis,
+                            Progress& progress) {
+  stage("assembly", basis, progress, [&] {
     if (!attachment.followers.empty()) U = extend_to_attached(attachment, U);
-    U /= scale;
+    U /= basis.scale;
     basis.vectors = U.cast<float>();
-    progress.report("assembly", 1.0);
-  }
-
-  // 7. The ghost, restricted from the double-precision basis (rigid motions stay exact). "ghost"
-  // times what it adds to the bake: waiting for the thread, and the restriction.
-  {
-    const Stopwatch stopwatch(time["ghost"]);
-    progress.report("ghost", 0.0);
+  });
+  stage("ghost", basis, progress, [&] {
     basis.ghost_vectors = restrict_to_ghost(coarse, basis.mass, U);
     basis.ghost_vertices = std::move(coarse.V);
     basis.ghost_faces = std::move(coarse.F);
     basis.ghost_map = std::move(coarse.map);
-    progress.report("ghost", 1.0);
-  }
+  });
+}
+
+Basis bake_stages(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Progress& progress) {
+  check_options(options);
+  validate_mesh(V, F);
+  Basis basis = rest_state(V, F, options);
+  const Simulated sim = simulated_submesh(V, F, options, basis, progress);
+  const Stiffness stiffness = stiffness_at_rest(sim, options, basis, progress);
+  const Eigen::MatrixXd rigid = rigid_motions(sim.V, sim.attachment.component, sim.mass);
+  CholmodLLT factor(3);  // one factorisation for the modes and the derivative solves
+  Ghost coarse = order_beside_the_ghost(V, F, sim, stiffness.K, options, factor, basis, progress);
+  const Modes modes = vibration_stage(V, sim, stiffness.K, rigid, factor, basis, progress);
+  Eigen::MatrixXd derivatives = derivative_stage(sim, stiffness, rigid, modes, options, factor, basis, progress);
+  basis.timings["factorisation"] = factor.seconds();
+  Eigen::MatrixXd U = orthonormal_basis(sim, rigid, modes, std::move(derivatives), options, basis, progress);
+  fine_and_ghost_vectors(std::move(U), sim.attachment, std::move(coarse), basis, progress);
   validate_basis(basis);
   return basis;
 }
