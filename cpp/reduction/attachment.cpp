@@ -51,17 +51,20 @@ Attachment::Follower follow(const VerticesRef& V, const RowMatrixX3d& P, const E
   double reach = std::max(kRegionReach * std::max(radius, distance.minCoeff()), sorted[static_cast<size_t>(k)]);
 
   // The region: its principal axes (ascending extent) from the mass-weighted covariance.
+  // Its weights w and its vertices relative to their weighted mean, kept for the fit below.
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> axes;
   Eigen::RowVector3d mean;
+  Eigen::VectorXd w;
+  RowMatrixX3d centred;
   bool flat = false;
   for (;;) {
     follower.anchors.clear();
     for (int s = 0; s < S; ++s)
       if (distance[s] <= reach) follower.anchors.push_back(s);
-    const Eigen::VectorXd w = mass(follower.anchors);
+    w = mass(follower.anchors);
     const RowMatrixX3d A = P(follower.anchors, Eigen::all);
     mean = (w.transpose() * A) / w.sum();
-    const RowMatrixX3d centred = A.rowwise() - mean;
+    centred = A.rowwise() - mean;
     axes.compute(centred.transpose() * w.asDiagonal() * centred / w.sum());
     const bool collinear = axes.eigenvalues()[1] <= kCollinear * kCollinear * axes.eigenvalues()[2];
     flat = axes.eigenvalues()[0] < kMinThickness * kMinThickness * axes.eigenvalues()[2];
@@ -83,9 +86,7 @@ Attachment::Follower follow(const VerticesRef& V, const RowMatrixX3d& P, const E
   const auto K = static_cast<Eigen::Index>(follower.anchors.size());
   Eigen::MatrixXd design(1 + directions.cols(), K);  // column k: [1; y_k·e]
   design.row(0).setOnes();
-  design.bottomRows(directions.cols()) =
-      directions.transpose() * (P(follower.anchors, Eigen::all).rowwise() - mean).transpose();
-  const Eigen::VectorXd w = mass(follower.anchors);
+  design.bottomRows(directions.cols()) = directions.transpose() * centred.transpose();
   const Eigen::MatrixXd gram = design * w.asDiagonal() * design.transpose();
   const Eigen::MatrixXd solved = gram.ldlt().solve(design * w.asDiagonal());  // column k: G⁻¹ w_k [1; y_k·e]
   follower.offsets.resize(static_cast<Eigen::Index>(group.vertices.size()), 3);

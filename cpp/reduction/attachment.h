@@ -27,7 +27,6 @@
 // to each basis vector (x = x̄ + U q stays linear).
 #pragma once
 
-#include <array>
 #include <vector>
 
 #include "util/types.h"
