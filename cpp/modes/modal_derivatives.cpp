@@ -179,8 +179,9 @@ std::vector<std::vector<int>> components_moved(const Eigen::Ref<const Eigen::Mat
   for (Eigen::Index col = 0; col < Phi.cols(); ++col) {
     Eigen::VectorXd norm = Eigen::VectorXd::Zero(c);
     for (Eigen::Index v = 0; v < component.size(); ++v) norm[component[v]] += Phi.col(col).segment<3>(3 * v).squaredNorm();
+    const double total = norm.sum();
     for (int k = 0; k < c; ++k)
-      if (norm[k] > 1e-12 * norm.sum()) moved[static_cast<size_t>(col)].push_back(k);
+      if (norm[k] > 1e-12 * total) moved[static_cast<size_t>(col)].push_back(k);
   }
   return moved;
 }
