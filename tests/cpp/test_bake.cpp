@@ -97,17 +97,29 @@ TEST(Bake, ModesAreTheEigenpairsOfTheNormalisedShellsHessian) {
   }
 }
 
+// The shells energy of a mesh at rest in the normalised frame: its stiffness, masses and rigid
+// motions (one component).
+struct ShellsAtRest {
+  RowMatrixX3d X;
+  DiscreteShells shells;
+  SparseMatrix K;
+  Eigen::VectorXd mass;
+  Eigen::MatrixXd Z;
+
+  explicit ShellsAtRest(const TriangleMesh& mesh)
+      : X(normalizing_scale(mesh.V) * mesh.V),
+        shells(X, mesh.F),
+        K(shells.hessian(shells.rest())),
+        mass(lumped_mass(X, mesh.F)),
+        Z(rigid_motions(X, Eigen::VectorXi::Zero(X.rows()), mass)) {}
+};
+
 TEST(Bake, BasisSpansTheModalDerivativesOfEquation13) {
   // The derivatives solved independently of the bake (rigid kernel pinned at other DOFs) lie in
   // the span of the baked basis; K ψ = P ∇³E(φᵢ, φⱼ) holds, and ψᵢⱼ = ψⱼᵢ.
   const TriangleMesh mesh = bumpy_plane(10, 1.0, 4, 0.2);
   const Basis basis = bake_with(mesh, 12, 12);
-  const double s = basis.scale;
-  const RowMatrixX3d X = s * mesh.V;
-  const DiscreteShells shells(X, mesh.F);
-  const SparseMatrix K = shells.hessian(shells.rest());
-  const Eigen::VectorXd mass = s * s * lumped_mass(mesh.V, mesh.F);
-  const Eigen::MatrixXd Z = rigid_motions(X, Eigen::VectorXi::Zero(X.rows()), mass);
+  const auto& [X, shells, K, mass, Z] = ShellsAtRest(mesh);
   const VibrationModes modes = vibration_modes(K, mass, 6, Z);
   // The paper's pairs: the three rotations first (λ = 0), then the six flexible modes.
   Eigen::MatrixXd phi(K.rows(), 9);
@@ -144,7 +156,7 @@ TEST(Bake, BasisSpansTheModalDerivativesOfEquation13) {
     EXPECT_LT((Psi - Psi_shifted).norm(), tolerance * Psi.norm()) << "sigma " << sigma;
   }
 
-  const Eigen::MatrixXd U = s * basis.vectors.cast<double>();
+  const Eigen::MatrixXd U = basis.scale * basis.vectors.cast<double>();
   for (Eigen::Index c = 0; c < Psi.cols(); ++c) {
     const Eigen::VectorXd psi = Psi.col(c);
     const Eigen::VectorXd outside = psi - U * (U.transpose() * m.cwiseProduct(psi));
@@ -158,11 +170,7 @@ TEST(Bake, BasisSpansTheModalDerivativesOfEquation13) {
 // rotated, −W φ, up to a part ∝ λ), and with another rotation −K W_a W_b x̄.
 TEST(Bake, RotationsDerivativesAreTheModesRotated) {
   const TriangleMesh mesh = bumpy_plane(8, 1.0, 3, 0.2);
-  const RowMatrixX3d X = normalizing_scale(mesh.V) * mesh.V;
-  const DiscreteShells shells(X, mesh.F);
-  const SparseMatrix K = shells.hessian(shells.rest());
-  const Eigen::VectorXd mass = lumped_mass(X, mesh.F);
-  const Eigen::MatrixXd Z = rigid_motions(X, Eigen::VectorXi::Zero(X.rows()), mass);
+  const auto& [X, shells, K, mass, Z] = ShellsAtRest(mesh);
   const VibrationModes modes = vibration_modes(K, mass, 2, Z);
   const Eigen::RowVector3d centre = (mass.transpose() * X) / mass.sum();
   const RowMatrixX3d P = X.rowwise() - centre;
@@ -195,11 +203,7 @@ TEST(Bake, RotationsDerivativesAreTheModesRotated) {
 
 TEST(Bake, ShiftedSolvesRefuseInconsistentInput) {
   const TriangleMesh mesh = bumpy_plane(6, 1.0, 2, 0.2);
-  const RowMatrixX3d X = normalizing_scale(mesh.V) * mesh.V;
-  const DiscreteShells shells(X, mesh.F);
-  const SparseMatrix K = shells.hessian(shells.rest());
-  const Eigen::VectorXd mass = lumped_mass(X, mesh.F);
-  const Eigen::MatrixXd Z = rigid_motions(X, Eigen::VectorXi::Zero(X.rows()), mass);
+  const auto& [X, shells, K, mass, Z] = ShellsAtRest(mesh);
   CholmodLLT shifted(3);
   const VibrationModes modes = vibration_modes(K, mass, 4, Z, nullptr, &shifted);
   const Eigen::MatrixXd B = Eigen::MatrixXd::Random(K.rows(), 2);
