@@ -9,19 +9,18 @@ ready to pose: select the mesh, Sidebar > Modal Deform > Pose, then move the Emp
 Prints the bake time and the time per interactive update.
 """
 import argparse
+import importlib
 import math
 import pathlib
 import sys
 import time
 
-import addon_utils
 import bpy
 import numpy as np
 from mathutils import Matrix, Vector
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "python_addon"))
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-from headless import add_handle  # noqa: E402
+from headless import add_handle, enable_addon  # noqa: E402
 from rendering import render, side_by_side, stage  # noqa: E402
 
 
@@ -51,10 +50,10 @@ def subdivided_suzanne(levels):
     return suzanne
 
 
-def interactive_updates(obj, count):
+def interactive_updates(posing, obj, count):
     """Time `count` updates of the interactive pose (what each timer tick of the Pose operator does:
-    controllers -> solver within its budget -> shape key) while the controllers move in steps."""
-    from modal_deform import posing
+    controllers -> solver within its budget -> shape key) after the controllers were placed: the
+    first updates solve toward them, the later ones find the pose converged."""
     pose = posing.Pose(bpy.context, obj)
     state = posing.ShapeKeyState(obj, posing.POSE_KEY)
     block = state.ensure()
@@ -71,8 +70,7 @@ def interactive_updates(obj, count):
 
 def main():
     args = arguments()
-    addon_utils.enable("modal_deform", default_set=True)
-    from modal_deform import posing
+    posing = importlib.import_module(f"{enable_addon().__name__}.posing")
     output = pathlib.Path(args.output).resolve()
     output.mkdir(parents=True, exist_ok=True)
 
@@ -98,7 +96,7 @@ def main():
                                     @ head.controller.matrix_world)
     bpy.context.view_layer.update()
 
-    times = interactive_updates(suzanne, 30)
+    times = interactive_updates(posing, suzanne, 30)
     print(f"interactive pose: {np.median(times):.1f} ms per update (median of {len(times)}; first {times[0]:.1f} ms; "
           f"budget {suzanne.modal_deform.budget:.0f} ms for the solver)")
     assert bpy.ops.modal_deform.solve() == {"FINISHED"}
