@@ -36,7 +36,8 @@ from mathutils import Matrix
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "python_addon"))
 sys.path.insert(0, str(ROOT / "blender_scripts"))
-from headless import add_handle, enable_addon  # noqa: E402 (found through the line above)
+from headless import (add_handle, bind_laplacian_deform, enable_addon,  # noqa: E402 (found through the line above)
+                      evaluated_positions)
 MESHES = ROOT.parent / "shared" / "meshes"
 ADDON = "modal_deform"  # the add-on's module: bl_ext.<repository>.modal_deform when installed as an extension
 
@@ -189,22 +190,13 @@ def bind_laplacian(obj, anchors, moving):
     """Blender's Laplacian Deform on obj with the vertices `anchors` held and `moving` (among them)
     carried by a hook to an Empty at the origin (its matrix_world is then the handle's transform).
     Returns the Empty and the bind time in seconds."""
-    group = obj.vertex_groups.new(name="Anchors")
-    group.add(np.asarray(anchors).tolist(), 1.0, "REPLACE")
     group = obj.vertex_groups.new(name="Moving")
     group.add(np.asarray(moving).tolist(), 1.0, "REPLACE")
     empty = bpy.data.objects.new("Hook", None)
     bpy.context.scene.collection.objects.link(empty)
     hook = obj.modifiers.new("Hook", "HOOK")
-    hook.object, hook.vertex_group = empty, "Moving"
-    laplacian = obj.modifiers.new("LaplacianDeform", "LAPLACIANDEFORM")
-    laplacian.vertex_group = "Anchors"
-    bpy.context.view_layer.update()
-    t = time.perf_counter()
-    with bpy.context.temp_override(object=obj, active_object=obj):
-        bpy.ops.object.laplaciandeform_bind(modifier=laplacian.name)
-    bpy.context.view_layer.update()
-    return empty, time.perf_counter() - t
+    hook.object, hook.vertex_group = empty, group.name
+    return empty, bind_laplacian_deform(obj, anchors)
 
 
 def laplacian_deform(updates, subdivisions):
@@ -284,15 +276,6 @@ def laplacian_on_shapes(folder):
               f"{rows[-1]['energy_laplacian']:.4g}; ours {rows[-1]['ours_update_ms']:.2f} ms, energy "
               f"{rows[-1]['energy_ours']:.4g}; full {rows[-1]['energy_full']:.4g}", flush=True)
     return rows
-
-
-def evaluated_positions(obj):
-    evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
-    mesh = evaluated.to_mesh()
-    co = np.empty(3 * len(mesh.vertices), np.float32)
-    mesh.vertices.foreach_get("co", co)
-    evaluated.to_mesh_clear()
-    return co.reshape(-1, 3)
 
 
 def main():

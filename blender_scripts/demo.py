@@ -1,12 +1,14 @@
 """The main job, headless: bake Suzanne (~31k vertices), pose it strongly with two handles (the top
-of the head turned by 30 and bent sideways by 25 degrees against the held chin: a pose with large
-rotations, what modal derivatives are for), render before/after.
+of the head turned by TURN and bent sideways by BEND degrees against the held chin: a pose with large
+rotations, what modal derivatives are for), and set Blender's own Laplacian Deform the same task
+with the same handles.
 
     blender -b --factory-startup --python blender_scripts/demo.py -- --output out
 
-Writes OUTPUT/demo.png (Cycles on the CPU, rest and posed side by side) and OUTPUT/demo.blend,
-ready to pose: select the mesh, Sidebar > Modal Deform > Pose, then move the Empties with G/R.
-Prints the bake time and the time per interactive update.
+Writes OUTPUT/demo.png (Cycles on the CPU: rest, Modal Deform, Laplacian Deform side by side) and
+OUTPUT/demo.blend, ready to pose: select the mesh, Sidebar > Modal Deform > Pose, then move the
+Empties with G/R. Prints the bake time, the time per interactive update and how much each result
+stretches the surface.
 """
 import argparse
 import importlib
@@ -20,12 +22,14 @@ import numpy as np
 from mathutils import Matrix, Vector
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-from headless import add_handle, enable_addon  # noqa: E402
+from headless import add_handle, bind_laplacian_deform, enable_addon, evaluated_positions  # noqa: E402
 from rendering import render, side_by_side, stage  # noqa: E402
 
 
 #: The pose: the top of the head turned about the vertical and then bent sideways (degrees).
-TURN, BEND = 30, 25
+TURN, BEND = 45, 45
+#: The top of the head (the moved handle): Suzanne's vertices above this height (she spans -1 to 1).
+TOP = 0.6
 
 
 def arguments():
@@ -34,7 +38,9 @@ def arguments():
     parser.add_argument("--output", default="out", help="folder for demo.png and demo.blend")
     parser.add_argument("--subdivisions", type=int, default=3, help="Catmull-Clark levels (3: ~31k vertices)")
     parser.add_argument("--samples", type=int, default=16, help="Cycles samples per pixel")
-    parser.add_argument("--width", type=int, default=800, help="width of each of the two pictures, pixels")
+    parser.add_argument("--turn", type=float, default=TURN, help="the top of the head turned about the vertical, degrees")
+    parser.add_argument("--bend", type=float, default=BEND, help="then bent sideways, degrees")
+    parser.add_argument("--width", type=int, default=800, help="width of each of the three pictures, pixels")
     return parser.parse_args(argv)
 
 
@@ -68,9 +74,40 @@ def interactive_updates(posing, obj, count):
     return times
 
 
+def laplacian_deform_copy(obj, anchors, moving, transform):
+    """A copy of obj's rest mesh with Blender's Laplacian Deform: the vertices `anchors` held, those
+    of them in `moving` carried by `transform` (a hook to an Empty), as Modal Deform's handles are."""
+    copy = bpy.data.objects.new("Laplacian Deform", obj.data.copy())
+    copy.matrix_world = obj.matrix_world
+    copy.shape_key_clear()
+    bpy.context.scene.collection.objects.link(copy)
+    group = copy.vertex_groups.new(name="Moving")
+    group.add(np.flatnonzero(moving).tolist(), 1.0, "REPLACE")
+    empty = bpy.data.objects.new("Laplacian Deform hook", None)
+    bpy.context.scene.collection.objects.link(empty)
+    hook = copy.modifiers.new("Hook", "HOOK")
+    hook.object, hook.vertex_group = empty, group.name
+    bind_laplacian_deform(copy, np.flatnonzero(anchors))
+    empty.matrix_world = transform
+    bpy.context.view_layer.update()
+    return copy, empty
+
+
+def edge_strain(mesh, rest, posed):
+    """Mean and largest |l / l_rest - 1| over the mesh's edges: how much a pose stretches or
+    squashes the surface (an artist sees it as rubbery or shrunken parts)."""
+    edges = np.empty(2 * len(mesh.edges), np.int32)
+    mesh.edges.foreach_get("vertices", edges)
+    edges = edges.reshape(-1, 2)
+    length = np.linalg.norm(posed[edges[:, 0]] - posed[edges[:, 1]], axis=1)
+    strain = np.abs(length / np.linalg.norm(rest[edges[:, 0]] - rest[edges[:, 1]], axis=1) - 1)
+    return strain.mean(), strain.max()
+
+
 def main():
     args = arguments()
-    posing = importlib.import_module(f"{enable_addon().__name__}.posing")
+    addon = enable_addon().__name__
+    posing, mesh_io, mdc = (importlib.import_module(f"{addon}.{name}") for name in ("posing", "mesh_io", "core"))
     output = pathlib.Path(args.output).resolve()
     output.mkdir(parents=True, exist_ok=True)
 
@@ -88,12 +125,13 @@ def main():
 
     # Handles: the top of the head, turned about the vertical and bent sideways about the head's
     # centre; the chin, held where it is (its Empty is not moved).
-    head = add_handle(suzanne, V[:, 2] > 0.4)
-    add_handle(suzanne, (V[:, 2] < -0.55) & (V[:, 1] < -0.3))
-    turn = Matrix.Rotation(math.radians(BEND), 4, "Y") @ Matrix.Rotation(math.radians(TURN), 4, "Z")
+    top, chin = V[:, 2] > TOP, (V[:, 2] < -0.55) & (V[:, 1] < -0.3)
+    head = add_handle(suzanne, top)
+    add_handle(suzanne, chin)
+    turn = Matrix.Rotation(math.radians(args.bend), 4, "Y") @ Matrix.Rotation(math.radians(args.turn), 4, "Z")
     centre = suzanne.matrix_world.translation
-    head.controller.matrix_world = (Matrix.Translation(centre) @ turn @ Matrix.Translation(-centre)
-                                    @ head.controller.matrix_world)
+    transform = Matrix.Translation(centre) @ turn @ Matrix.Translation(-centre)
+    head.controller.matrix_world = transform @ head.controller.matrix_world
     bpy.context.view_layer.update()
 
     times = interactive_updates(posing, suzanne, 30)
@@ -101,16 +139,34 @@ def main():
           f"budget {suzanne.modal_deform.budget:.0f} ms for the solver)")
     assert bpy.ops.modal_deform.solve() == {"FINISHED"}
 
+    # Laplacian Deform gets the same handles. Each connected component needs an anchor of its own:
+    # the eyes go with the top of the head.
+    component = mdc.check(V, mesh_io.triangles(suzanne.data))["vertex_component"]
+    eyes = component != component[np.flatnonzero(top)[0]]
+    laplacian, hook = laplacian_deform_copy(suzanne, top | chin | eyes, top | eyes, transform)
+    key = suzanne.data.shape_keys.key_blocks[posing.POSE_KEY]
+    posed = np.empty(V.size, np.float32)
+    key.data.foreach_get("co", posed)
+    for name, X in (("Modal Deform", posed.reshape(-1, 3)), ("Laplacian Deform", evaluated_positions(laplacian))):
+        mean, largest = edge_strain(suzanne.data, V, X)
+        print(f"{name}: edges stretched or squashed by {100 * mean:.1f}% on average, at most {100 * largest:.0f}%")
+
     stage(suzanne.matrix_world.translation + Vector((0.1, 0.0, 0.05)), eye=(1.0, -6.0, 0.8), lens=70,
           samples=args.samples, resolution=(args.width, args.width * 3 // 4))
-    key = suzanne.data.shape_keys.key_blocks[posing.POSE_KEY]
     start = time.perf_counter()
+    laplacian.hide_render = True
     key.value = 0.0
-    before = render(output / "demo_before.png")
+    rest = render(output / "demo_before.png")
     key.value = 1.0
-    after = render(output / "demo_after.png")
-    side_by_side([before, after], output / "demo.png")
-    print(f"rendered {output / 'demo.png'} in {time.perf_counter() - start:.1f} s")
+    ours = render(output / "demo_after.png")
+    suzanne.hide_render, laplacian.hide_render = True, False
+    theirs = render(output / "demo_laplacian.png")
+    side_by_side([rest, ours, theirs], output / "demo.png")
+    print(f"rendered {output / 'demo.png'} (rest, Modal Deform, Laplacian Deform) in {time.perf_counter() - start:.1f} s")
+    # The file keeps Suzanne alone, ready to pose.
+    suzanne.hide_render = False
+    bpy.data.objects.remove(laplacian)
+    bpy.data.objects.remove(hook)
 
     bpy.context.view_layer.objects.active = suzanne
     for obj in bpy.context.view_layer.objects:

@@ -1,8 +1,10 @@
-"""What the headless scripts share: their arguments after "--", the object they work on, saving."""
+"""What the headless scripts share: their arguments after "--", the object they work on, saving, handles
+made as an artist makes them, and Blender's Laplacian Deform to compare with."""
 import argparse
 import importlib
 import pathlib
 import sys
+import time
 
 import addon_utils
 import bmesh
@@ -85,3 +87,29 @@ def add_handle(obj, mask):
     if result != {"FINISHED"}:
         raise RuntimeError(f"Add Handle on {obj.name!r} did not finish: {result}")
     return obj.modal_deform.handles[-1]
+
+
+def bind_laplacian_deform(obj, anchors):
+    """Add Blender's Laplacian Deform to obj (last in its stack) with the vertices `anchors` as its
+    anchor group, bound to obj's current shape; returns the bind time in seconds. Every connected
+    component needs an anchor, or the modifier finds no solution and passes its input through."""
+    group = obj.vertex_groups.new(name="Anchors")
+    group.add(np.asarray(anchors).tolist(), 1.0, "REPLACE")
+    laplacian = obj.modifiers.new("LaplacianDeform", "LAPLACIANDEFORM")
+    laplacian.vertex_group = group.name
+    bpy.context.view_layer.update()
+    start = time.perf_counter()
+    with bpy.context.temp_override(object=obj, active_object=obj):
+        bpy.ops.object.laplaciandeform_bind(modifier=laplacian.name)
+    bpy.context.view_layer.update()
+    return time.perf_counter() - start
+
+
+def evaluated_positions(obj):
+    """obj's vertex positions after its modifiers and shape keys, (n, 3) float32."""
+    evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    mesh = evaluated.to_mesh()
+    co = np.empty(3 * len(mesh.vertices), np.float32)
+    mesh.vertices.foreach_get("co", co)
+    evaluated.to_mesh_clear()
+    return co.reshape(-1, 3)
