@@ -186,19 +186,6 @@ def storage_figures(obj, folder):
     return figures
 
 
-def bind_laplacian(obj, anchors, moving):
-    """Blender's Laplacian Deform on obj with the vertices `anchors` held and `moving` (among them)
-    carried by a hook to an Empty at the origin (its matrix_world is then the handle's transform).
-    Returns the Empty and the bind time in seconds."""
-    group = obj.vertex_groups.new(name="Moving")
-    group.add(np.asarray(moving).tolist(), 1.0, "REPLACE")
-    empty = bpy.data.objects.new("Hook", None)
-    bpy.context.scene.collection.objects.link(empty)
-    hook = obj.modifiers.new("Hook", "HOOK")
-    hook.object, hook.vertex_group = empty, group.name
-    return empty, bind_laplacian_deform(obj, anchors)
-
-
 def laplacian_deform(updates, subdivisions):
     """Blender's Laplacian Deform on Suzanne at `subdivisions` levels: bind time and time per update
     (1 iteration, the modifier's default) with a hook moving the top anchors."""
@@ -217,7 +204,7 @@ def laplacian_deform(updates, subdivisions):
     label = mdc.check(V, mesh_io.triangles(obj.data))["vertex_component"]
     eyes = np.flatnonzero(label != label[top[0]])
     anchors = np.concatenate([top, bottom, eyes])
-    empty, bind = bind_laplacian(obj, anchors, top)
+    empty, bind = bind_laplacian_deform(obj, anchors, top)
     times = []
     for i in range(updates):
         empty.location = (0.02 * (i + 1), 0.0, 0.01 * (i + 1))
@@ -244,7 +231,7 @@ def laplacian_on_shapes(folder):
         V, F, steps = data["rest"], data["F"], data["transforms"]
         clear_scene()
         obj = mesh_object("Shape", V, F)
-        empty, bind = bind_laplacian(obj, np.concatenate([data["handle0"], data["handle1"]]), data["handle1"])
+        empty, bind = bind_laplacian_deform(obj, np.concatenate([data["handle0"], data["handle1"]]), data["handle1"])
         laplacian_ms = []
         for transforms in steps:
             empty.matrix_world = Matrix(transforms[1].tolist())

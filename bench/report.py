@@ -222,9 +222,14 @@ ACCURACY_READING = """What the figures say (run of 2026-11-24).
   spanned well only from 130 dimensions, where the twists' gaps fall to 0.09 and 0.15. At 130
   dimensions the bar bent by 180° misses gap ≤ 0.2 narrowly (0.21), and the buckled 180° twist misses
   RMS ≤ 1.5% (2.5%) at a gap of 0.15: the twist can spread differently along the bar at almost the
-  same objective, so RMS is a poor judge there. (The issue's own measurement, gap 0.79 for the 90°
-  twist at 67 dimensions, used handle stiffness 100 and another bar; this run uses the project's
-  stiffness 1000 and the 12 x 12 x 120 bar.)
+  same objective, so RMS is a poor judge there. It is the thin bar's torsion that 67 dimensions span
+  poorly: on issue 16's own bar (60 x 10 x 10 scaled to length 10, so 1.7 times as thick, handle
+  stiffness 100) the 90° twist's gap at 67 dimensions is 0.12 against linear modes' 7.1 (the issue's
+  independent implementation: 0.79), and the bends' 0.23 and 0.28 (issue: 0.27 and 0.32), measured
+  by tests/cpp/test_posing_accuracy.cpp (BarOfTheIssueTwistedAndBent). On that bar linear modes come
+  closer in position than the issue found (RMS 0.97% against the derivatives' 1.13% at the 60° bend;
+  issue: 4.83%) because they reach half its objective in the same space (gap 3.6; issue: 7.7): its
+  linear solves had stopped short. In energy they stay 15 to 60 times further off.
 - Where linear modes win: the bumpy plane, held at its border and lifted (and tilted) in the middle,
   at every size up to 130 dimensions (gap 0.67 against 3.1 at 67, 0.42 against 0.81 at 130). The
   pose bends the plate without large rotations, so the derivatives' second-order corrections have

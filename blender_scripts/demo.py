@@ -81,13 +81,7 @@ def laplacian_deform_copy(obj, anchors, moving, transform):
     copy.matrix_world = obj.matrix_world
     copy.shape_key_clear()
     bpy.context.scene.collection.objects.link(copy)
-    group = copy.vertex_groups.new(name="Moving")
-    group.add(np.flatnonzero(moving).tolist(), 1.0, "REPLACE")
-    empty = bpy.data.objects.new("Laplacian Deform hook", None)
-    bpy.context.scene.collection.objects.link(empty)
-    hook = copy.modifiers.new("Hook", "HOOK")
-    hook.object, hook.vertex_group = empty, group.name
-    bind_laplacian_deform(copy, np.flatnonzero(anchors))
+    empty, _ = bind_laplacian_deform(copy, np.flatnonzero(anchors), np.flatnonzero(moving))
     empty.matrix_world = transform
     bpy.context.view_layer.update()
     return copy, empty

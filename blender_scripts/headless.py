@@ -89,10 +89,18 @@ def add_handle(obj, mask):
     return obj.modal_deform.handles[-1]
 
 
-def bind_laplacian_deform(obj, anchors):
-    """Add Blender's Laplacian Deform to obj (last in its stack) with the vertices `anchors` as its
-    anchor group, bound to obj's current shape; returns the bind time in seconds. Every connected
-    component needs an anchor, or the modifier finds no solution and passes its input through."""
+def bind_laplacian_deform(obj, anchors, moving):
+    """Blender's Laplacian Deform on obj, bound to its current shape, with the vertices `anchors`
+    held and those of them in `moving` carried by a hook to an Empty at the origin (its matrix_world
+    is then the moving handle's transform). Every connected component needs an anchor, or the
+    modifier finds no solution and passes the hooked mesh through. Returns the Empty and the bind
+    time in seconds."""
+    group = obj.vertex_groups.new(name="Moving")
+    group.add(np.asarray(moving).tolist(), 1.0, "REPLACE")
+    empty = bpy.data.objects.new(f"{obj.name} hook", None)
+    bpy.context.scene.collection.objects.link(empty)
+    hook = obj.modifiers.new("Hook", "HOOK")
+    hook.object, hook.vertex_group = empty, group.name
     group = obj.vertex_groups.new(name="Anchors")
     group.add(np.asarray(anchors).tolist(), 1.0, "REPLACE")
     laplacian = obj.modifiers.new("LaplacianDeform", "LAPLACIANDEFORM")
@@ -102,7 +110,7 @@ def bind_laplacian_deform(obj, anchors):
     with bpy.context.temp_override(object=obj, active_object=obj):
         bpy.ops.object.laplaciandeform_bind(modifier=laplacian.name)
     bpy.context.view_layer.update()
-    return time.perf_counter() - start
+    return empty, time.perf_counter() - start
 
 
 def evaluated_positions(obj):
