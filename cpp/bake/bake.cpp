@@ -141,8 +141,10 @@ void check_options(const BakeOptions& o) {
   if (o.modes < 1) throw InputError(message("modes: expected at least 1, got ", o.modes));
   if (o.derivatives < 0) throw InputError(message("derivatives: expected 0 or more, got ", o.derivatives));
   if (o.ghost < 4) throw InputError(message("ghost: a ghost needs at least 4 vertices, got ", o.ghost));
-  if (o.proxy < 0 || (o.proxy > 0 && o.proxy < o.ghost))
-    throw InputError(message("proxy: expected 0 (none) or at least the ghost's ", o.ghost, " vertices, got ", o.proxy));
+  if (o.proxy_above < 0) throw InputError(message("proxy_above: expected 0 (never) or more, got ", o.proxy_above));
+  if (o.proxy_above > 0 && (o.proxy < o.ghost || o.proxy > o.proxy_above))
+    throw InputError(message("proxy: expected between the ghost's ", o.ghost, " and proxy_above's ", o.proxy_above,
+                             " vertices, got ", o.proxy));
   if (o.energy == EnergyKind::kArap && o.derivatives > 0)
     throw InputError(message("derivatives: the ARAP energy has no third derivative, so it has no modal derivatives; ",
                              "bake it with derivatives = 0, or use the shells energy (asked for ", o.derivatives, ")"));
@@ -404,7 +406,7 @@ Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, 
   try {
     check_options(options);
     validate_mesh(V, F);
-    Basis basis = options.proxy > 0 && V.rows() > options.proxy
+    Basis basis = options.proxy_above > 0 && V.rows() > options.proxy_above
                       ? bake_on_proxy(V, F, options, progress)
                       : bake_stages(V, F, options, rest_state(V, F, options, normalizing_scale(V)), progress);
     validate_basis(basis);

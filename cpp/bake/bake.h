@@ -24,8 +24,8 @@
 //   6. Attached rows, conversion to mesh units (x = x̄ + U q), float32 vectors.
 //   7. Ghost: edge collapse of the whole mesh to about `ghost` vertices, the basis restricted.
 //
-// A mesh of more than options.proxy vertices goes through steps 2 to 7 as a proxy: the fine mesh
-// simplified by the same edge collapse to about options.proxy vertices ("proxy"), baked in the
+// A mesh of more than options.proxy_above vertices goes through steps 2 to 7 as a proxy: the fine
+// mesh simplified by the same edge collapse to about options.proxy vertices ("proxy"), baked in the
 // fine mesh's normalised frame; then each fine vertex gets its barycentric weights on the nearest
 // proxy triangle ("prolongation"). The Basis keeps the fine rest positions and masses, the
 // proxy's vectors and the prolongation: memory and storage grow with the fine mesh only by
@@ -67,9 +67,11 @@ struct BakeOptions {
   // Derivatives of pairs with the linearised rotations too (the paper's rule), or of pairs of
   // flexible modes only (false; needs more modes for as many derivatives).
   bool rotation_pairs = true;
-  // A mesh of more vertices is baked on a proxy of about this many (≥ ghost), made by edge
-  // collapse, and its basis prolongated to the fine vertices (prolongation.h); 0: never.
-  int proxy = 0;
+  // A mesh of more than proxy_above vertices (0: never) is baked on a proxy of about `proxy`
+  // vertices (ghost ≤ proxy ≤ proxy_above), made by edge collapse, and its basis prolongated to
+  // the fine vertices (prolongation.h).
+  int proxy_above = 0;
+  int proxy = 50000;
 };
 
 // The reduced space of (V #V by 3, F #F by 3, any length unit) per the pipeline above: a Basis in

@@ -78,15 +78,17 @@ void bind_bake(py::module_& m) {
   m.def(
       "bake",
       [](const VerticesRef& V, const FacesRef& F, int modes, int derivatives, int ghost, const std::string& energy,
-         double bending, double membrane, bool rotation_pairs, int proxy, const py::object& progress) {
-        const BakeOptions options{modes,    derivatives, ghost,          energy_kind(energy),
-                                  bending,  membrane,    rotation_pairs, proxy};
+         double bending, double membrane, bool rotation_pairs, int proxy_above, int proxy,
+         const py::object& progress) {
+        const BakeOptions options{modes,   derivatives, ghost,          energy_kind(energy), bending,
+                                  membrane, rotation_pairs, proxy_above, proxy};
         Progress reporter(python_progress(progress));
         py::gil_scoped_release release;
         return bake(V, F, options, reporter);
       },
       py::arg("V"), py::arg("F"), py::arg("modes"), py::arg("derivatives"), py::arg("ghost"), py::arg("energy"),
-      py::arg("bending"), py::arg("membrane"), py::arg("rotation_pairs"), py::arg("proxy"), py::arg("progress"));
+      py::arg("bending"), py::arg("membrane"), py::arg("rotation_pairs"), py::arg("proxy_above"), py::arg("proxy"),
+      py::arg("progress"));
 }
 
 }  // namespace modal_deform

@@ -81,6 +81,7 @@ struct ProxyBake {
     options.modes = 12;
     options.derivatives = 10;
     options.ghost = 200;
+    options.proxy_above = 1000;
     options.proxy = 800;
     Progress progress;
     basis = bake(mesh.V, mesh.F, options, progress);
@@ -120,13 +121,19 @@ TEST(BakeOnProxy, SmallerMeshesAreBakedAsTheyAre) {
   options.modes = 10;
   options.derivatives = 4;
   options.ghost = 100;
-  options.proxy = static_cast<int>(mesh.V.rows());
+  options.proxy_above = static_cast<int>(mesh.V.rows());
+  options.proxy = 200;
   Progress progress;
   const Basis basis = bake(mesh.V, mesh.F, options, progress);
   EXPECT_FALSE(basis.on_proxy());
   EXPECT_EQ(basis.vectors.rows(), 3 * mesh.V.rows());
+  options.proxy_above = 300;
   options.proxy = 50;  // fewer than the ghost's vertices
-  expect_input_error([&] { bake(mesh.V, mesh.F, options, progress); }, "proxy");
+  expect_input_error([&] { bake(mesh.V, mesh.F, options, progress); }, "proxy: expected between");
+  options.proxy = 400;  // more than proxy_above
+  expect_input_error([&] { bake(mesh.V, mesh.F, options, progress); }, "proxy: expected between");
+  options.proxy_above = -1;
+  expect_input_error([&] { bake(mesh.V, mesh.F, options, progress); }, "proxy_above");
 }
 
 TEST(BakeOnProxy, ReportsTheProxyAndProlongationStages) {
@@ -135,6 +142,7 @@ TEST(BakeOnProxy, ReportsTheProxyAndProlongationStages) {
   options.modes = 10;
   options.derivatives = 4;
   options.ghost = 100;
+  options.proxy_above = 400;
   options.proxy = 400;
   std::vector<std::string> stages;
   Progress progress([&stages](const std::string& stage, double) {

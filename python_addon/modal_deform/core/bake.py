@@ -19,9 +19,13 @@ from . import _arrays
 
 FORMAT_VERSION = 2  # 2: the prolongation of a basis baked on a proxy (version 1 has none)
 
-#: Meshes with more vertices than this are baked on a proxy of about this many (``bake``'s
-#: ``proxy``).
-PROXY = 150_000
+#: ``bake``'s defaults for dense meshes: more than PROXY_ABOVE vertices are baked on a proxy of
+#: about PROXY vertices. Measured on the shared 2-core machine (bench/multires.py, docs): the
+#: 100k dragon bakes as it is in about 20 s within 2.1 GB, while a raw scan of 406k took
+#: 1120 s and 9 GB; on the dragon subdivided twice (1.6M), a 50k proxy bakes in about 24 s and a
+#: 100k one in 34 s, and both pose within 0.3% RMS of the 100k dragon's own bake.
+PROXY_ABOVE = 150_000
+PROXY = 50_000
 
 # name: (dtype, number of dimensions) of each array to_arrays writes; shapes are checked
 # natively against each other (validate_basis).
@@ -140,11 +144,10 @@ class Basis:
         except AttributeError:
             raise ValueError(f"arrays: expected a dict of numpy arrays, got {type(arrays).__name__}") from None
         checked = {}
-        if "format_version" in keys and np.asarray(arrays["format_version"]).tolist() == 1:
-            arrays = {**arrays, **{name: np.zeros((0, 3), _ARRAYS[name][0]) for name in _SINCE_VERSION_2}}
-            arrays["format_version"] = np.array(FORMAT_VERSION, dtype=np.int32)
-            keys |= set(_SINCE_VERSION_2)
         for name, (dtype, ndim) in _ARRAYS.items():
+            if name not in keys and name in _SINCE_VERSION_2 and int(checked["format_version"]) == 1:
+                checked[name] = np.zeros((0, 3), dtype)  # a basis of the mesh itself
+                continue
             if name not in keys:
                 raise ValueError(f"{name}: missing from the stored basis")
             a = np.asarray(arrays[name])
@@ -154,8 +157,8 @@ class Basis:
                 raise ValueError(f"{name}: expected {ndim} dimensions, got shape {a.shape}")
             checked[name] = a
         version = int(checked.pop("format_version"))
-        if version != FORMAT_VERSION:
-            raise ValueError(f"format_version: this add-on reads version {FORMAT_VERSION}, got {version}; re-bake")
+        if version not in (1, FORMAT_VERSION):
+            raise ValueError(f"format_version: this add-on reads versions 1 and {FORMAT_VERSION}, got {version}; re-bake")
         for name in ("rest", "ghost_vertices", "ghost_faces") + _SINCE_VERSION_2:
             if checked[name].shape[1] != 3:
                 raise ValueError(f"{name}: expected 3 columns, got shape {checked[name].shape}")
@@ -179,7 +182,7 @@ def _flag(value, name):
 
 
 def bake(V, F, modes=20, derivatives=52, ghost=1000, energy="shells", bending=1.0, membrane=1.0, progress=None,
-         rotation_pairs=True, proxy=PROXY):
+         rotation_pairs=True, proxy=PROXY, proxy_above=PROXY_ABOVE):
     """Bake the reduced space of the triangle mesh (V (n, 3), F (m, 3)) for posing.
 
     modes: vibration modes, the rigid motions of the simulated components (6 each) included;
@@ -189,10 +192,12 @@ def bake(V, F, modes=20, derivatives=52, ghost=1000, energy="shells", bending=1.
     pairs of flexible modes only, the rule before; it needs more modes); ghost: the
     ghost's target vertex count (at least 4; the mesh itself when it has fewer vertices);
     energy: "shells" (discrete shells with weights ``bending`` and ``membrane``) or "arap" (only
-    with derivatives=0: ARAP has no third derivative); proxy: a mesh with more vertices than
-    this (at least ``ghost``) is baked on a proxy of about this many, made by the ghost's edge
-    collapse, and its basis carried to every fine vertex by barycentric weights on the nearest
-    proxy triangle (``Basis.on_proxy``); None bakes any mesh as it is. ``progress(stage, fraction)`` is called
+    with derivatives=0: ARAP has no third derivative); proxy, proxy_above: a mesh with more than
+    ``proxy_above`` vertices is baked on a proxy of about ``proxy`` vertices (between ``ghost``
+    and ``proxy_above``), made by the ghost's edge collapse, and its basis carried to every fine
+    vertex by barycentric weights on the nearest proxy triangle (``Basis.on_proxy``; stages
+    "proxy" and "prolongation"); ``proxy=None`` bakes any mesh as it is.
+    ``progress(stage, fraction)`` is called
     at least every second or so (not during a CHOLMOD factorisation, about 2 s at 100k vertices);
     returning False raises ``Cancelled``, and an exception it raises propagates.
 
@@ -209,7 +214,8 @@ def bake(V, F, modes=20, derivatives=52, ghost=1000, energy="shells", bending=1.
     native = _native.bake(V, F, _count(modes, "modes", 1), _count(derivatives, "derivatives", 0),
                           _count(ghost, "ghost", 4), energy, _arrays.number(bending, "bending"),
                           _arrays.number(membrane, "membrane"), _flag(rotation_pairs, "rotation_pairs"),
-                          0 if proxy is None else _count(proxy, "proxy", 4), progress)
+                          0 if proxy is None else _count(proxy_above, "proxy_above", 1),
+                          4 if proxy is None else _count(proxy, "proxy", 4), progress)
     basis = Basis(native)
     if basis.num_floppy:
         warnings.warn(f"the mesh is floppy: it has {basis.num_floppy} zero modes besides its rigid motions "
