@@ -69,7 +69,7 @@ class Basis:
     (3p, r) over its ``num_basis_vertices`` = p vertices, and each fine vertex i moves with
     ``prolongation_weights[i]`` (3,) float32 (barycentric) of the proxy vertices
     ``prolongation_vertices[i]`` (3,) int32: x_i = x̄_i + Σ_k w_ik (U q)_{v_ik}. Both are (0, 3)
-    for a basis of the mesh itself. ``fine_vectors()`` gives the (3n, r) basis in either case.
+    for a basis of the mesh itself. ``fine_vectors(columns)`` gives the fine (3n, c) basis in either case.
     """
 
     def __init__(self, native):
@@ -98,11 +98,13 @@ class Basis:
     prolongation_vertices = property(lambda self: self._native.prolongation_vertices, doc="(n, 3) or (0, 3) int32")
     prolongation_weights = property(lambda self: self._native.prolongation_weights, doc="(n, 3) or (0, 3) float32")
 
-    def fine_vectors(self):
-        """(3n, r) float32: U on the fine mesh (``vectors`` itself, or its prolongation: a new array)."""
+    def fine_vectors(self, columns=slice(None)):
+        """(3n, c) float32: the basis vectors ``columns`` (default all r) on the fine mesh: a view of
+        ``vectors``, or their prolongation from the proxy (a new array; at 1.6M vertices all 67 take
+        1.3 GB, so ask for the columns needed)."""
         if not self.on_proxy:
-            return self.vectors
-        U = self.vectors.reshape(self.num_basis_vertices, 3, -1)
+            return self.vectors[:, columns]
+        U = self.vectors[:, columns].reshape(self.num_basis_vertices, 3, -1)
         fine = np.einsum("nk,nkcr->ncr", self.prolongation_weights, U[self.prolongation_vertices])
         return fine.reshape(3 * self.num_vertices, -1)
 
