@@ -142,9 +142,8 @@ void check_options(const BakeOptions& o) {
   if (o.derivatives < 0) throw InputError(message("derivatives: expected 0 or more, got ", o.derivatives));
   if (o.ghost < 4) throw InputError(message("ghost: a ghost needs at least 4 vertices, got ", o.ghost));
   if (o.proxy_above < 0) throw InputError(message("proxy_above: expected 0 (never) or more, got ", o.proxy_above));
-  if (o.proxy_above > 0 && (o.proxy < o.ghost || o.proxy > o.proxy_above))
-    throw InputError(message("proxy: expected between the ghost's ", o.ghost, " and proxy_above's ", o.proxy_above,
-                             " vertices, got ", o.proxy));
+  if (o.proxy_above > 0 && (o.proxy < 4 || o.proxy > o.proxy_above))
+    throw InputError(message("proxy: expected between 4 and proxy_above's ", o.proxy_above, " vertices, got ", o.proxy));
   if (o.energy == EnergyKind::kArap && o.derivatives > 0)
     throw InputError(message("derivatives: the ARAP energy has no third derivative, so it has no modal derivatives; ",
                              "bake it with derivatives = 0, or use the shells energy (asked for ", o.derivatives, ")"));

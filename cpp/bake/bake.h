@@ -68,8 +68,8 @@ struct BakeOptions {
   // flexible modes only (false; needs more modes for as many derivatives).
   bool rotation_pairs = true;
   // A mesh of more than proxy_above vertices (0: never) is baked on a proxy of about `proxy`
-  // vertices (ghost ≤ proxy ≤ proxy_above), made by edge collapse, and its basis prolongated to
-  // the fine vertices (prolongation.h).
+  // vertices (4 ≤ proxy ≤ proxy_above; a ghost of as many or more is the proxy itself), made by
+  // edge collapse, and its basis prolongated to the fine vertices (prolongation.h).
   int proxy_above = 0;
   int proxy = 50000;
 };

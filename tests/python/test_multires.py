@@ -94,7 +94,7 @@ def test_proxy_options_and_progress():
     assert basis.on_proxy and stages[0] == "proxy" and stages[-1] == "prolongation"
     assert not mdc.bake(V, F, modes=10, derivatives=4, ghost=100, proxy=None).on_proxy
     assert not mdc.bake(V, F, modes=10, derivatives=4, ghost=100, proxy=400, proxy_above=len(V)).on_proxy
-    for options, name in (({"proxy": 50, "proxy_above": 1000}, "proxy"), ({"proxy": 1500, "proxy_above": 1000}, "proxy"),
+    for options, name in (({"proxy": 3, "proxy_above": 1000}, "proxy"), ({"proxy": 1500, "proxy_above": 1000}, "proxy"),
                           ({"proxy": 400, "proxy_above": 0}, "proxy_above"), ({"proxy": "many"}, "proxy")):
         with pytest.raises(ValueError, match=name):
             mdc.bake(V, F, modes=10, derivatives=4, ghost=100, **options)

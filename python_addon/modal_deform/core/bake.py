@@ -195,8 +195,8 @@ def bake(V, F, modes=20, derivatives=52, ghost=1000, energy="shells", bending=1.
     ghost's target vertex count (at least 4; the mesh itself when it has fewer vertices);
     energy: "shells" (discrete shells with weights ``bending`` and ``membrane``) or "arap" (only
     with derivatives=0: ARAP has no third derivative); proxy, proxy_above: a mesh with more than
-    ``proxy_above`` vertices is baked on a proxy of about ``proxy`` vertices (between ``ghost``
-    and ``proxy_above``), made by the ghost's edge collapse, and its basis carried to every fine
+    ``proxy_above`` vertices is baked on a proxy of about ``proxy`` vertices (4 to
+    ``proxy_above``), made by the ghost's edge collapse, and its basis carried to every fine
     vertex by barycentric weights on the nearest proxy triangle (``Basis.on_proxy``; stages
     "proxy" and "prolongation"); ``proxy=None`` bakes any mesh as it is.
     ``progress(stage, fraction)`` is called
