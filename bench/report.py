@@ -317,6 +317,12 @@ def section_blender(result):
                       f"({b['tick']:.1f} ms)")
     out += ["", "Targets (the add-on issue: 60 fps): " + "; ".join(checks) + ". Blender's own evaluation of the "
             "changed shape key for display (\"evaluate\") comes on top and is not ours to shorten."]
+    if "dense" in f:
+        dims, b = next(iter(f["dense"]["bases"].items()))
+        out += ["", f"Dense: {f['dense']['mesh']} ({f['dense']['vertices']} vertices) baked on a proxy of "
+                f"{b['proxy_vertices']} vertices in {b['bake_s']:.1f} s ({dims} dims): tick {b['tick']:.1f} ms "
+                f"(solve {b['solve']:.1f}, map {b['positions']:.1f}, write {b['write']:.1f}), Blender's evaluation "
+                f"{b['evaluate']:.0f} ms per update."]
     lap = f["laplacian_deform"]
     outcome = ("it solved" if lap["solved"] else "it found no solution on this mesh (the modifier then passes the "
                "hooked mesh through), so this is not the time of a solve")

@@ -65,6 +65,11 @@ def blender(quick):
                                   "--shapes", str(common.MESHES), *extra],
                        check=True, cwd=common.ROOT)
         raw = json.loads(out.read_text())
+        if not quick:  # the dragon subdivided twice (1.6M vertices), baked on a proxy: pose updates only
+            dense = pathlib.Path(folder) / "blender_dense.json"
+            subprocess.run(BLENDER + [str(common.ROOT / "bench" / "blender_pose.py"), "--", "--output", str(dense),
+                                      "--subdivide", "2", "--updates", "15"], check=True, cwd=common.ROOT)
+            raw["dense"] = json.loads(dense.read_text())
     return raw.pop("parameters"), raw
 
 
