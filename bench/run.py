@@ -12,6 +12,8 @@ Experiments (each writes bench/results/<name>.json: machine, commit, command, pa
   taylor       Fig. 9 analogue (bench/taylor.py)
   raw_scan     a damaged, subdivided dragon of about 405k vertices baked in a fresh process: time
                and peak memory against issue 15's targets (bench/raw_scan.py)
+  multires     the dragon subdivided twice (1.6M vertices) baked on a proxy: time, memory, stored
+               size, update time and agreement with the dragon's own bake (bench/multires.py)
   blender      the add-on's pose update in headless Blender and Blender's Laplacian Deform
                (bench/blender_pose.py)
   renders      Cycles renders of the accuracy experiment's bar and cylinder poses
@@ -32,7 +34,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import common  # noqa: E402
 import report  # noqa: E402
 
-PYTHON_EXPERIMENTS = ("table1", "accuracy", "convergence", "taylor", "raw_scan")
+PYTHON_EXPERIMENTS = ("table1", "accuracy", "convergence", "taylor", "raw_scan", "multires")
 EXPERIMENTS = ("native",) + PYTHON_EXPERIMENTS + ("blender", "renders")
 NATIVE_IN_TABLE1 = "BM_Bake|BM_BfgsIteration|BM_Positions"
 BLENDER = ["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python"]
@@ -63,6 +65,11 @@ def blender(quick):
                                   "--shapes", str(common.MESHES), *extra],
                        check=True, cwd=common.ROOT)
         raw = json.loads(out.read_text())
+        if not quick:  # the dragon subdivided twice (1.6M vertices), baked on a proxy: pose updates only
+            dense = pathlib.Path(folder) / "blender_dense.json"
+            subprocess.run(BLENDER + [str(common.ROOT / "bench" / "blender_pose.py"), "--", "--output", str(dense),
+                                      "--subdivide", "2", "--updates", "15"], check=True, cwd=common.ROOT)
+            raw["dense"] = json.loads(dense.read_text())
     return raw.pop("parameters"), raw
 
 

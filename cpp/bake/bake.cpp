@@ -23,6 +23,7 @@
 #include "reduction/attachment.h"
 #include "reduction/ghost.h"
 #include "reduction/orthonormalize.h"
+#include "reduction/prolongation.h"
 #include "util/errors.h"
 #include "util/require_weight.h"
 #include "util/stopwatch.h"
@@ -140,6 +141,9 @@ void check_options(const BakeOptions& o) {
   if (o.modes < 1) throw InputError(message("modes: expected at least 1, got ", o.modes));
   if (o.derivatives < 0) throw InputError(message("derivatives: expected 0 or more, got ", o.derivatives));
   if (o.ghost < 4) throw InputError(message("ghost: a ghost needs at least 4 vertices, got ", o.ghost));
+  if (o.proxy_above < 0) throw InputError(message("proxy_above: expected 0 (never) or more, got ", o.proxy_above));
+  if (o.proxy_above > 0 && (o.proxy < 4 || o.proxy > o.proxy_above))
+    throw InputError(message("proxy: expected between 4 and proxy_above's ", o.proxy_above, " vertices, got ", o.proxy));
   if (o.energy == EnergyKind::kArap && o.derivatives > 0)
     throw InputError(message("derivatives: the ARAP energy has no third derivative, so it has no modal derivatives; ",
                              "bake it with derivatives = 0, or use the shells energy (asked for ", o.derivatives, ")"));
@@ -163,12 +167,13 @@ auto stage(const char* name, Basis& basis, Progress& progress, Work&& work) {
   }
 }
 
-// 1. What the basis keeps of the input: the rest mesh, its masses and the normalising scale.
-Basis rest_state(const VerticesRef& V, const FacesRef& F, const BakeOptions& options) {
+// 1. What the basis keeps of the input: the rest mesh, its masses and the normalising scale
+// (the fine mesh's, also for a proxy: the energy is the fine mesh's, in its frame).
+Basis rest_state(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, double scale) {
   Basis basis;
   basis.rest = V;
   basis.mass = lumped_mass(V, F);
-  basis.scale = normalizing_scale(V);
+  basis.scale = scale;
   basis.bending = options.bending;
   basis.membrane = options.membrane;
   return basis;
@@ -354,10 +359,9 @@ void fine_and_ghost_vectors(Eigen::MatrixXd U, const Attachment& attachment, Gho
   });
 }
 
-Basis bake_stages(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Progress& progress) {
-  check_options(options);
-  validate_mesh(V, F);
-  Basis basis = rest_state(V, F, options);
+// The bake of (V, F) itself, stages 2 to 8 on the rest state `basis`.
+Basis bake_stages(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Basis basis,
+                  Progress& progress) {
   const Simulated sim = simulated_submesh(V, F, options, basis, progress);
   const Stiffness stiffness = stiffness_at_rest(sim, options, basis, progress);
   const Eigen::MatrixXd rigid = rigid_motions(sim.V, sim.attachment.component, sim.mass);
@@ -368,7 +372,30 @@ Basis bake_stages(const VerticesRef& V, const FacesRef& F, const BakeOptions& op
   basis.timings["factorisation"] = factor.seconds();
   Eigen::MatrixXd U = orthonormal_basis(sim, rigid, modes, std::move(derivatives), options, basis, progress);
   fine_and_ghost_vectors(std::move(U), sim.attachment, std::move(coarse), basis, progress);
-  validate_basis(basis);
+  return basis;
+}
+
+// A dense mesh: the stages above on a proxy made by edge collapse of the fine mesh to about
+// options.proxy vertices, then the prolongation of the proxy's basis to the fine vertices
+// (prolongation.h); the ghost is the proxy's, reached from a fine vertex through its proxy vertex.
+Basis bake_on_proxy(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Progress& progress) {
+  const Basis fine = rest_state(V, F, options, normalizing_scale(V));
+  Basis timed;  // the proxy stage's time, until the proxy's basis exists
+  Progress as_proxy([&progress](const std::string&, double fraction) {
+    progress.report("proxy", fraction);
+    return true;
+  });
+  const Ghost proxy =
+      stage("proxy", timed, progress, [&] { return ghost_mesh(V, F, fine.mass, options.proxy, &as_proxy); });
+  Basis basis = rest_state(proxy.V, proxy.F, options, fine.scale);
+  basis.timings = timed.timings;
+  basis = bake_stages(proxy.V, proxy.F, options, std::move(basis), progress);
+  stage("prolongation", basis, progress, [&] {
+    basis.prolongation = prolongation_to_proxy(V, proxy.V, proxy.F, proxy.map);
+    basis.ghost_map = basis.ghost_map(proxy.map).eval();
+    basis.rest = fine.rest;
+    basis.mass = fine.mass;
+  });
   return basis;
 }
 
@@ -376,7 +403,13 @@ Basis bake_stages(const VerticesRef& V, const FacesRef& F, const BakeOptions& op
 
 Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Progress& progress) {
   try {
-    return bake_stages(V, F, options, progress);
+    check_options(options);
+    validate_mesh(V, F);
+    Basis basis = options.proxy_above > 0 && V.rows() > options.proxy_above
+                      ? bake_on_proxy(V, F, options, progress)
+                      : bake_stages(V, F, options, rest_state(V, F, options, normalizing_scale(V)), progress);
+    validate_basis(basis);
+    return basis;
   } catch (const std::bad_alloc&) {
     throw OutOfMemory(message("bake: out of memory: an allocation failed (", available_memory() / 1e9,
                               " GB still available); close other programs, bake fewer modes and derivatives, "

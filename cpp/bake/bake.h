@@ -24,10 +24,18 @@
 //   6. Attached rows, conversion to mesh units (x = x̄ + U q), float32 vectors.
 //   7. Ghost: edge collapse of the whole mesh to about `ghost` vertices, the basis restricted.
 //
+// A mesh of more than options.proxy_above vertices goes through steps 2 to 7 as a proxy: the fine
+// mesh simplified by the same edge collapse to about options.proxy vertices ("proxy"), baked in the
+// fine mesh's normalised frame; then each fine vertex gets its barycentric weights on the nearest
+// proxy triangle ("prolongation"). The Basis keeps the fine rest positions and masses, the
+// proxy's vectors and the prolongation: memory and storage grow with the fine mesh only by
+// those weights.
+//
 // Stages are timed into Basis::timings ("attachment", "hessian", "factorisation" (CHOLMOD
 // analysis and numeric factorisation, done inside the modes), "modes" (the rest of them),
 // "third derivatives", "derivative solves", "orthonormalisation", "assembly" (step 6), "ghost"
-// (what the ghost adds: it is simplified on a thread of its own during steps 3 to 6); seconds)
+// (what the ghost adds: it is simplified on a thread of its own during steps 3 to 6), and for a
+// proxy bake "proxy" and "prolongation"; seconds)
 // and reported through Progress with the same names.
 // A cancel throws Cancelled at the next report and leaves nothing behind. CHOLMOD cannot report
 // during its analysis and factorisation (about 1 s and 2.5 s at 100k vertices), nor a blocked
@@ -59,6 +67,11 @@ struct BakeOptions {
   // Derivatives of pairs with the linearised rotations too (the paper's rule), or of pairs of
   // flexible modes only (false; needs more modes for as many derivatives).
   bool rotation_pairs = true;
+  // A mesh of more than proxy_above vertices (0: never) is baked on a proxy of about `proxy`
+  // vertices (4 ≤ proxy ≤ proxy_above; a ghost of as many or more is the proxy itself), made by
+  // edge collapse, and its basis prolongated to the fine vertices (prolongation.h).
+  int proxy_above = 0;
+  int proxy = 50000;
 };
 
 // The reduced space of (V #V by 3, F #F by 3, any length unit) per the pipeline above: a Basis in

@@ -31,14 +31,47 @@ void require_shared(Check&& check) {
   }
 }
 
+// A stored prolongation: one row per fine vertex, proxy vertices in range (vectors has 3 rows
+// per proxy vertex), barycentric weights.
+void require_prolongation(const Prolongation& P, Eigen::Index n, Eigen::Index vector_rows) {
+  require(vector_rows > 0 && vector_rows % 3 == 0,
+          message("vectors has ", vector_rows, " rows, expected 3 per proxy vertex"));
+  const Eigen::Index p = vector_rows / 3;
+  require(P.vertices.rows() == n && P.weights.rows() == n,
+          message("prolongation has ", P.vertices.rows(), " vertex rows and ", P.weights.rows(), " weight rows for ", n,
+                  " vertices"));
+  require_finite(P.weights, "prolongation weights");
+  constexpr float kSlack = 1e-5f;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if ((P.vertices.row(i).array() < 0).any() || (P.vertices.row(i).array() >= p).any())
+      require(false, message("prolongation vertices[", i, "] = (", P.vertices.row(i), ") leaves [0, ", p,
+                             "), the proxy vertices of vectors"));
+    if ((P.weights.row(i).array() < -kSlack).any() || std::abs(P.weights.row(i).sum() - 1.0f) > kSlack)
+      require(false, message("prolongation weights[", i, "] = (", P.weights.row(i),
+                             ") are not barycentric (each in [0, 1], summing to 1)"));
+  }
+}
+
 }  // namespace
+
+Eigen::Matrix<double, 3, Eigen::Dynamic> Basis::vertex_rows(int v) const {
+  if (!on_proxy()) return vectors.middleRows<3>(3 * static_cast<Eigen::Index>(v)).cast<double>();
+  Eigen::Matrix<double, 3, Eigen::Dynamic> rows = Eigen::MatrixXd::Zero(3, vectors.cols());
+  for (int k = 0; k < 3; ++k)
+    rows += static_cast<double>(prolongation.weights(v, k)) *
+            vectors.middleRows<3>(3 * static_cast<Eigen::Index>(prolongation.vertices(v, k))).cast<double>();
+  return rows;
+}
 
 void validate_basis(const Basis& b) {
   const Eigen::Index n = b.rest.rows(), r = b.vectors.cols(), g = b.ghost_vertices.rows();
   require(n > 0, "rest has no vertices");
   require(r > 0, "vectors has no columns");
   require(b.mass.size() == n, message("mass has ", b.mass.size(), " entries for ", n, " vertices"));
-  require(b.vectors.rows() == 3 * n, message("vectors has ", b.vectors.rows(), " rows, expected ", 3 * n));
+  if (b.on_proxy())
+    require_prolongation(b.prolongation, n, b.vectors.rows());
+  else
+    require(b.vectors.rows() == 3 * n, message("vectors has ", b.vectors.rows(), " rows, expected ", 3 * n));
   require(
       0 <= b.num_rigid && b.num_rigid <= b.num_modes && b.num_modes <= r,
       message("num_rigid, num_modes out of order: rigid ", b.num_rigid, ", modes ", b.num_modes, ", dimension ", r));

@@ -1,6 +1,7 @@
 // The reduced shape space a bake produces and the solver consumes; stored with the asset.
 //
-// Everything is in the mesh's own units: the fine positions are x = x̄ + U q. The energy is
+// Everything is in the mesh's own units: the fine positions are x = x̄ + U q, or, for a dense mesh
+// baked on a proxy, x = x̄ + P U q with U the proxy's basis (prolongation.h). The energy is
 // evaluated in the paper's normalised frame (longest bounding-box edge 10), reached by
 // multiplying positions by `scale`; eigenvalues are those of that frame.
 #pragma once
@@ -8,6 +9,7 @@
 #include <map>
 #include <string>
 
+#include "reduction/prolongation.h"
 #include "util/types.h"
 
 namespace modal_deform {
@@ -16,7 +18,8 @@ struct Basis {
   // Fine mesh: #V by 3 rest positions and #V lumped masses (mesh units).
   RowMatrixX3d rest;
   Eigen::VectorXd mass;
-  // 3n by r, x = x̄ + U q. Columns: rigid motions, vibration modes, then modal derivatives;
+  // 3n by r, x = x̄ + U q (3p by r over the proxy's vertices when `prolongation` is not empty).
+  // Columns: rigid motions, vibration modes, then modal derivatives;
   // M-orthonormal in the normalised frame over the simulated vertices (the bake's attached
   // vertices, bake.h, ride along without mass). float32 rows: mapping q to the mesh is memory
   // bound.
@@ -27,6 +30,8 @@ struct Basis {
   // columns num_rigid .. num_rigid + num_floppy − 1. They have no modal derivatives.
   int num_floppy = 0;
   Eigen::VectorXd eigenvalues;  // num_modes, ascending (normalised frame)
+  // Empty, or for a basis baked on a proxy the map from the proxy's vertices to the fine ones.
+  Prolongation prolongation;
   // Ghost: #G by 3 rest positions, #H by 3 triangles, #V fine vertex -> ghost vertex, and
   // 3g by r restricted basis (mass-weighted means over each ghost vertex's preimage).
   RowMatrixX3d ghost_vertices;
@@ -44,6 +49,11 @@ struct Basis {
 
   int num_vertices() const { return static_cast<int>(rest.rows()); }
   int dimension() const { return static_cast<int>(vectors.cols()); }
+  // Vertices the rows of `vectors` belong to: the proxy's, or the fine mesh's own.
+  int num_basis_vertices() const { return static_cast<int>(vectors.rows() / 3); }
+  bool on_proxy() const { return !prolongation.empty(); }
+  // The 3 by r rows of the fine basis at fine vertex v (in double): P U's rows on a proxy.
+  Eigen::Matrix<double, 3, Eigen::Dynamic> vertex_rows(int v) const;
 };
 
 // Throws InputError naming the first array that is missing, of the wrong shape, non-finite or
@@ -52,7 +62,8 @@ struct Basis {
 // counts and index ranges, what the bake guarantees is checked where it is cheap (O(#V r)):
 // coordinates within require_positions's range, scale = normalizing_scale(rest), ghost vertices
 // inside the bounding box of rest forming a usable mesh, and ghost vector entries no larger than
-// the largest entry of their column of vectors (they are weighted means of them).
+// the largest entry of their column of vectors (they are weighted means of them); a prolongation's
+// proxy vertices in range and its weights barycentric.
 void validate_basis(const Basis& basis);
 
 }  // namespace modal_deform

@@ -22,6 +22,8 @@ constexpr double kBoundaryWeight = 10.0;
 // added to the quadric error. Both are area times length squared; where the quadric is flat
 // this keeps clusters compact and alike in size instead of growing one cluster at random.
 constexpr double kCompactnessWeight = 0.1;
+// Collapses go in rounds (collapse_in_rounds) down to this many times the target.
+constexpr int kRoundsAbove = 2;
 // Heap pops between progress reports (a pop takes microseconds).
 constexpr long kReportInterval = 256;
 
@@ -111,9 +113,11 @@ class Simplifier {
   void tally_neighbours(int x, std::vector<Neighbour>& out);
   void add_boundary_quadrics();
   void seed();
+  void add_candidates(int x, bool higher_only, std::vector<Candidate>& out);
   void push_edges(int x, bool higher_only);
+  void collapse_in_rounds(int until, const std::function<void()>& report);
   double cost(int u, int v) const;
-  bool try_collapse(int u, int v);
+  int try_collapse(int u, int v);
   bool face_stays_sound(int f, int u, int v, const Eigen::Vector3d& p) const;
   void collapse(int u, int v, const Eigen::Vector3d& p);
 
@@ -131,6 +135,7 @@ class Simplifier {
   // Scratch space of try_collapse and push_edges, kept to avoid allocations per collapse.
   std::vector<int> shared_, u_only_, v_only_, degenerate_faces_;
   std::vector<Neighbour> around_u_, around_v_;
+  std::vector<Candidate> candidates_;
 };
 
 Simplifier::Simplifier(const VerticesRef& V, const FacesRef& F, const VectorRef& mass) {
@@ -253,7 +258,7 @@ double Simplifier::cost(int u, int v) const {
   return quadric_error + kCompactnessWeight * ward;
 }
 
-void Simplifier::push_edges(int x, bool higher_only) {
+void Simplifier::add_candidates(int x, bool higher_only, std::vector<Candidate>& out) {
   tally_neighbours(x, around_u_);
   degenerate_faces_.clear();
   for (int f : vertex_faces_[x])
@@ -263,8 +268,14 @@ void Simplifier::push_edges(int x, bool higher_only) {
     if (higher_only && s.vertex < x) continue;
     const bool on_degenerate_face = std::any_of(degenerate_faces_.begin(), degenerate_faces_.end(),
                                                 [&](int f) { return has_vertex(f, s.vertex); });
-    heap_.push({on_degenerate_face ? -1.0 : cost(x, s.vertex), x, s.vertex, version_[x], version_[s.vertex]});
+    out.push_back({on_degenerate_face ? -1.0 : cost(x, s.vertex), x, s.vertex, version_[x], version_[s.vertex]});
   }
+}
+
+void Simplifier::push_edges(int x, bool higher_only) {
+  candidates_.clear();
+  add_candidates(x, higher_only, candidates_);
+  for (const Candidate& c : candidates_) heap_.push(c);
 }
 
 void Simplifier::seed() {
@@ -291,7 +302,8 @@ bool Simplifier::face_stays_sound(int f, int u, int v, const Eigen::Vector3d& p)
   return new_shape.normal.dot(input_normals_[f]) > 0 || input_normals_[f].squaredNorm() == 0;
 }
 
-bool Simplifier::try_collapse(int u, int v) {
+// Collapses the edge uv if that keeps the mesh sound; returns the vertex that stays, or -1.
+int Simplifier::try_collapse(int u, int v) {
   if (live_faces(u).size() < live_faces(v).size()) std::swap(u, v);  // rename the smaller star
   shared_.clear();
   u_only_.clear();
@@ -299,7 +311,7 @@ bool Simplifier::try_collapse(int u, int v) {
   for (int f : vertex_faces_[u]) (has_vertex(f, v) ? shared_ : u_only_).push_back(f);
   for (int f : vertex_faces_[v])
     if (!has_vertex(f, u)) v_only_.push_back(f);
-  if (shared_.empty() || (u_only_.empty() && v_only_.empty())) return false;
+  if (shared_.empty() || (u_only_.empty() && v_only_.empty())) return -1;
 
   // Boundary: merge two boundary vertices only along a boundary edge, never a boundary vertex
   // with an interior one.
@@ -309,7 +321,7 @@ bool Simplifier::try_collapse(int u, int v) {
     return std::any_of(around.begin(), around.end(), [](const Neighbour& s) { return s.faces == 1; });
   };
   const bool u_boundary = on_boundary(around_u_);
-  if (u_boundary != on_boundary(around_v_) || (u_boundary && shared_.size() != 1)) return false;
+  if (u_boundary != on_boundary(around_v_) || (u_boundary && shared_.size() != 1)) return -1;
 
   // Link condition: every common neighbour spans a face with u and v.
   for (const Neighbour& s : around_u_) {
@@ -318,7 +330,7 @@ bool Simplifier::try_collapse(int u, int v) {
                                     [&s](const Neighbour& t) { return t.vertex == s.vertex; });
     const bool opposite =
         std::any_of(shared_.begin(), shared_.end(), [&](int f) { return has_vertex(f, s.vertex); });
-    if (common && !opposite) return false;
+    if (common && !opposite) return -1;
   }
 
   // No face of v may land on a face of u.
@@ -333,16 +345,16 @@ bool Simplifier::try_collapse(int u, int v) {
   for (int f : v_only_) {
     const auto pair = other_two(f, v);
     for (int g : u_only_)
-      if (other_two(g, u) == pair) return false;
+      if (other_two(g, u) == pair) return -1;
   }
 
   const Eigen::Vector3d p = merged_centroid(clusters_[u], clusters_[v]);
   for (int f : u_only_)
-    if (!face_stays_sound(f, u, v, p)) return false;
+    if (!face_stays_sound(f, u, v, p)) return -1;
   for (int f : v_only_)
-    if (!face_stays_sound(f, u, v, p)) return false;
+    if (!face_stays_sound(f, u, v, p)) return -1;
   collapse(u, v, p);
-  return true;
+  return u;
 }
 
 void Simplifier::collapse(int u, int v, const Eigen::Vector3d& p) {
@@ -365,15 +377,47 @@ void Simplifier::collapse(int u, int v, const Eigen::Vector3d& p) {
   merged_into_[v] = u;
   --num_alive_;
   ++version_[u];
-  push_edges(u, false);
+}
+
+// Far above the target, collapses go in rounds: every live edge's candidate, sorted by cost; the
+// cheaper half is collapsed in that order, skipping the edges of a vertex that grew earlier in the
+// round (a cost depends only on the edge's two clusters, so the others are up to date). A round
+// costs a sort and a sweep instead of heap operations with cache misses per candidate and the
+// candidates pushed again after every collapse: 1.6M vertices to 100k took 22 s with the heap
+// alone, 14 s so. The heap then finishes in the exact greedy order near the target.
+void Simplifier::collapse_in_rounds(int until, const std::function<void()>& report) {
+  std::vector<Candidate> round;
+  std::vector<int> locked(alive_.size(), -1);  // the last round each vertex grew in
+  for (int r = 0; num_alive_ > until; ++r) {
+    round.clear();
+    for (int x = 0; x < static_cast<int>(alive_.size()); ++x)
+      if (alive_[x]) add_candidates(x, true, round);
+    std::sort(round.begin(), round.end(), [](const Candidate& a, const Candidate& b) { return a.cost < b.cost; });
+    int collapses = 0;
+    for (size_t i = 0; i < round.size() / 2 && num_alive_ > until; ++i) {
+      const Candidate& c = round[i];
+      if (locked[c.u] == r || locked[c.v] == r || !alive_[c.u] || !alive_[c.v]) continue;
+      const int kept = try_collapse(c.u, c.v);
+      if (kept < 0) continue;
+      ++collapses;
+      locked[kept] = r;
+      report();
+    }
+    if (collapses == 0) break;
+  }
 }
 
 void Simplifier::simplify(int target, Progress* progress) {
   if (progress) progress->report("ghost", 0.0);
   if (num_alive_ <= target) return;
   const int start = num_alive_;
-  seed();
   long pops = 0;
+  auto report = [&] {
+    if (progress && ++pops % kReportInterval == 0)
+      progress->report("ghost", double(start - num_alive_) / double(start - target));
+  };
+  collapse_in_rounds(target < num_alive_ / kRoundsAbove ? kRoundsAbove * target : num_alive_, report);
+  seed();
   int collapses_in_pass = 0;
   while (num_alive_ > target) {
     // A rejected candidate returns only when one of its vertices changes; a fresh pass over all
@@ -386,10 +430,12 @@ void Simplifier::simplify(int target, Progress* progress) {
     }
     const Candidate c = heap_.top();
     heap_.pop();
-    if (progress && ++pops % kReportInterval == 0)
-      progress->report("ghost", double(start - num_alive_) / double(start - target));
+    report();
     if (!alive_[c.u] || !alive_[c.v] || version_[c.u] != c.version_u || version_[c.v] != c.version_v) continue;
-    if (try_collapse(c.u, c.v)) ++collapses_in_pass;
+    const int kept = try_collapse(c.u, c.v);
+    if (kept < 0) continue;
+    ++collapses_in_pass;
+    push_edges(kept, false);
   }
 }
 

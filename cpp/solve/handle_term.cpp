@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 
 #include "util/errors.h"
 #include "util/require_positions.h"
@@ -90,16 +91,15 @@ Eigen::VectorXd HandleTerm::hessian_diagonal(int num_vertices) const {
   return diagonal;
 }
 
-ReducedHandleTerm::ReducedHandleTerm(const HandleTerm& term, const Eigen::Ref<const RowMatrixXf>& U) {
-  const Eigen::Index r = U.cols();
+ReducedHandleTerm::ReducedHandleTerm(const HandleTerm& term, const VertexRows& rows, Eigen::Index r) {
   // A = Σ_i ω_i U_iᵀU_i with ω_i = Σ_{h∋i} c w_h m_i: rank updates with the gathered rows √ω_i U_i,
   // a block of vertices at a time (bounded memory for a handle of any size).
-  std::vector<double> omega(static_cast<size_t>(U.rows() / 3), 0.0);
+  std::map<int, double> omega;
   for (const std::vector<HandleTerm::Member>& members : term.members())
-    for (const HandleTerm::Member& member : members) omega[static_cast<size_t>(member.vertex)] += member.weight;
+    for (const HandleTerm::Member& member : members) omega[member.vertex] += member.weight;
   std::vector<int> pulled;
-  for (size_t v = 0; v < omega.size(); ++v)
-    if (omega[v] > 0) pulled.push_back(static_cast<int>(v));
+  for (const auto& [v, w] : omega)
+    if (w > 0) pulled.push_back(v);
   constexpr size_t kBlock = 1024;
   A_ = Eigen::MatrixXd::Zero(r, r);
   Eigen::MatrixXd G(3 * kBlock, r);
@@ -107,7 +107,7 @@ ReducedHandleTerm::ReducedHandleTerm(const HandleTerm& term, const Eigen::Ref<co
     const size_t count = std::min(kBlock, pulled.size() - begin);
     for (size_t k = 0; k < count; ++k) {
       const int v = pulled[begin + k];
-      G.middleRows<3>(3 * k) = std::sqrt(omega[static_cast<size_t>(v)]) * U.middleRows<3>(3 * v).cast<double>();
+      G.middleRows<3>(3 * k) = std::sqrt(omega[v]) * rows(v);
     }
     A_.selfadjointView<Eigen::Lower>().rankUpdate(G.topRows(3 * count).transpose());
   }
@@ -128,8 +128,9 @@ ReducedHandleTerm::ReducedHandleTerm(const HandleTerm& term, const Eigen::Ref<co
     for (const HandleTerm::Member& member : members) {
       const Eigen::Vector3d offset = member.rest - handle.centroid;
       handle.second_moment += member.weight * offset * offset.transpose();
+      const Eigen::Matrix<double, 3, Eigen::Dynamic> U_i = rows(member.vertex);
       for (int a = 0; a < 3; ++a) {
-        const Eigen::VectorXd row = U.row(3 * member.vertex + a).transpose().cast<double>();
+        const Eigen::VectorXd row = U_i.row(a).transpose();
         for (int c = 0; c < 3; ++c) handle.coefficients.col(3 * a + c) += member.weight * offset[c] * row;
         handle.coefficients.col(9 + a) += member.weight * row;
       }

@@ -26,6 +26,7 @@
 // without mass (in no triangle) pull with zero weight.
 #pragma once
 
+#include <functional>
 #include <vector>
 
 #include "util/types.h"
@@ -75,11 +76,14 @@ class HandleTerm {
   std::vector<std::vector<Eigen::Vector3d>> targets_;  // per handle and member: T_h x̄_i
 };
 
+// The 3 by r rows U_v of a basis x = x̄ + U q at fine vertex v (Basis::vertex_rows).
+using VertexRows = std::function<Eigen::Matrix<double, 3, Eigen::Dynamic>(int vertex)>;
+
 // E_C restricted to x = x̄ + U q, in O(r²) per evaluation.
 class ReducedHandleTerm {
  public:
-  // U: 3#V by r, the basis x = x̄ + U q of the fine term's mesh.
-  ReducedHandleTerm(const HandleTerm& term, const Eigen::Ref<const RowMatrixXf>& U);
+  // rows: U's rows at the fine term's vertices, asked only for those of the handles; r columns.
+  ReducedHandleTerm(const HandleTerm& term, const VertexRows& rows, Eigen::Index r);
 
   // One transform per handle (check_transforms first).
   void set_transforms(const Transforms& transforms);

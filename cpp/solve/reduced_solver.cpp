@@ -41,7 +41,7 @@ ReducedSolver::ReducedSolver(const Basis& basis, const Handles& handles, const V
       handle_term_(HandleTerm(basis.rest, basis.mass, handles,
                               checked_handle_weights(handles, weights, basis.num_vertices()),
                               checked_stiffness(stiffness) * std::pow(basis.scale, 4)),
-                   basis.vectors) {
+                   [&basis](int v) { return basis.vertex_rows(v); }, basis.dimension()) {
   const Eigen::Index r = basis.dimension();
   if (warm_start) {
     const SparseMatrix K = energy_->hessian(ghost_rest_);
@@ -62,6 +62,7 @@ ReducedSolver::ReducedSolver(const Basis& basis, const Handles& handles, const V
   ghost_gradient_.resize(ghost_rest_.size());
   handle_gradient_.resize(r);
   handle_gradient_old_.resize(r);
+  if (basis.on_proxy()) proxy_displacement_.resize(basis.vectors.rows());
   reset();
 }
 
@@ -108,10 +109,18 @@ double ReducedSolver::objective(const Eigen::VectorXd& q, Eigen::VectorXd& gradi
 }
 
 void ReducedSolver::positions(Eigen::Ref<Eigen::VectorXf> out) const {
+  const Eigen::Index fine_rows = 3 * static_cast<Eigen::Index>(basis_.num_vertices());
+  if (out.size() != fine_rows)
+    throw InputError(message("out: expected ", fine_rows, " values (3 per vertex), got ", out.size()));
+  if (!basis_.on_proxy()) return map_to_basis_vertices(basis_.rest.data(), out.data());
+  // On a proxy: its displacement U q, then x̄ + P (U q) on the fine vertices.
+  map_to_basis_vertices(nullptr, proxy_displacement_.data());
+  prolongate_positions(basis_.prolongation, basis_.rest.data(), proxy_displacement_.data(), out.data());
+}
+
+void ReducedSolver::map_to_basis_vertices(const double* rest, float* out) const {
   const RowMatrixXf& U = basis_.vectors;
   const Eigen::Index rows = U.rows(), r = U.cols();
-  if (out.size() != rows) throw InputError(message("out: expected ", rows, " values (3 per vertex), got ", out.size()));
-  const double* rest = basis_.rest.data();
   const float* q = q_float_.data();
   const Eigen::Index blocks = (rows + kBlockRows - 1) / kBlockRows;
   // One SIMD dot product per row (a third faster than Eigen's row-major product here, which
@@ -124,7 +133,7 @@ void ReducedSolver::positions(Eigen::Ref<Eigen::VectorXf> out) const {
       float dot = 0;
 #pragma omp simd reduction(+ : dot)
       for (Eigen::Index j = 0; j < r; ++j) dot += u[j] * q[j];
-      out[k] = static_cast<float>(rest[k] + static_cast<double>(dot));
+      out[k] = rest ? static_cast<float>(rest[k] + static_cast<double>(dot)) : dot;
     }
   }
 }

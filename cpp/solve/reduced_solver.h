@@ -65,7 +65,8 @@ class ReducedSolver {
   void reset();
 
   // x̄ + U q on the fine mesh (3#V, interleaved, mesh units) in single precision, written into
-  // `out`. Rows are split over threads in blocks; throws InputError for a wrong size.
+  // `out`; x̄ + P U q for a basis on a proxy (prolongation.h). Rows are split over threads in
+  // blocks; throws InputError for a wrong size.
   void positions(Eigen::Ref<Eigen::VectorXf> out) const;
 
   // f(q) with ∇f(q) (r) written into `gradient`; +inf where a ghost coordinate leaves the range
@@ -85,7 +86,11 @@ class ReducedSolver {
   ReducedHandleTerm handle_term_;
   Eigen::MatrixXd initial_inverse_hessian_;
   Bfgs bfgs_;
+  // U q, plus x̄ when `rest` is given, on the basis's own vertices into `out` (3 per vertex).
+  void map_to_basis_vertices(const double* rest, float* out) const;
+
   Eigen::VectorXf q_float_;  // q for positions()
+  mutable Eigen::VectorXf proxy_displacement_;  // U q on a proxy's vertices, for positions()
   // Work space, sized once.
   Eigen::VectorXd ghost_x_, ghost_gradient_, handle_gradient_, handle_gradient_old_;
 };

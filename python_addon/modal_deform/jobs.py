@@ -37,7 +37,8 @@ class BakeJob:
         self.fingerprint = storage.fingerprint(obj.data)
         self.options = dict(modes=settings.modes, derivatives=settings.derivatives if self.energy == "SHELLS" else 0,
                             ghost=settings.ghost, energy=self.energy.lower(), bending=settings.bending,
-                            membrane=settings.membrane)
+                            membrane=settings.membrane,
+                            proxy=settings.proxy if settings.proxy_above else None, proxy_above=settings.proxy_above)
         self.stage, self.fraction = "starting", 0.0
         self.basis = self.error = None
         self.seconds = 0.0

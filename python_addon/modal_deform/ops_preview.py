@@ -27,7 +27,7 @@ def describe(status, index):
 def displaced(basis, index, amplitude):
     """#V by 3 float32: rest positions plus basis vector `index` scaled so that the largest vertex
     displacement is `amplitude` times the longest bounding-box edge."""
-    u = basis.vectors[:, index].reshape(-1, 3).astype(np.float64)
+    u = basis.fine_vectors([index]).reshape(-1, 3).astype(np.float64)
     largest = np.sqrt((u * u).sum(axis=1)).max()
     size = np.ptp(basis.rest, axis=0).max()
     scale = amplitude * size / largest if largest > 0 else 0.0

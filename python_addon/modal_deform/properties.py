@@ -7,6 +7,8 @@ import bpy
 from bpy.props import (CollectionProperty, EnumProperty, FloatProperty, FloatVectorProperty,
                        IntProperty, PointerProperty, StringProperty)
 
+from . import core as mdc
+
 IDENTITY = ((1.0, 0.0, 0.0, 0.0), (0.0, 1.0, 0.0, 0.0), (0.0, 0.0, 1.0, 0.0), (0.0, 0.0, 0.0, 1.0))
 
 
@@ -57,6 +59,8 @@ class ModalDeformBakeStatus(bpy.types.PropertyGroup):
     num_derivatives: IntProperty(name="Derivatives", description="Modal derivatives in the basis")
     num_floppy: IntProperty(name="Floppy", description="Zero modes besides the rigid motions (mechanisms)")
     ghost_vertices: IntProperty(name="Ghost Vertices", description="Vertices of the coarse mesh used while posing")
+    proxy_vertices: IntProperty(
+        name="Proxy Vertices", description="Vertices of the proxy a dense mesh was baked on (0: baked as it is)")
     energy: StringProperty(name="Energy", description="The energy the basis was baked with")
     baked_at: StringProperty(name="Baked At", description="Local date and time of the bake")
     seconds: FloatProperty(name="Seconds", description="Wall time of the bake")
@@ -78,6 +82,13 @@ class ModalDeformSettings(bpy.types.PropertyGroup):
         name="Ghost Size", default=1000, min=4, soft_min=200, soft_max=5000,
         description="Vertices of the coarse mesh the energy is evaluated on while posing: more follow the "
                     "energy of the full mesh more closely, fewer make each iteration faster")
+    proxy: IntProperty(
+        name="Proxy Size", default=mdc.PROXY, min=4, soft_min=10000, soft_max=150000,
+        description="A dense mesh (more vertices than Proxy Above) is baked on a simplified proxy of about this "
+                    "many vertices, and every vertex follows it with its own detail")
+    proxy_above: IntProperty(
+        name="Proxy Above", default=mdc.PROXY_ABOVE, min=0, soft_max=500000,
+        description="Meshes with more vertices than this are baked on a proxy (0: never)")
     energy: EnumProperty(
         name="Energy", default="SHELLS",
         items=(("SHELLS", "Discrete Shells", "Resists bending and stretching like a thin shell (the paper's energy)"),

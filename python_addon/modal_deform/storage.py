@@ -105,6 +105,7 @@ def store(obj, basis, mesh_fingerprint, seconds, energy):
     status.num_derivatives = basis.dimension - basis.num_modes
     status.num_floppy = basis.num_floppy
     status.ghost_vertices = len(basis.ghost_vertices)
+    status.proxy_vertices = basis.num_basis_vertices if basis.on_proxy else 0
     status.energy = energy
     status.baked_at = time.strftime("%Y-%m-%d %H:%M")
     status.seconds = seconds

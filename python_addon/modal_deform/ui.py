@@ -62,6 +62,11 @@ class VIEW3D_PT_modal_deform_bake(_Panel, bpy.types.Panel):
         row.enabled = settings.energy == "SHELLS"
         row.prop(settings, "derivatives")
         column.prop(settings, "ghost")
+        dense = column.column(align=True)
+        dense.prop(settings, "proxy_above")
+        row = dense.row()
+        row.enabled = settings.proxy_above > 0
+        row.prop(settings, "proxy")
         shells = column.column(align=True)
         shells.enabled = settings.energy == "SHELLS"
         shells.prop(settings, "bending")
@@ -74,6 +79,8 @@ class VIEW3D_PT_modal_deform_bake(_Panel, bpy.types.Panel):
             status = settings.status
             box.label(text=f"{status.dimension} dimensions: {status.num_modes} modes, "
                            f"{status.num_derivatives} derivatives", icon="OUTLINER_DATA_LIGHTPROBE")
+            if status.proxy_vertices:
+                box.label(text=f"Proxy: {status.proxy_vertices} of {status.num_vertices} vertices")
             box.label(text=f"Ghost: {status.ghost_vertices} vertices ({status.energy.title()})")
             box.label(text=f"Baked {status.baked_at} in {status.seconds:.1f} s")
             if status.num_floppy:

@@ -29,10 +29,15 @@ double direct_handle_term(const RowMatrixX3d& rest, const Eigen::VectorXd& mass,
   return sum;
 }
 
+// The rows of a dense basis U (3#V by r) at each vertex.
+VertexRows rows_of(const RowMatrixXf& U) {
+  return [&U](int v) { return U.middleRows<3>(3 * v).cast<double>().eval(); };
+}
+
 // The reduced term of `setup`-like arguments: the fine term restricted to x̄ + U q.
 ReducedHandleTerm reduced(const RowMatrixX3d& rest, const Eigen::VectorXd& mass, const RowMatrixXf& U,
                           const Handles& handles, const Eigen::VectorXd& weights, double coefficient) {
-  return ReducedHandleTerm(HandleTerm(rest, mass, handles, weights, coefficient), U);
+  return ReducedHandleTerm(HandleTerm(rest, mass, handles, weights, coefficient), rows_of(U), U.cols());
 }
 
 struct Handled {
@@ -112,7 +117,7 @@ TEST(HandleTerm, OnTheFineMeshEqualsTheSumAndItsDerivatives) {
   EXPECT_NEAR(diagonal[21], 2 * setup.coefficient * 1.5 * setup.mass[7], 1e-12);
   EXPECT_EQ(diagonal[3], 0.0);
   // Restricted to x̄ + U q it is the reduced term.
-  ReducedHandleTerm restricted(term, setup.U);
+  ReducedHandleTerm restricted(term, rows_of(setup.U), setup.U.cols());
   restricted.set_transforms(setup.transforms);
   Eigen::VectorXd reduced_gradient(5);
   EXPECT_NEAR(restricted.value_and_gradient(q, reduced_gradient), expected, 1e-10 * expected);

@@ -1,0 +1,115 @@
+#include "reduction/prolongation.h"
+
+#include <algorithm>
+#include <limits>
+#include <vector>
+
+#include "util/errors.h"
+
+namespace modal_deform {
+namespace {
+
+// Fine vertices per block of prolongate_positions: threads only where they pay.
+constexpr Eigen::Index kBlockVertices = 4096;
+
+// Barycentric coordinates (of a, b, c) of the point of triangle abc closest to p: the Voronoi
+// region test of Ericson, Real-Time Collision Detection, 5.1.5. A degenerate triangle gives a
+// point of one of its edges.
+Eigen::Vector3d closest_barycentric(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                    const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return {1, 0, 0};
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return {0, 1, 0};
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    const double v = d1 / (d1 - d3);
+    return {1 - v, v, 0};
+  }
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return {0, 0, 1};
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+    const double w = d2 / (d2 - d6);
+    return {1 - w, 0, w};
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return {0, 1 - w, w};
+  }
+  const double denominator = va + vb + vc;
+  if (!(denominator > 0)) return {1, 0, 0};  // degenerate: the edges above did not catch it
+  const double v = vb / denominator, w = vc / denominator;
+  return {1 - v - w, v, w};
+}
+
+}  // namespace
+
+Prolongation prolongation_to_proxy(const VerticesRef& V, const VerticesRef& proxy_V, const FacesRef& proxy_F,
+                                   const Eigen::Ref<const Eigen::VectorXi>& cluster) {
+  const Eigen::Index n = V.rows(), p = proxy_V.rows();
+  if (cluster.size() != n)
+    throw InputError(message("cluster: expected ", n, " entries (one per fine vertex), got ", cluster.size()));
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (cluster[i] < 0 || cluster[i] >= p)
+      throw InputError(message("cluster[", i, "] = ", cluster[i], " is outside [0, ", p, ")"));
+  // The triangles around each proxy vertex, compressed by vertex.
+  std::vector<int> first(static_cast<size_t>(p) + 1, 0);
+  for (Eigen::Index f = 0; f < proxy_F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) ++first[static_cast<size_t>(proxy_F(f, k)) + 1];
+  for (Eigen::Index x = 0; x < p; ++x) first[x + 1] += first[x];
+  std::vector<int> faces(static_cast<size_t>(first[p])), next(first.begin(), first.end() - 1);
+  for (Eigen::Index f = 0; f < proxy_F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) faces[static_cast<size_t>(next[proxy_F(f, k)]++)] = static_cast<int>(f);
+
+  Prolongation prolongation;
+  prolongation.vertices.resize(n, 3);
+  prolongation.weights.resize(n, 3);
+#pragma omp parallel for schedule(static)
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const int c = cluster[i];
+    const Eigen::Vector3d x = V.row(i).transpose();
+    double nearest = std::numeric_limits<double>::infinity();
+    prolongation.vertices.row(i) << c, c, c;
+    prolongation.weights.row(i) << 1, 0, 0;
+    for (int j = first[c]; j < first[c + 1]; ++j) {
+      const int f = faces[static_cast<size_t>(j)];
+      const Eigen::Vector3d a = proxy_V.row(proxy_F(f, 0)), b = proxy_V.row(proxy_F(f, 1)),
+                            d = proxy_V.row(proxy_F(f, 2));
+      const Eigen::Vector3d w = closest_barycentric(x, a, b, d);
+      const double distance = (w[0] * a + w[1] * b + w[2] * d - x).squaredNorm();
+      if (distance < nearest) {
+        nearest = distance;
+        prolongation.vertices.row(i) = proxy_F.row(f);
+        prolongation.weights.row(i) = w.cast<float>().transpose();
+      }
+    }
+  }
+  return prolongation;
+}
+
+void prolongate_positions(const Prolongation& prolongation, const double* rest, const float* proxy_displacement,
+                          float* out) {
+  const Eigen::Index n = prolongation.size();
+  const int* vertices = prolongation.vertices.data();
+  const float* weights = prolongation.weights.data();
+  const Eigen::Index blocks = (n + kBlockVertices - 1) / kBlockVertices;
+#pragma omp parallel for schedule(static) if (blocks > 1)
+  for (Eigen::Index block = 0; block < blocks; ++block) {
+    const Eigen::Index end = std::min(n, (block + 1) * kBlockVertices);
+    for (Eigen::Index i = block * kBlockVertices; i < end; ++i) {
+      const float* d0 = proxy_displacement + 3 * vertices[3 * i];
+      const float* d1 = proxy_displacement + 3 * vertices[3 * i + 1];
+      const float* d2 = proxy_displacement + 3 * vertices[3 * i + 2];
+      const float w0 = weights[3 * i], w1 = weights[3 * i + 1], w2 = weights[3 * i + 2];
+      for (int a = 0; a < 3; ++a)
+        out[3 * i + a] = static_cast<float>(rest[3 * i + a] + static_cast<double>(w0 * d0[a] + w1 * d1[a] + w2 * d2[a]));
+    }
+  }
+}
+
+}  // namespace modal_deform
