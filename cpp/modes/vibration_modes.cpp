@@ -4,6 +4,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -29,7 +30,8 @@ constexpr double kDeflatedShiftFraction = 1e-10;
 constexpr double kEigenTolerance = 1e-10;
 constexpr int kMaxRestarts = 1000;
 // A mode fails when its residual exceeds kResidualTolerance · (|λ| + the largest λ computed) +
-// kRoundingFloor · tr K / tr M, the last term for rounding in modes with λ = 0.
+// kRoundingFloor · tr K / tr M, the last term for rounding in modes with λ = 0, plus the rounding
+// of K φ itself (rounding_levels).
 constexpr double kResidualTolerance = 1e-6;
 constexpr double kRoundingFloor = 1e-12;
 
@@ -109,6 +111,32 @@ struct MassProduct {
   }
 };
 
+// ‖R.col(i)‖ in the M⁻¹-norm for each column (DOFs without mass left out).
+Eigen::VectorXd inverse_mass_norms(const Eigen::MatrixXd& R, const Eigen::VectorXd& m) {
+  Eigen::VectorXd norms(R.cols());
+  for (Eigen::Index i = 0; i < R.cols(); ++i) {
+    double squared = 0;
+    for (Eigen::Index d = 0; d < R.rows(); ++d)
+      if (m[d] > 0) squared += R(d, i) * R(d, i) / m[d];
+    norms[i] = std::sqrt(squared);
+  }
+  return norms;
+}
+
+// How far rounding alone can put each K φ off, in the M⁻¹-norm: a sum of k products carries an
+// error up to about k ε Σ|K_dj||φ_j| (Higham's γ_k), k the nonzeros per row. Modes on a scan's
+// stiff small parts (needles, flaps at non-manifold edges) have |K||φ| far above tr K / tr M, so
+// their residuals stop at this level rather than at kRoundingFloor's, which assumes an even mesh.
+Eigen::VectorXd rounding_levels(const SparseMatrix& K, const Eigen::MatrixXd& modes, const Eigen::VectorXd& m) {
+  const Eigen::MatrixXd magnitudes = modes.cwiseAbs().transpose();  // count by 3n: a DOF's values contiguous
+  Eigen::MatrixXd products = Eigen::MatrixXd::Zero(magnitudes.rows(), magnitudes.cols());
+  for (Eigen::Index j = 0; j < K.outerSize(); ++j)
+    for (SparseMatrix::InnerIterator it(K, j); it; ++it)
+      products.col(it.row()) += std::abs(it.value()) * magnitudes.col(j);
+  const double terms_per_row = static_cast<double>(K.nonZeros()) / static_cast<double>(K.rows());
+  return terms_per_row * std::numeric_limits<double>::epsilon() * inverse_mass_norms(products.transpose(), m);
+}
+
 // Z: a checked kernel basis (see checked_kernel_basis), possibly empty.
 VibrationModes deflated_modes(const SparseMatrix& K, const VectorRef& mass, int count, const Eigen::MatrixXd& Z,
                               Progress* progress, CholmodLLT* factor) {
@@ -184,16 +212,10 @@ VibrationModes deflated_modes(const SparseMatrix& K, const VectorRef& mass, int 
   result.modes = Y * ritz.eigenvectors();   // M-orthonormal
   const Eigen::MatrixXd residual =
       KY * ritz.eigenvectors() - m.asDiagonal() * (result.modes * result.eigenvalues.asDiagonal());
-  result.residuals.resize(count);
-  for (int i = 0; i < count; ++i) {
-    double squared = 0;
-    for (int d = 0; d < n; ++d)
-      if (m[d] > 0) squared += residual(d, i) * residual(d, i) / m[d];
-    result.residuals[i] = std::sqrt(squared);
-  }
+  result.residuals = inverse_mass_norms(residual, m);
   const double largest = result.eigenvalues[count - 1];
-  result.tolerances =
-      kResidualTolerance * (result.eigenvalues.array().abs() + largest) + kRoundingFloor * scale;
+  result.tolerances = kResidualTolerance * (result.eigenvalues.array().abs() + largest) + kRoundingFloor * scale +
+                      rounding_levels(K, result.modes, m).array();
   result.shift = sigma;
   result.solves = op.solves();
   if (progress) progress->report("modes", 1.0);

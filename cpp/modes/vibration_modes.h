@@ -15,7 +15,7 @@ struct VibrationModes {
   // lies within it of the reported one.
   Eigen::VectorXd residuals;
   // The residual each mode must stay within: 1e-6 of (|λ| + the largest λ computed), plus a
-  // rounding floor for λ = 0 (count, units of λ).
+  // rounding floor for λ = 0 and the rounding error of computing K φ (count, units of λ).
   Eigen::VectorXd tolerances;
   double shift = 0;  // σ of the shift-invert transform
   int solves = 0;    // solves with the factor of K − σM
