@@ -87,8 +87,12 @@ Eigen::MatrixXd solve_by_blocks(const SparseMatrix& K, const VectorRef& mass, co
   const double norm_K = norm_1(K);
   Eigen::MatrixXd& Psi = B;
   Eigen::MatrixXd PB;
-  for (Eigen::Index first = 0; first < B.cols(); first += kBlockColumns) {
-    const Eigen::Index width = std::min(kBlockColumns, B.cols() - first);
+  // Blocks of equal width, at most kBlockColumns: 110 columns go as 55 + 55 rather than 64 + 46,
+  // so the buffers are the narrower (at 100k vertices 88 MB less for the four of them).
+  const Eigen::Index blocks = (B.cols() + kBlockColumns - 1) / kBlockColumns;
+  const Eigen::Index block_columns = blocks > 0 ? (B.cols() + blocks - 1) / blocks : 1;
+  for (Eigen::Index first = 0; first < B.cols(); first += block_columns) {
+    const Eigen::Index width = std::min(block_columns, B.cols() - first);
     PB = B.middleCols(first, width);
     for (Eigen::Index d = 0; d < n; ++d)
       if (decoupled[static_cast<size_t>(d)]) PB.row(d).setZero();
