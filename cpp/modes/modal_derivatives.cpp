@@ -282,6 +282,7 @@ Eigen::MatrixXd solve_in_range_shifted(const SparseMatrix& K, const VectorRef& m
           if (k > 0) report(static_cast<double>(k) / steps);
           step(X, k + 1 == steps);
         }
+        R.resize(0, 0);  // not kept through the residual check, where the bake's memory peaks
       },
       progress);
 }
