@@ -10,6 +10,9 @@ Experiments (each writes bench/results/<name>.json: machine, commit, command, pa
   accuracy     Fig. 5/12 analogue (bench/accuracy.py)
   convergence  Fig. 7 analogue (bench/convergence.py)
   taylor       Fig. 9 analogue (bench/taylor.py)
+  bake_limit   the 100k-vertex dragon's bake at 67 and 130 dimensions, three fresh processes, against
+               CHOLMOD's analysis and factorisation of the same matrix and issue 14's targets
+               (bench/bake_limit.py)
   raw_scan     a damaged, subdivided dragon of about 405k vertices baked in a fresh process: time
                and peak memory against issue 15's targets (bench/raw_scan.py)
   multires     the dragon subdivided twice (1.6M vertices) baked on a proxy: time, memory, stored
@@ -34,7 +37,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import common  # noqa: E402
 import report  # noqa: E402
 
-PYTHON_EXPERIMENTS = ("table1", "accuracy", "convergence", "taylor", "raw_scan", "multires")
+PYTHON_EXPERIMENTS = ("table1", "accuracy", "convergence", "taylor", "bake_limit", "raw_scan", "multires")
 EXPERIMENTS = ("native",) + PYTHON_EXPERIMENTS + ("blender", "renders")
 NATIVE_IN_TABLE1 = "BM_Bake|BM_BfgsIteration|BM_Positions"
 BLENDER = ["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python"]

@@ -244,11 +244,15 @@ Eigen::MatrixXd CholmodLLT::solve(const Eigen::Ref<const Eigen::MatrixXd>& B) {
 }
 
 void CholmodLLT::solve(const Eigen::Ref<const Eigen::MatrixXd>& B, Eigen::Ref<Eigen::MatrixXd> X) {
-  if (!factorized_) throw std::logic_error("CholmodLLT::solve: no successful factorisation to solve with");
-  if (B.rows() != rows()) throw InputError(message("B: expected ", rows(), " rows, got ", B.rows()));
   if (X.rows() != B.rows() || X.cols() != B.cols())
     throw InputError(message("X: expected ", B.rows(), " by ", B.cols(), ", got ", X.rows(), " by ", X.cols()));
-  if (B.cols() == 0) return;
+  X = solve_in_workspace(B);
+}
+
+CholmodLLT::Solution CholmodLLT::solve_in_workspace(const Eigen::Ref<const Eigen::MatrixXd>& B) {
+  if (!factorized_) throw std::logic_error("CholmodLLT::solve: no successful factorisation to solve with");
+  if (B.rows() != rows()) throw InputError(message("B: expected ", rows(), " rows, got ", B.rows()));
+  if (B.cols() == 0) return Solution(nullptr, B.rows(), 0, Eigen::OuterStride<>(B.rows()));
   cholmod_dense rhs{};
   rhs.nrow = static_cast<size_t>(B.rows());
   rhs.ncol = static_cast<size_t>(B.cols());
@@ -261,9 +265,8 @@ void CholmodLLT::solve(const Eigen::Ref<const Eigen::MatrixXd>& B, Eigen::Ref<Ei
   const int ok =
       cholmod_solve2(CHOLMOD_A, c.factor, &rhs, nullptr, &c.solution, nullptr, &c.work_y, &c.work_e, &c.common);
   c.check(ok != 0, "solve");
-  const auto* x = static_cast<const double*>(c.solution->x);
-  for (Eigen::Index j = 0; j < X.cols(); ++j)
-    X.col(j) = Eigen::Map<const Eigen::VectorXd>(x + j * c.solution->d, X.rows());
+  return Solution(static_cast<const double*>(c.solution->x), B.rows(), B.cols(),
+                  Eigen::OuterStride<>(static_cast<Eigen::Index>(c.solution->d)));
 }
 
 }  // namespace modal_deform

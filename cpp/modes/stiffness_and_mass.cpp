@@ -19,6 +19,11 @@ constexpr double kSymmetryTolerance = 1e-10;
 constexpr double kOrthonormalTolerance = 1e-8;
 // ‖K z‖ ≤ kKernelTolerance ‖K‖₁ ‖z‖ for each column z of a kernel basis.
 constexpr double kKernelTolerance = 1e-8;
+// Columns of X per task of add_product, copied to row-major storage: Eigen then streams K once per
+// task and adds each entry's multiple of a contiguous row, where column-major columns make it
+// stream K once per column. On dragon_vrip_res2 (300k rows, 52 columns) 0.34-0.37 s against
+// 0.56-0.57 s (4 columns: 0.43 s, 13: 0.37 s), for two 8-column buffers per thread (38 MB).
+constexpr Eigen::Index kProductColumns = 8;
 
 // Entries [begin, end) of column `col` in K's index and value arrays; rows come sorted.
 std::pair<int, int> column_range(const SparseMatrix& K, int col) {
@@ -30,13 +35,18 @@ std::pair<int, int> column_range(const SparseMatrix& K, int col) {
 
 void add_product(const SparseMatrix& K, const Eigen::Ref<const Eigen::MatrixXd>& X, double scale,
                  Eigen::Ref<Eigen::MatrixXd> out) {
-  // One block of columns per thread: each streams K once for all its columns, where a product
-  // per column would stream K once per column.
-  const auto blocks = std::min<Eigen::Index>(omp_get_max_threads(), X.cols());
-#pragma omp parallel for schedule(static)
-  for (Eigen::Index b = 0; b < blocks; ++b) {
-    const Eigen::Index first = X.cols() * b / blocks, last = X.cols() * (b + 1) / blocks;
-    out.middleCols(first, last - first).noalias() += scale * (K * X.middleCols(first, last - first));
+  using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const Eigen::Index tasks = (X.cols() + kProductColumns - 1) / kProductColumns;
+#pragma omp parallel if (tasks > 1)
+  {
+    RowMajorMatrix rows, product;  // reused from task to task
+#pragma omp for schedule(dynamic)
+    for (Eigen::Index task = 0; task < tasks; ++task) {
+      const Eigen::Index first = task * kProductColumns, width = std::min(kProductColumns, X.cols() - first);
+      rows = X.middleCols(first, width);
+      product.noalias() = K * rows;
+      out.middleCols(first, width) += scale * product;
+    }
   }
 }
 

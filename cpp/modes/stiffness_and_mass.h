@@ -21,8 +21,8 @@ Eigen::VectorXd dof_masses(const VectorRef& mass);
 // column of K, such as those of unreferenced vertices. Modes and derivatives are zero there.
 std::vector<bool> decoupled_dofs(const SparseMatrix& K, const VectorRef& mass);
 
-// out += scale K X, and K X, in column blocks on the OpenMP threads (Eigen's sparse products run
-// on one thread).
+// out += scale K X, and K X, in blocks of a few columns on the OpenMP threads (Eigen's sparse
+// products run on one thread).
 void add_product(const SparseMatrix& K, const Eigen::Ref<const Eigen::MatrixXd>& X, double scale,
                  Eigen::Ref<Eigen::MatrixXd> out);
 Eigen::MatrixXd multiply(const SparseMatrix& K, const Eigen::Ref<const Eigen::MatrixXd>& X);
