@@ -4,6 +4,7 @@
 #include <limits>
 #include <vector>
 
+#include "mesh/closest_point.h"
 #include "util/errors.h"
 
 namespace modal_deform {
@@ -11,41 +12,6 @@ namespace {
 
 // Fine vertices per block of prolongate_positions: threads only where they pay.
 constexpr Eigen::Index kBlockVertices = 4096;
-
-// Barycentric coordinates (of a, b, c) of the point of triangle abc closest to p: the Voronoi
-// region test of Ericson, Real-Time Collision Detection, 5.1.5. A degenerate triangle gives a
-// point of one of its edges.
-Eigen::Vector3d closest_barycentric(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                                    const Eigen::Vector3d& c) {
-  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return {1, 0, 0};
-  const Eigen::Vector3d bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return {0, 1, 0};
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
-    const double v = d1 / (d1 - d3);
-    return {1 - v, v, 0};
-  }
-  const Eigen::Vector3d cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return {0, 0, 1};
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
-    const double w = d2 / (d2 - d6);
-    return {1 - w, 0, w};
-  }
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
-    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-    return {0, 1 - w, w};
-  }
-  const double denominator = va + vb + vc;
-  if (!(denominator > 0)) return {1, 0, 0};  // degenerate: the edges above did not catch it
-  const double v = vb / denominator, w = vc / denominator;
-  return {1 - v - w, v, w};
-}
 
 }  // namespace
 
@@ -80,7 +46,7 @@ Prolongation prolongation_to_proxy(const VerticesRef& V, const VerticesRef& prox
       const int f = faces[static_cast<size_t>(j)];
       const Eigen::Vector3d a = proxy_V.row(proxy_F(f, 0)), b = proxy_V.row(proxy_F(f, 1)),
                             d = proxy_V.row(proxy_F(f, 2));
-      const Eigen::Vector3d w = closest_barycentric(x, a, b, d);
+      const Eigen::Vector3d w = closest_point_barycentric(x, a, b, d);
       const double distance = (w[0] * a + w[1] * b + w[2] * d - x).squaredNorm();
       if (distance < nearest) {
         nearest = distance;

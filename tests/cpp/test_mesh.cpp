@@ -2,6 +2,7 @@
 
 #include <set>
 
+#include "mesh/closest_point.h"
 #include "mesh/mass.h"
 #include "mesh/mesh_check.h"
 #include "mesh/mesh_topology.h"
@@ -141,6 +142,27 @@ TEST(Mesh, DegenerateFacesAreFound) {
   F << 0, 1, 2, 0, 1, 3, 0, 0, 3;
   const MeshReport report = check_mesh(V, F);
   EXPECT_EQ(count_of(report, "degenerate_faces"), 2);
+}
+
+}  // namespace
+}  // namespace modal_deform
+
+namespace modal_deform {
+namespace {
+
+// Inside, beyond an edge, beyond a corner, and on triangles that are a segment or a point.
+TEST(ClosestPoint, InsideOnEdgesAtCornersAndOnDegenerateTriangles) {
+  const Eigen::Vector3d a(0, 0, 0), b(2, 0, 0), c(0, 2, 0);
+  EXPECT_TRUE(closest_point_barycentric({0.5, 0.5, 3}, a, b, c).isApprox(Eigen::Vector3d(0.5, 0.25, 0.25)));
+  EXPECT_TRUE(closest_point_barycentric({1, -1, 0}, a, b, c).isApprox(Eigen::Vector3d(0.5, 0.5, 0)));
+  EXPECT_TRUE(closest_point_barycentric({2, 2, 1}, a, b, c).isApprox(Eigen::Vector3d(0, 0.5, 0.5)));
+  EXPECT_TRUE(closest_point_barycentric({3, -1, 0}, a, b, c).isApprox(Eigen::Vector3d(0, 1, 0)));
+  EXPECT_TRUE(closest_point_barycentric({-1, -1, -1}, a, b, c).isApprox(Eigen::Vector3d(1, 0, 0)));
+  const Eigen::Vector3d on_segment = closest_point_barycentric({1, 1, 0}, a, b, Eigen::Vector3d(1, 0, 0));
+  EXPECT_TRUE((on_segment[0] * a + on_segment[1] * b + on_segment[2] * Eigen::Vector3d(1, 0, 0))
+                  .isApprox(Eigen::Vector3d(1, 0, 0)));
+  EXPECT_NEAR(on_segment.sum(), 1, 1e-15);
+  EXPECT_TRUE(closest_point_barycentric({1, 1, 1}, a, a, a).isApprox(Eigen::Vector3d(1, 0, 0)));
 }
 
 }  // namespace

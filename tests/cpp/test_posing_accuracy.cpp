@@ -19,6 +19,7 @@
 #include <map>
 #include <string>
 
+#include "mesh/closest_point.h"
 #include "mesh/primitives.h"
 #include "bake/bake.h"
 #include "solve/full_solver.h"
@@ -231,31 +232,6 @@ TEST(PosingAccuracy, ArapInTheShellsBasis) {
   EXPECT_LE(e.gap[0], e.gap[1]);
 }
 
-// The point of triangle (a, b, c) nearest to p, as barycentric weights.
-Eigen::Vector3d nearest_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                                    const Eigen::Vector3d& c) {
-  Eigen::Matrix<double, 3, 2> E;
-  E << b - a, c - a;
-  const Eigen::Vector2d st = (E.transpose() * E).ldlt().solve(E.transpose() * (p - a));
-  if (st.minCoeff() >= 0 && st.sum() <= 1) return {1 - st.sum(), st[0], st[1]};
-  Eigen::Vector3d best = Eigen::Vector3d::Zero();
-  double closest = INFINITY;
-  const Eigen::Vector3d corner[3] = {a, b, c};
-  for (int e = 0; e < 3; ++e) {
-    const Eigen::Vector3d& x = corner[e];
-    const Eigen::Vector3d& y = corner[(e + 1) % 3];
-    const double t = std::clamp((p - x).dot(y - x) / (y - x).squaredNorm(), 0.0, 1.0);
-    const double d = (p - x - t * (y - x)).norm();
-    if (d < closest) {
-      closest = d;
-      best.setZero();
-      best[e] = 1 - t;
-      best[(e + 1) % 3] = t;
-    }
-  }
-  return best;
-}
-
 // The distance between the vertices rows [first, first + count) of X and the surface of the faces
 // of F whose vertices all lie below `first` (the part they are attached to).
 double gap_to_surface(const RowMatrixX3d& X, const RowMatrixX3i& F, int first, int count) {
@@ -264,7 +240,7 @@ double gap_to_surface(const RowMatrixX3d& X, const RowMatrixX3i& F, int first, i
     for (Eigen::Index f = 0; f < F.rows(); ++f) {
       if (F.row(f).maxCoeff() >= first) continue;
       const Eigen::Vector3d a = X.row(F(f, 0)), b = X.row(F(f, 1)), c = X.row(F(f, 2)), p = X.row(v);
-      const Eigen::Vector3d w = nearest_on_triangle(p, a, b, c);
+      const Eigen::Vector3d w = closest_point_barycentric(p, a, b, c);
       gap = std::min(gap, (w[0] * a + w[1] * b + w[2] * c - p).norm());
     }
   return gap;
