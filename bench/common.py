@@ -5,6 +5,7 @@ import os
 import pathlib
 import platform
 import subprocess
+import sys
 import time
 
 import numpy as np
@@ -70,3 +71,13 @@ def rms_error(X, reference):
     X, reference = np.asarray(X, np.float64), np.asarray(reference, np.float64)
     diagonal = np.linalg.norm(np.ptp(reference, axis=0))
     return float(np.sqrt(np.mean(np.sum((X - reference) ** 2, axis=1))) / diagonal)
+
+
+def json_from_fresh_process(code):
+    """Run the Python `code` in a fresh process of this interpreter (from the project's root) and
+    return the JSON object its last line prints, with "ok": True unless it says otherwise; when it
+    fails, {"ok": False, "error": [its last line of standard error]}."""
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
+    if result.returncode != 0:
+        return {"ok": False, "error": result.stderr.strip().splitlines()[-1:]}
+    return {"ok": True} | json.loads(result.stdout.strip().splitlines()[-1])

@@ -7,11 +7,9 @@ on the vertices the two meshes share (RMS relative to the bounding-box diagonal)
 Targets (issue 15, printed, not asserted): bake 30 s, 4 GB, 200 MB stored, 16 ms per update, 1% RMS.
 """
 import json
-import subprocess
-import sys
 import textwrap
 
-from common import ROOT
+from common import ROOT, json_from_fresh_process
 
 PROXIES = (100_000, 50_000)
 TARGETS = {"seconds": 30.0, "peak_gb": 4.0, "stored_mb": 200.0, "update_ms": 16.0, "rms": 0.01}
@@ -65,10 +63,7 @@ _CHILD = textwrap.dedent("""
 
 def bake_in_fresh_process(name, levels, proxy):
     code = _CHILD.format(bench=str(ROOT / "bench"), name=name, levels=levels, proxy=proxy)
-    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
-    if result.returncode != 0:
-        return {"ok": False, "error": result.stderr.strip().splitlines()[-1:]}
-    return dict(ok=True, **json.loads(result.stdout.strip().splitlines()[-1]))
+    return json_from_fresh_process(code)
 
 
 def run(quick=False):

@@ -4,11 +4,9 @@ paper's 67 dimensions (20 modes + 47 derivatives, 1k ghost), each seed in a fres
 time, peak resident memory, what the bake found. Targets (issue 15): at most 60 s within 4 GB.
 """
 import json
-import subprocess
-import sys
 import textwrap
 
-from common import ROOT
+from common import ROOT, json_from_fresh_process
 
 SEEDS = (0, 1)
 TARGET_SECONDS, TARGET_GB = 60.0, 4.0
@@ -42,10 +40,7 @@ _CHILD = textwrap.dedent("""
 
 def bake_in_fresh_process(name, levels, seed):
     code = _CHILD.format(bench=str(ROOT / "bench"), name=name, levels=levels, seed=seed)
-    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
-    if result.returncode != 0:
-        return {"ok": False, "error": result.stderr.strip().splitlines()[-1:]}
-    return json.loads(result.stdout.strip().splitlines()[-1])
+    return json_from_fresh_process(code)
 
 
 def run(quick=False):
