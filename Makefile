@@ -31,7 +31,7 @@ CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 
 # Debian packages the project needs, with the reason for each in README.md.
 PACKAGES := cmake g++ make pkg-config ninja-build binutils \
-	libeigen3-dev libspectra-dev libsuitesparse-dev libopenblas0-pthread zlib1g-dev \
+	libeigen3-dev libsuitesparse-dev libopenblas0-pthread zlib1g-dev \
 	pybind11-dev python3-dev python3-numpy python3-scipy python3-pytest \
 	libgtest-dev libbenchmark-dev \
 	blender xvfb xauth python3-matplotlib

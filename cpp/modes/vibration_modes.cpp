@@ -1,16 +1,17 @@
 #include "modes/vibration_modes.h"
 
-#include <Spectra/SymGEigsShiftSolver.h>
-
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
 #include <string>
 
 #include "linalg/cholmod_llt.h"
+#include "linalg/tall_products.h"
 #include "modes/stiffness_and_mass.h"
 #include "util/errors.h"
+#include "util/parallel_for.h"
 
 namespace modal_deform {
 namespace {
@@ -22,47 +23,53 @@ namespace {
 // singular. Zero modes left in K (undeflated ones, a floppy mesh's mechanisms) want σ not too
 // close to 0: at 1e-10 the residuals of the other modes of two small spring networks exceed
 // 1e-8 of the top eigenvalue. The wanted modes want it not far below them: deflating the rigid
-// motions, the 100k dragon took 111 solves for 14 modes at 1e-8, 50 at 1e-10 or 1e-12; on the
-// 23k dragon 20 modes took 93 solves for every fraction from 1e-12 to 1e-8 (106 at 1e-6).
+// motions, Spectra's single-vector Lanczos (used before the block solver) took on the 100k
+// dragon 111 solves for 14 modes at 1e-8, 50 at 1e-10 or 1e-12; on the 23k dragon 20 modes took
+// 93 solves for every fraction from 1e-12 to 1e-8 (106 at 1e-6).
 // 1e-12 would let the bake's derivative solves refine once instead of twice (their contraction
 // −σ/(λ − σ) below 1e-3 on the 100k dragon), but leaves small meshes' modes above their residual
 // tolerance (the ARAP bake of a 3 by 3 by 3 bar: 5.3e-7 against 3.0e-7).
 constexpr double kShiftFraction = 1e-8;
 constexpr double kDeflatedShiftFraction = 1e-10;
-// Spectra's convergence tolerance on the transformed eigenvalues.
-constexpr double kEigenTolerance = 1e-10;
-constexpr int kMaxRestarts = 1000;
 // A mode fails when its residual exceeds kResidualTolerance · (|λ| + the largest λ computed) +
 // kRoundingFloor · tr K / tr M, the last term for rounding in modes with λ = 0, plus the rounding
 // of K φ itself (rounding_levels).
 constexpr double kResidualTolerance = 1e-6;
 constexpr double kRoundingFloor = 1e-12;
 
-// y = (K − σM)⁻¹ x through one CHOLMOD factorisation: Spectra's operator for the shift-invert mode
-// (its own SymShiftInvert factors with SparseLU, far slower). Each solve reports progress.
-// Single-vector Lanczos still beats block methods here, although a single solve on the 100k
-// dragon costs 115-130 ms against 18-26 ms per right-hand side in blocks of 15 to 52 (two solves
-// at once on the two cores gain nothing: they are memory bound): block subspace iteration from
-// modes of a 2000-vertex edge-collapsed coarse mesh, prolongated piecewise constant (after
-// Nasikun & Hildebrandt 2022), needed 200 right-hand sides for 15 modes of the 100k dragon where
-// Lanczos needs 52, and 480 against 72 for 20 modes of the 23k dragon (2.2 times the time).
+// Lanczos stops when ‖T y − ν y‖_M ≤ kEigenTolerance |ν| for each wanted Ritz pair (Spectra's
+// criterion, used here before the block solver): 1e-8 left residuals of 9e-11 on the bunny's
+// springs after the final inverse iteration, 1e-10 5e-13 (tests/cpp/test_vibration_modes.cpp
+// asks for 2.5e-11). On dragon_vrip_res2 each block of 8 takes the estimate down 30 to 60 times.
+constexpr double kEigenTolerance = 1e-10;
+// A new Lanczos direction whose M-norm is below this fraction of the largest one in its block is
+// dropped (the Krylov space has closed, up to rounding).
+constexpr double kDependentNorm = 1e-8;
+// Lanczos vectors allowed: kMaxColumnsPerMode per wanted mode, at least kMinColumns (a flat plate's
+// 4 lowest modes took more than 56), plus the first block. The dragons take 5 to 6 per mode.
+constexpr int kMaxColumnsPerMode = 12;
+constexpr int kMinColumns = 120;
+// Right-hand sides per block solve. A single solve streams the whole factor (92 ms on
+// dragon_vrip_res2, whose factor is 572 MB); blocks share the stream: 27 ms per right-hand side
+// in blocks of 8, 20 in blocks of 16. 15 modes of that dragon took 103 right-hand sides in blocks
+// of 8 (3.5 s) where Spectra's single-vector Lanczos took 52 (5.0 s); blocks of 16 need about 1.4
+// times as many, which their cheaper solves do not repay, and keep more vectors.
+constexpr int kBlockWidth = 8;
+
+// T X = P (K − σM)⁻¹ M X through one CHOLMOD factorisation, P the M-orthogonal projection off the
+// deflated kernel Z: Z spans eigenvectors, so projecting commutes with the inverse and keeps the
+// Krylov space off the kernel. T is self-adjoint in the M inner product.
 class ShiftInvert {
  public:
-  using Scalar = double;
-
   ShiftInvert(const SparseMatrix& K, const Eigen::VectorXd& dof_mass, const Eigen::MatrixXd& Z,
               Eigen::VectorXd decoupled_stiffness, Progress* progress, int expected_solves, CholmodLLT& llt)
       : K_(K),
         dof_mass_(dof_mass),
         Z_(Z),
-        MZ_(dof_mass.asDiagonal() * Z),
         decoupled_stiffness_(std::move(decoupled_stiffness)),
         progress_(progress),
         expected_solves_(expected_solves),
         llt_(llt) {}
-
-  Eigen::Index rows() const { return K_.rows(); }
-  Eigen::Index cols() const { return K_.cols(); }
 
   // Factors K − σM; DOFs outside the problem get a stiffness so the matrix stays definite. With
   // σ < 0 and K semidefinite it is definite however ill-conditioned (shift-invert wants it near
@@ -81,19 +88,14 @@ class ShiftInvert {
     }
   }
 
-  void perform_op(const Scalar* x, Scalar* y) {
-    Eigen::Map<Eigen::VectorXd>(y, rows()) = solve(Eigen::Map<const Eigen::VectorXd>(x, rows()));
-  }
-
-  // (K − σM)⁻¹ B, M-orthogonal to Z: Z spans eigenvectors, so projecting commutes with the
-  // inverse and keeps the Krylov space off the deflated kernel.
-  Eigen::MatrixXd solve(const Eigen::Ref<const Eigen::MatrixXd>& B) {
-    Eigen::MatrixXd X = llt_.solve(B);
-    if (Z_.cols()) X -= Z_ * (MZ_.transpose() * X);
-    solves_ += static_cast<int>(B.cols());
-    // Lanczos needs a few times ncv solves; the bar approaches 1 without reaching it.
+  // T X: one block solve of X's columns.
+  Eigen::MatrixXd apply(const Eigen::Ref<const Eigen::MatrixXd>& X) {
+    Eigen::MatrixXd Y = llt_.solve(dof_mass_.asDiagonal() * X);
+    if (Z_.cols()) subtract_product(Z_, weighted_inner(Z_, dof_mass_, Y), Y);
+    solves_ += static_cast<int>(X.cols());
+    // The bar approaches 1 without reaching it: the number of solves is not known in advance.
     if (progress_) progress_->report("modes", 1.0 - std::exp(-static_cast<double>(solves_) / expected_solves_));
-    return X;
+    return Y;
   }
 
   int solves() const { return solves_; }
@@ -102,7 +104,6 @@ class ShiftInvert {
   const SparseMatrix& K_;
   const Eigen::VectorXd& dof_mass_;
   const Eigen::MatrixXd& Z_;
-  const Eigen::MatrixXd MZ_;
   Eigen::VectorXd decoupled_stiffness_;
   Progress* progress_;
   int expected_solves_;
@@ -110,14 +111,103 @@ class ShiftInvert {
   CholmodLLT& llt_;
 };
 
-// y = M x with the lumped (diagonal) mass matrix: the inner product of the Lanczos vectors.
-struct MassProduct {
-  using Scalar = double;
-  const Eigen::VectorXd& dof_mass;
-  void perform_op(const Scalar* x, Scalar* y) const {
-    Eigen::Map<Eigen::VectorXd>(y, dof_mass.size()) =
-        dof_mass.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(x, dof_mass.size()));
+// The eigenvectors of T with the largest ν = 1/(λ − σ), by block Lanczos with full
+// reorthogonalisation in the M inner product. Stops when the Ritz residual ‖T y − ν y‖_M of each
+// of the `count` largest is below kEigenTolerance |ν|; throws NumericalError past max_columns.
+class BlockLanczos {
+ public:
+  // dimension: of the space T acts on (DOFs with mass less the deflated kernel); max_columns:
+  // Lanczos vectors allowed, at most that.
+  BlockLanczos(ShiftInvert& T, const Eigen::VectorXd& m, Eigen::Index dimension, Eigen::Index max_columns)
+      : T_(T), m_(m), dimension_(dimension), Q_(m.size(), max_columns), H_(Eigen::MatrixXd::Zero(max_columns, max_columns)) {}
+
+  // R: the random start block (n by width). Returns the Ritz vectors (n by count, M-orthonormal)
+  // of the `count` largest ν, descending.
+  Eigen::MatrixXd run(const Eigen::MatrixXd& R, int count) {
+    // The start block is T² R: undeflated zero modes dominate T R by up to 1/|σ| over the others
+    // (1e7 on small meshes), whose directions in the orthonormalised block then carry rough
+    // rounding error of that relative size, which K amplifies into residuals far above those of
+    // a smooth start. A second solve damps it.
+    Eigen::MatrixXd W = T_.apply(R);
+    orthonormal_coefficients(W);
+    W = T_.apply(W);
+    orthonormal_coefficients(W);
+    append(W);
+    for (;;) {
+      const Eigen::Index first = block_first_, last = columns_;
+      W = T_.apply(Q_.middleCols(first, last - first));
+      H_.block(0, first, last, last - first) = orthogonalize(W, last);
+      const Eigen::MatrixXd next = orthonormal_coefficients(W);  // W before = W after · next
+      // Ritz pairs of the space so far: T Q = Q H + W next Eᵀ over its last block.
+      const Eigen::MatrixXd H = 0.5 * (H_.topLeftCorner(last, last) + H_.topLeftCorner(last, last).transpose());
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> ritz(H);
+      if (ritz.info() != Eigen::Success) throw NumericalError("vibration modes: the Ritz step failed");
+      const Eigen::Index added = std::min<Eigen::Index>(next.rows(), Q_.cols() - last);
+      if (last >= count) {
+        const Eigen::MatrixXd S = ritz.eigenvectors().rowwise().reverse().leftCols(count);
+        const Eigen::VectorXd nu = ritz.eigenvalues().reverse().head(count);
+        const Eigen::VectorXd estimate = (next * S.bottomRows(last - first)).colwise().norm();
+        // With `dimension` vectors the space is the whole problem and its Ritz pairs are exact
+        // (small meshes).
+        if ((estimate.array() <= kEigenTolerance * nu.array().abs()).all() || next.rows() == 0 ||
+            last == dimension_)
+          return Q_.leftCols(last) * S;
+      }
+      if (added == 0)
+        throw NumericalError(message("vibration modes: the eigensolver did not converge within ", last,
+                                     " Lanczos vectors (", T_.solves(), " solves)"));
+      H_.block(last, first, added, last - first) = next.topRows(added);
+      append(W.leftCols(added));
+    }
   }
+
+ private:
+  // W −= Q Qᵀ M W over the first `columns` of Q, twice (once leaves rounding of the size of the
+  // removed part); returns the coefficients removed.
+  Eigen::MatrixXd orthogonalize(Eigen::MatrixXd& W, Eigen::Index columns) const {
+    const auto Q = Q_.leftCols(columns);
+    const Eigen::MatrixXd C = weighted_inner(Q, m_, W);
+    subtract_product(Q, C, W);
+    const Eigen::MatrixXd again = weighted_inner(Q, m_, W);
+    subtract_product(Q, again, W);
+    return C + again;
+  }
+
+  // Makes W M-orthonormal in place, dropping directions below kDependentNorm of its largest
+  // column; returns B with W before = W after · B. Twice: the Gram matrix squares W's condition,
+  // so one pass leaves W orthonormal only up to rounding times that condition.
+  Eigen::MatrixXd orthonormal_coefficients(Eigen::MatrixXd& W) const {
+    const Eigen::MatrixXd first = orthonormal_pass(W);
+    return orthonormal_pass(W) * first;
+  }
+
+  Eigen::MatrixXd orthonormal_pass(Eigen::MatrixXd& W) const {
+    if (W.cols() == 0) return Eigen::MatrixXd(0, 0);  // Eigen's eigensolver fails on an empty matrix
+    const Eigen::MatrixXd gram = weighted_inner(W, m_, W);
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(gram);
+    const double floor = kDependentNorm * kDependentNorm * gram.diagonal().maxCoeff();
+    Eigen::Index keep = 0;
+    while (keep < gram.rows() && eig.eigenvalues()[gram.rows() - 1 - keep] > floor) ++keep;
+    const Eigen::MatrixXd V = eig.eigenvectors().rightCols(keep);
+    const Eigen::VectorXd d = eig.eigenvalues().tail(keep).cwiseSqrt();
+    W = W * (V * d.cwiseInverse().asDiagonal());
+    return d.asDiagonal() * V.transpose();
+  }
+
+  // Appends W (M-orthonormal, M-orthogonal to Q) to Q as a new block.
+  void append(const Eigen::Ref<const Eigen::MatrixXd>& W) {
+    block_first_ = columns_;
+    Q_.middleCols(columns_, W.cols()) = W;
+    columns_ += W.cols();
+  }
+
+  ShiftInvert& T_;
+  const Eigen::VectorXd& m_;
+  Eigen::Index dimension_;
+  Eigen::MatrixXd Q_;  // the Lanczos vectors, columns_ of them so far
+  Eigen::MatrixXd H_;  // Qᵀ M T Q
+  Eigen::Index columns_ = 0;
+  Eigen::Index block_first_ = 0;
 };
 
 // ‖R.col(i)‖ in the M⁻¹-norm for each column (DOFs without mass left out).
@@ -139,9 +229,10 @@ Eigen::VectorXd inverse_mass_norms(const Eigen::MatrixXd& R, const Eigen::Vector
 Eigen::VectorXd rounding_levels(const SparseMatrix& K, const Eigen::MatrixXd& modes, const Eigen::VectorXd& m) {
   const Eigen::MatrixXd magnitudes = modes.cwiseAbs().transpose();  // count by 3n: a DOF's values contiguous
   Eigen::MatrixXd products = Eigen::MatrixXd::Zero(magnitudes.rows(), magnitudes.cols());
-  for (Eigen::Index j = 0; j < K.outerSize(); ++j)
-    for (SparseMatrix::InnerIterator it(K, j); it; ++it)
-      products.col(it.row()) += std::abs(it.value()) * magnitudes.col(j);
+  // Row d of |K||φ| from column d of K, K being symmetric: each column is summed on one thread.
+  parallel_for(K.outerSize(), [&](Eigen::Index d) {
+    for (SparseMatrix::InnerIterator it(K, d); it; ++it) products.col(d) += std::abs(it.value()) * magnitudes.col(it.row());
+  });
   const double terms_per_row = static_cast<double>(K.nonZeros()) / static_cast<double>(K.rows());
   return terms_per_row * std::numeric_limits<double>::epsilon() * inverse_mass_norms(products.transpose(), m);
 }
@@ -166,49 +257,24 @@ VibrationModes deflated_modes(const SparseMatrix& K, const VectorRef& mass, int 
   for (int d = 0; d < n; ++d)
     if (decoupled[static_cast<size_t>(d)]) decoupled_stiffness[d] = trace_K / (n - num_decoupled);
 
-  const int ncv = std::min(free, std::max(2 * count, count + 20));
+  const int width = std::min(free, kBlockWidth);
+  const Eigen::Index max_columns = std::min(free, std::max(kMaxColumnsPerMode * count, kMinColumns) + width);
   if (progress) progress->report("modes", 0.0);
   CholmodLLT own_factor(3);  // orders vertices, 3 DOFs each
-  ShiftInvert op(K, m, Z, std::move(decoupled_stiffness), progress, 3 * ncv, factor ? *factor : own_factor);
-  MassProduct mass_product{m};
-  // Spectra selects among the transformed values ν = 1/(λ − σ): the smallest λ above σ have the
-  // largest ν, hence LargestMagn. SmallestAlge only orders the result by ascending λ.
-  Spectra::SymGEigsShiftSolver<ShiftInvert, MassProduct, Spectra::GEigsMode::ShiftInvert> eigs(op, mass_product, count,
-                                                                                               ncv, sigma);
-  // Start from (K − σM)⁻¹ M r for a random r: a rough start vector leaves rough components in the
-  // Ritz vectors, which K amplifies into large residuals.
+  ShiftInvert T(K, m, Z, std::move(decoupled_stiffness), progress, 6 * count, factor ? *factor : own_factor);
+  T.set_shift(sigma);
   std::mt19937 random(1);
   std::uniform_real_distribution<double> uniform(-0.5, 0.5);
-  Eigen::VectorXd r(n), start(n);
-  for (int d = 0; d < n; ++d) r[d] = m[d] * uniform(random);
-  op.perform_op(r.data(), start.data());
-  Eigen::Index converged = 0;
-  try {
-    eigs.init(start.data());
-    converged =
-        eigs.compute(Spectra::SortRule::LargestMagn, kMaxRestarts, kEigenTolerance, Spectra::SortRule::SmallestAlge);
-  } catch (const NumericalError&) {
-    throw;
-  } catch (const Cancelled&) {
-    throw;
-  } catch (const OutOfMemory&) {
-    throw;
-  } catch (const std::runtime_error& e) {
-    // Spectra's own failures (e.g. "TridiagEigen: eigen decomposition failed"): seen when most of
-    // the mesh's motions cost no energy, so Lanczos meets one eigenvalue of huge multiplicity.
-    throw NumericalError(message("vibration modes: the eigensolver failed (", e.what(),
-                                 "); does the energy leave most motions free (a flat mesh under ARAP, a zero "
-                                 "weight)? Try the shells energy with positive weights, or fewer modes"));
-  }
-  if (eigs.info() != Spectra::CompInfo::Successful)
-    throw NumericalError(message("vibration modes: the eigensolver did not converge: ", converged, " of ", count,
-                                 " eigenpairs after ", eigs.num_iterations(), " restarts and ", op.solves(),
-                                 " solves"));
+  Eigen::MatrixXd R(n, width);
+  for (Eigen::Index j = 0; j < width; ++j)
+    for (int d = 0; d < n; ++d) R(d, j) = uniform(random);
+  BlockLanczos lanczos(T, m, free, max_columns);
+  const Eigen::MatrixXd ritz_vectors = lanczos.run(R, count);
 
   // One step of inverse iteration on the Ritz vectors, then Rayleigh–Ritz on the block: a Ritz
   // vector keeps a trace of rough rounding error that K amplifies into a large residual, and one
   // more solve damps it by λ / λ_max.
-  Eigen::MatrixXd Y = op.solve(m.asDiagonal() * eigs.eigenvectors());
+  Eigen::MatrixXd Y = T.apply(ritz_vectors);
   const Eigen::MatrixXd KY = multiply(K, Y);
   const Eigen::MatrixXd reduced_K = Y.transpose() * KY;
   const Eigen::MatrixXd reduced_M = Y.transpose() * (m.asDiagonal() * Y);
@@ -226,7 +292,7 @@ VibrationModes deflated_modes(const SparseMatrix& K, const VectorRef& mass, int 
   result.tolerances = kResidualTolerance * (result.eigenvalues.array().abs() + largest) + kRoundingFloor * scale +
                       rounding_levels(K, result.modes, m).array();
   result.shift = sigma;
-  result.solves = op.solves();
+  result.solves = T.solves();
   if (progress) progress->report("modes", 1.0);
   return result;
 }

@@ -24,8 +24,9 @@ struct VibrationModes {
 // The `count` eigenpairs of K φ = λ M φ with the smallest λ, rigid motions (λ = 0) included.
 // K: 3n by 3n symmetric positive semidefinite; mass: n vertex masses (M = diag(mass) ⊗ I₃); see
 // stiffness_and_mass.h for the checks and for DOFs without mass, which stay zero.
-// Lanczos (Spectra) on (K − σM)⁻¹M with σ < 0 from the scale of the problem, the inverse applied
-// through one CHOLMOD factorisation. Reports ("modes", fraction) to `progress`, which may cancel.
+// Block Lanczos on (K − σM)⁻¹M with σ < 0 from the scale of the problem, the inverse applied
+// through one CHOLMOD factorisation in blocks of right-hand sides, then one step of inverse
+// iteration and Rayleigh–Ritz on K. Reports ("modes", fraction) to `progress`, which may cancel.
 // Throws InputError for bad input, NumericalError when the eigensolver does not converge or a
 // mode's residual is too large.
 VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int count, Progress* progress = nullptr);

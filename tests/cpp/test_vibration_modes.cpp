@@ -149,7 +149,7 @@ TEST(VibrationModes, ReportsProgressAndCancels) {
       },
       0.0);
   vibration_modes(K, mass, 12, &progress);
-  ASSERT_GT(fractions.size(), 10u);
+  ASSERT_GT(fractions.size(), 5u);  // one report per block solve
   EXPECT_EQ(fractions.front(), 0.0);
   EXPECT_EQ(fractions.back(), 1.0);
   EXPECT_TRUE(std::is_sorted(fractions.begin(), fractions.end()));
