@@ -2,7 +2,8 @@
 dimensions (15 modes + 52 derivatives) and 130 (20 + 110) with a 1k ghost by the native benchmark
 BM_Bake (bench/bench_bake.cpp), each run in a fresh process: wall time, the stages, peak resident
 memory, and CHOLMOD alone analysing and factoring the same stiffness matrix in the same process
-(the floor: every bake analyses and factors it once). Medians over the runs; the ratio to CHOLMOD
+(the floor: every bake analyses and factors it once), and the cost of its solves per right-hand
+side one, 8 and 52 wide. Medians over the runs; the ratio to CHOLMOD
 is taken run by run, so that both sides of it saw the same load.
 """
 import json
@@ -18,6 +19,8 @@ RUNS = 3
 #: Issue 14's targets: seconds for each dimension, the 67-dimensional bake's ratio to CHOLMOD's
 #: analysis and factorisation, and peak memory (GB of 2^30 bytes) at 100k vertices.
 TARGETS = {"seconds_67": 8.0, "seconds_130": 12.0, "ratio_67": 2.5, "peak_gb": 2.0}
+#: Block widths at which bench_bake.cpp times CHOLMOD's solves with the factor it made alone.
+SOLVE_WIDTHS = ("1", "8", "52")
 STAGE_KEYS = ("attachment", "hessian", "factorisation", "ghost", "modes", "third derivatives", "derivative solves",
               "orthonormalisation", "assembly")
 
@@ -33,7 +36,8 @@ def bake_in_fresh_process(benchmark_filter):
         dimension = "67" if "modes:15/" in b["name"] else "130"
         bakes[dimension] = {"seconds": b["real_time"], "cholmod_s": b["cholmod_s"], "peak_gb": b["peak_rss_MB"] / 1024,
                             "dimension_with_zero_modes": b["dimension"],
-                            "stages": {k: b[k] for k in STAGE_KEYS if k in b}}
+                            "stages": {k: b[k] for k in STAGE_KEYS if k in b},
+                            "solve_ms_per_rhs": {w: b[f"solve_ms_per_rhs_{w}"] for w in SOLVE_WIDTHS}}
     return bakes
 
 
@@ -51,6 +55,7 @@ def summary(runs):
             "ratio": statistics.median(b["seconds"] / b["cholmod_s"] for b in bakes),
             "peak_gb": max(b["peak_gb"] for b in bakes),
             "stages": {k: statistics.median(b["stages"].get(k, 0.0) for b in bakes) for k in STAGE_KEYS},
+            "solve_ms_per_rhs": {w: statistics.median(b["solve_ms_per_rhs"][w] for b in bakes) for w in SOLVE_WIDTHS},
         }
     return out
 

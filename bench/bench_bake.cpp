@@ -6,7 +6,7 @@
 // factorisation towards "modes"), the dimension, the dragon's zero modes, the peak resident
 // memory of the bake, and "cholmod_s": CHOLMOD alone analysing and factoring K − σM of the same
 // stiffness matrix in the same process right after the bake, the floor the bake is measured
-// against (bench/bake_limit.py).
+// against (bench/bake_limit.py), with the cost of its solves per right-hand side.
 #include <benchmark/benchmark.h>
 
 #include <sys/resource.h>
@@ -47,9 +47,16 @@ double peak_rss_mb() {
   return kb / 1024;
 }
 
-// Seconds CHOLMOD takes to analyse and factor K − σM for the bake's K (the shells Hessian of the
-// simulated submesh in the normalised frame) and the bake's σ for deflated rigid motions.
-double cholmod_seconds(const TriangleMesh& mesh) {
+// CHOLMOD alone on K − σM for the bake's K (the shells Hessian of the simulated submesh in the
+// normalised frame) and the bake's σ for deflated rigid motions: seconds to analyse and factor,
+// and milliseconds per right-hand side of a solve one, 8 and 52 wide (the eigensolver's blocks and
+// the derivatives'). Together with the right-hand sides a bake needs, the floor of its time.
+struct CholmodAlone {
+  double seconds = 0;
+  std::map<int, double> ms_per_rhs;  // by block width
+};
+
+CholmodAlone cholmod_alone(const TriangleMesh& mesh) {
   const Attachment attachment = attach(mesh.V, mesh.F);
   const double scale = normalizing_scale(mesh.V);
   const Eigen::VectorXd fine_mass = lumped_mass(mesh.V, mesh.F);
@@ -64,14 +71,25 @@ double cholmod_seconds(const TriangleMesh& mesh) {
   const SparseMatrix K = shells.hessian(shells.rest());
   const Eigen::VectorXd m = dof_masses(mass);
   const Eigen::VectorXd shift = 1e-10 * K.diagonal().sum() / m.sum() * m;
-  double seconds = 0;
+  CholmodAlone alone;
+  CholmodLLT llt(3);
   {
-    const Stopwatch stopwatch(seconds);
-    CholmodLLT llt(3);
+    const Stopwatch stopwatch(alone.seconds);
     llt.analyze(K);
     llt.factorize(K, shift, 0.0);
   }
-  return seconds;
+  for (const int width : {1, 8, 52}) {
+    const Eigen::MatrixXd B = Eigen::MatrixXd::Random(K.rows(), width);
+    llt.solve_in_workspace(B);  // the workspace allocated and touched once, as in the bake
+    double seconds = 0;
+    constexpr int kRepeats = 3;
+    {
+      const Stopwatch stopwatch(seconds);
+      for (int r = 0; r < kRepeats; ++r) llt.solve_in_workspace(B);
+    }
+    alone.ms_per_rhs[width] = 1e3 * seconds / (kRepeats * width);
+  }
+  return alone;
 }
 
 // User and system CPU seconds of the whole process so far.
@@ -110,7 +128,9 @@ void BM_Bake(benchmark::State& state) {
     account("");
     state.counters["peak_rss_MB"] = peak_rss_mb();
   }
-  state.counters["cholmod_s"] = cholmod_seconds(mesh);
+  const CholmodAlone alone = cholmod_alone(mesh);
+  state.counters["cholmod_s"] = alone.seconds;
+  for (const auto& [width, ms] : alone.ms_per_rhs) state.counters["solve_ms_per_rhs_" + std::to_string(width)] = ms;
   for (const auto& [stage, seconds] : basis.timings) state.counters[stage] = seconds;
   for (const auto& [stage, seconds] : cpu) state.counters["cpu " + stage] = seconds;
   state.counters["dimension"] = basis.dimension();

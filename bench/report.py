@@ -424,6 +424,11 @@ def section_bake_limit(result):
              f"{s['ratio']:.2f}", f"{s['peak_gb']:.2f}"] + [f"{s['stages'][k]:.2f}" for k in bake_limit.STAGE_KEYS]
             for d, s in summary.items()]
     out.append(table(["dims", "bake s", "CHOLMOD s", "ratio", "peak GB"] + list(bake_limit.STAGE_KEYS), rows))
+    solves = next(iter(summary.values())).get("solve_ms_per_rhs")
+    if solves:
+        out += ["", "CHOLMOD's solves with that factor, per right-hand side: " +
+                ", ".join(f"{solves[w]:.1f} ms {'alone' if w == '1' else f'in blocks of {w}'}"
+                          for w in bake_limit.SOLVE_WIDTHS) + "."]
     out += ["", "Targets:", ""]
     out += [f"- {what}: **{measured:.2f} {unit}** — {'met' if measured <= target else 'NOT met'}"
             for what, measured, target, unit in bake_limit.checks(summary)]
