@@ -144,8 +144,9 @@ sanitize: deps
 		PYTHONPATH=$(SANITIZE_DIR)/python_addon \
 		$(PYTHON) -m pytest -q -p no:cacheprovider tests/python
 
-# libFuzzer comes with Debian's clang (its runtime in libclang-rt-14-dev); only this target needs it.
-fuzz: PACKAGES += clang libclang-rt-14-dev
+# libFuzzer comes with Debian's clang (its runtime in libclang-rt-14-dev, OpenMP in libomp-14-dev);
+# only this target needs them.
+fuzz: PACKAGES += clang libclang-rt-14-dev libomp-14-dev
 # Each target runs FUZZ_SECONDS from its seeds (tests/fuzz/corpus/<target>/, read only) and what
 # earlier runs found ($(FUZZ_DIR)/corpus/<target>/); a failing input is written to
 # $(FUZZ_DIR)/crash-<target>-*.

@@ -240,13 +240,36 @@ void stored_basis(const std::uint8_t* data, std::size_t size) {
   // Mostly consistent shapes (so the solver is reached), each one off now and then.
   auto off = [&in] { return in.byte() > 245 ? in.integer(-1, 1) : 0; };
   const int n = in.integer(0, 8), r = in.integer(0, 6), g = in.integer(0, 6), h = in.integer(0, 6);
+  // Now and then a multiresolution bake's basis: vectors over p proxy vertices, and each fine
+  // vertex a mostly barycentric combination of three of them (reduction/prolongation.h).
+  const bool proxy = in.byte() > 200;
+  const int p = proxy ? in.integer(1, 5) : n;
   Basis b;
   b.rest.resize(std::max(0, n + off()), 3);
   for (Eigen::Index i = 0; i < b.rest.size(); ++i) b.rest.data()[i] = in.number();
   b.mass.resize(std::max(0, n + off()));
   for (Eigen::Index i = 0; i < b.mass.size(); ++i) b.mass[i] = in.positive();
-  b.vectors.resize(std::max(0, 3 * n + off()), std::max(0, r + off()));
+  b.vectors.resize(std::max(0, 3 * p + off()), std::max(0, r + off()));
   for (Eigen::Index i = 0; i < b.vectors.size(); ++i) b.vectors.data()[i] = static_cast<float>(in.number());
+  if (proxy) {
+    Prolongation& P = b.prolongation;
+    P.vertices.resize(std::max(0, n + off()), 3);
+    P.weights.resize(std::max(0, static_cast<int>(P.vertices.rows()) + off()), 3);
+    for (Eigen::Index i = 0; i < P.vertices.size(); ++i) P.vertices.data()[i] = vertex_index(in, p);
+    for (Eigen::Index i = 0; i < P.weights.rows(); ++i) {
+      for (int k = 0; k < 3; ++k) P.weights(i, k) = static_cast<float>(in.byte() > 250 ? in.number() : in.positive());
+      if (in.byte() < 240) P.weights.row(i) /= P.weights.row(i).sum();
+    }
+  }
+  // The fine rows of vectors at vertex v when the prolongation has them in range, else none.
+  const auto fine_rows = [&b, p](Eigen::Index v) -> Eigen::MatrixXd {
+    if (!b.on_proxy()) return b.vectors.middleRows(3 * v, 3).cast<double>();
+    const Prolongation& P = b.prolongation;
+    if (v >= P.vertices.rows() || v >= P.weights.rows() || (P.vertices.row(v).array() < 0).any() ||
+        (P.vertices.row(v).array() >= std::min<Eigen::Index>(p, b.vectors.rows() / 3)).any())
+      return Eigen::MatrixXd::Zero(3, b.vectors.cols());
+    return b.vertex_rows(static_cast<int>(v));
+  };
   b.num_rigid = in.integer(-1, r + 1);
   b.num_modes = in.integer(-1, r + 1);
   b.num_floppy = in.integer(-1, 2);
@@ -254,7 +277,7 @@ void stored_basis(const std::uint8_t* data, std::size_t size) {
   for (Eigen::Index i = 0; i < b.eigenvalues.size(); ++i) b.eigenvalues[i] = in.number();
   // Mostly what a bake stores (ghost vertices and vectors copied from fine ones, the normalising
   // scale), so validate_basis passes and the solver is reached; otherwise anything.
-  const bool baked = in.byte() < 192 && b.rest.rows() > 0 && b.vectors.rows() == 3 * b.rest.rows();
+  const bool baked = in.byte() < 192 && n > 0 && b.rest.rows() == n && b.vectors.rows() == 3 * p;
   b.ghost_vertices.resize(std::max(0, g + off()), 3);
   b.ghost_vectors.resize(std::max(0, 3 * g + off()), std::max(0, r + off()));
   b.ghost_vectors.setZero();
@@ -265,9 +288,10 @@ void stored_basis(const std::uint8_t* data, std::size_t size) {
     }
     const int of = in.integer(0, static_cast<int>(b.rest.rows()) - 1);
     b.ghost_vertices.row(i) = b.rest.row(of);
+    const Eigen::MatrixXd rows = fine_rows(of);
     for (Eigen::Index k = 3 * i; k < std::min<Eigen::Index>(3 * i + 3, b.ghost_vectors.rows()); ++k)
       for (Eigen::Index j = 0; j < std::min(b.ghost_vectors.cols(), b.vectors.cols()); ++j)
-        b.ghost_vectors(k, j) = b.vectors(3 * of + k - 3 * i, j);
+        b.ghost_vectors(k, j) = rows(k - 3 * i, j);
   }
   if (!baked)
     for (Eigen::Index i = 0; i < b.ghost_vectors.size(); ++i) b.ghost_vectors.data()[i] = in.number();
