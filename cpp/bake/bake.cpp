@@ -13,6 +13,7 @@
 #include "energy/arap.h"
 #include "energy/discrete_shells.h"
 #include "linalg/cholmod_llt.h"
+#include "linalg/row_blocks.h"
 #include "mesh/mass.h"
 #include "mesh/mesh_check.h"
 #include "mesh/normalization.h"
@@ -303,8 +304,10 @@ Eigen::MatrixXd derivative_stage(const Simulated& sim, Stiffness& stiffness, con
     for (size_t first = 0; first < pairs.size(); first += kPairsPerPass) {
       progress.report("third derivatives", static_cast<double>(first) / pairs.size());
       const size_t last = std::min(pairs.size(), first + kPairsPerPass);
-      derivatives.middleCols(static_cast<Eigen::Index>(first), static_cast<Eigen::Index>(last - first)) =
-          shells.third_batch(shells.rest(), phi, {pairs.begin() + first, pairs.begin() + last});
+      const RowMatrixXd batch = shells.third_batch(shells.rest(), phi, {pairs.begin() + first, pairs.begin() + last});
+      for_row_blocks(batch.rows(), [&](Eigen::Index row, Eigen::Index rows) {
+        derivatives.block(row, static_cast<Eigen::Index>(first), rows, batch.cols()) = batch.middleRows(row, rows);
+      });
     }
   });
   stiffness.shells.reset();

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <type_traits>
 
 #include "energy/dual.h"
@@ -232,12 +233,21 @@ void add_vertex_pairs(const std::vector<Term>& terms, std::vector<std::array<int
 template <typename Term>
 void finish_set(shells::TermSet<Term>& set, const BlockSparsity& sparsity, const VertexPartition& partition) {
   constexpr int K = kVerticesOf<Term>;
-  // In the order of their smallest vertex, so that sweeps move through the outputs in order.
-  std::stable_sort(set.terms.begin(), set.terms.end(), [](const Term& a, const Term& b) {
-    return *std::min_element(a.vertices.begin(), a.vertices.end()) < *std::min_element(b.vertices.begin(), b.vertices.end());
-  });
+  // In the order of their smallest vertex, so that sweeps move through the outputs in order: a
+  // stable counting sort, linear (a comparison sort found each term's smallest vertex again for
+  // every comparison).
+  const auto smallest = [](const Term& term) { return *std::min_element(term.vertices.begin(), term.vertices.end()); };
+  std::vector<int> start(static_cast<size_t>(sparsity.num_vertices()) + 1, 0);
+  for (const Term& term : set.terms) ++start[smallest(term) + 1];
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<Term> sorted(set.terms.size());
+  for (const Term& term : set.terms) sorted[start[smallest(term)]++] = term;
+  set.terms = std::move(sorted);
+  // Each term's lookups are its own: in parallel.
+  const int count = static_cast<int>(set.terms.size());
   set.block_offsets.resize(set.terms.size());
-  for (size_t e = 0; e < set.terms.size(); ++e)
+#pragma omp parallel for schedule(dynamic, 4096) if (partition.parts() > 1)
+  for (int e = 0; e < count; ++e)
     for (int p = 0; p < K; ++p)
       for (int q = 0; q < K; ++q)
         set.block_offsets[e][p * K + q] = sparsity.offset(set.terms[e].vertices[p], set.terms[e].vertices[q]);
@@ -437,8 +447,8 @@ Eigen::VectorXd DiscreteShells::third(const VectorRef& x, const VectorRef& u, co
   return out;
 }
 
-Eigen::MatrixXd DiscreteShells::third_batch(const VectorRef& x, const Eigen::Ref<const Eigen::MatrixXd>& Phi,
-                                            const std::vector<std::array<int, 2>>& pairs) const {
+RowMatrixXd DiscreteShells::third_batch(const VectorRef& x, const Eigen::Ref<const Eigen::MatrixXd>& Phi,
+                                        const std::vector<std::array<int, 2>>& pairs) const {
   require_positions(x, rest_.size(), "X");
   if (Phi.rows() != rest_.size())
     throw InputError(message("Phi: expected ", rest_.size(), " rows, got ", Phi.rows()));
@@ -460,14 +470,19 @@ Eigen::MatrixXd DiscreteShells::third_batch(const VectorRef& x, const Eigen::Ref
     }
   const int num_used = static_cast<int>(used.size());
   const int num_pairs = static_cast<int>(pairs.size());
-  Eigen::MatrixXd out(rest_.size(), num_pairs);
+  // The result is row-major, each DOF's values side by side: an element then adds to a few runs
+  // of memory, not to one place in each column.
+  RowMatrixXd out(rest_.size(), num_pairs);
 #pragma omp parallel for schedule(static, 1) if (parallel())
   for (int part = 0; part < partition_.parts(); ++part) {
     const VertexPartition::Range owned = partition_.range(part);
-    out.middleRows(3 * owned.first, 3 * (owned.last - owned.first)).setZero();
-    // Φ over each element's relative coordinates (slot by slot) and ∇²s times it.
-    constexpr int kMaxDofs = kDofsOf<HingeTerm>;
+    auto rows = out.middleRows(3 * owned.first, 3 * (owned.last - owned.first));
+    rows.setZero();
+    // Φ over each element's relative coordinates (slot by slot) and ∇²s times it, and the
+    // element's third derivative for each pair over its vertices.
+    constexpr int kMaxDofs = kDofsOf<HingeTerm>, kMaxVertices = kVerticesOf<HingeTerm>;
     std::vector<double> phi(kMaxDofs * num_used), h_phi(kMaxDofs * num_used);
+    std::vector<double> full(3 * kMaxVertices * static_cast<size_t>(num_pairs));
     for_each_term(part, [&](const auto& term, int) {
       using Term = std::decay_t<decltype(term)>;
       constexpr int K = kVerticesOf<Term>, N = kDofsOf<Term>;
@@ -483,15 +498,22 @@ Eigen::MatrixXd DiscreteShells::third_batch(const VectorRef& x, const Eigen::Ref
       }
       for (int p = 0; p < num_pairs; ++p) {
         const int i = slot[pairs[p][0]], j = slot[pairs[p][1]];
-        double tuw[N], local[N], full[3 * K];
+        double tuw[N], local[N];
         if (q.df != 0) {  // away from rest: ∇³s(Φ_i, Φ_j) too
           double unused_g[N], unused_hu[N], unused_hw[N];
           third_derivatives<typename Term::Quantity, N>(r, &phi[N * i], &phi[N * j], unused_g, unused_hu, unused_hw,
                                                         tuw);
         }
         third_of_term<N>(q, g, &h_phi[N * i], &h_phi[N * j], &phi[N * i], &phi[N * j], tuw, local);
-        to_vertices<K>(local, full);
-        add_owned(term, full, owned, out.col(p).data());
+        to_vertices<K>(local, &full[3 * K * p]);
+      }
+      for (int m = 0; m < K; ++m) {
+        const int v = term.vertices[m];
+        if (!owned.contains(v)) continue;
+        for (int i = 0; i < 3; ++i) {
+          double* row = rows.row(3 * (v - owned.first) + i).data();
+          for (int p = 0; p < num_pairs; ++p) row[p] += full[3 * K * p + 3 * m + i];
+        }
       }
     });
   }

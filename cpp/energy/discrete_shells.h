@@ -132,11 +132,12 @@ class DiscreteShells final : public Energy {
   Eigen::VectorXd third(const VectorRef& x, const VectorRef& u, const VectorRef& w) const override;
 
   // The third derivative contracted with pairs of columns of Phi (3n by k, e.g. vibration
-  // modes): column p of the 3n by #pairs result is ∇³E(x)(Φ_i, Φ_j) for {i, j} = pairs[p].
+  // modes): column p of the 3n by #pairs result is ∇³E(x)(Φ_i, Φ_j) for {i, j} = pairs[p]
+  // (row-major: that is the order in which elements write it).
   // One pass over the elements serves all pairs. Throws InputError for a bad shape, a
   // non-finite entry or a column index outside [0, k).
-  Eigen::MatrixXd third_batch(const VectorRef& x, const Eigen::Ref<const Eigen::MatrixXd>& Phi,
-                              const std::vector<std::array<int, 2>>& pairs) const;
+  RowMatrixXd third_batch(const VectorRef& x, const Eigen::Ref<const Eigen::MatrixXd>& Phi,
+                          const std::vector<std::array<int, 2>>& pairs) const;
 
   struct TermCounts {
     int edges, triangles, hinges;

@@ -7,6 +7,12 @@
 #include "util/errors.h"
 
 namespace modal_deform {
+namespace {
+
+// Fewer columns are sorted on the calling thread.
+constexpr int kParallelColumns = 20000;
+
+}  // namespace
 
 BlockSparsity::BlockSparsity(int num_vertices, const std::vector<std::array<int, 2>>& pairs) {
   // Counting sort of both directions of every pair (plus the diagonal) by column, then sort
@@ -25,13 +31,19 @@ BlockSparsity::BlockSparsity(int num_vertices, const std::vector<std::array<int,
     rows[fill[b]++] = a;
     rows[fill[a]++] = b;
   }
+  // The columns are sorted in parallel (each is its own), then moved together in order.
+  std::vector<int> unique(num_vertices);
+#pragma omp parallel for schedule(dynamic, 4096) if (num_vertices >= kParallelColumns)
+  for (int v = 0; v < num_vertices; ++v) {
+    const auto first = rows.begin() + start[v], last = rows.begin() + start[v + 1];
+    std::sort(first, last);
+    unique[v] = static_cast<int>(std::unique(first, last) - first);
+  }
   begin_.assign(num_vertices + 1, 0);
   long long kept = 0;
   for (int v = 0; v < num_vertices; ++v) {
-    auto first = rows.begin() + start[v], last = rows.begin() + start[v + 1];
-    std::sort(first, last);
-    last = std::unique(first, last);
-    for (auto it = first; it != last; ++it) rows[kept++] = *it;
+    std::copy(rows.begin() + start[v], rows.begin() + start[v] + unique[v], rows.begin() + kept);
+    kept += unique[v];
     if (9 * kept > std::numeric_limits<int>::max())
       throw InputError(message("mesh too large: the Hessian's vertex blocks up to vertex ", v,
                                " already have more than 2^31 nonzeros"));

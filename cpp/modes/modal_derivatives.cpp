@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "linalg/cholmod_llt.h"
+#include "linalg/row_blocks.h"
 #include "mesh/union_find.h"
 #include "modes/stiffness_and_mass.h"
 #include "util/errors.h"
@@ -93,17 +94,20 @@ Eigen::MatrixXd solve_by_blocks(const SparseMatrix& K, const VectorRef& mass, co
   const Eigen::Index block_columns = blocks > 0 ? (B.cols() + blocks - 1) / blocks : 1;
   for (Eigen::Index first = 0; first < B.cols(); first += block_columns) {
     const Eigen::Index width = std::min(block_columns, B.cols() - first);
-    PB = B.middleCols(first, width);
-    for (Eigen::Index d = 0; d < n; ++d)
-      if (decoupled[static_cast<size_t>(d)]) PB.row(d).setZero();
-    if (Z.cols()) PB -= Z * gram.solve(Z.transpose() * PB);
+    PB.resize(n, width);
+    for_row_blocks(n, [&](Eigen::Index first_row, Eigen::Index rows) {
+      PB.middleRows(first_row, rows) = B.block(first_row, first, rows, width);
+      for (Eigen::Index d = first_row; d < first_row + rows; ++d)
+        if (decoupled[static_cast<size_t>(d)]) PB.row(d).setZero();
+    });
+    if (Z.cols()) add_dense_product(PB, Z, -gram.solve(inner_product(Z, PB)));
     const auto report = [&](double part) {
       if (progress) progress->report("derivative solves", (static_cast<double>(first) + part * width) / B.cols());
     };
     auto X = Psi.middleCols(first, width);
     solve(PB, X, report);
     report(1.0);  // the check below takes a product with K, as long as a step
-    if (Z.cols()) X -= Z * (MZ.transpose() * X);
+    if (Z.cols()) add_dense_product(X, Z, -inner_product(MZ, X));
     const Eigen::VectorXd rhs_norms = PB.colwise().norm();
     add_product(K, X, -1.0, PB);  // PB becomes the residual P B − K X
     for (Eigen::Index j = 0; j < width; ++j) {
@@ -258,20 +262,29 @@ Eigen::MatrixXd solve_in_range_shifted(const SparseMatrix& K, const VectorRef& m
   // One step: X += (K − σM)⁻¹ R less its kernel part, corrected on the known pairs by w. What it
   // leaves of R needs no product with K: K (K − σM)⁻¹ R = R + σM (K − σM)⁻¹ R, K Z = 0 and
   // K Φ = M Φ Λ, so R − K X = −σ M (K − σM)⁻¹ R − M Φ Λ w, which overwrites R unless `last`.
-  // Each product is a statement of its own: nested in one expression, Eigen evaluated
-  // M (σY − ΦΛw) coefficient by coefficient, which took as long as the solve. Y stays in the
-  // factor's solution buffer, which is kept from step to step.
+  // The updates of X and R go through the rows once, block by block in parallel (rather than a
+  // pass over 3n rows per statement on one thread). Each product is a statement of its own: nested
+  // in one expression, Eigen evaluated M (σY − ΦΛw) coefficient by coefficient, which took as long
+  // as the solve. Y stays in the factor's solution buffer, which is kept from step to step.
   Eigen::MatrixXd R;
   const auto step = [&](Eigen::Ref<Eigen::MatrixXd> X, bool last) {
     const CholmodLLT::Solution Y = shifted.solve_in_workspace(R);
-    const Eigen::MatrixXd w = correction.asDiagonal() * (modes.transpose() * R);
-    X += Y;
-    if (kernel.Z.cols()) X.noalias() -= kernel.Z * (MZ.transpose() * Y);
-    X.noalias() += modes * w;
-    if (last) return;
-    R = (-sigma) * Y;
-    R.noalias() -= modes * (eigenvalues.asDiagonal() * w);
-    R.array().colwise() *= m.array();
+    const Eigen::MatrixXd w = correction.asDiagonal() * inner_product(modes, R);
+    const Eigen::MatrixXd lambda_w = eigenvalues.asDiagonal() * w;
+    const Eigen::MatrixXd kernel_part = inner_product(MZ, Y);
+    for_row_blocks(n, [&](Eigen::Index first, Eigen::Index rows) {
+      auto x = X.middleRows(first, rows);
+      const auto y = Y.middleRows(first, rows);
+      const auto phi = modes.middleRows(first, rows);
+      x += y;
+      x.noalias() -= kernel.Z.middleRows(first, rows) * kernel_part;
+      x.noalias() += phi * w;
+      if (last) return;
+      auto r = R.middleRows(first, rows);
+      r = (-sigma) * y;
+      r.noalias() -= phi * lambda_w;
+      r.array().colwise() *= m.segment(first, rows).array();
+    });
   };
   return solve_by_blocks(
       K, mass, kernel, std::move(B),

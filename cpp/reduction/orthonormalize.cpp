@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "linalg/row_blocks.h"
 #include "util/errors.h"
 
 namespace modal_deform {
@@ -12,58 +13,25 @@ namespace {
 // Columns orthonormalised together: wide enough for BLAS-3 speed, narrow enough that progress
 // moves.
 constexpr Eigen::Index kBlockColumns = 32;
-// Rows per parallel task of the dense products; a basis of fewer rows stays on the calling thread
-// (waking a team of threads on a busy machine costs more than such a product).
-constexpr Eigen::Index kBlockRows = 8192;
-
-Eigen::Index row_blocks(Eigen::Index rows) { return (rows + kBlockRows - 1) / kBlockRows; }
-
-// Aᵀ M B (a by b) for A (3n by a), B (3n by b), summed over row blocks in parallel.
-Eigen::MatrixXd m_inner(const Eigen::Ref<const Eigen::MatrixXd>& A, const VectorRef& dof_mass,
-                        const Eigen::Ref<const Eigen::MatrixXd>& B) {
-  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(A.cols(), B.cols());
-  const Eigen::Index blocks = row_blocks(A.rows());
-#pragma omp parallel if (blocks > 1)
-  {
-    Eigen::MatrixXd partial = Eigen::MatrixXd::Zero(A.cols(), B.cols());
-#pragma omp for schedule(static)
-    for (Eigen::Index block = 0; block < blocks; ++block) {
-      const Eigen::Index first = block * kBlockRows, rows = std::min(kBlockRows, A.rows() - first);
-      partial.noalias() += A.middleRows(first, rows).transpose() *
-                           (dof_mass.segment(first, rows).asDiagonal() * B.middleRows(first, rows));
-    }
-#pragma omp critical
-    sum += partial;
-  }
-  return sum;
+// The squared M-norms of X's columns: the diagonal of Xᵀ M X without the rest of it.
+Eigen::VectorXd squared_m_norms(const Eigen::Ref<const Eigen::MatrixXd>& X, const VectorRef& dof_mass) {
+  return sum_over_row_blocks(X.rows(), 1, X.cols(), [&](Eigen::Index first, Eigen::Index count) {
+           return dof_mass.segment(first, count).transpose() * X.middleRows(first, count).cwiseAbs2();
+         }).transpose();
 }
 
-// X −= Q C, over row blocks in parallel.
-void subtract_product(Eigen::Ref<Eigen::MatrixXd> X, const Eigen::Ref<const Eigen::MatrixXd>& Q,
-                      const Eigen::MatrixXd& C) {
-  const Eigen::Index blocks = row_blocks(X.rows());
-#pragma omp parallel for schedule(static) if (blocks > 1)
-  for (Eigen::Index block = 0; block < blocks; ++block) {
-    const Eigen::Index first = block * kBlockRows, rows = std::min(kBlockRows, X.rows() - first);
-    X.middleRows(first, rows).noalias() -= Q.middleRows(first, rows) * C;
-  }
-}
-
-// X ← X R⁻¹ for upper triangular R, over row blocks in parallel.
+// X ← X R⁻¹ for upper triangular R.
 void solve_upper_on_the_right(Eigen::Ref<Eigen::MatrixXd> X, const Eigen::MatrixXd& R) {
-  const Eigen::Index blocks = row_blocks(X.rows());
-#pragma omp parallel for schedule(static) if (blocks > 1)
-  for (Eigen::Index block = 0; block < blocks; ++block) {
-    const Eigen::Index first = block * kBlockRows, rows = std::min(kBlockRows, X.rows() - first);
-    auto part = X.middleRows(first, rows);
+  for_row_blocks(X.rows(), [&](Eigen::Index first, Eigen::Index count) {
+    auto part = X.middleRows(first, count);
     R.triangularView<Eigen::Upper>().solveInPlace<Eigen::OnTheRight>(part);
-  }
+  });
 }
 
 // Removes from X its components along the M-orthonormal columns Q (classical Gram–Schmidt; each
 // of the two passes does it once, which makes it twice, "twice is enough").
 void project_out(Eigen::Ref<Eigen::MatrixXd> X, const Eigen::Ref<const Eigen::MatrixXd>& Q, const VectorRef& dof_mass) {
-  if (Q.cols()) subtract_product(X, Q, m_inner(Q, dof_mass, X));
+  if (Q.cols()) add_dense_product(X, Q, -inner_product(Q, dof_mass, X));
 }
 
 // Cholesky factor R (upper) of the Gram matrix G over the columns it keeps: column j is dropped
@@ -109,11 +77,10 @@ std::vector<int> orthonormalize(Eigen::MatrixXd& U, const VectorRef& dof_mass, d
     const Eigen::Index width = std::min(kBlockColumns, U.cols() - first);
     Eigen::MatrixXd X = U.middleCols(first, width);
     const auto Q = U.leftCols(done);
-    const Eigen::VectorXd floor =
-        (tolerance * tolerance) * m_inner(X, dof_mass, X).diagonal();  // squared M-norms before projection
+    const Eigen::VectorXd floor = (tolerance * tolerance) * squared_m_norms(X, dof_mass);  // before projection
     project_out(X, Q, dof_mass);
     std::vector<int> kept;
-    const Eigen::MatrixXd R = dropping_cholesky(m_inner(X, dof_mass, X), floor, kept);
+    const Eigen::MatrixXd R = dropping_cholesky(inner_product(X, dof_mass, X), floor, kept);
     Eigen::MatrixXd Y(X.rows(), static_cast<Eigen::Index>(kept.size()));
     for (size_t a = 0; a < kept.size(); ++a) Y.col(static_cast<Eigen::Index>(a)) = X.col(kept[a]);
     X.resize(0, 0);
@@ -121,7 +88,7 @@ std::vector<int> orthonormalize(Eigen::MatrixXd& U, const VectorRef& dof_mass, d
     // Second pass: Y is orthonormal up to rounding amplified by R's condition; once more makes it
     // orthonormal to working precision.
     project_out(Y, Q, dof_mass);
-    const Eigen::LLT<Eigen::MatrixXd> second(m_inner(Y, dof_mass, Y));
+    const Eigen::LLT<Eigen::MatrixXd> second(inner_product(Y, dof_mass, Y));
     if (second.info() != Eigen::Success)
       throw NumericalError("orthonormalize: the second Cholesky-QR pass failed; the columns are too dependent");
     solve_upper_on_the_right(Y, Eigen::MatrixXd(second.matrixU()));

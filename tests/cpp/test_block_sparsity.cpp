@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <random>
+#include <set>
 #include <stdexcept>
 
 #include "linalg/block_sparsity.h"
@@ -37,6 +39,36 @@ TEST(BlockSparsity, ColumnsFilledInPiecesEqualTheWholeMatrix) {
   ASSERT_EQ(pieces.nonZeros(), whole.nonZeros());
   for (int k = 0; k <= pieces.outerSize(); ++k) EXPECT_EQ(pieces.outerIndexPtr()[k], whole.outerIndexPtr()[k]);
   for (int k = 0; k < pieces.nonZeros(); ++k) EXPECT_EQ(pieces.innerIndexPtr()[k], whole.innerIndexPtr()[k]);
+}
+
+
+// Enough vertices that the columns are sorted in parallel: each column holds its distinct rows in
+// order, the diagonal included, as a set of the pairs says.
+TEST(BlockSparsity, LargePatternMatchesASetOfItsPairs) {
+  const int n = 50000;
+  std::mt19937 random(3);
+  std::uniform_int_distribution<int> vertex(0, n - 1);
+  std::vector<std::array<int, 2>> pairs;
+  std::set<std::pair<int, int>> blocks;  // (column, row), in the matrix's order
+  for (int v = 0; v < n; ++v) blocks.insert({v, v});
+  for (int k = 0; k < 4 * n; ++k) {
+    const int a = vertex(random), b = (a + 1 + vertex(random) % 40) % n;  // near a, repeats likely
+    pairs.push_back({a, b});
+    blocks.insert({a, b});
+    blocks.insert({b, a});
+  }
+  const BlockSparsity pattern(n, pairs);
+  EXPECT_EQ(pattern.num_nonzeros(), 9 * static_cast<int>(blocks.size()));
+  const SparseMatrix zero = pattern.zero_matrix();
+  auto block = blocks.begin();
+  for (int b = 0; b < n; ++b)
+    for (SparseMatrix::InnerIterator it(zero, 3 * b); it; ++it)
+      if (it.row() % 3 == 0) {
+        ASSERT_EQ(*block, (std::pair<int, int>{b, static_cast<int>(it.row() / 3)})) << "column " << b;
+        EXPECT_EQ(pattern.offset(block->second, b), &it.valueRef() - zero.valuePtr());
+        ++block;
+      }
+  EXPECT_EQ(block, blocks.end());
 }
 
 }  // namespace
