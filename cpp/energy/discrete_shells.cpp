@@ -12,6 +12,7 @@
 #include "mesh/mesh_topology.h"
 #include "mesh/normalization.h"
 #include "util/errors.h"
+#include "util/parallel_for.h"
 #include "util/require_positions.h"
 #include "util/require_weight.h"
 
@@ -243,14 +244,15 @@ void finish_set(shells::TermSet<Term>& set, const BlockSparsity& sparsity, const
   std::vector<Term> sorted(set.terms.size());
   for (const Term& term : set.terms) sorted[start[smallest(term)]++] = term;
   set.terms = std::move(sorted);
-  // Each term's lookups are its own: in parallel.
-  const int count = static_cast<int>(set.terms.size());
+  // Each term's lookups are its own: in parallel, in chunks of terms.
+  constexpr size_t kChunk = 4096;
   set.block_offsets.resize(set.terms.size());
-#pragma omp parallel for schedule(dynamic, 4096) if (partition.parts() > 1)
-  for (int e = 0; e < count; ++e)
-    for (int p = 0; p < K; ++p)
-      for (int q = 0; q < K; ++q)
-        set.block_offsets[e][p * K + q] = sparsity.offset(set.terms[e].vertices[p], set.terms[e].vertices[q]);
+  parallel_for((set.terms.size() + kChunk - 1) / kChunk, [&](size_t chunk) {
+    for (size_t e = chunk * kChunk; e < std::min(set.terms.size(), (chunk + 1) * kChunk); ++e)
+      for (int p = 0; p < K; ++p)
+        for (int q = 0; q < K; ++q)
+          set.block_offsets[e][p * K + q] = sparsity.offset(set.terms[e].vertices[p], set.terms[e].vertices[q]);
+  });
   if (partition.parts() > 1) set.by_part = elements_by_part(partition, set.terms);
 }
 

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "util/parallel_for.h"
 #include "util/types.h"
 
 namespace modal_deform {
@@ -21,12 +22,10 @@ inline Eigen::Index row_blocks(Eigen::Index rows) { return (rows + kRowBlock - 1
 // Calls work(first, count) for each block of rows [first, first + count) of [0, rows).
 template <typename Work>
 void for_row_blocks(Eigen::Index rows, Work&& work) {
-  const Eigen::Index blocks = row_blocks(rows);
-#pragma omp parallel for schedule(static) if (blocks > 1)
-  for (Eigen::Index block = 0; block < blocks; ++block) {
+  parallel_for(row_blocks(rows), [&](Eigen::Index block) {
     const Eigen::Index first = block * kRowBlock;
     work(first, std::min(kRowBlock, rows - first));
-  }
+  });
 }
 
 // Σ over the blocks of term(first, count), each an r by c matrix, added in block order.

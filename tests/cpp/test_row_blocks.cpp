@@ -1,7 +1,13 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <atomic>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
 #include "linalg/row_blocks.h"
+#include "util/parallel_for.h"
 #include "test_support.h"
 
 namespace modal_deform {
@@ -51,6 +57,17 @@ TEST(RowBlocks, VisitsEachRowOnceAndHandlesFewOrNoRows) {
     EXPECT_EQ(inner_product(Eigen::MatrixXd::Ones(n, 2), Eigen::MatrixXd::Ones(n, 3)),
               Eigen::MatrixXd::Constant(2, 3, static_cast<double>(n)));
   }
+}
+
+TEST(ParallelFor, RunsEveryIndexOnceAndRethrowsTheFirstFailure) {
+  std::vector<std::atomic<int>> runs(1000);
+  parallel_for(1000, [&](int i) { ++runs[static_cast<size_t>(i)]; });
+  for (const auto& count : runs) EXPECT_EQ(count.load(), 1);
+  EXPECT_THROW(parallel_for(1000,
+                            [](int i) {
+                              if (i % 100 == 7) throw std::runtime_error("index " + std::to_string(i));
+                            }),
+               std::runtime_error);
 }
 
 }  // namespace
