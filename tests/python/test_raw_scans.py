@@ -2,6 +2,7 @@
 dragons) bake and pose; near-degenerate elements have bounded stiffness; a bake that cannot fit
 in memory is refused up front with the sizes, and a lack of memory is never reported as a matrix
 that is not positive definite. The 400k-vertex raw scan is in make bench (bench/raw_scan.py)."""
+import os
 import pathlib
 import subprocess
 import sys
@@ -90,13 +91,19 @@ def test_sliver_stiffness_is_bounded_and_sound_elements_keep_theirs():
     np.testing.assert_allclose(Ks, K, atol=1e-12 * np.abs(K).max())
 
 
+#: AddressSanitizer reserves terabytes of address space for its shadow memory: under `make sanitize`
+#: (libasan preloaded) any limit on the address space leaves it none, and it aborts.
+limits_address_space = pytest.mark.skipif("libasan" in os.environ.get("LD_PRELOAD", ""),
+                                          reason="AddressSanitizer cannot run under an address-space limit")
+
+
 def run_limited(code, address_space, setup=""):
     """Runs `code` in a fresh Python that has read dragon_vrip_res3 into V, F and run `setup`, with
     its address space limited to `address_space` bytes more than it has mapped then; returns
-    (exit code, output)."""
+    (exit code, output). The Python imports the modal_deform under test."""
     script = textwrap.dedent(f"""
         import resource, sys
-        sys.path.insert(0, {str(ROOT / "python_addon")!r})
+        sys.path.insert(0, {str(pathlib.Path(mdc.__file__).parents[2])!r})
         import numpy as np
         import modal_deform.core as mdc
         V, F = mdc.read_mesh({str(ROOT.parent / "shared" / "meshes" / "dragon_vrip_res3.ply.gz")!r})
@@ -109,6 +116,7 @@ def run_limited(code, address_space, setup=""):
     return result.returncode, result.stdout + result.stderr
 
 
+@limits_address_space
 def test_a_bake_that_cannot_fit_is_refused_before_the_factorisation():
     code, output = run_limited("""
         try:
@@ -122,6 +130,7 @@ def test_a_bake_that_cannot_fit_is_refused_before_the_factorisation():
     assert "factor of K" in output and "from CHOLMOD's analysis" in output, output
 
 
+@limits_address_space
 def test_a_factorisation_out_of_memory_is_not_called_indefinite():
     """Lanczos on its own (no bake estimate) under growing address-space limits, from too small
     for anything to too small for the factor only: every failure is a MemoryError, those in CHOLMOD
