@@ -84,7 +84,6 @@ Eigen::MatrixXd solve_by_blocks(const SparseMatrix& K, const VectorRef& mass, co
   const std::vector<bool>& decoupled = kernel.decoupled;
   // P = I − Z (ZᵀZ)⁻¹ Zᵀ, also zero on the decoupled DOFs (part of the kernel, zero rows in Z).
   const Eigen::LLT<Eigen::MatrixXd> gram(Z.transpose() * Z);
-  const Eigen::MatrixXd MZ = m.asDiagonal() * Z;
   const double norm_K = norm_1(K);
   Eigen::MatrixXd& Psi = B;
   Eigen::MatrixXd PB;
@@ -107,7 +106,7 @@ Eigen::MatrixXd solve_by_blocks(const SparseMatrix& K, const VectorRef& mass, co
     auto X = Psi.middleCols(first, width);
     solve(PB, X, report);
     report(1.0);  // the check below takes a product with K, as long as a step
-    if (Z.cols()) add_dense_product(X, Z, -inner_product(MZ, X));
+    if (Z.cols()) add_dense_product(X, Z, -inner_product(Z, m, X));
     const Eigen::VectorXd rhs_norms = PB.colwise().norm();
     add_product(K, X, -1.0, PB);  // PB becomes the residual P B − K X
     for (Eigen::Index j = 0; j < width; ++j) {
@@ -258,7 +257,6 @@ Eigen::MatrixXd solve_in_range_shifted(const SparseMatrix& K, const VectorRef& m
     throw InputError(message("sigma: ", sigma, " is too far below the largest eigenvalue given, ",
                              eigenvalues.maxCoeff(), ": ", steps, " refinement steps would be needed"));
   const Eigen::VectorXd m = dof_masses(mass);
-  const Eigen::MatrixXd MZ = m.asDiagonal() * kernel.Z;
   // One step: X += (K − σM)⁻¹ R less its kernel part, corrected on the known pairs by w. What it
   // leaves of R needs no product with K: K (K − σM)⁻¹ R = R + σM (K − σM)⁻¹ R, K Z = 0 and
   // K Φ = M Φ Λ, so R − K X = −σ M (K − σM)⁻¹ R − M Φ Λ w, which overwrites R unless `last`.
@@ -271,7 +269,7 @@ Eigen::MatrixXd solve_in_range_shifted(const SparseMatrix& K, const VectorRef& m
     const CholmodLLT::Solution Y = shifted.solve_in_workspace(R);
     const Eigen::MatrixXd w = correction.asDiagonal() * inner_product(modes, R);
     const Eigen::MatrixXd lambda_w = eigenvalues.asDiagonal() * w;
-    const Eigen::MatrixXd kernel_part = inner_product(MZ, Y);
+    const Eigen::MatrixXd kernel_part = inner_product(kernel.Z, m, Y);
     for_row_blocks(n, [&](Eigen::Index first, Eigen::Index rows) {
       auto x = X.middleRows(first, rows);
       const auto y = Y.middleRows(first, rows);

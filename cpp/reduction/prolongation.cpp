@@ -1,19 +1,13 @@
 #include "reduction/prolongation.h"
 
-#include <algorithm>
 #include <limits>
 #include <vector>
 
+#include "linalg/row_blocks.h"
 #include "mesh/closest_point.h"
 #include "util/errors.h"
 
 namespace modal_deform {
-namespace {
-
-// Fine vertices per block of prolongate_positions: threads only where they pay.
-constexpr Eigen::Index kBlockVertices = 4096;
-
-}  // namespace
 
 Prolongation prolongation_to_proxy(const VerticesRef& V, const VerticesRef& proxy_V, const FacesRef& proxy_F,
                                    const Eigen::Ref<const Eigen::VectorXi>& cluster) {
@@ -60,14 +54,10 @@ Prolongation prolongation_to_proxy(const VerticesRef& V, const VerticesRef& prox
 
 void prolongate_positions(const Prolongation& prolongation, const double* rest, const float* proxy_displacement,
                           float* out) {
-  const Eigen::Index n = prolongation.size();
   const int* vertices = prolongation.vertices.data();
   const float* weights = prolongation.weights.data();
-  const Eigen::Index blocks = (n + kBlockVertices - 1) / kBlockVertices;
-#pragma omp parallel for schedule(static) if (blocks > 1)
-  for (Eigen::Index block = 0; block < blocks; ++block) {
-    const Eigen::Index end = std::min(n, (block + 1) * kBlockVertices);
-    for (Eigen::Index i = block * kBlockVertices; i < end; ++i) {
+  for_row_blocks(prolongation.size(), [&](Eigen::Index first, Eigen::Index count) {
+    for (Eigen::Index i = first; i < first + count; ++i) {
       const float* d0 = proxy_displacement + 3 * vertices[3 * i];
       const float* d1 = proxy_displacement + 3 * vertices[3 * i + 1];
       const float* d2 = proxy_displacement + 3 * vertices[3 * i + 2];
@@ -75,7 +65,7 @@ void prolongate_positions(const Prolongation& prolongation, const double* rest, 
       for (int a = 0; a < 3; ++a)
         out[3 * i + a] = static_cast<float>(rest[3 * i + a] + static_cast<double>(w0 * d0[a] + w1 * d1[a] + w2 * d2[a]));
     }
-  }
+  });
 }
 
 }  // namespace modal_deform
