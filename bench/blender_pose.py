@@ -34,12 +34,13 @@ import numpy as np
 from mathutils import Matrix
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "python_addon"))
+# Not python_addon/: the add-on is the extension Blender installed, or enable_addon() adds the
+# source tree's; two modal_deform packages in one Blender would register the core's types twice.
 sys.path.insert(0, str(ROOT / "blender_scripts"))
 sys.path.insert(0, str(ROOT / "bench"))
 from headless import (add_handle, bind_laplacian_deform, enable_addon,  # noqa: E402 (found through the lines above)
                       evaluated_positions)
-import raw_scans  # noqa: E402 (the project's midpoint subdivision)
+import subdivision  # noqa: E402 (the project's midpoint subdivision)
 MESHES = ROOT.parent / "shared" / "meshes"
 ADDON = "modal_deform"  # the add-on's module: bl_ext.<repository>.modal_deform when installed as an extension
 
@@ -79,7 +80,7 @@ def dragon(name, subdivisions):
     mdc = addon("core")
     V, F = mdc.read_mesh(MESHES / f"{name}.ply.gz")
     for _ in range(subdivisions):
-        V, F = raw_scans.midpoint_subdivide(V, F)
+        V, F = subdivision.midpoint_subdivide(V, F)
     return mesh_object("Dragon", V, F)
 
 

@@ -329,6 +329,19 @@ def section_blender(result):
                 f"{b['proxy_vertices']} vertices in {b['bake_s']:.1f} s ({dims} dims): tick {b['tick']:.1f} ms "
                 f"(solve {b['solve']:.1f}, map {b['positions']:.1f}, write {b['write']:.1f}), Blender's evaluation "
                 f"{b['evaluate']:.0f} ms per update."]
+    if "bpy" in f:
+        out += ["", "The pose update in the Blenders artists run, with the add-on installed from its extension zip "
+                "by Blender's own installer (bpy from the package index; medians, ms; 1.6M: the dragon subdivided "
+                "twice, on its proxy):", ""]
+        rows = []
+        for version, runs in f["bpy"].items():
+            for run in runs:
+                for dims, b in run["bases"].items():
+                    rows.append([run["blender"], run["vertices"], dims, f"{b['solve']:.2f}", f"{b['positions']:.2f}",
+                                 f"{b['write']:.2f}", f"{b['tick']:.2f}", f"{b['evaluate']:.2f}",
+                                 f"{b['tick'] + b['evaluate']:.1f}", f"{b['iterations']:.0f}"])
+        out.append(table(["Blender", "vertices", "dims", "solve", "map", "write", "tick (ours)", "evaluate (Blender)",
+                          "update", "iterations"], rows))
     lap = f["laplacian_deform"]
     outcome = ("it solved" if lap["solved"] else "it found no solution on this mesh (the modifier then passes the "
                "hooked mesh through), so this is not the time of a solve")
@@ -389,7 +402,7 @@ def section_raw_scan(result):
 def section_multires(result):
     p, t = result["parameters"], result["parameters"]["targets"]
     out = ["## Multiresolution bake of a dense mesh (issue 15)", "",
-           f"{p['mesh']} midpoint-subdivided {p['subdivisions']} times (bench/raw_scans.midpoint_subdivide), baked "
+           f"{p['mesh']} midpoint-subdivided {p['subdivisions']} times (bench/subdivision.py), baked "
            f"on a proxy with {p['modes']} modes + {p['derivatives']} derivatives and a {p['ghost']}-vertex ghost, "
            "each proxy size in a fresh process. Update: new transforms, 10 BFGS iterations and the fine positions, "
            "median over the end-pull animation. RMS: the converged end-pull pose against the dragon's own bake on "

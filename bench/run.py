@@ -18,7 +18,9 @@ Experiments (each writes bench/results/<name>.json: machine, commit, command, pa
   multires     the dragon subdivided twice (1.6M vertices) baked on a proxy: time, memory, stored
                size, update time and agreement with the dragon's own bake (bench/multires.py)
   blender      the add-on's pose update in headless Blender and Blender's Laplacian Deform
-               (bench/blender_pose.py)
+               (bench/blender_pose.py), in Debian's 3.4.1 app from the source tree; then the pose
+               update alone at 100k and 1.6M vertices in bpy 4.5 and 5.3 (.venv/bpy-<version>, `make
+               bench` makes them) with the add-on installed from its extension zip (`make addon`)
   renders      Cycles renders of the accuracy experiment's bar and cylinder poses
                (blender_scripts/render_figures.py; needs accuracy's meshes from the same run)
 --quick runs tiny sizes (the smoke test): results go to bench/results/tmp/, the report is not
@@ -27,7 +29,9 @@ written. The report alone is regenerated from the JSON with --report-only (or be
 import argparse
 import importlib
 import json
+import os
 import pathlib
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -41,6 +45,9 @@ PYTHON_EXPERIMENTS = ("table1", "accuracy", "convergence", "taylor", "bake_limit
 EXPERIMENTS = ("native",) + PYTHON_EXPERIMENTS + ("blender", "renders")
 NATIVE_IN_TABLE1 = "BM_Bake|BM_BfgsIteration|BM_Positions"
 BLENDER = ["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python"]
+BPY_VERSIONS = ("4.5", "5.3")
+sys.path.insert(0, str(common.ROOT / "python_addon"))
+import package  # noqa: E402 (which extension zip serves which Python)
 
 
 def command(name):
@@ -60,19 +67,45 @@ def native(quick):
             "context": raw["context"]}, {"benchmarks": raw["benchmarks"]}
 
 
+def in_bpy(version, script, arguments, folder):
+    """Run `script` in bpy `version` (.venv/bpy-<version>) as tests/blender/bpy_session.py runs the
+    tests: the extension zip of its Python installed by Blender's installer into a fresh user
+    folder, neither the source tree's add-on nor the machine's libraries in sight."""
+    python = common.ROOT / ".venv" / f"bpy-{version}" / "bin" / "python"
+    tag = subprocess.run([str(python), "-c", "import sys; print('%d.%d' % sys.version_info[:2])"],
+                         capture_output=True, text=True, check=True).stdout.strip()
+    extension = next(e for e in package.EXTENSIONS if e.python == tag)
+    user = pathlib.Path(folder) / f"user-{version}"
+    environment = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
+    environment.update(LD_LIBRARY_PATH="", BLENDER_USER_RESOURCES=str(user))
+    subprocess.run([str(python), str(common.ROOT / "tests" / "blender" / "bpy_session.py"), "--extension",
+                    str(common.ROOT / "dist" / package.extension_zip_name(extension)), str(script), "--", *arguments],
+                   check=True, cwd=common.ROOT, env=environment)
+    shutil.rmtree(user)
+
+
 def blender(quick):
+    pose = common.ROOT / "bench" / "blender_pose.py"
     with tempfile.TemporaryDirectory() as folder:
         out = pathlib.Path(folder) / "blender_pose.json"
         extra = ["--updates", "3", "--quick"] if quick else []
-        subprocess.run(BLENDER + [str(common.ROOT / "bench" / "blender_pose.py"), "--", "--output", str(out),
-                                  "--shapes", str(common.MESHES), *extra],
+        subprocess.run(BLENDER + [str(pose), "--", "--output", str(out), "--shapes", str(common.MESHES), *extra],
                        check=True, cwd=common.ROOT)
         raw = json.loads(out.read_text())
         if not quick:  # the dragon subdivided twice (1.6M vertices), baked on a proxy: pose updates only
             dense = pathlib.Path(folder) / "blender_dense.json"
-            subprocess.run(BLENDER + [str(common.ROOT / "bench" / "blender_pose.py"), "--", "--output", str(dense),
-                                      "--subdivide", "2", "--updates", "15"], check=True, cwd=common.ROOT)
+            subprocess.run(BLENDER + [str(pose), "--", "--output", str(dense), "--subdivide", "2", "--updates", "15"],
+                           check=True, cwd=common.ROOT)
             raw["dense"] = json.loads(dense.read_text())
+        # The installed extension alone, in the Blenders artists run: 100k vertices and 1.6M on a proxy.
+        raw["bpy"] = {}
+        for version in BPY_VERSIONS:
+            raw["bpy"][version] = []
+            for subdivide in (0,) if quick else (0, 2):
+                out = pathlib.Path(folder) / f"bpy-{version}-{subdivide}.json"
+                in_bpy(version, pose, ["--output", str(out), "--pose-only", "--subdivide", str(subdivide),
+                                       "--updates", "3" if quick else "15", *(["--quick"] if quick else [])], folder)
+                raw["bpy"][version].append(json.loads(out.read_text()))
     return raw.pop("parameters"), raw
 
 

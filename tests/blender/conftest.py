@@ -14,6 +14,7 @@ A script signals failure by raising (exit code 1).
 import os
 import pathlib
 import subprocess
+import sys
 
 import pytest
 
@@ -21,6 +22,8 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 SCRIPTS = pathlib.Path(__file__).resolve().parent / "scripts"
 BLENDER_PYTHON = os.environ.get("BLENDER_PYTHON")
 DIST = pathlib.Path(os.environ.get("MODAL_DEFORM_DIST", ROOT / "dist"))
+sys.path.insert(0, str(ROOT / "python_addon"))
+import package  # noqa: E402
 
 
 def built(pattern):
@@ -31,9 +34,22 @@ def built(pattern):
     return found[0]
 
 
+def blender_python_version():
+    """"3.13": the Python of the bpy venv (BLENDER_PYTHON), which is the one its Blender embeds."""
+    return subprocess.run([BLENDER_PYTHON, "-c", "import sys; print('%d.%d' % sys.version_info[:2])"],
+                          capture_output=True, text=True, check=True).stdout.strip()
+
+
 @pytest.fixture(scope="session")
 def extension_zip():
-    return built("modal_deform-*[0-9]-linux_x64.zip") if BLENDER_PYTHON else None
+    """The extension zip whose wheel is for this Blender's Python (package.EXTENSIONS)."""
+    if not BLENDER_PYTHON:
+        return None
+    python = blender_python_version()
+    extension = next((e for e in package.EXTENSIONS if e.python == python), None)
+    if extension is None:
+        pytest.fail(f"{BLENDER_PYTHON} runs Python {python}: no extension zip is made for it (package.EXTENSIONS)")
+    return built(package.extension_zip_name(extension))
 
 
 @pytest.fixture

@@ -1,6 +1,7 @@
-"""The zips `make addon` writes into dist/: their layout and manifest, the shared objects inside them
-(nothing of the build machine), Blender's own validation, and installing each in a fresh Blender
-(the extension under bpy 4.2+, the legacy zip in the 3.4 app): enable, disable, enable."""
+"""The zips `make addon` writes into dist/: their layout and manifests, which Blenders each serves,
+the shared objects inside them (nothing of the build machine), Blender's own validation, and
+installing each in a fresh Blender (the extension for its Python under bpy 4.2+, the legacy zip
+in the 3.4 app): enable, disable, enable; the other Python's extension is refused."""
 import ast
 import glob
 import io
@@ -8,16 +9,13 @@ import os
 import pathlib
 import re
 import subprocess
-import sys
 import tomllib
 import zipfile
 
 import pytest
-from conftest import BLENDER_PYTHON, built
+from conftest import BLENDER_PYTHON, blender_python_version, built
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "python_addon"))
-import package  # noqa: E402
+import package
 
 # What a manylinux wheel may need from the system: the libraries of the manylinux policy (glibc's,
 # the C++ and GCC runtimes, zlib) that the core uses; everything else must be bundled in the zip.
@@ -25,14 +23,20 @@ MANYLINUX = {"libc.so.6", "libm.so.6", "libstdc++.so.6", "libgcc_s.so.1", "libpt
              "librt.so.1", "ld-linux-x86-64.so.2", "libz.so.1"}
 
 
-@pytest.fixture(scope="module")
-def extension():
-    return built("modal_deform-*[0-9]-linux_x64.zip")
+EXTENSIONS = {extension.blenders: extension for extension in package.EXTENSIONS}
+
+
+def zip_for(blenders):
+    return built(package.extension_zip_name(EXTENSIONS[blenders]))
 
 
 @pytest.fixture(scope="module")
 def legacy():
-    return built("modal_deform-*-legacy-linux_x64.zip")
+    return built(package.legacy_zip_name())
+
+
+def python_tag(python):
+    return "cp" + python.replace(".", "")
 
 
 def sources():
@@ -49,30 +53,54 @@ def zip_manifest(extension):
     return tomllib.loads(zipfile.ZipFile(extension).read(package.MANIFEST).decode())
 
 
-def test_extension_zip_is_laid_out_as_blenders_extension_build(extension):
-    assert extension.name == f"modal_deform-{package.version()}-linux_x64.zip"
-    archive = zipfile.ZipFile(extension)
+def test_the_extensions_serve_every_blender_from_4_2_once():
+    """Sorted, the extensions' ranges of Blender versions start at 4.2.0 and each starts where the
+    last one ended, the newest open: no Blender is left without a zip or offered two."""
+    def parse(version):
+        return tuple(map(int, version.split(".")))
+
+    ranges = sorted((parse(e.blender_min), e.blender_max and parse(e.blender_max)) for e in package.EXTENSIONS)
+    assert ranges[0][0] == (4, 2, 0)
+    for (low, high), (next_low, _) in zip(ranges, ranges[1:]):
+        assert high is not None and low < high == next_low, ranges
+    assert ranges[-1][1] is None, ranges
+    assert len({e.python for e in package.EXTENSIONS}) == len(package.EXTENSIONS)
+
+
+@pytest.mark.parametrize("blenders", EXTENSIONS)
+def test_extension_zip_is_laid_out_as_blenders_extension_build(blenders):
+    """The package's files at the top, the manifest, and the one wheel of its Blenders' Python."""
+    extension = EXTENSIONS[blenders]
+    path = zip_for(blenders)
+    assert path.name == f"modal_deform-{package.version()}-{blenders}-linux_x64.zip"
+    archive = zipfile.ZipFile(path)
     names = set(archive.namelist())
     wheels = [name for name in names if name.startswith("wheels/")]
-    assert len(wheels) == 1 and re.fullmatch(r"wheels/modal_deform_native-[\d.]+-cp311-cp311-manylinux_2_\d+_x86_64"
+    tag = python_tag(extension.python)
+    assert len(wheels) == 1 and re.fullmatch(rf"wheels/modal_deform_native-[\d.]+-{tag}-{tag}-manylinux_2_\d+_x86_64"
                                              r"(\.manylinux_2_\d+_x86_64)*\.whl", wheels[0]), wheels
     assert archive.getinfo(wheels[0]).compress_type == zipfile.ZIP_STORED
     assert names == sources() | {package.MANIFEST, wheels[0]}, "the package's files at the top, nothing else"
-    assert zip_manifest(extension)["wheels"] == [f"./{wheels[0]}"]
+    manifest = zip_manifest(path)
+    assert manifest["wheels"] == [f"./{wheels[0]}"]
+    assert manifest["blender_version_min"] == extension.blender_min
+    assert manifest.get("blender_version_max") == extension.blender_max
 
 
-def test_legacy_zip_holds_the_add_on_folder_with_the_wheels_core(legacy):
+def test_legacy_zip_holds_the_add_on_folder_with_a_core_per_python(legacy):
     assert legacy.name == f"modal_deform-{package.version()}-legacy-linux_x64.zip"
     names = set(zipfile.ZipFile(legacy).namelist())
-    native = {name for name in names if re.fullmatch(r"modal_deform/_native\.cpython-311-x86_64-linux-gnu\.so", name)}
+    native = {f"modal_deform/_native.cpython-{python_tag(python)[2:]}-x86_64-linux-gnu.so"
+              for python in package.LEGACY_PYTHONS}
     libraries = {name for name in names if name.startswith("modal_deform/_native.libs/")}
-    assert len(native) == 1 and any("cholmod" in name for name in libraries), sorted(names)
+    assert native <= names and any("cholmod" in name for name in libraries), sorted(names)
     assert names == {f"modal_deform/{name}" for name in sources()} | native | libraries
     assert not any("__pycache__" in name or name.endswith(".toml") for name in names)
 
 
-def test_manifest_fields_and_version_match_bl_info(extension):
-    manifest = zip_manifest(extension)
+@pytest.mark.parametrize("blenders", EXTENSIONS)
+def test_manifest_fields_and_version_match_bl_info(blenders):
+    manifest = zip_manifest(zip_for(blenders))
     info = bl_info()
     assert manifest["schema_version"] == "1.0.0"
     assert manifest["id"] == "modal_deform" == package.PACKAGE.name
@@ -81,7 +109,6 @@ def test_manifest_fields_and_version_match_bl_info(extension):
     assert manifest["type"] == "add-on"
     assert 0 < len(manifest["tagline"]) <= 64 and not manifest["tagline"].endswith(".")
     assert manifest["maintainer"]
-    assert manifest["blender_version_min"] == "4.2.0"
     assert manifest["license"] == ["SPDX:GPL-3.0-or-later"]
     assert manifest["platforms"] == ["linux-x64"]
     assert "permissions" not in manifest, "the add-on reads no files, uses no network, clipboard, camera or microphone"
@@ -107,12 +134,13 @@ def readelf(data, tmp_path, *options):
                           check=True).stdout
 
 
-@pytest.mark.parametrize("which", ["extension", "legacy"])
-def test_shared_objects_need_only_manylinux_libraries_and_what_is_bundled(which, request, tmp_path):
+@pytest.mark.parametrize("which", [*EXTENSIONS, "legacy"])
+def test_shared_objects_need_only_manylinux_libraries_and_what_is_bundled(which, tmp_path):
     """readelf -d of every shared object: each NEEDED library is in the manylinux set or in the zip
     under a private (hashed) name, run paths stay inside the zip ($ORIGIN), and the compiled core
     exports nothing but its module init (symbols hidden: nothing clashes with Blender's libraries)."""
-    objects = dict(shared_objects(zipfile.ZipFile(request.getfixturevalue(which))))
+    path = built(package.legacy_zip_name()) if which == "legacy" else zip_for(which)
+    objects = dict(shared_objects(zipfile.ZipFile(path)))
     bundled = {os.path.basename(name) for name in objects}
     # OpenBLAS's threaded build (libopenblasp: pthreads) and OpenMP, renamed: a reference BLAS or a
     # lost OpenMP would cost the bake twice the time.
@@ -131,22 +159,34 @@ def test_shared_objects_need_only_manylinux_libraries_and_what_is_bundled(which,
 
 
 @pytest.mark.skipif(not BLENDER_PYTHON, reason="Blender's extension validator ships with bpy 4.2+")
-def test_blenders_validator_accepts_the_extension(extension):
+@pytest.mark.parametrize("blenders", EXTENSIONS)
+def test_blenders_validator_accepts_the_extension(blenders):
     validator = glob.glob(str(pathlib.Path(BLENDER_PYTHON).parents[1] / "lib" / "python3.*" / "site-packages" / "bpy"
                               / "*" / "scripts" / "addons_core" / "bl_pkg" / "cli" / "blender_ext.py"))
     assert len(validator) == 1, validator
-    result = subprocess.run([BLENDER_PYTHON, validator[0], "validate", str(extension)], capture_output=True, text=True)
+    result = subprocess.run([BLENDER_PYTHON, validator[0], "validate", str(zip_for(blenders))],
+                            capture_output=True, text=True)
     assert result.returncode == 0, result.stdout + result.stderr
     assert "Success parsing TOML" in result.stdout, result.stdout
 
 
-def test_install_enable_disable_enable(run_blender, tmp_path):
-    """The extension under bpy (4.2+), the legacy zip in the Blender app (3.4)."""
+def test_install_enable_disable_enable(run_blender, extension_zip, tmp_path):
+    """The extension for this Blender's Python under bpy (4.2+), the legacy zip in the Blender app (3.4)."""
     if BLENDER_PYTHON:
-        zip_path, user_folder = built("modal_deform-*[0-9]-linux_x64.zip"), tmp_path / "blender_user"
-        env = {}
+        zip_path, user_folder, env = extension_zip, tmp_path / "blender_user", {}
     else:
-        zip_path, user_folder = built("modal_deform-*-legacy-linux_x64.zip"), tmp_path / "user_scripts"
+        zip_path, user_folder = built(package.legacy_zip_name()), tmp_path / "user_scripts"
         env = {"BLENDER_USER_SCRIPTS": str(user_folder)}
     result = run_blender("install_enable_disable.py", zip_path, user_folder, env=env, addon=False)
     assert "INSTALL_OK" in result.stdout
+
+
+@pytest.mark.skipif(not BLENDER_PYTHON, reason="extensions are Blender 4.2+")
+def test_the_other_pythons_extension_is_refused(run_blender):
+    """Blender's installer refuses the zip made for the other Blenders, with a message, and installs nothing."""
+    python = blender_python_version()
+    others = [blenders for blenders, extension in EXTENSIONS.items() if extension.python != python]
+    assert others
+    for blenders in others:
+        result = run_blender("install_refused.py", zip_for(blenders), addon=False)
+        assert "REFUSED" in result.stdout, result.stdout

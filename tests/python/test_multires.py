@@ -9,7 +9,7 @@ import modal_deform.core as mdc
 from modal_deform.core.bake import PROXY
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "bench"))
-import raw_scans  # noqa: E402  (midpoint_subdivide: the project's own)
+import subdivision  # noqa: E402  (midpoint_subdivide: the project's own)
 import shapes  # noqa: E402  (end_pull: the benchmark's handles and pose)
 
 
@@ -105,7 +105,7 @@ def test_the_subdivided_dragon_on_a_proxy_poses_like_the_dragon(shared_mesh):
     (of the bounding-box diagonal) of the dragon's own bake under the same handles, on the
     vertices the two share; its stored basis is a fraction of a dense one."""
     V, F = shared_mesh("dragon_vrip_res2.ply.gz")
-    V_fine, F_fine = raw_scans.midpoint_subdivide(V, F)
+    V_fine, F_fine = subdivision.midpoint_subdivide(V, F)
 
     def posed(basis, V):
         handles, poses = shapes.end_pull(V)

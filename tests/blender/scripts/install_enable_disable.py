@@ -1,7 +1,8 @@
 """Install a zip as an artist does, then enable, disable, enable again: nothing may be left behind
 by disabling (classes, properties, handlers, timers), and the installed copy (not the source tree)
-bakes. Blender 4.2+: the extension zip with Blender's extension installer (module
-bl_ext.user_default.modal_deform); earlier: the legacy zip like Preferences > Add-ons > Install.
+bakes, with the compiled core of this Blender's Python. Blender 4.2+: the extension zip with
+Blender's extension installer (module bl_ext.user_default.modal_deform); earlier: the legacy zip
+like Preferences > Add-ons > Install.
 
 Arguments: ZIP USER_FOLDER (where Blender installs into)."""
 import os
@@ -28,6 +29,10 @@ def enable_and_bake():
     module = addon_utils.enable(module_name, default_set=True, handle_error=None)
     assert module is not None, "enabling failed"
     assert os.path.realpath(module.__file__).startswith(os.path.realpath(user_folder)), module.__file__
+    # The compiled core of this Blender's own Python, from where Blender installed it.
+    native = sys.modules[f"{module_name}._native"].__file__
+    assert os.path.realpath(native).startswith(os.path.realpath(user_folder)), native
+    assert os.path.basename(native).startswith(f"_native.cpython-{sys.version_info[0]}{sys.version_info[1]}-"), native
     assert hasattr(bpy.types.Object, "modal_deform") and hasattr(bpy.types, "VIEW3D_PT_modal_deform")
     obj = support.suzanne(0)
     obj.modal_deform.modes, obj.modal_deform.derivatives, obj.modal_deform.ghost = 10, 5, 100

@@ -1,0 +1,22 @@
+"""Install an extension zip made for other Blenders (another Python): Blender's installer must
+refuse it with a message, and nothing may be installed or enabled.
+
+Arguments: ZIP."""
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(__file__))
+import bpy  # noqa: E402
+import support  # noqa: E402
+
+(zip_path,) = support.arguments()
+try:
+    result = bpy.ops.extensions.package_install_files(filepath=zip_path, repo="user_default", enable_on_install=True)
+except RuntimeError as error:  # the operator's error report
+    message = str(error)
+else:
+    raise AssertionError(f"Blender {bpy.app.version_string} installed {zip_path}: {result}")
+assert "bl_ext.user_default.modal_deform" not in bpy.context.preferences.addons
+repository = bpy.utils.user_resource('EXTENSIONS', path="user_default")
+assert not os.path.exists(os.path.join(repository, "modal_deform")), f"files left in {repository}"
+print("REFUSED", message.replace("\n", " "))
