@@ -18,9 +18,9 @@ Experiments (each writes bench/results/<name>.json: machine, commit, command, pa
   multires     the dragon subdivided twice (1.6M vertices) baked on a proxy: time, memory, stored
                size, update time and agreement with the dragon's own bake (bench/multires.py)
   blender      the add-on's pose update in headless Blender and Blender's Laplacian Deform
-               (bench/blender_pose.py), in Debian's 3.4.1 app from the source tree; then the pose
-               update alone at 100k and 1.6M vertices in bpy 4.5 and 5.3 (.venv/bpy-<version>, `make
-               bench` makes them) with the add-on installed from its extension zip (`make addon`)
+               (bench/blender_pose.py), in Debian's 3.4.1 app from the source tree
+  bpy_pose     the pose update alone at 100k and 1.6M vertices in bpy 4.5 and 5.3 (.venv/bpy-<version>,
+               made by `make bench`) with the add-on installed from its extension zip (`make addon`)
   renders      Cycles renders of the accuracy experiment's bar and cylinder poses
                (blender_scripts/render_figures.py; needs accuracy's meshes from the same run)
 --quick runs tiny sizes (the smoke test): results go to bench/results/tmp/, the report is not
@@ -42,7 +42,7 @@ import common  # noqa: E402
 import report  # noqa: E402
 
 PYTHON_EXPERIMENTS = ("table1", "accuracy", "convergence", "taylor", "bake_limit", "raw_scan", "multires")
-EXPERIMENTS = ("native",) + PYTHON_EXPERIMENTS + ("blender", "renders")
+EXPERIMENTS = ("native",) + PYTHON_EXPERIMENTS + ("blender", "bpy_pose", "renders")
 NATIVE_IN_TABLE1 = "BM_Bake|BM_BfgsIteration|BM_Positions"
 BLENDER = ["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python"]
 BPY_VERSIONS = ("4.5", "5.3")
@@ -97,16 +97,21 @@ def blender(quick):
             subprocess.run(BLENDER + [str(pose), "--", "--output", str(dense), "--subdivide", "2", "--updates", "15"],
                            check=True, cwd=common.ROOT)
             raw["dense"] = json.loads(dense.read_text())
-        # The installed extension alone, in the Blenders artists run: 100k vertices and 1.6M on a proxy.
-        raw["bpy"] = {}
+    return raw.pop("parameters"), raw
+
+
+def bpy_pose(quick):
+    """The installed extension alone, in the Blenders artists run: 100k vertices and 1.6M on a proxy."""
+    runs = []
+    with tempfile.TemporaryDirectory() as folder:
         for version in BPY_VERSIONS:
-            raw["bpy"][version] = []
             for subdivide in (0,) if quick else (0, 2):
                 out = pathlib.Path(folder) / f"bpy-{version}-{subdivide}.json"
-                in_bpy(version, pose, ["--output", str(out), "--pose-only", "--subdivide", str(subdivide),
-                                       "--updates", "3" if quick else "15", *(["--quick"] if quick else [])], folder)
-                raw["bpy"][version].append(json.loads(out.read_text()))
-    return raw.pop("parameters"), raw
+                in_bpy(version, common.ROOT / "bench" / "blender_pose.py",
+                       ["--output", str(out), "--pose-only", "--subdivide", str(subdivide),
+                        "--updates", "3" if quick else "15", *(["--quick"] if quick else [])], folder)
+                runs.append(json.loads(out.read_text()))
+    return {"blenders": BPY_VERSIONS, "subdivisions": [0] if quick else [0, 2]}, {"runs": runs}
 
 
 def renders(quick):

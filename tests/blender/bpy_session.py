@@ -25,24 +25,29 @@ CORE_LIBRARIES = re.compile(r"lib(cholmod|amd|camd|colamd|ccolamd|suitesparsecon
 PRIVATE_NAME = re.compile(r"-[0-9a-f]{8}\.")  # auditwheel's renaming: libcholmod-7426373e.so.3.0.14
 
 
+def mapped_files():
+    return {line.split(maxsplit=5)[5].strip() for line in open("/proc/self/maps") if len(line.split()) == 6}
+
+
 def install_extension(zip_path):
+    blenders_own = mapped_files()
     result = bpy.ops.extensions.package_install_files(filepath=str(zip_path), repo="user_default",
                                                       enable_on_install=True)
     assert result == {"FINISHED"}, f"installing {zip_path} as an extension: {result}"
     assert MODULE in bpy.context.preferences.addons, f"{MODULE} is not enabled after installing {zip_path}"
     assert hasattr(bpy.types.Object, "modal_deform"), "the extension did not register"
-    check_nothing_of_the_build_machine_is_used()
+    check_nothing_of_the_build_machine_is_used(mapped_files() - blenders_own)
 
 
-def check_nothing_of_the_build_machine_is_used():
+def check_nothing_of_the_build_machine_is_used(loaded):
     """The add-on and its compiled core come from the user folder Blender installed them into, and
-    no library of the core is the machine's own (the -dev packages' /usr/lib/.../libcholmod.so.3 ...):
-    every one loaded has a wheel's private name (bpy's NumPy brings its own libgfortran, renamed)."""
+    no library of the core among those `loaded` with it is the machine's own (the -dev packages'
+    /usr/lib/.../libcholmod.so.3 ...): every one has a wheel's private name. (What Blender loaded
+    before is its own: bpy 4.2.0 maps the system's libgomp itself.)"""
     user = os.path.realpath(os.environ["BLENDER_USER_RESOURCES"]) + os.sep
     for module in (sys.modules[MODULE], sys.modules[f"{MODULE}._native"]):
         assert os.path.realpath(module.__file__).startswith(user), f"{module.__name__} from {module.__file__}"
-    mapped = {line.split(maxsplit=5)[5].strip() for line in open("/proc/self/maps") if len(line.split()) == 6}
-    core = sorted(path for path in mapped if CORE_LIBRARIES.match(os.path.basename(path)))
+    core = sorted(path for path in loaded if CORE_LIBRARIES.match(os.path.basename(path)))
     machine = [path for path in core if not PRIVATE_NAME.search(os.path.basename(path))]
     assert not machine, f"the compiled core loaded libraries of this machine: {machine}"
     cholmod = [path for path in core if "cholmod" in path]

@@ -183,10 +183,14 @@ def test_install_enable_disable_enable(run_blender, extension_zip, tmp_path):
 
 @pytest.mark.skipif(not BLENDER_PYTHON, reason="extensions are Blender 4.2+")
 def test_the_other_pythons_extension_is_refused(run_blender):
-    """Blender's installer refuses the zip made for the other Blenders, with a message, and installs nothing."""
+    """Blender's installer refuses the zip made for the other Blenders, saying which Blender versions
+    it needs, and installs nothing."""
     python = blender_python_version()
     others = [blenders for blenders, extension in EXTENSIONS.items() if extension.python != python]
     assert others
     for blenders in others:
         result = run_blender("install_refused.py", zip_for(blenders), addon=False)
         assert "REFUSED" in result.stdout, result.stdout
+        bounds = "|".join(re.escape(v) for v in (EXTENSIONS[blenders].blender_min, EXTENSIONS[blenders].blender_max) if v)
+        assert re.search(r"This Blender version \([\d.]+\) (doesn't meet the minimum supported version|must be less "
+                         rf"than the maximum version) \(({bounds})\)", result.stdout), result.stdout

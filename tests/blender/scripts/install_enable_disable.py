@@ -9,7 +9,6 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(__file__))
-import addon_utils  # noqa: E402
 import bpy  # noqa: E402
 import support  # noqa: E402
 
@@ -26,8 +25,10 @@ assert installed == {"FINISHED"}, installed
 
 
 def enable_and_bake():
-    module = addon_utils.enable(module_name, default_set=True, handle_error=None)
-    assert module is not None, "enabling failed"
+    # The operator behind Preferences' checkbox, as an artist enables it: in Blender 4.2.0 it, and not
+    # addon_utils.enable, installs the extension's wheels first.
+    assert bpy.ops.preferences.addon_enable(module=module_name) == {"FINISHED"}, "enabling failed"
+    module = sys.modules[module_name]
     assert os.path.realpath(module.__file__).startswith(os.path.realpath(user_folder)), module.__file__
     # The compiled core of this Blender's own Python, from where Blender installed it.
     native = sys.modules[f"{module_name}._native"].__file__
@@ -41,7 +42,7 @@ def enable_and_bake():
 
 
 def disable():
-    addon_utils.disable(module_name, default_set=True)
+    assert bpy.ops.preferences.addon_disable(module=module_name) == {"FINISHED"}
     assert not hasattr(bpy.types.Object, "modal_deform")
     for name in ("VIEW3D_PT_modal_deform", "MODAL_DEFORM_UL_handles", "ModalDeformSettings"):
         assert not hasattr(bpy.types, name), f"{name} is still registered"
