@@ -60,7 +60,11 @@ BfgsResult Bfgs::minimize(const Objective& objective, int max_iterations, double
       result.evaluations += search.evaluations;
     }
     if (search.step == 0) {
-      if (at_initial_) break;
+      ++result.line_search_failures;
+      if (at_initial_) {
+        result.stalled = true;
+        break;
+      }
       H_ = H0_;
       at_initial_ = true;
       continue;

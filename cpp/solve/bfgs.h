@@ -27,6 +27,10 @@ struct BfgsResult {
   int iterations = 0;   // steps taken by this call
   int evaluations = 0;  // objective calls by this call
   bool converged = false;
+  // The call ended because no step from x decreases f, even along −H0∇f (line-search failure):
+  // x is not a minimum by the stopping test, but BFGS cannot leave it (a stall, not convergence).
+  bool stalled = false;
+  int line_search_failures = 0;  // line searches of this call that found no decrease
 };
 
 class Bfgs {
@@ -47,7 +51,7 @@ class Bfgs {
   // Each step searches along p = −H∇f; H takes the BFGS update (N&W eq. 6.17) when the step's
   // curvature yᵀs is positive, as the Wolfe conditions ensure. When p is not a descent direction
   // or the line search finds no decrease, H restarts from H0 once; a second failure ends the
-  // call unconverged (the objective cannot be decreased at this precision). Throws
+  // call unconverged and stalled (the objective cannot be decreased at this precision). Throws
   // NumericalError when f is not finite at the current x.
   BfgsResult minimize(const Objective& objective, int max_iterations, double tolerance,
                       double budget_ms = std::numeric_limits<double>::infinity());
