@@ -12,7 +12,9 @@
 //   ‖x_{k−1} − x_k‖ < √ε (1 + ‖x_k‖),
 //   ‖∇f(x_k)‖ ≤ ∛ε (1 + |f(x_k)|)
 // all hold (Euclidean norms), and before any iteration when ‖∇f(x)‖ ≤ ε (1 + |f(x)|) (GMW's
-// test U4, e.g. at rest with the handles at rest). Once converged, further calls return at once
+// test U4, e.g. at rest with the handles at rest), or when a line search fails on a step whose
+// predicted decrease −∇fᵀp is below 1e-12 (1 + |f|), which f cannot resolve (a minimum at working
+// precision: a small ε can ask for more than that). Once converged, further calls return at once
 // until the objective changes.
 #pragma once
 

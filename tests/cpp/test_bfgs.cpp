@@ -260,5 +260,23 @@ TEST(Bfgs, ReportsAStallWhenNoStepDecreases) {
   EXPECT_EQ(converged.line_search_failures, 0);
 }
 
+// Every step away from x0 raises f by 1e-9, as the rounding of a large sum can: no line search
+// succeeds. Where the predicted decrease (‖x0‖² with H0 = I, g = x) is below what f resolves, that
+// is a minimum at working precision; where it is not, a stall.
+TEST(Bfgs, AMinimumAtWorkingPrecisionIsNoStall) {
+  for (const double x0 : {1e-5, 1.0}) {
+    const Objective rounded = [x0](const Eigen::VectorXd& x, Eigen::VectorXd& g) {
+      g = x;
+      return x[0] == x0 ? 1e6 : 1e6 + 1e-9;
+    };
+    Bfgs bfgs;
+    bfgs.start(Eigen::VectorXd::Constant(1, x0), Eigen::MatrixXd::Identity(1, 1));
+    const BfgsResult result = bfgs.minimize(rounded, 10, 1e-13);
+    EXPECT_EQ(result.converged, x0 < 1) << x0;
+    EXPECT_EQ(result.stalled, x0 == 1) << x0;
+    EXPECT_EQ(result.line_search_failures, 1) << x0;
+  }
+}
+
 }  // namespace
 }  // namespace modal_deform
