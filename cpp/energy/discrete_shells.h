@@ -54,8 +54,8 @@
 //   smoothstep φ(t) = u³(10 − 15u + 6u²), u = t / kHingeFade², for t below kHingeFade², 1
 //   above. φ and its first two derivatives are continuous, and near t = 0 φ ∝ ‖n_k‖⁶ outweighs
 //   ∇θ ∝ 1/‖n_k‖ and ∇²θ ∝ 1/‖n_k‖², so the term, its gradient and Hessian go to 0 continuously
-//   as a triangle collapses and E is twice continuously differentiable wherever the edges have
-//   length. At rest (t = 1) φ = 1 with zero derivatives: K and ∇³E(x̄) do not change.
+//   as a triangle collapses and turns over (the membrane terms stay continuous there, their
+//   gradients bounded). At rest (t = 1) φ = 1 with zero derivatives: K and ∇³E(x̄) do not change.
 // - a deformed element that collapses (edge length, triangle area or, for a hinge, either
 //   triangle's area below 1e-12 times its rest value) is not differentiable there: an edge or a
 //   triangle keeps its value but contributes no derivatives (its value is continuous there); a
