@@ -121,7 +121,7 @@ struct TermSet {
 // A bending or area term's rest stiffness is at most this multiple of its equilateral one (above).
 constexpr double kMaxStiffnessRatio = 100.0;
 // A bending term fades out once either triangle's area falls below this fraction of its rest area.
-constexpr double kHingeFade = 0.2;
+constexpr double kHingeFade = 0.1;
 
 class DiscreteShells final : public Energy {
  public:

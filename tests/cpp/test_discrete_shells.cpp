@@ -222,7 +222,8 @@ TEST(DiscreteShells, BendingFadesOutContinuouslyAsATriangleTurnsOver) {
   F << 0, 1, 2, 1, 0, 3;
   const DiscreteShells energy(V, F);
   // E(t) sampled every 1e-5 from t = 0.3 to −0.3: no step changes E by more than its slope allows
-  // (the step across t = 0 changed it by 6.0 = 2w before the fade).
+  // (at most 3.3e-3, where the fade is steepest; the step across t = 0 changed it by 6.0 = 2w
+  // before the fade).
   const double dt = 1e-5;
   double largest_step = 0, previous = energy.value(crushed_hinge(0.3));
   for (double t = 0.3 - dt; t > -0.3; t -= dt) {
@@ -230,12 +231,12 @@ TEST(DiscreteShells, BendingFadesOutContinuouslyAsATriangleTurnsOver) {
     largest_step = std::max(largest_step, std::abs(value - previous));
     previous = value;
   }
-  EXPECT_LT(largest_step, 1e-3) << "E jumps along the path";
+  EXPECT_LT(largest_step, 1e-2) << "E jumps along the path";
   // The membrane terms alone at t = ±1e-9 (the hinge faded to nothing): E is even in t there.
   EXPECT_NEAR(energy.value(crushed_hinge(1e-9)), energy.value(crushed_hinge(-1e-9)), 1e-9);
 
   const Eigen::VectorXd d = random_vector(12, 7), u = random_vector(12, 8);
-  for (double t : {0.15, 0.05, -0.05, -0.15}) {
+  for (double t : {0.03, 0.015, -0.015, -0.03}) {  // area ratios 0.032, 0.018: faded
     const Eigen::VectorXd x = crushed_hinge(t, 0.01);
     const std::string where = "crushed hinge at t = " + std::to_string(t);
     Eigen::VectorXd gradient(12), plus(12), minus(12);
