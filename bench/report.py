@@ -444,6 +444,8 @@ def section_strong_poses(result):
     out.append(table(["turn deg", "1.6M converged", "stalled calls", "calls without progress", "1.6M objective",
                       "100k objective", "solve_full", "1.6M gap", "100k gap", "RMS 1.6M vs 100k", "difference error"],
                      rows))
+    if p.get("note"):
+        out += ["", p["note"]]
     out += ["", provenance(result)]
     return "\n".join(out)
 
