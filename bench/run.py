@@ -17,6 +17,9 @@ Experiments (each writes bench/results/<name>.json: machine, commit, command, pa
                and peak memory against issue 15's targets (bench/raw_scan.py)
   multires     the dragon subdivided twice (1.6M vertices) baked on a proxy: time, memory, stored
                size, update time and agreement with the dragon's own bake (bench/multires.py)
+  strong_poses the 100k dragon under turns of 90/170 and bends of 90/180 degrees, and the 1.6M
+               dragon on its proxy under end turns of 30/90/170 degrees against the 100k dragon's
+               own bake and solve_full (bench/strong_poses.py)
   blender      the add-on's pose update in headless Blender and Blender's Laplacian Deform
                (bench/blender_pose.py), in Debian's 3.4.1 app from the source tree
   bpy_pose     the pose update alone at 100k and 1.6M vertices in bpy 4.5 and 5.3 (.venv/bpy-<version>,
@@ -41,7 +44,8 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import common  # noqa: E402
 import report  # noqa: E402
 
-PYTHON_EXPERIMENTS = ("table1", "accuracy", "convergence", "taylor", "bake_limit", "raw_scan", "multires")
+PYTHON_EXPERIMENTS = ("table1", "accuracy", "convergence", "taylor", "bake_limit", "raw_scan", "multires",
+                      "strong_poses")
 EXPERIMENTS = ("native",) + PYTHON_EXPERIMENTS + ("blender", "bpy_pose", "renders")
 NATIVE_IN_TABLE1 = "BM_Bake|BM_BfgsIteration|BM_Positions"
 BLENDER = ["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python"]

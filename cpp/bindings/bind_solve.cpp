@@ -49,7 +49,9 @@ void bind_solve(py::module_& m) {
             }
             return py::dict(py::arg("iterations") = stats.iterations, py::arg("energy") = stats.energy,
                             py::arg("converged") = stats.converged, py::arg("ms") = stats.milliseconds,
-                            py::arg("evaluations") = stats.evaluations, py::arg("gradient_norm") = stats.gradient_norm);
+                            py::arg("evaluations") = stats.evaluations, py::arg("gradient_norm") = stats.gradient_norm,
+                            py::arg("stalled") = stats.stalled,
+                            py::arg("line_search_failures") = stats.line_search_failures);
           },
           py::arg("max_iterations"), py::arg("tolerance"), py::arg("budget_ms"))
       .def("reset", &ReducedSolver::reset)

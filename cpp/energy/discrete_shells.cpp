@@ -41,10 +41,12 @@ template <typename Term>
 constexpr int kDofsOf = 3 * (kVerticesOf<Term> - 1);
 
 // A term's f and its derivatives with respect to s at the current s (the weight included), and
-// whether s is differentiable there.
+// whether s is differentiable there. For a faded hinge (header) s is the whole term itself:
+// f = s, f' = 1, and gradients of s are those of the term (gradient_of).
 struct Response {
   double f = 0, df = 0, d2f = 0, d3f = 0;
   bool differentiable = false;
+  bool faded = false;
 };
 
 // f(s) = ½ w (s − s̄)².
@@ -61,11 +63,79 @@ Response respond(const TriangleTerm& term, const TriangleArea::Frame<double>& fr
   return quadratic(TriangleArea::measure(frame), term.rest_area, term.weight, frame.norm > term.collapsed_norm);
 }
 
+// The hinge fade (header): φ(t) and φ'(t) for t = ‖n‖² / ‖n̄‖², the quintic smoothstep in
+// u = t / kHingeFade², 1 from u = 1 on.
+template <typename T>
+struct Fade {
+  T value, slope;
+};
+
+constexpr double kFadeEnd = kHingeFade * kHingeFade;
+
+template <typename T>
+Fade<T> fade(const T& t) {
+  if (value_of(t) >= kFadeEnd) return {T(1.0), T(0.0)};
+  const T u = t * (1 / kFadeEnd);
+  const T uu = u * u, rest = T(1.0) - u;
+  return {uu * u * (T(10.0) + u * (T(-15.0) + u * 6.0)), uu * rest * rest * (30 / kFadeEnd)};
+}
+
+// Below this t a triangle of a hinge counts as collapsed (the header's 1e-12 of its rest area).
+constexpr double kCollapsedNormRatio = kCollapse * kCollapse;
+
+bool hinge_collapsed(const HingeTerm& term, double n1n1, double n2n2) {
+  return n1n1 <= kCollapsedNormRatio * term.rest_n1n1 || n2n2 <= kCollapsedNormRatio * term.rest_n2n2;
+}
+
+bool hinge_faded(const HingeTerm& term, double n1n1, double n2n2) {
+  return n1n1 < kFadeEnd * term.rest_n1n1 || n2n2 < kFadeEnd * term.rest_n2n2;
+}
+
+// ½ w (2 sin(δ/2))² = ½ w ‖(cos θ, sin θ) − (cos θ̄, sin θ̄)‖², the unfaded bending term, and
+// w sin δ, its derivative in θ, from the frame (any scalar).
+template <typename T>
+std::array<T, 2> bending_and_slope(const HingeTerm& term, const DihedralAngle::Frame<T>& f) {
+  using std::sqrt;
+  const T inverse = sqrt(f.inverse_product);  // 1 / (‖a‖‖n1‖‖n2‖)
+  const T cos_theta = shells::dot(f.n1, f.n2) * f.length * inverse;
+  const T sin_theta = -(shells::dot(f.n1, f.c) * f.aa * inverse);
+  const T dc = cos_theta - T(term.cos_rest), ds = sin_theta - T(term.sin_rest);
+  return {(dc * dc + ds * ds) * (0.5 * term.weight),
+          (sin_theta * term.cos_rest - cos_theta * term.sin_rest) * term.weight};
+}
+
+// The gradient of a faded hinge's whole term b(θ) φ(t1) φ(t2) over r = (a, b, c):
+// φ1 φ2 b'(θ) ∇θ + b (φ1' φ2 ∇t1 + φ1 φ2' ∇t2), with ∇_a ‖n1‖² = 2 b × n1, ∇_b ‖n1‖² = 2 n1 × a,
+// ∇_c ‖n2‖² = 2 a × n2, ∇_a ‖n2‖² = 2 n2 × c (n1 = a × b, n2 = c × a).
+template <typename T>
+void faded_hinge_gradient(const HingeTerm& term, const DihedralAngle::Frame<T>& f, T* g) {
+  const auto [bending, slope] = bending_and_slope(term, f);
+  const Fade<T> fade1 = fade(f.n1n1 * (1 / term.rest_n1n1)), fade2 = fade(f.n2n2 * (1 / term.rest_n2n2));
+  DihedralAngle::gradient(f, g);
+  const T along_theta = fade1.value * fade2.value * slope;
+  const T c1 = bending * fade1.slope * fade2.value * (2 / term.rest_n1n1);
+  const T c2 = bending * fade1.value * fade2.slope * (2 / term.rest_n2n2);
+  using shells::cross;
+  const shells::Vec3<T> a_from_n1 = cross(f.b, f.n1), b_from_n1 = cross(f.n1, f.a);
+  const shells::Vec3<T> a_from_n2 = cross(f.n2, f.c), c_from_n2 = cross(f.a, f.n2);
+  for (int i = 0; i < 3; ++i) {
+    g[i] = g[i] * along_theta + c1 * a_from_n1[i] + c2 * a_from_n2[i];
+    g[3 + i] = g[3 + i] * along_theta + c1 * b_from_n1[i];
+    g[6 + i] = g[6 + i] * along_theta + c2 * c_from_n2[i];
+  }
+}
+
 // f(θ) = ½ w (2 sin(δ/2))², δ = θ − θ̄. The factor (2 sin(δ/2))² is the squared distance
 // between the points (cos θ, sin θ) and (cos θ̄, sin θ̄) of the unit circle: no cancellation at
-// small δ, exactly 0 at rest. The derivatives in δ use the angle-difference formulas.
+// small δ, exactly 0 at rest. The derivatives in δ use the angle-difference formulas. A crushed
+// triangle fades the term out (header); a collapsed one leaves nothing.
 Response respond(const HingeTerm& term, const DihedralAngle::Frame<double>& frame) {
-  if (frame.n1n1 <= term.collapsed_n1n1 || frame.n2n2 <= term.collapsed_n2n2) return {};
+  if (hinge_collapsed(term, frame.n1n1, frame.n2n2)) return {};
+  if (hinge_faded(term, frame.n1n1, frame.n2n2)) {
+    const double faded = bending_and_slope(term, frame)[0] * fade(frame.n1n1 / term.rest_n1n1).value *
+                         fade(frame.n2n2 / term.rest_n2n2).value;
+    return {faded, 1.0, 0.0, 0.0, true, true};
+  }
   const auto [cos_theta, sin_theta] = DihedralAngle::measure(frame);
   const double cos_delta = cos_theta * term.cos_rest + sin_theta * term.sin_rest;
   const double sin_delta = sin_theta * term.cos_rest - cos_theta * term.sin_rest;
@@ -73,6 +143,15 @@ Response respond(const HingeTerm& term, const DihedralAngle::Frame<double>& fram
                                (sin_theta - term.sin_rest) * (sin_theta - term.sin_rest);
   const double w = term.weight;
   return {0.5 * w * chord_squared, w * sin_delta, w * cos_delta, -w * sin_delta, true};
+}
+
+// ∇s at `frame`: the element quantity's, or a faded hinge's whole term's (Response::faded).
+template <typename Term, typename T>
+void gradient_of(const Term& term, bool faded, const typename Term::Quantity::template Frame<T>& frame, T* g) {
+  if constexpr (std::is_same_v<Term, HingeTerm>) {
+    if (faded) return faded_hinge_gradient(term, frame, g);
+  }
+  Term::Quantity::gradient(frame, g);
 }
 
 // r = (y_{v1} − y_{v0}, ..., y_{v_{K−1}} − y_{v0}) for the term's vertices v, y a flat 3n array.
@@ -144,17 +223,17 @@ void visit_part(const shells::TermSet<Term>& set, int part, Visit& visit) {
   }
 }
 
-// ∇s and ∇²s (N by N, symmetrised, row-major) at r: the gradient evaluated on dual numbers
-// with one direction per coordinate.
-template <typename Quantity, int N>
-void second_derivatives(const double* r, double* gradient, double* hessian) {
+// ∇s and ∇²s (N by N, symmetrised, row-major) at r (s as gradient_of takes it): the gradient
+// evaluated on dual numbers with one direction per coordinate.
+template <typename Term, int N = kDofsOf<Term>>
+void second_derivatives(const Term& term, bool faded, const double* r, double* gradient, double* hessian) {
   using D = Dual<double, N>;
   D rd[N], g[N];
   for (int i = 0; i < N; ++i) {
     rd[i].v = r[i];
     rd[i].d[i] = 1.0;
   }
-  Quantity::gradient(Quantity::frame(rd), g);
+  gradient_of(term, faded, Term::Quantity::frame(rd), g);
   for (int i = 0; i < N; ++i) {
     gradient[i] = g[i].v;
     for (int j = 0; j < N; ++j) hessian[i * N + j] = 0.5 * (g[i].d[j] + g[j].d[i]);
@@ -163,9 +242,9 @@ void second_derivatives(const double* r, double* gradient, double* hessian) {
 
 // ∇s, ∇²s u, ∇²s w and ∇³s(u, w) at r: the gradient evaluated on hyper-dual numbers
 // r + ε1 u + ε2 w, read off at 1, ε2, ε1 and ε1ε2.
-template <typename Quantity, int N>
-void third_derivatives(const double* r, const double* u, const double* w, double* gradient, double* hu, double* hw,
-                       double* tuw) {
+template <typename Term, int N = kDofsOf<Term>>
+void third_derivatives(const Term& term, bool faded, const double* r, const double* u, const double* w,
+                       double* gradient, double* hu, double* hw, double* tuw) {
   using H = Dual<Dual<double, 1>, 1>;
   H rh[N], g[N];
   for (int i = 0; i < N; ++i) {
@@ -173,7 +252,7 @@ void third_derivatives(const double* r, const double* u, const double* w, double
     rh[i].v.d[0] = w[i];
     rh[i].d[0].v = u[i];
   }
-  Quantity::gradient(Quantity::frame(rh), g);
+  gradient_of(term, faded, Term::Quantity::frame(rh), g);
   for (int i = 0; i < N; ++i) {
     gradient[i] = g[i].v.v;
     hw[i] = g[i].v.d[0];
@@ -316,8 +395,8 @@ DiscreteShells::DiscreteShells(const VerticesRef& V, const FacesRef& F, double b
     term.sin_rest = sin_rest;
     term.weight = bounded_weight(3 * bending * frame.aa / (area[hinge.faces[0]] + area[hinge.faces[1]]),
                                  squared_gradient_norm<HingeTerm>(frame), bending * equilateral_hinge_stiffness(frame.aa));
-    term.collapsed_n1n1 = std::pow(kCollapse, 2) * frame.n1n1;
-    term.collapsed_n2n2 = std::pow(kCollapse, 2) * frame.n2n2;
+    term.rest_n1n1 = frame.n1n1;
+    term.rest_n2n2 = frame.n2n2;
     hinges_.terms.push_back(term);
   }
 
@@ -375,7 +454,7 @@ double DiscreteShells::value_and_gradient(const VectorRef& x, Eigen::Ref<Eigen::
       if (owned.contains(term.vertices[0])) energy += q.f;
       if (!q.differentiable || q.df == 0) return;
       double g[N], full[3 * K];
-      Term::Quantity::gradient(frame, g);
+      gradient_of(term, q.faded, frame, g);
       for (double& gi : g) gi *= q.df;
       to_vertices<K>(g, full);
       add_owned(term, full, owned, gradient.data());
@@ -402,9 +481,9 @@ SparseMatrix DiscreteShells::hessian(const VectorRef& x) const {
       if (!q.differentiable) return;
       double g[N], h[N * N], full[M * M];
       if (q.df != 0)
-        second_derivatives<typename Term::Quantity, N>(r, g, h);
+        second_derivatives(term, q.faded, r, g, h);
       else  // at rest, for instance: ∇²s is not needed
-        Term::Quantity::gradient(frame, g);
+        gradient_of(term, q.faded, frame, g);
       term_hessian<K>(q, g, h, full);
       const auto& offsets = set_of(term).block_offsets[e];
       for (int b = 0; b < K; ++b) {
@@ -440,7 +519,7 @@ Eigen::VectorXd DiscreteShells::third(const VectorRef& x, const VectorRef& u, co
       double ur[N], wr[N], g[N], hu[N], hw[N], tuw[N], local[N], full[3 * K];
       relative(term, u.data(), ur);
       relative(term, w.data(), wr);
-      third_derivatives<typename Term::Quantity, N>(r, ur, wr, g, hu, hw, tuw);
+      third_derivatives(term, q.faded, r, ur, wr, g, hu, hw, tuw);
       third_of_term<N>(q, g, hu, hw, ur, wr, tuw, local);
       to_vertices<K>(local, full);
       add_owned(term, full, owned, out.data());
@@ -492,7 +571,7 @@ RowMatrixXd DiscreteShells::third_batch(const VectorRef& x, const Eigen::Ref<con
       const Response q = respond_at(term, x.data(), r);
       if (!q.differentiable) return;
       double g[N], h[N * N];
-      second_derivatives<typename Term::Quantity, N>(r, g, h);
+      second_derivatives(term, q.faded, r, g, h);
       for (int s = 0; s < num_used; ++s) {
         double* phi_s = &phi[N * s];
         relative(term, Phi.col(used[s]).data(), phi_s);
@@ -503,8 +582,7 @@ RowMatrixXd DiscreteShells::third_batch(const VectorRef& x, const Eigen::Ref<con
         double tuw[N], local[N];
         if (q.df != 0) {  // away from rest: ∇³s(Φ_i, Φ_j) too
           double unused_g[N], unused_hu[N], unused_hw[N];
-          third_derivatives<typename Term::Quantity, N>(r, &phi[N * i], &phi[N * j], unused_g, unused_hu, unused_hw,
-                                                        tuw);
+          third_derivatives(term, q.faded, r, &phi[N * i], &phi[N * j], unused_g, unused_hu, unused_hw, tuw);
         }
         third_of_term<N>(q, g, &h_phi[N * i], &h_phi[N * j], &phi[N * i], &phi[N * j], tuw, local);
         to_vertices<K>(local, &full[3 * K * p]);

@@ -46,11 +46,20 @@
 //   failed its bake: the shift fell far below the modes), and they leave small pivots of K − σM
 //   to rounding. Measured ratio to the equilateral stiffness: the bunny's largest hinge 46,
 //   dragon_vrip_res2's median 2.5, 99th percentile 210, largest 2.9e8.
+// - a hinge's angle jumps by π when one of its triangles passes through zero area (its normal
+//   turns over), which made a bending term, and so E, jump by up to 2w there: the reduced
+//   solver's line search stalled on ghost triangles crushed during strong poses (issue 22). So a
+//   bending term fades out as either triangle is crushed: it is multiplied by φ(t1) φ(t2), with
+//   t_k = ‖n_k‖² / ‖n̄_k‖² (the squared ratio of deformed to rest area) and the quintic
+//   smoothstep φ(t) = u³(10 − 15u + 6u²), u = t / kHingeFade², for t below kHingeFade², 1
+//   above. φ and its first two derivatives are continuous, and near t = 0 φ ∝ ‖n_k‖⁶ outweighs
+//   ∇θ ∝ 1/‖n_k‖ and ∇²θ ∝ 1/‖n_k‖², so the term, its gradient and Hessian go to 0 continuously
+//   as a triangle collapses and turns over (the membrane terms stay continuous there, their
+//   gradients bounded). At rest (t = 1) φ = 1 with zero derivatives: K and ∇³E(x̄) do not change.
 // - a deformed element that collapses (edge length, triangle area or, for a hinge, either
 //   triangle's area below 1e-12 times its rest value) is not differentiable there: an edge or a
-//   triangle keeps its value but contributes no derivatives; a hinge has no angle at all and
-//   contributes nothing until its triangles open again (the area terms penalise the collapse).
-//   Every output stays finite.
+//   triangle keeps its value but contributes no derivatives (its value is continuous there); a
+//   hinge, faded out, contributes nothing. Every output stays finite.
 //
 // Meshes with at least kParallelElements terms are evaluated in parallel (OpenMP) over vertex
 // ranges (vertex_partition.h), with the same results for any number of threads (but for the
@@ -87,12 +96,13 @@ struct TriangleTerm {
   double collapsed_norm;  // ‖n‖ = 2A at or below which the triangle counts as collapsed
 };
 
-// f(θ) = ½ w (2 sin((θ − θ̄)/2))², w = 3 α ‖ē‖² / Ā_e.
+// f(θ) = ½ w (2 sin((θ − θ̄)/2))² φ(t1) φ(t2), w = 3 α ‖ē‖² / Ā_e, t_k = ‖n_k‖² / ‖n̄_k‖² (the
+// fade, above).
 struct HingeTerm {
   using Quantity = DihedralAngle;
   std::array<int, 4> vertices;  // as in Hinge::vertices
   double cos_rest, sin_rest, weight;
-  double collapsed_n1n1, collapsed_n2n2;  // ‖n1‖², ‖n2‖² at or below which a triangle has collapsed
+  double rest_n1n1, rest_n2n2;  // ‖n̄1‖², ‖n̄2‖²: four times the rest areas squared
 };
 
 // The terms of one kind with what assembly needs: the value-array offset of each of a term's
@@ -110,6 +120,8 @@ struct TermSet {
 
 // A bending or area term's rest stiffness is at most this multiple of its equilateral one (above).
 constexpr double kMaxStiffnessRatio = 100.0;
+// A bending term fades out once either triangle's area falls below this fraction of its rest area.
+constexpr double kHingeFade = 0.1;
 
 class DiscreteShells final : public Energy {
  public:

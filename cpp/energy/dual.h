@@ -91,4 +91,12 @@ Dual<T, N> sqrt(const Dual<T, N>& a) {
   return r;
 }
 
+// The plain value of a scalar, dual or not (to branch on it).
+inline double value_of(double a) { return a; }
+
+template <typename T, int N>
+double value_of(const Dual<T, N>& a) {
+  return value_of(a.v);
+}
+
 }  // namespace modal_deform

@@ -119,6 +119,7 @@ class Simplifier {
   double cost(int u, int v) const;
   int try_collapse(int u, int v);
   bool face_stays_sound(int f, int u, int v, const Eigen::Vector3d& p) const;
+  double star_quality(int u, int v, const Eigen::Vector3d& p, bool merged) const;
   void collapse(int u, int v, const Eigen::Vector3d& p);
 
   RowMatrixX3i faces_;  // the kept input faces; a collapse of v into u renames v to u
@@ -293,13 +294,30 @@ bool Simplifier::face_stays_sound(int f, int u, int v, const Eigen::Vector3d& p)
   const TriangleShape old_shape = triangle_shape(before[0], before[1], before[2]);
   const TriangleShape new_shape = triangle_shape(after[0], after[1], after[2]);
   if (new_shape.degenerate) return old_shape.degenerate;
-  if (new_shape.quality < kMinFaceQuality && new_shape.quality < old_shape.quality) return false;
   const double max_turn_cosine = std::cos(kMaxNormalTurnDegrees * kPi / 180.0);
-  if (!old_shape.degenerate &&
+  // A needle's normal turns with any small move of its vertices: only sound faces must not turn.
+  if (!old_shape.degenerate && old_shape.quality >= kMinFaceQuality &&
       new_shape.normal.dot(old_shape.normal) < max_turn_cosine * new_shape.normal.norm() * old_shape.normal.norm())
     return false;
   // Turning in small steps must not add up to a flip against the input.
   return new_shape.normal.dot(input_normals_[f]) > 0 || input_normals_[f].squaredNorm() == 0;
+}
+
+// The least quality of the faces around u and v (shared_, u_only_, v_only_) as they are, or of
+// those around the merged vertex at p once v is merged into u (`merged`).
+double Simplifier::star_quality(int u, int v, const Eigen::Vector3d& p, bool merged) const {
+  const auto point = [&](int x) -> const Eigen::Vector3d& {
+    return merged && (x == u || x == v) ? p : position_[x];
+  };
+  const auto quality = [&](int f) {
+    return triangle_shape(point(faces_(f, 0)), point(faces_(f, 1)), point(faces_(f, 2))).quality;
+  };
+  double least = 1.0;
+  for (const std::vector<int>* faces : {&u_only_, &v_only_, &shared_}) {
+    if (merged && faces == &shared_) continue;
+    for (int f : *faces) least = std::min(least, quality(f));
+  }
+  return least;
 }
 
 // Collapses the edge uv if that keeps the mesh sound; returns the vertex that stays, or -1.
@@ -353,6 +371,11 @@ int Simplifier::try_collapse(int u, int v) {
     if (!face_stays_sound(f, u, v, p)) return -1;
   for (int f : v_only_)
     if (!face_stays_sound(f, u, v, p)) return -1;
+  // Needles: the worst face around the merged vertex may be below kMinFaceQuality only if it is no
+  // worse than the worst face around u and v before, the faces the collapse removes included. A
+  // rule per face locked islands of small clusters among large ones for good: merging one into a
+  // neighbour removes the needles between them but makes its other faces a little thinner.
+  if (star_quality(u, v, p, true) < std::min(kMinFaceQuality, star_quality(u, v, p, false))) return -1;
   collapse(u, v, p);
   return u;
 }

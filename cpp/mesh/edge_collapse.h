@@ -14,9 +14,14 @@
 //     them), no duplicate face, the merged vertex keeps a face;
 //   - boundary: boundary vertices merge only along boundary edges, never with interior vertices,
 //     so boundary loops are neither pulled inward nor pinched;
-//   - geometry: no changed face turns its normal by more than kMaxNormalTurnDegrees, points
-//     against the input face it descends from, becomes degenerate, or becomes a needle (quality
-//     below kMinFaceQuality and worse than before).
+//   - geometry: no changed face of quality at least kMinFaceQuality turns its normal by more than
+//     kMaxNormalTurnDegrees (a needle's normal is noise), no changed face points against the input
+//     face it descends from or becomes degenerate, and the worst face around the merged vertex is
+//     no needle (quality below kMinFaceQuality) unless it is no worse than the worst face around
+//     the two vertices before (the removed faces included). Judged face by face, the last two rules
+//     left islands of uncollapsed fine vertices among large clusters on subdivided scans (every
+//     collapse there thins some needle a little or turns its normal): tiny ghost triangles that a
+//     pose crushes first (issue 22).
 // Edges of degenerate input faces are collapsed first, which removes those faces.
 #pragma once
 

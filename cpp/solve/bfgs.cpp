@@ -6,6 +6,14 @@
 #include "util/errors.h"
 
 namespace modal_deform {
+namespace {
+
+// A step whose predicted decrease −∇fᵀp is below this fraction of 1 + |f| is lost in the rounding
+// of f (a sum of thousands of rounded terms): a line search failing on it finds x a minimum at
+// working precision, not a stall.
+constexpr double kUnresolvableDecrease = 1e-12;
+
+}  // namespace
 
 void Bfgs::start(const Eigen::VectorXd& x, const Eigen::MatrixXd& initial_inverse_hessian) {
   const Eigen::Index n = x.size();
@@ -60,7 +68,16 @@ BfgsResult Bfgs::minimize(const Objective& objective, int max_iterations, double
       result.evaluations += search.evaluations;
     }
     if (search.step == 0) {
-      if (at_initial_) break;
+      ++result.line_search_failures;
+      const double predicted_decrease = -gradient_.dot(p_);
+      if (predicted_decrease > 0 && predicted_decrease <= kUnresolvableDecrease * (1 + std::abs(value_))) {
+        converged_ = true;
+        break;
+      }
+      if (at_initial_) {
+        result.stalled = true;
+        break;
+      }
       H_ = H0_;
       at_initial_ = true;
       continue;

@@ -12,7 +12,9 @@
 //   ‖x_{k−1} − x_k‖ < √ε (1 + ‖x_k‖),
 //   ‖∇f(x_k)‖ ≤ ∛ε (1 + |f(x_k)|)
 // all hold (Euclidean norms), and before any iteration when ‖∇f(x)‖ ≤ ε (1 + |f(x)|) (GMW's
-// test U4, e.g. at rest with the handles at rest). Once converged, further calls return at once
+// test U4, e.g. at rest with the handles at rest), or when a line search fails on a step whose
+// predicted decrease −∇fᵀp is below 1e-12 (1 + |f|), which f cannot resolve (a minimum at working
+// precision: a small ε can ask for more than that). Once converged, further calls return at once
 // until the objective changes.
 #pragma once
 
@@ -27,6 +29,10 @@ struct BfgsResult {
   int iterations = 0;   // steps taken by this call
   int evaluations = 0;  // objective calls by this call
   bool converged = false;
+  // The call ended because no step from x decreases f, even along −H0∇f (line-search failure):
+  // x is not a minimum by the stopping test, but BFGS cannot leave it (a stall, not convergence).
+  bool stalled = false;
+  int line_search_failures = 0;  // line searches of this call that found no decrease
 };
 
 class Bfgs {
@@ -47,7 +53,7 @@ class Bfgs {
   // Each step searches along p = −H∇f; H takes the BFGS update (N&W eq. 6.17) when the step's
   // curvature yᵀs is positive, as the Wolfe conditions ensure. When p is not a descent direction
   // or the line search finds no decrease, H restarts from H0 once; a second failure ends the
-  // call unconverged (the objective cannot be decreased at this precision). Throws
+  // call unconverged and stalled (the objective cannot be decreased at this precision). Throws
   // NumericalError when f is not finite at the current x.
   BfgsResult minimize(const Objective& objective, int max_iterations, double tolerance,
                       double budget_ms = std::numeric_limits<double>::infinity());

@@ -86,6 +86,8 @@ ReducedSolveStats ReducedSolver::solve(int max_iterations, double tolerance, dou
   stats.iterations = result.iterations;
   stats.evaluations = result.evaluations;
   stats.converged = result.converged;
+  stats.stalled = result.stalled;
+  stats.line_search_failures = result.line_search_failures;
   stats.energy = bfgs_.value();
   stats.gradient_norm = bfgs_.gradient().norm();
   stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

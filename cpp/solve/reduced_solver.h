@@ -37,6 +37,8 @@ struct ReducedSolveStats {
   double energy = 0;         // f(q) at the end: deformation energy plus handle term
   double gradient_norm = 0;  // ‖∇f(q)‖
   bool converged = false;    // the stopping test holds (bfgs.h)
+  bool stalled = false;      // not converged, and no step decreases f (BfgsResult::stalled)
+  int line_search_failures = 0;  // line searches of this call that found no decrease
   double milliseconds = 0;   // wall time of the call
 };
 

@@ -82,7 +82,9 @@ keeps the pose, Esc restores the mesh as it was"""
             self.report({"ERROR"}, str(error))
             return self._end(context, "CANCEL")
         stats = self.pose.stats
-        state = "converged" if stats["converged"] else "solving"
+        state = posing.state(stats)
+        if state == "stalled":
+            state = f"stalled: {posing.STALLED_HINT}"
         if self.area is not None:
             self.area.header_text_set(f"Modal Deform: {state}, {stats['iterations']} iterations, energy "
                                       f"{stats['energy']:.5g}, {self.tick_ms:.1f} ms per update")
@@ -165,9 +167,14 @@ class MODAL_DEFORM_OT_solve(bpy.types.Operator):
         block, _ = mesh_io.shape_key(obj, posing.POSE_KEY)
         block.value, block.mute = 1.0, False
         pose.write(block)
-        level = "INFO" if stats["converged"] else "WARNING"
-        self.report({level}, f"{'Converged' if stats['converged'] else 'Not converged'} after {stats['iterations']} "
-                             f"iterations in {stats['ms']:.0f} ms (energy {stats['energy']:.5g})")
+        state = posing.state(stats)
+        summary = f"after {stats['iterations']} iterations in {stats['ms']:.0f} ms (energy {stats['energy']:.5g})"
+        if state == "converged":
+            self.report({"INFO"}, f"Converged {summary}")
+        elif state == "stalled":
+            self.report({"WARNING"}, f"Stalled {summary}: {posing.STALLED_HINT}")
+        else:
+            self.report({"WARNING"}, f"Not converged {summary}")
         return {"FINISHED"}
 
 

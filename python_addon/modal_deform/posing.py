@@ -30,7 +30,7 @@ class Pose:
                                         energy=settings.status.energy.lower())
         self.out = np.empty((self.basis.num_vertices, 3), np.float32)
         self._transforms = None
-        self.stats = {"iterations": 0, "energy": 0.0, "converged": False}
+        self.stats = {"iterations": 0, "energy": 0.0, "converged": False, "stalled": False}
 
     def follow_controllers(self):
         """Give the solver the controllers' current placement; True when it changed."""
@@ -57,6 +57,17 @@ class Pose:
         """x̄ + U q into the shape key `block` of the object's mesh."""
         self.solver.positions(self.out)
         mesh_io.write_shape_key(self.obj.data, block, self.out)
+
+
+def state(stats):
+    """How a solve ended, for the artist: "converged", "stalled" (no step lowers the objective:
+    the mesh stops following the controllers and the pose shown is not a solution) or "solving"."""
+    if stats["converged"]:
+        return "converged"
+    return "stalled" if stats.get("stalled") else "solving"
+
+
+STALLED_HINT = "the solver cannot follow this pose (no step lowers its energy); ease the controllers back or re-bake"
 
 
 class ShapeKeyState:

@@ -19,6 +19,10 @@ def test_dense_mesh_bakes_on_a_proxy_through_the_same_button(run_blender):
     assert "PROXY_OK" in run_blender("proxy_bake.py").stdout
 
 
+def test_suzanne_follows_strong_poses(run_blender):
+    assert "STRONG_POSES_OK" in run_blender("strong_pose.py").stdout
+
+
 def test_stale_mesh_and_bad_handles_are_refused(run_blender):
     assert "STALE_OK" in run_blender("stale_and_bad_handles.py").stdout
 

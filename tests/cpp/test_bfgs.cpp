@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include "solve/bfgs.h"
@@ -234,6 +235,47 @@ TEST(Bfgs, AKnownChangeOfTheObjectiveEqualsReevaluation) {
   const BfgsResult b = reevaluated.minimize(f, 6, 1e-12);
   EXPECT_EQ(a.evaluations + 1, b.evaluations);
   EXPECT_LE((told.x() - reevaluated.x()).norm(), 1e-10);
+}
+
+// An objective whose gradient points the wrong way (as a jump in f can make it): no step lowers
+// f, from H or from H0, and the call says it stalled instead of passing for convergence.
+TEST(Bfgs, ReportsAStallWhenNoStepDecreases) {
+  const Objective misleading = [](const Eigen::VectorXd& x, Eigen::VectorXd& g) {
+    g = -x;
+    return 0.5 * x.squaredNorm();
+  };
+  Bfgs bfgs;
+  bfgs.start(Eigen::VectorXd::Constant(3, 1.0), Eigen::MatrixXd::Identity(3, 3));
+  const BfgsResult stalled = bfgs.minimize(misleading, 10, 1e-8);
+  EXPECT_TRUE(stalled.stalled);
+  EXPECT_FALSE(stalled.converged);
+  EXPECT_EQ(stalled.iterations, 0);
+  EXPECT_EQ(stalled.line_search_failures, 1);
+
+  const Quadratic f(4);
+  bfgs.start(Eigen::VectorXd::Zero(4), Eigen::MatrixXd::Identity(4, 4));
+  const BfgsResult converged = bfgs.minimize(std::cref(f), 100, 1e-10);
+  EXPECT_TRUE(converged.converged);
+  EXPECT_FALSE(converged.stalled);
+  EXPECT_EQ(converged.line_search_failures, 0);
+}
+
+// Every step away from x0 raises f by 1e-9, as the rounding of a large sum can: no line search
+// succeeds. Where the predicted decrease (‖x0‖² with H0 = I, g = x) is below what f resolves, that
+// is a minimum at working precision; where it is not, a stall.
+TEST(Bfgs, AMinimumAtWorkingPrecisionIsNoStall) {
+  for (const double x0 : {1e-5, 1.0}) {
+    const Objective rounded = [x0](const Eigen::VectorXd& x, Eigen::VectorXd& g) {
+      g = x;
+      return x[0] == x0 ? 1e6 : 1e6 + 1e-9;
+    };
+    Bfgs bfgs;
+    bfgs.start(Eigen::VectorXd::Constant(1, x0), Eigen::MatrixXd::Identity(1, 1));
+    const BfgsResult result = bfgs.minimize(rounded, 10, 1e-13);
+    EXPECT_EQ(result.converged, x0 < 1) << x0;
+    EXPECT_EQ(result.stalled, x0 == 1) << x0;
+    EXPECT_EQ(result.line_search_failures, 1) << x0;
+  }
 }
 
 }  // namespace

@@ -204,6 +204,69 @@ TEST(DiscreteShells, DerivativesAreSmoothWhereTheAngleWraps) {
                       1e-7, "Hessian across the fold");
 }
 
+// A hinge with its opposite vertex 2 at (0.4, t, lift): with no lift the first triangle turns
+// over through zero area as t passes 0 (its normal from +z to −z).
+Eigen::VectorXd crushed_hinge(double t, double lift = 0) {
+  RowMatrixX3d X(4, 3);
+  X << 0, 0, 0, 1, 0, 0, 0.4, t, lift, 0.6, -1, 0;
+  return flat(X);
+}
+
+// Issue 22: a triangle turning over used to turn the dihedral angle by π at once and make E jump
+// by up to 2w; the bending term now fades out as either triangle is crushed, so E is continuous
+// through the turn and twice continuously differentiable on either side.
+TEST(DiscreteShells, BendingFadesOutContinuouslyAsATriangleTurnsOver) {
+  RowMatrixX3d V(4, 3);
+  V << 0, 0, 0, 1, 0, 0, 0.4, 1, 0, 0.6, -1, 0;
+  RowMatrixX3i F(2, 3);
+  F << 0, 1, 2, 1, 0, 3;
+  const DiscreteShells energy(V, F);
+  // E(t) sampled every 1e-5 from t = 0.3 to −0.3: no step changes E by more than its slope allows
+  // (at most 3.3e-3, where the fade is steepest; the step across t = 0 changed it by 6.0 = 2w
+  // before the fade).
+  const double dt = 1e-5;
+  double largest_step = 0, previous = energy.value(crushed_hinge(0.3));
+  for (double t = 0.3 - dt; t > -0.3; t -= dt) {
+    const double value = energy.value(crushed_hinge(t));
+    largest_step = std::max(largest_step, std::abs(value - previous));
+    previous = value;
+  }
+  EXPECT_LT(largest_step, 1e-2) << "E jumps along the path";
+  // The membrane terms alone at t = ±1e-9 (the hinge faded to nothing): E is even in t there.
+  EXPECT_NEAR(energy.value(crushed_hinge(1e-9)), energy.value(crushed_hinge(-1e-9)), 1e-9);
+
+  const Eigen::VectorXd d = random_vector(12, 7), u = random_vector(12, 8);
+  for (double t : {0.03, 0.015, -0.015, -0.03}) {  // area ratios 0.032, 0.018: faded
+    const Eigen::VectorXd x = crushed_hinge(t, 0.01);
+    const std::string where = "crushed hinge at t = " + std::to_string(t);
+    Eigen::VectorXd gradient(12), plus(12), minus(12);
+    energy.value_and_gradient(x, gradient);
+    Eigen::VectorXd slope(1);
+    slope[0] = gradient.dot(d);
+    expect_second_order(difference_errors(slope,
+                                          [&](double h) {
+                                            Eigen::VectorXd s(1);
+                                            s[0] = (energy.value(x + h * d) - energy.value(x - h * d)) / (2 * h);
+                                            return s;
+                                          }),
+                        1e-6, "gradient, " + where);
+    expect_second_order(difference_errors(energy.hessian(x) * d,
+                                          [&](double h) {
+                                            energy.value_and_gradient(x + h * d, plus);
+                                            energy.value_and_gradient(x - h * d, minus);
+                                            return Eigen::VectorXd((plus - minus) / (2 * h));
+                                          }),
+                        1e-6, "Hessian, " + where);
+    expect_second_order(difference_errors(energy.third(x, u, d),
+                                          [&](double h) {
+                                            return Eigen::VectorXd(
+                                                (energy.hessian(x + h * u) * d - energy.hessian(x - h * u) * d) /
+                                                (2 * h));
+                                          }),
+                        1e-6, "third, " + where);
+  }
+}
+
 // Turning one triangle of a flat hinge by φ about the edge changes neither lengths nor areas:
 // E = ½ · 3‖ē‖²/Ā_e · (2 sin(φ/2))², for φ up to and beyond π.
 TEST(DiscreteShells, BendingTermIsThePapersFormula) {

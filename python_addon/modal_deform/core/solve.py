@@ -135,7 +135,11 @@ class ReducedSolver:
         no iteration once ``budget_ms`` milliseconds (> 0; None: no limit) have passed: a frame's
         share of time (the iteration under way is finished, so a call always progresses). Returns
         {"iterations", "energy" (the objective), "converged", "ms", "evaluations",
-        "gradient_norm"}. q and the inverse Hessian carry over to the next call.
+        "gradient_norm", "stalled", "line_search_failures"}: "stalled" when the call ended
+        unconverged because no step lowers the objective (the line search failed even from the
+        initial inverse Hessian), which a caller must not mistake for a solution;
+        "line_search_failures" counts the failed line searches. q and the inverse Hessian carry
+        over to the next call.
         """
         return self._native.solve(_arrays.integer(max_iterations, "max_iterations"),
                                   _arrays.number(tolerance, "tolerance"),
