@@ -17,6 +17,8 @@ Experiments (each writes bench/results/<name>.json: machine, commit, command, pa
                and peak memory against issue 15's targets (bench/raw_scan.py)
   multires     the dragon subdivided twice (1.6M vertices) baked on a proxy: time, memory, stored
                size, update time and agreement with the dragon's own bake (bench/multires.py)
+  refine       the full solve from rest and Refine from the reduced pose on the 23k and 100k dragons and
+               a raw-scan-like 23k dragon, turned by 30, 90, 170 degrees and bent (bench/refine.py)
   blender      the add-on's pose update in headless Blender and Blender's Laplacian Deform
                (bench/blender_pose.py)
   renders      Cycles renders of the accuracy experiment's bar and cylinder poses
@@ -37,7 +39,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import common  # noqa: E402
 import report  # noqa: E402
 
-PYTHON_EXPERIMENTS = ("table1", "accuracy", "convergence", "taylor", "bake_limit", "raw_scan", "multires")
+PYTHON_EXPERIMENTS = ("table1", "accuracy", "convergence", "taylor", "bake_limit", "raw_scan", "multires", "refine")
 EXPERIMENTS = ("native",) + PYTHON_EXPERIMENTS + ("blender", "renders")
 NATIVE_IN_TABLE1 = "BM_Bake|BM_BfgsIteration|BM_Positions"
 BLENDER = ["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python"]
