@@ -88,7 +88,8 @@ class PoseObjective {
   bool turns_a_triangle_over(const Eigen::VectorXd& y, const Eigen::VectorXd& y_new) const {
     for (Eigen::Index f = 0; f < faces_.rows(); ++f) {
       const int a = faces_(f, 0), b = faces_(f, 1), c = faces_(f, 2);
-      const Eigen::Vector3d n = (y.segment<3>(3 * b) - y.segment<3>(3 * a)).cross(y.segment<3>(3 * c) - y.segment<3>(3 * a));
+      const Eigen::Vector3d n =
+          (y.segment<3>(3 * b) - y.segment<3>(3 * a)).cross(y.segment<3>(3 * c) - y.segment<3>(3 * a));
       const Eigen::Vector3d n_new =
           (y_new.segment<3>(3 * b) - y_new.segment<3>(3 * a)).cross(y_new.segment<3>(3 * c) - y_new.segment<3>(3 * a));
       if (n.dot(n_new) < 0) return true;

@@ -174,7 +174,8 @@ class MODAL_DEFORM_OT_solve(bpy.types.Operator):
 
 
 class MODAL_DEFORM_OT_refine(bpy.types.Operator):
-    """Solve the pose for the controllers as they are, then polish it on the full mesh (Newton's method) into the "Modal Deform" shape key: the exact physically based shape, for a final frame. Takes seconds; Esc cancels"""
+    """Solve the pose for the controllers as they are, then polish it on the full mesh (Newton's method) into \
+the "Modal Deform" shape key: the exact physically based shape, for a final frame. Takes seconds; Esc cancels"""
     bl_idname = "modal_deform.refine"
     bl_label = "Refine"
     bl_options = {"REGISTER", "UNDO"}
@@ -271,7 +272,8 @@ class MODAL_DEFORM_OT_reset(bpy.types.Operator):
         return {"FINISHED"}
 
 
-CLASSES = (MODAL_DEFORM_OT_pose, MODAL_DEFORM_OT_pose_end, MODAL_DEFORM_MT_pose, MODAL_DEFORM_OT_solve, MODAL_DEFORM_OT_refine,
+CLASSES = (MODAL_DEFORM_OT_pose, MODAL_DEFORM_OT_pose_end, MODAL_DEFORM_MT_pose, MODAL_DEFORM_OT_solve,
+           MODAL_DEFORM_OT_refine,
            MODAL_DEFORM_OT_reset)
 
 

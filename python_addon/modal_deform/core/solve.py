@@ -20,6 +20,9 @@ from .bake import PROXY_ABOVE, Basis
 #: The most vertices ReducedSolver.refine takes: the size bake takes without a proxy.
 REFINE_MAX_VERTICES = PROXY_ABOVE
 
+#: The most Newton iterations Refine spends from its start before it also solves from rest.
+REFINE_ITERATIONS_FROM_START = 40
+
 #: The default handle stiffness μ: stiff enough that handles land within a small fraction of a
 #: percent of the model's size in the test poses, soft enough to keep BFGS well conditioned.
 STIFFNESS = 1000.0
@@ -160,9 +163,9 @@ class ReducedSolver:
         transforms. ``progress(stage, fraction) -> bool`` is called from time to time (False
         cancels: ``Cancelled``). Returns (positions (n, 3) float64, stats) with the stats of
         ``solve_full`` ("initial_energy" is the objective at the start). When the solve from the
-        start does not converge, the solve from rest (in load steps) is run as well and its answer
-        returned if it converged or is lower: stats["from_rest"] says so (iterations,
-        factorisations and seconds then count both solves).
+        start does not converge within ``REFINE_ITERATIONS_FROM_START`` iterations, the solve from
+        rest (in load steps) is run as well and its answer returned if it converged or is lower:
+        stats["from_rest"] says so (iterations, factorisations and seconds then count both solves).
 
         The solve runs on the fine mesh, not on the proxy of a basis baked on one: the proxy's rest
         mesh is not kept, and a refined proxy pose carried back by the prolongation would lose the
@@ -184,19 +187,23 @@ class ReducedSolver:
         if progress is not None and not callable(progress):
             raise ValueError(f"progress: expected a callable or None, got {type(progress).__name__}")
 
-        def solve(initial, share):
+        def solve(initial, iterations, share):
             report = progress and (lambda stage, fraction: progress(stage, share[0] + share[1] * fraction))
             return solve_full(basis.rest, F, problem["handles"], self._transforms, stiffness=problem["stiffness"],
                               weights=problem["weights"], energy=problem["energy"], bending=basis.bending,
-                              membrane=basis.membrane, tolerance=tolerance, max_iterations=max_iterations,
+                              membrane=basis.membrane, tolerance=tolerance, max_iterations=iterations,
                               initial=initial, progress=report, return_stats=True)
 
-        X, stats = solve(start, (0.0, 1.0))
+        # From a good start Newton converges in a few dozen iterations; from a poor one it stalls
+        # at a kink, and the iterations beyond these would be lost.
+        X, stats = solve(start, min(max_iterations, REFINE_ITERATIONS_FROM_START), (0.0, 0.5))
         stats["from_rest"] = False
+        if stats["converged"] and progress:
+            progress("solve", 1.0)
         if not stats["converged"]:
             # A start far from the minimum (a small basis, a strong pose) can lead Newton's first
             # steps to collapse triangles; the solve from rest, in load steps, does not start there.
-            X_rest, stats_rest = solve(None, (0.5, 0.5))
+            X_rest, stats_rest = solve(None, max_iterations, (0.5, 0.5))
             if stats_rest["converged"] or stats_rest["energy"] < stats["energy"]:
                 stats_rest.update(from_rest=True, initial_energy=stats["initial_energy"],
                                   iterations=stats["iterations"] + stats_rest["iterations"],
