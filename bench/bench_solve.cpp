@@ -130,8 +130,8 @@ void run(benchmark::State& state, const Rod& rod) {
   const EnergyKind energy = state.range(0) == 0 ? EnergyKind::kShells : EnergyKind::kArap;
   FullSolveResult result;
   for (auto _ : state)
-    result = solve_full(rod.mesh.V, rod.mesh.F, rod.handles, Eigen::VectorXd(), rod.transforms, 1000, energy, 1.0, 1.0,
-                        1e-8, 200);
+    result = solve_full(rod.mesh.V, rod.mesh.F, rod.handles, Eigen::VectorXd(), rod.transforms, 1000,
+        FullSolveOptions{energy, 1.0, 1.0, 1e-8, 200});
   state.SetLabel(energy == EnergyKind::kShells ? "shells" : "arap");
   state.counters["vertices"] = static_cast<double>(rod.mesh.V.rows());
   state.counters["steps"] = result.steps;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "bindings/bindings.h"
+#include "bindings/python_progress.h"
 #include "solve/full_solver.h"
 #include "solve/reduced_solver.h"
 #include "util/errors.h"
@@ -79,23 +80,31 @@ void bind_solve(py::module_& m) {
       [](const VerticesRef& V, const FacesRef& F, const std::vector<Eigen::VectorXi>& handles,
          const Transforms& transforms, const VectorRef& weights, double stiffness, const std::string& energy,
          double bending, double membrane, double tolerance, int max_iterations,
-         const std::optional<RowMatrixX3d>& initial) {
+         const std::optional<RowMatrixX3d>& initial, const py::object& progress) {
+        FullSolveOptions options;
+        options.energy = energy_kind(energy);
+        options.bending = bending;
+        options.membrane = membrane;
+        options.tolerance = tolerance;
+        options.max_iterations = max_iterations;
+        options.progress = python_progress(progress);
         FullSolveResult result;
         {
           py::gil_scoped_release release;
-          result = solve_full(V, F, to_handles(handles), weights, transforms, stiffness, energy_kind(energy), bending,
-                              membrane, tolerance, max_iterations, initial ? &*initial : nullptr);
+          result = solve_full(V, F, to_handles(handles), weights, transforms, stiffness, options,
+                              initial ? &*initial : nullptr);
         }
         py::dict stats(py::arg("steps") = result.steps, py::arg("iterations") = result.iterations,
                        py::arg("energy") = result.energy, py::arg("converged") = result.converged,
                        py::arg("gradient_norm") = result.gradient_norm,
                        py::arg("gradient_scale") = result.gradient_scale,
-                       py::arg("factorizations") = result.factorizations);
+                       py::arg("factorizations") = result.factorizations,
+                       py::arg("initial_energy") = result.initial_energy, py::arg("seconds") = result.seconds);
         return py::make_tuple(std::move(result.positions), stats);
       },
       py::arg("V"), py::arg("F"), py::arg("handles"), py::arg("transforms"), py::arg("weights"), py::arg("stiffness"),
       py::arg("energy"), py::arg("bending"), py::arg("membrane"), py::arg("tolerance"), py::arg("max_iterations"),
-      py::arg("initial"));
+      py::arg("initial"), py::arg("progress"));
 }
 
 }  // namespace modal_deform

@@ -2,6 +2,7 @@
 
 #include <omp.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -273,10 +274,26 @@ void third_of_term(const Response& q, const double* gradient, const double* hu, 
     for (int i = 0; i < N; ++i) out[i] += q.df * tuw[i];
 }
 
-// ∇²(w f(s)) = f'' ∇s∇sᵀ + f' ∇²s over the relative coordinates (N by N), expanded to the
-// 3K by 3K Hessian over the term's vertices (row-major). ∇²s is only read when f' ≠ 0.
+// The N by N block at `full` + offset (row stride M) replaced by its projection onto the positive
+// semidefinite matrices: V max(Λ, 0) Vᵀ. Exactly symmetric.
+template <int N, int M>
+void project_block(double* block) {
+  Eigen::Matrix<double, N, N> A;
+  for (int i = 0; i < N; ++i)
+    for (int j = 0; j < N; ++j) A(i, j) = block[i * M + j];
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, N, N>> eigen(A);
+  if (eigen.eigenvalues()(0) >= 0) return;
+  const auto& V = eigen.eigenvectors();
+  A = V * eigen.eigenvalues().cwiseMax(0).asDiagonal() * V.transpose();
+  for (int i = 0; i < N; ++i)
+    for (int j = 0; j <= i; ++j) block[i * M + j] = block[j * M + i] = 0.5 * (A(i, j) + A(j, i));
+}
+
+// ∇²(w f(s)) = f'' ∇s∇sᵀ + f' ∇²s over the relative coordinates (N by N), projected onto the
+// positive semidefinite matrices when `projected`, expanded to the 3K by 3K Hessian over the
+// term's vertices (row-major). ∇²s is only read when f' ≠ 0.
 template <int K>
-void term_hessian(const Response& q, const double* gradient, const double* hessian, double* full) {
+void term_hessian(const Response& q, const double* gradient, const double* hessian, bool projected, double* full) {
   constexpr int N = 3 * (K - 1), M = 3 * K;
   // Written so that the result is exactly symmetric (the assembled Hessian then is too).
   for (int i = 0; i < N; ++i)
@@ -284,6 +301,8 @@ void term_hessian(const Response& q, const double* gradient, const double* hessi
   if (q.df != 0)
     for (int i = 0; i < N; ++i)
       for (int j = 0; j < N; ++j) full[(3 + i) * M + 3 + j] += q.df * hessian[i * N + j];
+  // Without the f' term the block is f'' ∇s∇sᵀ: semidefinite unless f'' < 0.
+  if (projected && (q.df != 0 || q.d2f < 0)) project_block<N, M>(full + 3 * M + 3);
   // The first vertex's columns, then its rows: minus the sums over the other vertices.
   for (int i = 3; i < M; ++i)
     for (int c = 0; c < 3; ++c) {
@@ -463,7 +482,11 @@ double DiscreteShells::value_and_gradient(const VectorRef& x, Eigen::Ref<Eigen::
   return energy;
 }
 
-SparseMatrix DiscreteShells::hessian(const VectorRef& x) const {
+SparseMatrix DiscreteShells::hessian(const VectorRef& x) const { return assemble_hessian(x, false); }
+
+SparseMatrix DiscreteShells::projected_hessian(const VectorRef& x) const { return assemble_hessian(x, true); }
+
+SparseMatrix DiscreteShells::assemble_hessian(const VectorRef& x, bool projected) const {
   require_positions(x, rest_.size(), "X");
   SparseMatrix H = sparsity_.allocate_matrix();
   double* values = H.valuePtr();
@@ -484,7 +507,7 @@ SparseMatrix DiscreteShells::hessian(const VectorRef& x) const {
         second_derivatives(term, q.faded, r, g, h);
       else  // at rest, for instance: ∇²s is not needed
         gradient_of(term, q.faded, frame, g);
-      term_hessian<K>(q, g, h, full);
+      term_hessian<K>(q, g, h, projected, full);
       const auto& offsets = set_of(term).block_offsets[e];
       for (int b = 0; b < K; ++b) {
         const int column_vertex = term.vertices[b];

@@ -141,6 +141,9 @@ class DiscreteShells final : public Energy {
   // Exactly symmetric; its pattern (vertex blocks of every vertex pair sharing a term, and all
   // diagonal blocks) is the same at every x.
   SparseMatrix hessian(const VectorRef& x) const override;
+  // Each term's Hessian projected onto the positive semidefinite cone (an eigendecomposition of
+  // its 3(K−1) by 3(K−1) block over the relative coordinates of its K vertices).
+  SparseMatrix projected_hessian(const VectorRef& x) const override;
   Eigen::VectorXd third(const VectorRef& x, const VectorRef& u, const VectorRef& w) const override;
 
   // The third derivative contracted with pairs of columns of Phi (3n by k, e.g. vibration
@@ -158,6 +161,7 @@ class DiscreteShells final : public Energy {
   TermCounts term_counts() const;
 
  private:
+  SparseMatrix assemble_hessian(const VectorRef& x, bool projected) const;
   template <typename Visit>
   void for_each_set(Visit&& visit) const {
     visit(edges_);

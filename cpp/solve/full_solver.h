@@ -1,5 +1,6 @@
-// The reference solve: Newton's method on the full mesh for the reduced solver's objective, to
-// measure how far the reduced answer is from the true minimiser.
+// The reference solve and Refine: Newton's method on the full mesh for the reduced solver's
+// objective, to measure how far the reduced answer is from the true minimiser and to polish a
+// pose on the full mesh.
 //
 // In the normalised frame y = s x (s = normalizing_scale(V)):
 //
@@ -8,29 +9,49 @@
 // with E the discrete shells energy (bending, membrane) or ARAP of the rest mesh s V, and m_i the
 // lumped masses of (V, F): the reduced solver's objective with U = I and no ghost.
 //
-// Large motions are taken in load steps, as an animation would: the handles' transforms are
-// interpolated from the identity (each handle turning about its centre, the mean of its rest
-// vertices, by at most 30° per step, the centre moving by at most a tenth of the bounding-box
-// diagonal per step, or by a hundredth of the move when it is longer than 10 diagonals: at most
-// 100 steps), and Newton converges at each step before the next. From rest, the first
-// Newton step is the linear elastic answer, which for a turned handle stretches the mesh
-// without bound; and a handle turned by 180° pulls its vertices straight through its axis.
+// Globalisation (what makes it converge on scans with floppy flaps and fins): each iteration
+// factors ∇²F + τD once (D the normalised lumped mass per coordinate, floored at 1e-6 of its mean;
+// CHOLMOD's analysis of the pattern is kept for the whole solve), the shift τ adapted to how
+// well the quadratic model predicted the decrease (Levenberg–Marquardt with Nielsen's update:
+// shrunk after a good step, grown after a poor one, grown tenfold when the factorisation finds the
+// matrix not positive definite, never below 1e-8 of the Hessian's scale so that a free component's
+// rigid motions stay regularised). A large τ shortens the step where curvature is low (flaps)
+// and leaves it Newton's where curvature is high, unlike a line search, which would shorten it
+// everywhere. The step is then backtracked (Armijo) when F does not decrease enough.
 //
-// Each Newton iteration factors ∇²F + τ D with CHOLMOD (the pattern is analysed once): τ = 0
-// when that is positive definite, else grown tenfold from 1e-8 of the Hessian's scale until the
-// factorisation succeeds (Hessian modification, Nocedal & Wright section 3.4), the next
-// iteration starting from a tenth of the last τ. D is the normalised lumped mass per coordinate
-// (floored at 1e-6 of its mean, so massless vertices are regularised too). Vertices in no energy
-// term and no handle (unreferenced ones) stay at rest. The step is then halved until F decreases
-// sufficiently (Armijo, c1 = 1e-4); where that decrease is below the rounding of F, a step that
-// reduces ‖∇F‖ is taken.
+// Load steps: from rest, the handles' transforms are followed from the identity (each handle
+// turning about its centre, the mean of its rest vertices, its centre moving in a straight
+// line). The suggested increment turns a handle by at most 30° and moves its centre by at most a
+// tenth of the bounding-box diagonal (at least a hundredth of the whole motion); the first
+// increment is a sixth of it (a longer first step, nearly the linear elastic answer, tangles
+// fins and flaps), and each next one doubles after a load step that took few iterations (up to
+// the suggested one) and halves after one that took many. Intermediate loads are solved to a
+// loose tolerance (1e-3), and each load step starts from the previous answer moved on along the
+// path the last step took (a secant predictor), when F is lower there.
+//
+// Where F has a kink rather than a minimum (a sliver triangle collapsed: its bending terms'
+// angle flips as its normal does), F stops decreasing while ‖∇F‖ stays large; the solve then
+// stops and reports that it did not converge.
 #pragma once
 
 #include "energy/make_energy.h"
 #include "solve/handle_term.h"
+#include "util/progress.h"
 #include "util/types.h"
 
 namespace modal_deform {
+
+struct FullSolveOptions {
+  EnergyKind energy = EnergyKind::kShells;
+  double bending = 1.0;  // the shells weights (ignored by ARAP)
+  double membrane = 1.0;
+  // In (0, 1): the factor by which ‖∇F‖ must drop below the larger of its values at rest and at
+  // `initial` at the full load.
+  double tolerance = 1e-8;
+  int max_iterations = 300;  // ≥ 0: Newton iterations at most, all load steps together
+  // Called as ("solve", fraction done) at most every 0.1 s; returning false cancels (Cancelled).
+  ProgressCallback progress;
+};
 
 struct FullSolveResult {
   RowMatrixX3d positions;     // #V by 3, mesh units
@@ -40,22 +61,21 @@ struct FullSolveResult {
   double energy = 0;          // F at the result: deformation energy plus handle term
   double gradient_norm = 0;   // ‖∇F‖ at the result (normalised frame)
   double gradient_scale = 0;  // the larger ‖∇F‖ at rest and at `initial`: the tolerance's unit
-  bool converged = false;     // gradient_norm ≤ tolerance · gradient_scale
+  double initial_energy = 0;  // F at the start (rest, or `initial`) under the full transforms
+  double seconds = 0;         // wall time of the solve
+  bool converged = false;     // gradient_norm ≤ tolerance · gradient_scale at the full load
 };
 
 // V: #V by 3 rest positions, F: #F by 3 triangles (validate_mesh); handles and weights as in
 // checked_handle_weights; transforms: one rigid 4 by 4 transform per handle (check_transforms);
-// stiffness μ > 0; bending, membrane: the shells weights (ignored by ARAP); tolerance in (0, 1):
-// the factor by which ‖∇F‖ must drop below the larger of its values at rest and at `initial`
-// (at each load step); at most
-// max_iterations ≥ 0 Newton steps per load step. Starts at rest, or at `initial` (#V by 3, mesh
-// units) when given, in a single load step: the caller takes the steps (an animation passes the
-// previous frame's answer). Throws InputError for bad input and NumericalError when no shift
-// makes the Hessian factorisable. Runs single-threaded but for CHOLMOD's BLAS and the energy's
-// own threads.
+// stiffness μ > 0. Starts at rest in load steps, or at `initial` (#V by 3, mesh units) when given,
+// in a single load step (Refine: the reduced pose, or an animation's previous frame). Throws
+// InputError for bad input, Cancelled when options.progress says stop, and NumericalError when
+// no shift makes the Hessian factorisable. Non-convergence (the iteration budget spent, or F no
+// longer decreasing at working precision) is reported in the result, not thrown. Runs
+// single-threaded but for CHOLMOD's BLAS and the energy's own threads.
 FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handles& handles, const VectorRef& weights,
-                           const Transforms& transforms, double stiffness, EnergyKind energy, double bending,
-                           double membrane, double tolerance, int max_iterations,
+                           const Transforms& transforms, double stiffness, const FullSolveOptions& options = {},
                            const RowMatrixX3d* initial = nullptr);
 
 }  // namespace modal_deform

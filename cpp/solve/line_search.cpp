@@ -120,4 +120,33 @@ LineSearchResult wolfe_line_search(const Objective& objective, const Eigen::Vect
   return result;
 }
 
+BacktrackingResult backtracking_line_search(const Objective& objective, const Eigen::VectorXd& x, double value,
+                                            const Eigen::VectorXd& gradient, const Eigen::VectorXd& p,
+                                            Eigen::VectorXd& x_new, double& value_new, Eigen::VectorXd& gradient_new,
+                                            double noise, double sufficient_decrease, int max_halvings) {
+  BacktrackingResult result;
+  const double slope = gradient.dot(p);
+  if (slope < 0) {
+    const double gradient_norm = gradient.norm();
+    double step = 1;
+    for (int halving = 0; halving <= max_halvings; ++halving, step /= 2) {
+      x_new = x + step * p;
+      value_new = objective(x_new, gradient_new);
+      ++result.evaluations;
+      if (!std::isfinite(value_new)) continue;
+      const bool decreased = value_new <= value + sufficient_decrease * step * slope;
+      const bool within_rounding =
+          -step * slope < noise && value_new <= value + noise && gradient_new.norm() < gradient_norm;
+      if (decreased || within_rounding) {
+        result.step = step;
+        return result;
+      }
+    }
+  }
+  x_new = x;
+  value_new = value;
+  gradient_new = gradient;
+  return result;
+}
+
 }  // namespace modal_deform

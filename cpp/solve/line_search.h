@@ -1,5 +1,6 @@
-// A line search for the strong Wolfe conditions (Nocedal & Wright, Numerical Optimization, 2nd
-// ed., algorithms 3.5 and 3.6), used by BFGS.
+// Line searches: one for the strong Wolfe conditions (Nocedal & Wright, Numerical Optimization, 2nd
+// ed., algorithms 3.5 and 3.6), used by BFGS, and Armijo backtracking, used by the full Newton solve
+// (whose step is long where its model is poor, not short).
 #pragma once
 
 #include <functional>
@@ -38,5 +39,23 @@ LineSearchResult wolfe_line_search(const Objective& objective, const Eigen::Vect
                                    const Eigen::VectorXd& gradient, const Eigen::VectorXd& p, Eigen::VectorXd& x_new,
                                    double& value_new, Eigen::VectorXd& gradient_new,
                                    const WolfeConditions& conditions = {});
+
+struct BacktrackingResult {
+  double step = 0;      // α, 0 when no halving gave a decrease
+  int evaluations = 0;  // calls of the objective
+};
+
+// Halves α from 1 until f(x + αp) ≤ f(x) + c1 α ∇f(x)ᵀp (a point where f returns +inf or NaN
+// counts as too far), at most max_halvings times. Near a minimum the decrease a step promises
+// falls below the rounding of f; with noise > 0 (an absolute bound on that rounding) a step whose
+// promised decrease is below it is also taken when f does not rise by more than noise and ‖∇f‖
+// falls (it would otherwise stall on rounding). On return x_new, value_new and gradient_new are
+// the point taken and f, ∇f there (x, value, gradient themselves when α = 0); x_new and
+// gradient_new must be sized like x.
+BacktrackingResult backtracking_line_search(const Objective& objective, const Eigen::VectorXd& x, double value,
+                                            const Eigen::VectorXd& gradient, const Eigen::VectorXd& p,
+                                            Eigen::VectorXd& x_new, double& value_new, Eigen::VectorXd& gradient_new,
+                                            double noise = 0, double sufficient_decrease = 1e-4,
+                                            int max_halvings = 40);
 
 }  // namespace modal_deform

@@ -1,17 +1,19 @@
 """The work the long operators drive, apart from their Blender UI plumbing: a bake of the mesh on a
-thread (BakeJob) and an animation bake a frame at a time (AnimationJob). Both read the object when
-made and change it only in finish(); cancel() leaves it as it was.
+thread (BakeJob), Refine on a thread (RefineJob) and an animation bake a frame at a time
+(AnimationJob). They read the object when made and change it only in finish() (AnimationJob: in
+step(), taken back by cancel()); cancel() leaves it as it was.
 
 Bake animation writes one shape key per frame, keyed to show on its frame only, so the result plays
 back and renders without the add-on: frame f shows shape key "Modal Deform f" (value 1 at f, 0 at
 f - 1 and f + 1, constant interpolation). Each frame starts from the previous frame's solution (the
-solver keeps q and its inverse Hessian).
+solver keeps q and its inverse Hessian); refined, from the previous frame's refined answer.
 """
 import re
 import threading
 import time
 
 import bpy
+import numpy as np
 
 from . import core as mdc
 from . import mesh_io, posing, storage
@@ -21,12 +23,40 @@ STAGES = ("attachment", "hessian", "factorisation", "modes", "third derivatives"
           "orthonormalisation", "assembly", "ghost")
 
 
-class BakeJob:
-    """One bake of obj's mesh as it is now, run by run() here or on a thread by start().
+class _ThreadJob:
+    """Native work run by run() here or on a thread by start(); the native call releases the GIL, so
+    Blender stays responsive. cancel() makes the next progress report stop it (Cancelled).
+    Subclasses set self.stage, self.fraction, self.cancelling, self.error, self.seconds in
+    __init__ and implement _work()."""
 
-    The mesh is read on the calling thread; the native bake releases the GIL, so Blender stays
-    responsive. cancel() makes the next progress report stop the bake (Cancelled).
-    """
+    _thread = None
+
+    def _progress(self, stage, fraction):
+        self.stage, self.fraction = stage, fraction
+        return not self.cancelling
+
+    def run(self):
+        start = time.perf_counter()
+        try:
+            self._work()
+        except Exception as error:  # reported on the main thread (Cancelled included)
+            self.error = error
+        self.seconds = time.perf_counter() - start
+
+    def start(self):
+        self._thread = threading.Thread(target=self.run, name=f"modal_deform {type(self).__name__}", daemon=True)
+        self._thread.start()
+
+    def cancel(self):
+        self.cancelling = True
+
+    @property
+    def done(self):
+        return self._thread is None or not self._thread.is_alive()
+
+
+class BakeJob(_ThreadJob):
+    """One bake of obj's mesh as it is now (read on the calling thread)."""
 
     def __init__(self, obj):
         settings = obj.modal_deform
@@ -43,11 +73,6 @@ class BakeJob:
         self.basis = self.error = None
         self.seconds = 0.0
         self.cancelling = False
-        self._thread = None
-
-    def _progress(self, stage, fraction):
-        self.stage, self.fraction = stage, fraction
-        return not self.cancelling
 
     @property
     def overall(self):
@@ -56,24 +81,8 @@ class BakeJob:
             return 0.0
         return (STAGES.index(self.stage) + self.fraction) / len(STAGES)
 
-    def run(self):
-        start = time.perf_counter()
-        try:
-            self.basis = mdc.bake(self.V, self.F, progress=self._progress, **self.options)
-        except Exception as error:  # reported on the main thread (Cancelled included)
-            self.error = error
-        self.seconds = time.perf_counter() - start
-
-    def start(self):
-        self._thread = threading.Thread(target=self.run, name="modal_deform bake", daemon=True)
-        self._thread.start()
-
-    def cancel(self):
-        self.cancelling = True
-
-    @property
-    def done(self):
-        return self._thread is None or not self._thread.is_alive()
+    def _work(self):
+        self.basis = mdc.bake(self.V, self.F, progress=self._progress, **self.options)
 
     def finish(self):
         """Store the basis on the object (main thread). Returns (level, message) for a report."""
@@ -94,6 +103,58 @@ class BakeJob:
         return "INFO", message
 
 
+class RefineJob(_ThreadJob):
+    """Refine the pose for the controllers as they are now: the reduced pose converged (here, on the
+    calling thread, in milliseconds), then Newton on the full mesh from it (run()/start()).
+
+    finish() writes the result into the "Modal Deform" shape key, where Solve and Pose put the
+    reduced pose: the refined shape is the same pose made exact, and one key per pose keeps the
+    artist's stack simple (a second key would add its offset on top unless muted). Until finish()
+    nothing changes, so a cancelled or failed refine leaves the key as it was.
+    """
+
+    def __init__(self, context, obj, tolerance=1e-8, max_iterations=300):
+        self.object_name = obj.name
+        self.pose = posing.Pose(context, obj)
+        self.pose.follow_controllers()
+        self.reduced = self.pose.converge()
+        self.F = mesh_io.triangles(obj.data)
+        self.fingerprint = storage.fingerprint(obj.data)
+        self.tolerance, self.max_iterations = tolerance, max_iterations
+        self.stage, self.fraction = "starting", 0.0
+        self.X = self.stats = self.error = None
+        self.seconds = 0.0
+        self.cancelling = False
+        self.written = False  # finish() wrote the shape key
+
+    @property
+    def overall(self):
+        return self.fraction if self.stage == "solve" else 0.0
+
+    def _work(self):
+        self.X, self.stats = self.pose.solver.refine(self.F, tolerance=self.tolerance,
+                                                     max_iterations=self.max_iterations, progress=self._progress)
+
+    def finish(self):
+        """Write the refined pose into the "Modal Deform" key (main thread). Returns (level, message)."""
+        if isinstance(self.error, mdc.Cancelled):
+            return "WARNING", "Refine cancelled: nothing changed"
+        if self.error is not None:
+            return "ERROR", f"Refine failed: {self.error}"
+        obj = bpy.data.objects.get(self.object_name)
+        if obj is None or obj.type != "MESH" or storage.fingerprint(obj.data) != self.fingerprint:
+            return "WARNING", f"'{self.object_name}' changed during Refine: the result was discarded"
+        block, _ = mesh_io.shape_key(obj, posing.POSE_KEY)
+        block.value, block.mute = 1.0, False
+        mesh_io.write_shape_key(obj.data, block, self.X.astype(np.float32))
+        self.written = True
+        stats = self.stats
+        outcome = "Refined" if stats["converged"] else "Refine did not converge"
+        message = (f"{outcome} in {self.seconds:.1f} s: {stats['iterations']} Newton iterations, objective "
+                   f"{stats['initial_energy']:.5g} -> {stats['energy']:.5g}")
+        return ("INFO" if stats["converged"] else "WARNING"), message
+
+
 _FRAME_KEY = re.compile(re.escape(posing.POSE_KEY) + r" -?\d{4,}")
 
 
@@ -104,8 +165,11 @@ def frame_key_name(frame):
 class AnimationJob:
     """Solves frames one at a time (step()); finish() or cancel() afterwards."""
 
-    def __init__(self, context, obj, frames):
+    def __init__(self, context, obj, frames, refine=False):
         self.pose = posing.Pose(context, obj)
+        # Refine: each frame's pose polished on the full mesh, from the previous frame's answer.
+        self.triangles = mesh_io.triangles(obj.data) if refine else None
+        self.refined = None
         self.obj, self.scene, self.frames = obj, context.scene, list(frames)
         self.frame_before = self.scene.frame_current
         self.done = 0
@@ -120,13 +184,20 @@ class AnimationJob:
         frame = self.frames[self.done]
         self.scene.frame_set(frame)
         self.pose.follow_controllers()
-        if not self.pose.converge()["converged"]:
+        converged = self.pose.converge()["converged"]
+        if self.triangles is not None:
+            self.refined, stats = self.pose.solver.refine(self.triangles, initial=self.refined)
+            converged = stats["converged"]
+        if not converged:
             self.unconverged += 1
         mesh_io.ensure_reference_key(self.obj)
         block = self.obj.shape_key_add(name=frame_key_name(frame), from_mix=False)
         block.value = 0.0
         self.created.append((frame, block.name))
-        self.pose.write(block)
+        if self.refined is None:
+            self.pose.write(block)
+        else:
+            mesh_io.write_shape_key(self.obj.data, block, self.refined.astype(np.float32))
         self.done += 1
         return True
 

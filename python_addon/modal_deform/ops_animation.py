@@ -16,6 +16,9 @@ render without the add-on. Esc cancels"""
 
     frame_start: bpy.props.IntProperty(name="Start", description="First frame to solve (default: the scene's)")
     frame_end: bpy.props.IntProperty(name="End", description="Last frame to solve (default: the scene's)")
+    refine: bpy.props.BoolProperty(name="Refine", default=False,
+                                   description="Polish every frame on the full mesh (Newton's method, from the "
+                                               "previous frame's answer): exact shapes, seconds per frame")
 
     poll = classmethod(mesh_poll)
 
@@ -25,7 +28,7 @@ render without the add-on. Esc cancels"""
         end = self.frame_end if self.properties.is_property_set("frame_end") else scene.frame_end
         if end < start:
             raise ValueError(f"frame range: the end ({end}) is before the start ({start})")
-        return AnimationJob(context, handles.owner(context.object), range(start, end + 1))
+        return AnimationJob(context, handles.owner(context.object), range(start, end + 1), refine=self.refine)
 
     def _finish(self, job):
         job.finish()

@@ -135,8 +135,11 @@ class VIEW3D_PT_modal_deform_pose(_Panel, bpy.types.Panel):
         row = layout.row(align=True)
         row.operator("modal_deform.pose", icon="PLAY")
         row.operator("modal_deform.solve", icon="CHECKMARK")
+        row.operator("modal_deform.refine", icon="SHADERFX")
         layout.operator("modal_deform.reset", icon="LOOP_BACK")
-        layout.operator("modal_deform.bake_animation", icon="RENDER_ANIMATION")
+        row = layout.row(align=True)
+        row.operator("modal_deform.bake_animation", icon="RENDER_ANIMATION")
+        row.operator("modal_deform.bake_animation", text="Refined", icon="SHADERFX").refine = True
 
 
 class VIEW3D_PT_modal_deform_preview(_Panel, bpy.types.Panel):

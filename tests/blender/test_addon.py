@@ -62,3 +62,7 @@ def test_headless_script_names_a_missing_object(run_blender):
     result = run_blender(BLENDER_SCRIPTS / "bake.py", "--object", "Nope", check=False)
     assert result.returncode == 1
     assert "--object: no mesh object named 'Nope'" in result.stdout + result.stderr
+
+
+def test_refine_polishes_the_pose_and_a_cancel_changes_nothing(run_blender):
+    assert "REFINE_OK" in run_blender("refine.py").stdout

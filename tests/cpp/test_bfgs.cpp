@@ -121,6 +121,36 @@ TEST(WolfeLineSearch, AnAscentDirectionTakesNoStep) {
   EXPECT_EQ(value_new, value);
 }
 
+TEST(BacktrackingLineSearch, HalvesUntilSufficientDecreaseSkippingWhatCannotBeEvaluated) {
+  const Quadratic quadratic(6);
+  const Eigen::VectorXd x = Eigen::VectorXd::Random(6);
+  Eigen::VectorXd g(6), x_new(6), g_new(6);
+  const double value = quadratic(x, g);
+  const Eigen::VectorXd newton = -quadratic.A.llt().solve(g);
+  double value_new;
+  // The Newton step passes at once; 8 times too long, after three halvings (α = 1/8).
+  EXPECT_EQ(backtracking_line_search(quadratic, x, value, g, newton, x_new, value_new, g_new).step, 1.0);
+  BacktrackingResult result = backtracking_line_search(quadratic, x, value, g, 8 * newton, x_new, value_new, g_new);
+  EXPECT_EQ(result.step, 0.125);
+  EXPECT_EQ(result.evaluations, 4);
+  EXPECT_LE((x_new - (x + newton)).norm(), 1e-12);
+  // Undefined beyond a radius: those trials count as too far.
+  const Objective bounded = [&](const Eigen::VectorXd& y, Eigen::VectorXd& gradient) {
+    return (y - x).norm() > 0.3 * newton.norm() ? std::nan("") : quadratic(y, gradient);
+  };
+  result = backtracking_line_search(bounded, x, value, g, newton, x_new, value_new, g_new);
+  EXPECT_EQ(result.step, 0.25);
+  Eigen::VectorXd check(6);
+  EXPECT_EQ(quadratic(x_new, check), value_new);
+  EXPECT_EQ(check, g_new);
+  // An ascent direction takes no step and leaves the point as it was.
+  result = backtracking_line_search(quadratic, x, value, g, -newton, x_new, value_new, g_new);
+  EXPECT_EQ(result.step, 0.0);
+  EXPECT_EQ(result.evaluations, 0);
+  EXPECT_EQ(x_new, x);
+  EXPECT_EQ(value_new, value);
+}
+
 TEST(Bfgs, MinimisesRosenbrockWithMonotoneDecrease) {
   Bfgs bfgs;
   bfgs.start(rosenbrock_start(10), Eigen::MatrixXd::Identity(10, 10));

@@ -236,7 +236,8 @@ void run(const std::string& entry, const TriangleMesh& mesh) {
       expect_finite(positions.cast<double>(), "positions");
     } else {
       const FullSolveResult result =
-          solve_full(mesh.V, mesh.F, {{0}}, Eigen::VectorXd(), {T}, 1e3, EnergyKind::kShells, 1, 1, 1e-6, 10);
+          solve_full(mesh.V, mesh.F, {{0}}, Eigen::VectorXd(), {T}, 1e3,
+              FullSolveOptions{EnergyKind::kShells, 1, 1, 1e-6, 10});
       expect_finite(result.positions, "solve_full");
     }
   }
@@ -285,7 +286,8 @@ TEST(Corpus, WeightsBeyondTheLimitAreRefused) {
   EXPECT_TRUE(gradient.allFinite());
   const Eigen::Matrix4d I = Eigen::Matrix4d::Identity();
   expect_input_error(
-      [&] { solve_full(mesh.V, mesh.F, {{0}}, Eigen::VectorXd(), {I}, 1e300, EnergyKind::kShells, 1, 1, 1e-6, 3); },
+      [&] { solve_full(mesh.V, mesh.F, {{0}}, Eigen::VectorXd(), {I}, 1e300,
+          FullSolveOptions{EnergyKind::kShells, 1, 1, 1e-6, 3}); },
       "stiffness: expected a finite value > 0 and at most 1e+12");
   expect_input_error([&] { checked_handle_weights({{0}}, Eigen::VectorXd::Constant(1, 1e300), 16); },
                      "weights[0] = 1e+300 is not a finite number in [0, 1e+12]");

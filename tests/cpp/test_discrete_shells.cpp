@@ -379,6 +379,24 @@ TEST(DiscreteShells, RestHessianKernelIsSixRigidMotionsPerComponent) {
   expect_rigid_kernel(side_by_side(cylinder(8, 3, 1.0, 3.0), cylinder(8, 3, 1.0, 3.0), Eigen::RowVector3d(5, 0, 0)), 2, "two disjoint cylinders");
 }
 
+// The projected Hessian: the exact one at rest (every term's Hessian is semidefinite there), and
+// positive semidefinite where the exact one is indefinite (a crushed, twisted cylinder); the
+// difference is itself semidefinite, since projecting only removes negative parts.
+TEST(DiscreteShells, ProjectedHessianIsSemidefiniteAndExactWhereTermsAre) {
+  const TriangleMesh mesh = cylinder(8, 4, 1.0, 3.0);
+  const DiscreteShells energy(mesh.V, mesh.F);
+  const Eigen::VectorXd rest = energy.rest();
+  EXPECT_EQ(Eigen::MatrixXd(energy.projected_hessian(rest)), Eigen::MatrixXd(energy.hessian(rest)));
+  const Eigen::VectorXd x = rest + 0.3 * random_vector(rest.size(), 7);
+  const Eigen::MatrixXd exact(energy.hessian(x)), projected(energy.projected_hessian(x));
+  const double scale = exact.cwiseAbs().maxCoeff();
+  EXPECT_EQ(projected, projected.transpose());
+  const Eigen::VectorXd exact_eigenvalues = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(exact).eigenvalues();
+  ASSERT_LT(exact_eigenvalues(0), -1e-3 * scale) << "the test needs an indefinite exact Hessian";
+  EXPECT_GE(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(projected).eigenvalues()(0), -1e-12 * scale);
+  EXPECT_GE(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(projected - exact).eigenvalues()(0), -1e-12 * scale);
+}
+
 // What `energy` returns at x is finite everywhere.
 void expect_finite_everywhere(const DiscreteShells& energy, const Eigen::VectorXd& x, const std::string& where) {
   const Eigen::Index size = x.size();

@@ -36,7 +36,7 @@ TEST(SolveFull, ConvergesToAStationaryPointWithTheHandlesNearTheirTargets) {
   const SmallTube tube;
   for (EnergyKind kind : {EnergyKind::kShells, EnergyKind::kArap}) {
     const FullSolveResult result = solve_full(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd(),
-                                              tube.transforms, 1e3, kind, 1.0, 1.0, 1e-10, 100);
+                                              tube.transforms, 1e3, FullSolveOptions{kind, 1.0, 1.0, 1e-10, 100});
     ASSERT_TRUE(result.converged) << "iterations " << result.iterations;
     EXPECT_LE(result.gradient_norm, 1e-10 * result.gradient_scale);
     EXPECT_TRUE(result.positions.allFinite());
@@ -55,7 +55,7 @@ TEST(SolveFull, HandlesAtRestLeaveTheMeshAtRest) {
   const SmallTube tube;
   const Transforms identity(2, Eigen::Matrix4d::Identity());
   const FullSolveResult result = solve_full(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd(), identity, 1e3,
-                                            EnergyKind::kShells, 1.0, 1.0, 1e-8, 20);
+                                            FullSolveOptions{EnergyKind::kShells, 1.0, 1.0, 1e-8, 20});
   EXPECT_TRUE(result.converged);
   EXPECT_EQ(result.iterations, 0);
   EXPECT_LE((result.positions - tube.mesh.V).cwiseAbs().maxCoeff(), 1e-14);
@@ -67,7 +67,7 @@ TEST(SolveFull, EqualsTheReducedSolveInAFullBasis) {
   const Basis basis = dense_modal_basis(tube.mesh, r);
   for (EnergyKind kind : {EnergyKind::kShells, EnergyKind::kArap}) {
     const FullSolveResult full = solve_full(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd(), tube.transforms,
-                                            1e3, kind, 1.0, 1.0, 1e-12, 100);
+                                            1e3, FullSolveOptions{kind, 1.0, 1.0, 1e-12, 100});
     ASSERT_TRUE(full.converged);
     ReducedSolver solver(basis, tube.handles, Eigen::VectorXd(), 1e3, kind);
     solver.set_transforms(tube.transforms);
@@ -87,8 +87,8 @@ TEST(SolveFull, EqualsTheReducedSolveInAFullBasis) {
   }
 }
 
-// A quarter turn from rest in load steps of 30°: the same answer as three solves from the
-// previous step's answer, and a twisted bar, not one crumpled by pulls through its axis.
+// A quarter turn from rest in load steps (the first of 30°): the same answer as three solves from
+// the previous step's answer, and a twisted bar, not one crumpled by pulls through its axis.
 TEST(SolveFull, LargeMotionsAreTakenInSteps) {
   const TriangleMesh mesh = bar(3, 3, 12, 1, 1, 4);
   const Handles handles = {vertices_where(mesh.V, [](const Eigen::Vector3d& x) { return x.z() < 1e-9; }),
@@ -98,13 +98,14 @@ TEST(SolveFull, LargeMotionsAreTakenInSteps) {
   };
   const double pi = 3.14159265358979323846;
   const FullSolveResult stepped =
-      solve_full(mesh.V, mesh.F, handles, Eigen::VectorXd(), turn(pi / 2), 1e3, EnergyKind::kShells, 1, 1, 1e-9, 100);
+      solve_full(mesh.V, mesh.F, handles, Eigen::VectorXd(), turn(pi / 2), 1e3,
+          FullSolveOptions{EnergyKind::kShells, 1, 1, 1e-9, 100});
   EXPECT_TRUE(stepped.converged);
-  EXPECT_EQ(stepped.steps, 3);
+  EXPECT_GE(stepped.steps, 2);
   RowMatrixX3d X = mesh.V;
   for (int step = 1; step <= 3; ++step)
-    X = solve_full(mesh.V, mesh.F, handles, Eigen::VectorXd(), turn(pi / 2 * step / 3), 1e3, EnergyKind::kShells, 1, 1,
-                   1e-9, 100, &X)
+    X = solve_full(mesh.V, mesh.F, handles, Eigen::VectorXd(), turn(pi / 2 * step / 3), 1e3,
+        FullSolveOptions{EnergyKind::kShells, 1, 1, 1e-9, 100}, &X)
             .positions;
   EXPECT_LE((stepped.positions - X).cwiseAbs().maxCoeff(), 1e-6);
   // Mid-bar, the cross-section has turned by about 45° and kept its size.
@@ -117,17 +118,21 @@ TEST(SolveFull, LargeMotionsAreTakenInSteps) {
 }
 
 // Started crushed to half its height, the tube's Hessian is indefinite (compressed edges buckle
-// sideways): the shifted factorisations bring it back to rest.
-TEST(SolveFull, AnIndefiniteHessianIsShiftedUntilItFactors) {
+// sideways). The shells take the projected Hessian there, which factors at once: one
+// factorisation per iteration. ARAP has no projection: its Hessian is shifted until it factors.
+TEST(SolveFull, AnIndefiniteHessianIsProjectedOrShifted) {
   const SmallTube tube;
   RowMatrixX3d crushed = tube.mesh.V;
   crushed.col(2) *= 0.5;
   for (EnergyKind kind : {EnergyKind::kShells, EnergyKind::kArap}) {
     const FullSolveResult result =
         solve_full(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd(),
-                   Transforms(2, Eigen::Matrix4d::Identity()), 1e3, kind, 1, 1, 1e-9, 200, &crushed);
+                   Transforms(2, Eigen::Matrix4d::Identity()), 1e3, FullSolveOptions{kind, 1, 1, 1e-10, 200}, &crushed);
     EXPECT_TRUE(result.converged);
-    EXPECT_GT(result.factorizations, result.iterations);
+    if (kind == EnergyKind::kShells)
+      EXPECT_EQ(result.factorizations, result.iterations);
+    else
+      EXPECT_GT(result.factorizations, result.iterations);
     EXPECT_LE((result.positions - tube.mesh.V).cwiseAbs().maxCoeff(), 1e-6);
   }
 }
@@ -138,20 +143,24 @@ TEST(SolveFull, UnreferencedVerticesStayAtRest) {
   tube.mesh.V.conservativeResize(loose + 1, 3);
   tube.mesh.V.row(loose) << 5, 5, 5;
   const FullSolveResult result = solve_full(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd(), tube.transforms,
-                                            1e3, EnergyKind::kShells, 1.0, 1.0, 1e-10, 100);
+                                            1e3, FullSolveOptions{EnergyKind::kShells, 1.0, 1.0, 1e-10, 100});
   EXPECT_TRUE(result.converged);
   EXPECT_LE((result.positions.row(loose) - tube.mesh.V.row(loose)).norm(), 1e-14);
 }
 
 // Regression (robustness corpus): a handle moved a million diagonals took 1e7 load steps, and a
-// move beyond 2^31 tenths of the diagonal overflowed the step count.
-TEST(SolveFull, AFarMoveTakesAtMostAHundredLoadSteps) {
+// move beyond 2^31 tenths of the diagonal overflowed the step count. Load steps now double while
+// they are easy, and once the iterations are spent the path jumps to its end.
+TEST(SolveFull, AFarMoveEndsWhenTheIterationsAreSpent) {
   const TriangleMesh mesh = grid(3, 3, 1.0, 1.0);
   for (double distance : {1e6, 1e12}) {
     const Transforms far = {rigid_transform({0, 0, 1}, 0.3, {0, 0, 0}, {distance, 0, 0})};
     const FullSolveResult result =
-        solve_full(mesh.V, mesh.F, {{0, 5}}, Eigen::VectorXd(), far, 1e3, EnergyKind::kShells, 1, 1, 1e-6, 3);
-    EXPECT_EQ(result.steps, 100);
+        solve_full(mesh.V, mesh.F, {{0, 5}}, Eigen::VectorXd(), far, 1e3,
+            FullSolveOptions{EnergyKind::kShells, 1, 1, 1e-6, 3});
+    EXPECT_LE(result.steps, 50);
+    EXPECT_LE(result.iterations, 3);
+    EXPECT_FALSE(result.converged);
     EXPECT_TRUE(result.positions.allFinite());
   }
 }
@@ -163,14 +172,14 @@ TEST(SolveFull, TheMeshIsCheckedBeforeTheHandles) {
   V(4, 1) = std::nan("");
   testing::expect_input_error(
       [&] {
-        solve_full(V, mesh.F, {{0}}, Eigen::VectorXd(), {Eigen::Matrix4d::Identity()}, 1e3, EnergyKind::kShells, 1, 1,
-                   1e-6, 3);
+        solve_full(V, mesh.F, {{0}}, Eigen::VectorXd(), {Eigen::Matrix4d::Identity()}, 1e3,
+            FullSolveOptions{EnergyKind::kShells, 1, 1, 1e-6, 3});
       },
       "V[4]");
   testing::expect_input_error(
       [&] {
         solve_full(RowMatrixX3d(0, 3), RowMatrixX3i(0, 3), {{0}}, Eigen::VectorXd(), {Eigen::Matrix4d::Identity()}, 1e3,
-                   EnergyKind::kShells, 1, 1, 1e-6, 3);
+                   FullSolveOptions{EnergyKind::kShells, 1, 1, 1e-6, 3});
       },
       "V: the mesh has no vertices");
 }
@@ -180,8 +189,8 @@ TEST(SolveFull, BadInputIsRefused) {
   const Eigen::VectorXd none;
   auto solve = [&](const Handles& handles, const Transforms& transforms, double stiffness, double tolerance,
                    int iterations) {
-    solve_full(tube.mesh.V, tube.mesh.F, handles, none, transforms, stiffness, EnergyKind::kShells, 1.0, 1.0, tolerance,
-               iterations);
+    solve_full(tube.mesh.V, tube.mesh.F, handles, none, transforms, stiffness,
+        FullSolveOptions{EnergyKind::kShells, 1.0, 1.0, tolerance, iterations});
   };
   EXPECT_THROW(solve(tube.handles, {Eigen::Matrix4d::Identity()}, 1.0, 1e-8, 10), InputError);
   EXPECT_THROW(solve({{0, 999}}, {Eigen::Matrix4d::Identity()}, 1.0, 1e-8, 10), InputError);
@@ -191,7 +200,8 @@ TEST(SolveFull, BadInputIsRefused) {
   RowMatrixX3i F = tube.mesh.F;
   F(2, 1) = 1000;
   EXPECT_THROW(
-      solve_full(tube.mesh.V, F, tube.handles, none, tube.transforms, 1.0, EnergyKind::kShells, 1.0, 1.0, 1e-8, 10),
+      solve_full(tube.mesh.V, F, tube.handles, none, tube.transforms, 1.0,
+          FullSolveOptions{EnergyKind::kShells, 1.0, 1.0, 1e-8, 10}),
       InputError);
 }
 

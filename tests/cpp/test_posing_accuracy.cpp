@@ -102,8 +102,9 @@ Errors pose(const std::string& name, const std::string& mesh_name, const Scenari
   for (int step = 1; step <= s.steps; ++step) {
     // From rest the full solve takes its own load steps; later steps continue from the last answer.
     const FullSolveResult full =
-        solve_full(s.mesh.V, s.mesh.F, s.handles, Eigen::VectorXd(), s.at(double(step) / s.steps), s.stiffness, energy,
-                   1.0, 1.0, 1e-9, 100, step == 1 ? nullptr : &reference);
+        solve_full(s.mesh.V, s.mesh.F, s.handles, Eigen::VectorXd(), s.at(double(step) / s.steps), s.stiffness,
+            FullSolveOptions{energy, 1.0, 1.0, 1e-9, 300},
+                   step == 1 ? nullptr : &reference);
     EXPECT_TRUE(full.converged) << name << ", step " << step;
     reference = full.positions;
     reference_objective = full.energy;

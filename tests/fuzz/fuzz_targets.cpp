@@ -228,8 +228,9 @@ void bake_and_pose(const std::uint8_t* data, std::size_t size) {
     });
   }
   runs("solve_full", [&] {
-    const FullSolveResult result = solve_full(mesh.V, mesh.F, handles, weights, transforms, stiffness, kind,
-                                              options.bending, options.membrane, tolerance, iterations);
+    const FullSolveResult result =
+        solve_full(mesh.V, mesh.F, handles, weights, transforms, stiffness,
+                   FullSolveOptions{kind, options.bending, options.membrane, tolerance, iterations});
     require_finite(result.positions, "solve_full: positions");
     require_finite(result.energy, "solve_full: energy");
   });

@@ -15,7 +15,13 @@ import numpy as np
 
 from .. import _native
 from . import _arrays
-from .bake import Basis
+from .bake import PROXY_ABOVE, Basis
+
+#: The most vertices ReducedSolver.refine takes: the size bake takes without a proxy.
+REFINE_MAX_VERTICES = PROXY_ABOVE
+
+#: The most Newton iterations Refine spends from its start before it also solves from rest.
+REFINE_ITERATIONS_FROM_START = 40
 
 #: The default handle stiffness μ: stiff enough that handles land within a small fraction of a
 #: percent of the model's size in the test poses, soft enough to keep BFGS well conditioned.
@@ -102,9 +108,13 @@ class ReducedSolver:
                              f"got {type(basis).__name__}")
         native_basis = basis._native
         handles = _handles(handles)
-        self._native = _native.ReducedSolver(native_basis, handles, _weights(weights, len(handles)),
-                                             _arrays.number(stiffness, "stiffness"), str(energy), bool(warm_start))
+        weights = _weights(weights, len(handles))
+        stiffness = _arrays.number(stiffness, "stiffness")
+        self._native = _native.ReducedSolver(native_basis, handles, weights, stiffness, str(energy), bool(warm_start))
         self._basis = basis
+        # What refine() solves on the full mesh: the same objective.
+        self._problem = dict(handles=handles, weights=weights, stiffness=stiffness, energy=str(energy))
+        self._transforms = [np.eye(4)] * len(handles)
 
     @property
     def num_vertices(self):
@@ -126,7 +136,9 @@ class ReducedSolver:
         Raises ValueError naming the handle whose matrix is not rigid (scaled, sheared,
         mirrored, or a last row other than 0 0 0 1). Cheap: O(r) per handle.
         """
-        self._native.set_transforms(_transforms(transforms, self._native.num_handles))
+        transforms = _transforms(transforms, self._native.num_handles)
+        self._native.set_transforms(transforms)
+        self._transforms = transforms
 
     def solve(self, max_iterations=10, tolerance=1e-6, budget_ms=None):
         """Up to ``max_iterations`` BFGS iterations from the current state.
@@ -144,6 +156,65 @@ class ReducedSolver:
         return self._native.solve(_arrays.integer(max_iterations, "max_iterations"),
                                   _arrays.number(tolerance, "tolerance"),
                                   float("inf") if budget_ms is None else _arrays.number(budget_ms, "budget_ms"))
+
+    def refine(self, F, initial=None, tolerance=1e-8, max_iterations=300, progress=None):
+        """Refine: the pose's exact minimum on the full mesh, by ``solve_full`` from a start.
+
+        ``F`` (m, 3): the fine mesh's triangles (the basis keeps only its rest positions).
+        ``initial`` (n, 3): where to start, by default the reduced pose ``positions()``; an
+        animation passes the previous frame's refined answer. Same objective as ``solve``: the
+        handles, weights, stiffness, energy (with the basis's material weights) and the current
+        transforms. ``progress(stage, fraction) -> bool`` is called from time to time (False
+        cancels: ``Cancelled``). Returns (positions (n, 3) float64, stats) with the stats of
+        ``solve_full`` ("initial_energy" is the objective at the start). When the solve from the
+        start does not converge within ``REFINE_ITERATIONS_FROM_START`` iterations, the solve from
+        rest (in load steps) is run as well and its answer returned if it converged or is lower:
+        stats["from_rest"] says so (iterations, factorisations and seconds then count both solves).
+
+        The solve runs on the fine mesh, not on the proxy of a basis baked on one: the proxy's rest
+        mesh is not kept, and a refined proxy pose carried back by the prolongation would lose the
+        fine detail refining is for. A Newton step factors the full Hessian once, which needs less
+        memory than the bake's factor and blocks of right-hand sides, so meshes up to
+        ``REFINE_MAX_VERTICES`` (the size the bake takes without a proxy) are refined; denser ones are
+        refused with a ValueError rather than risking the memory of the process.
+        """
+        n = self.num_vertices
+        if n > REFINE_MAX_VERTICES:
+            raise ValueError(f"refine: the mesh has {n} vertices; refining works on meshes of up to "
+                             f"{REFINE_MAX_VERTICES} (a full Newton solve of a denser one needs more memory than "
+                             f"is safe here)")
+        start = self.positions().astype(np.float64) if initial is None else _arrays.vertices(initial, "initial")
+        if start.shape != (n, 3):
+            raise ValueError(f"initial: expected shape ({n}, 3), got {start.shape}")
+        basis, problem = self._basis, self._problem
+        F = _arrays.faces(F)
+        if progress is not None and not callable(progress):
+            raise ValueError(f"progress: expected a callable or None, got {type(progress).__name__}")
+
+        def solve(initial, iterations, share):
+            report = progress and (lambda stage, fraction: progress(stage, share[0] + share[1] * fraction))
+            return solve_full(basis.rest, F, problem["handles"], self._transforms, stiffness=problem["stiffness"],
+                              weights=problem["weights"], energy=problem["energy"], bending=basis.bending,
+                              membrane=basis.membrane, tolerance=tolerance, max_iterations=iterations,
+                              initial=initial, progress=report, return_stats=True)
+
+        # From a good start Newton converges in a few dozen iterations; from a poor one it stalls
+        # at a kink, and the iterations beyond these would be lost.
+        X, stats = solve(start, min(max_iterations, REFINE_ITERATIONS_FROM_START), (0.0, 0.5))
+        stats["from_rest"] = False
+        if stats["converged"] and progress:
+            progress("solve", 1.0)
+        if not stats["converged"]:
+            # A start far from the minimum (a small basis, a strong pose) can lead Newton's first
+            # steps to collapse triangles; the solve from rest, in load steps, does not start there.
+            X_rest, stats_rest = solve(None, max_iterations, (0.5, 0.5))
+            if stats_rest["converged"] or stats_rest["energy"] < stats["energy"]:
+                stats_rest.update(from_rest=True, initial_energy=stats["initial_energy"],
+                                  iterations=stats["iterations"] + stats_rest["iterations"],
+                                  factorizations=stats["factorizations"] + stats_rest["factorizations"],
+                                  seconds=stats["seconds"] + stats_rest["seconds"])
+                X, stats = X_rest, stats_rest
+        return X, stats
 
     def objective(self, q):
         """The objective f(q) (ghost energy plus handle term, normalised frame) and its gradient
@@ -172,27 +243,33 @@ class ReducedSolver:
 
 
 def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, energy="shells", bending=1.0,
-               membrane=1.0, tolerance=1e-8, max_iterations=100, initial=None, return_stats=False):
+               membrane=1.0, tolerance=1e-8, max_iterations=300, initial=None, progress=None, return_stats=False):
     """The reference: Newton's method on the full mesh for the reduced solver's objective.
 
     V (n, 3), F (m, 3): the rest mesh; handles, transforms, weights, stiffness, energy as for
     ReducedSolver, with ``bending`` and ``membrane`` the shells weights. From rest, large motions
-    are taken in load steps (each handle turning by at most 30° and its centre moving by at most
-    a tenth of the bounding-box diagonal per step); with ``initial`` (n, 3) the solve starts there
-    in one step (an animation passes the previous frame's answer). Each step stops when the
-    gradient norm is below ``tolerance`` times its value at rest (or at ``initial``, if larger),
-    or after ``max_iterations``
-    Newton iterations (sparse Cholesky, the Hessian shifted by a multiple of the mass matrix where
-    it is not positive definite). Returns the positions (n, 3) float64, or with
+    are taken in load steps (the first turning each handle by at most 30° and moving its centre by
+    at most a tenth of the bounding-box diagonal, later ones longer or shorter as the previous
+    converged fast or slowly); with ``initial`` (n, 3) the solve starts there in one step
+    (Refine; an animation passes the previous frame's answer). Each Newton iteration factors the
+    Hessian shifted by a multiple of the mass matrix, the shift adapted to how well the step
+    predicted the decrease (see cpp/solve/full_solver.h). Stops when the gradient norm is below
+    ``tolerance`` times its value at rest (or at ``initial``, if larger), or after
+    ``max_iterations`` Newton iterations in all. ``progress(stage, fraction) -> bool`` is called
+    about every 0.1 s (False cancels: ``Cancelled``). Returns the positions (n, 3) float64, or with
     ``return_stats=True`` the pair (positions, stats) with stats = {"steps", "iterations",
-    "energy", "converged", "gradient_norm", "gradient_scale", "factorizations"}.
+    "energy", "converged", "gradient_norm", "gradient_scale", "factorizations", "seconds",
+    "initial_energy"}. A solve that did not converge says so in "converged"; only a converged
+    one is a reference.
     """
     V, F = _arrays.vertices(V), _arrays.faces(F)
     handles = _handles(handles)
     max_iterations = _arrays.integer(max_iterations, "max_iterations")
+    if progress is not None and not callable(progress):
+        raise ValueError(f"progress: expected a callable or None, got {type(progress).__name__}")
     X, stats = _native.solve_full(V, F, handles, _transforms(transforms, len(handles)), _weights(weights, len(handles)),
                                   _arrays.number(stiffness, "stiffness"), str(energy), _arrays.number(bending, "bending"),
                                   _arrays.number(membrane, "membrane"), _arrays.number(tolerance, "tolerance"),
                                   max_iterations,
-                                  None if initial is None else _arrays.vertices(initial, "initial"))
+                                  None if initial is None else _arrays.vertices(initial, "initial"), progress)
     return (X, stats) if return_stats else X
