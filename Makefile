@@ -157,10 +157,12 @@ demo: build
 
 # The Blender experiment also runs in bpy 4.5 and 5.3 on the extension zips.
 bench: build addon bpy-venv-4.5 bpy-venv-5.3
+	cmake --build $(BUILD_DIR) --target modal_deform_bench -j $(JOBS)
 	PYTHONPATH=python_addon $(PYTHON) bench/run.py
 
 # Every experiment at tiny sizes (about a minute): results in bench/results/tmp/, no report.
 bench-smoke: build addon bpy-venv-4.5 bpy-venv-5.3
+	cmake --build $(BUILD_DIR) --target modal_deform_bench -j $(JOBS)
 	PYTHONPATH=python_addon $(PYTHON) bench/run.py --quick
 
 # Checked builds: -O2 with assertions on (no NDEBUG: Eigen's index checks, libstdc++'s checked
