@@ -50,7 +50,7 @@ struct FullSolveOptions {
   double tolerance = 1e-8;
   int max_iterations = 300;  // ≥ 0: Newton iterations at most, all load steps together
   // Called as ("solve", fraction done) at most every 0.1 s; returning false cancels (Cancelled).
-  ProgressCallback progress;
+  ProgressCallback progress = nullptr;
 };
 
 struct FullSolveResult {
