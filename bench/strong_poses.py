@@ -86,10 +86,10 @@ def difference_error(solver, seed=0):
     return min(errors) / (1 + abs(value))
 
 
-def follow(basis, V, pose, check_differences=False, stiffness=STIFFNESS, final_iterations=3000):
+def follow(mdc, basis, V, pose, check_differences=False, stiffness=STIFFNESS, final_iterations=3000):
     """Reaches `pose` in steps of at most STEP_DEGREES, each solved to convergence (tolerance
-    1e-6); returns one dict of solve stats per step (with "difference_error" when asked)."""
-    import modal_deform.core as mdc
+    1e-6); returns one dict of solve stats per step (with "difference_error" when asked). `mdc`:
+    the modal_deform.core the basis came from (inside Blender, the installed add-on's)."""
     degrees = float(pose.split("_")[1])
     steps = int(np.ceil(degrees / STEP_DEGREES))
     handles, _ = transforms(V, pose, 0)
@@ -132,7 +132,7 @@ _CHILD = textwrap.dedent("""
     own = mdc.bake(coarse.V, coarse.F, modes=20, derivatives=47, ghost=1000, proxy=None)
     out["own_bake_s"] = time.perf_counter() - start
     for pose in strong_poses.POSES:
-        path = strong_poses.follow(own, coarse.V, pose, check_differences=True)
+        path = strong_poses.follow(mdc, own, coarse.V, pose, check_differences=True)
         out["own_poses"][pose] = dict(converged=path[-1]["converged"], stalled=any(s["stalled"] for s in path),
                                       iterations=sum(s["iterations"] for s in path), energy=path[-1]["energy"],
                                       difference_error=max(s["difference_error"] for s in path))

@@ -48,7 +48,7 @@ def baked(request):
 @pytest.mark.parametrize("pose", strong_poses.POSES)
 def test_strong_pose_converges_with_a_continuous_objective(baked, pose):
     name, V, F, basis = baked
-    path = strong_poses.follow(basis, V, pose, check_differences=True)
+    path = strong_poses.follow(mdc, basis, V, pose, check_differences=True)
     assert not any(step["stalled"] for step in path), f"{name}, {pose}: stalled at step {path}"
     final = path[-1]
     assert final["converged"], f"{name}, {pose}: not converged: {final}"

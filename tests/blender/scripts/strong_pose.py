@@ -10,14 +10,14 @@ import bpy  # noqa: E402
 import support  # noqa: E402
 import strong_poses  # noqa: E402
 
-storage = support.enable_addon("storage")
+storage, core = support.enable_addon("storage", "core")
 
 obj = support.suzanne(2)  # 7,958 vertices
 obj.modal_deform.ghost = 1000
 assert bpy.ops.modal_deform.bake() == {"FINISHED"}
 basis = storage.load(obj)
 for pose in strong_poses.POSES:
-    path = strong_poses.follow(basis, basis.rest, pose, check_differences=True)
+    path = strong_poses.follow(core, basis, basis.rest, pose, check_differences=True)
     assert not any(step["stalled"] for step in path), (pose, path)
     assert path[-1]["converged"], (pose, path[-1])
     worst = max(step["difference_error"] for step in path)
