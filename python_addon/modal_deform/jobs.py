@@ -26,10 +26,11 @@ STAGES = ("attachment", "hessian", "factorisation", "modes", "third derivatives"
 class _ThreadJob:
     """Native work run by run() here or on a thread by start(); the native call releases the GIL, so
     Blender stays responsive. cancel() makes the next progress report stop it (Cancelled).
-    Subclasses set self.stage, self.fraction, self.cancelling, self.error, self.seconds in
-    __init__ and implement _work()."""
+    Subclasses name their thread (what it does, e.g. "modal_deform bake"), set self.stage,
+    self.fraction, self.cancelling, self.error, self.seconds in __init__ and implement _work()."""
 
     _thread = None
+    thread_name = None
 
     def _progress(self, stage, fraction):
         self.stage, self.fraction = stage, fraction
@@ -44,7 +45,7 @@ class _ThreadJob:
         self.seconds = time.perf_counter() - start
 
     def start(self):
-        self._thread = threading.Thread(target=self.run, name=f"modal_deform {type(self).__name__}", daemon=True)
+        self._thread = threading.Thread(target=self.run, name=self.thread_name, daemon=True)
         self._thread.start()
 
     def cancel(self):
@@ -57,6 +58,8 @@ class _ThreadJob:
 
 class BakeJob(_ThreadJob):
     """One bake of obj's mesh as it is now (read on the calling thread)."""
+
+    thread_name = "modal_deform bake"
 
     def __init__(self, obj):
         settings = obj.modal_deform
@@ -112,6 +115,8 @@ class RefineJob(_ThreadJob):
     artist's stack simple (a second key would add its offset on top unless muted). Until finish()
     nothing changes, so a cancelled or failed refine leaves the key as it was.
     """
+
+    thread_name = "modal_deform refine"
 
     def __init__(self, context, obj, tolerance=1e-8, max_iterations=300):
         self.object_name = obj.name
