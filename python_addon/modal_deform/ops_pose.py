@@ -6,7 +6,7 @@ import bpy
 
 from . import handles, mesh_io, posing
 from .jobs import RefineJob
-from .ops_common import FAILURES, mesh_poll
+from .ops_common import FAILURES, ThreadJobOperator, mesh_poll
 
 
 # The running interactive pose, so the right-click menu's items can end it.
@@ -180,7 +180,7 @@ class MODAL_DEFORM_OT_solve(bpy.types.Operator):
         return {"FINISHED"}
 
 
-class MODAL_DEFORM_OT_refine(bpy.types.Operator):
+class MODAL_DEFORM_OT_refine(ThreadJobOperator, bpy.types.Operator):
     """Solve the pose for the controllers as they are, then polish it on the full mesh (Newton's method) into \
 the "Modal Deform" shape key: the exact physically based shape, for a final frame. Takes seconds; Esc cancels"""
     bl_idname = "modal_deform.refine"
@@ -206,60 +206,10 @@ the "Modal Deform" shape key: the exact physically based shape, for a final fram
         self.report({level}, message)
         return {"FINISHED"} if self.job.written else {"CANCELLED"}
 
-    def execute(self, context):
-        try:
-            self.job = self._job(context)
-        except FAILURES as error:
-            self.report({"ERROR"}, str(error))
-            return {"CANCELLED"}
-        self.job.run()
-        return self._finish()
-
-    def invoke(self, context, event):
-        try:
-            self.job = self._job(context)
-        except FAILURES as error:
-            self.report({"ERROR"}, str(error))
-            return {"CANCELLED"}
-        self.job.start()
-        wm = context.window_manager
-        self.timer = wm.event_timer_add(0.1, window=context.window)
-        wm.progress_begin(0, 1000)
-        wm.modal_handler_add(self)
-        self._show(context)
-        return {"RUNNING_MODAL"}
-
-    def _show(self, context):
+    def _status(self):
         job = self.job
-        context.window_manager.progress_update(int(1000 * job.overall))
         action = "cancelling" if job.cancelling else f"{100 * job.overall:.0f}%"
-        context.workspace.status_text_set(f"Modal Deform: refining '{job.object_name}': {action}   (Esc: cancel)")
-
-    def modal(self, context, event):
-        if event.type == "ESC" and event.value == "PRESS":
-            self.job.cancel()
-        if event.type != "TIMER":
-            return {"RUNNING_MODAL"} if event.type == "ESC" else {"PASS_THROUGH"}
-        if not self.job.done:
-            self._show(context)
-            return {"RUNNING_MODAL"}
-        self._stop(context)
-        result = self._finish()
-        for area in context.screen.areas:
-            area.tag_redraw()
-        return result
-
-    def _stop(self, context):
-        wm = context.window_manager
-        wm.event_timer_remove(self.timer)
-        wm.progress_end()
-        if context.workspace is not None:
-            context.workspace.status_text_set(None)
-
-    def cancel(self, context):
-        """Blender ends the operator (file loaded, window closed): the solve stops, nothing is written."""
-        self.job.cancel()
-        self._stop(context)
+        return f"Modal Deform: refining '{job.object_name}': {action}"
 
 
 class MODAL_DEFORM_OT_reset(bpy.types.Operator):
