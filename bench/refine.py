@@ -6,7 +6,8 @@ raw-scan-like 23k dragon (bench/raw_scans.damaged, seed 0: slivers, needles, fin
 Handles: the last 15% of the length at each end (1.5 units once scaled to a length of 10);
 stiffness 100. Poses: the far end turned about the long axis by 30, 90 and 170 degrees and moved
 by 9% of the length sideways and 4.5% up ("turn"), and bent about the up axis by 90 degrees
-("bend"). From rest: mdc.solve_full with its load steps. Refine: the paper's basis (15 modes + 52
+("bend"). From rest (the 23k dragon only: at 100k it takes most of an hour a pose): mdc.solve_full
+with its load steps. Refine: the paper's basis (15 modes + 52
 derivatives, 1k ghost), the reduced pose converged (at most 2000 BFGS iterations), then
 ReducedSolver.refine from it; the table reports the reduced pose's objective gap and vertex RMS
 (relative to the bounding-box diagonal) against the refined minimum. Targets: from rest the 23k
@@ -103,6 +104,9 @@ def run(quick=False, meshes=MESHES):
         for pose, transforms in named_poses.items():
             entry["refine"][pose] = row(refine(basis, F, handles, transforms))
             print(name, "refine", pose, json.dumps(entry["refine"][pose]), flush=True)
+        if name not in TARGETS["from_rest_converges"]:
+            figures[name] = entry
+            continue  # from rest at 100k takes most of an hour a pose
         for pose, transforms in named_poses.items():
             _, stats = from_rest(V, F, handles, transforms)
             entry["from_rest"][pose] = row(stats)

@@ -177,13 +177,19 @@ class ShiftedNewton {
 
   int factorizations() const { return factorizations_; }
 
-  // One iteration from y (F(y) = value, ∇F(y) = gradient), all three updated, with the exact
-  // Hessian or the projected one (Energy::projected_hessian). Returns whether it made progress:
-  // F fell by more than its rounding, or ‖∇F‖ by half (near the minimum, where F's decrease is
-  // below rounding).
-  bool iterate(Eigen::VectorXd& y, double& value, Eigen::VectorXd& gradient, bool exact) {
+  // One iteration from y (F(y) = value, ∇F(y) = gradient), all three updated. Near the minimum
+  // (`near_minimum`) the exact Hessian is tried first, at the current τ only: where it is not
+  // definite there (a flap still bent far from rest), the projected one (Energy::projected_hessian)
+  // serves instead for the next kRetryExactAfter iterations. Growing τ until the exact Hessian
+  // factors would damp the whole mesh (on the 23k dragon τ rose to 3e6 and the next ten
+  // iterations crept). Returns whether it made progress: F fell by more than its
+  // rounding, or ‖∇F‖ by half (near the minimum, where F's decrease is below rounding).
+  bool iterate(Eigen::VectorXd& y, double& value, Eigen::VectorXd& gradient, bool near_minimum) {
     const Energy& energy = objective_.energy();
-    factorize_shifted(exact ? energy.hessian(y) : energy.projected_hessian(y));
+    const bool try_exact = near_minimum && ++since_exact_failed_ > kRetryExactAfter;
+    const bool exact = try_exact && try_factorize(energy.hessian(y));
+    if (try_exact && !exact) since_exact_failed_ = 0;
+    if (!exact) factorize_shifted(energy.projected_hessian(y));
     llt_.solve(gradient, step_);
     step_ = -step_;
     const double slope = gradient.dot(step_);
@@ -205,7 +211,11 @@ class ShiftedNewton {
                          shift_ * std::max(0.1, 1 - std::pow(2 * ratio - 1, 3))});
       growth_ = 2;
     } else {
-      shift_ *= growth_;  // too long a step: lean towards steepest descent
+      // Too long a step: lean towards steepest descent. Where τD dominates the Hessian (the floppy
+      // parts that made the step too long) the step shrinks as 1/τ, so τ grows at least by the
+      // factor the line search cut the step by (from a poor start, τ must rise by ten orders of
+      // magnitude, which doubling alone took ten iterations to reach).
+      shift_ *= std::max(growth_, std::min(1 / search.step, kMaxCutGrowth));
       growth_ = std::min(2 * growth_, kMaxGrowth);
     }
     if (search.step == 0) return false;
@@ -218,19 +228,29 @@ class ShiftedNewton {
 
  private:
   static constexpr double kMaxGrowth = 16;
+  static constexpr double kMaxCutGrowth = 1e4;
+  // Iterations on the projected Hessian after the exact one failed to factor before it is tried
+  // again: the projected one converges only linearly (clamping the negative curvature of a bent
+  // flap overestimates it), so the exact one is retried soon, at one factorisation's cost.
+  static constexpr int kRetryExactAfter = 3;
 
+  // Factors ∇²F + τD at the current τ; false (the matrix not definite) leaves τ as it is.
+  bool try_factorize(const SparseMatrix& hessian) {
+    ++factorizations_;
+    try {
+      llt_.factorize(hessian, objective_.constant_diagonal() + shift_ * objective_.mass_diagonal());
+      return true;
+    } catch (const NumericalError&) {
+      return false;
+    }
+  }
+
+  // Factors ∇²F + τD, τ grown tenfold until it factors.
   void factorize_shifted(const SparseMatrix& hessian) {
-    const Eigen::VectorXd& D = objective_.mass_diagonal();
-    for (int attempt = 0;; ++attempt) {
-      ++factorizations_;
-      try {
-        llt_.factorize(hessian, objective_.constant_diagonal() + shift_ * D);
-        return;
-      } catch (const NumericalError&) {
-        if (attempt == 60) throw NumericalError("solve_full: no shift of the Hessian could be factored");
-        failed_shift_ = std::max(failed_shift_, shift_);
-        shift_ *= 10;
-      }
+    for (int attempt = 0; !try_factorize(hessian); ++attempt) {
+      if (attempt == 60) throw NumericalError("solve_full: no shift of the Hessian could be factored");
+      failed_shift_ = std::max(failed_shift_, shift_);
+      shift_ *= 10;
     }
   }
 
@@ -242,6 +262,8 @@ class ShiftedNewton {
   // only cost another failed factorisation.
   double failed_shift_ = 0;
   int factorizations_ = 0;
+  // Iterations since the exact Hessian was last found not definite at τ.
+  int since_exact_failed_ = kRetryExactAfter;
   Eigen::VectorXd step_, y_new_, gradient_new_;
 };
 
@@ -331,8 +353,8 @@ FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handle
                              : std::min(kIterationsPerIntermediateStep, options.max_iterations - result.iterations);
     int iterations = 0, stalled = 0;
     while (iterations < budget && stalled < kMaxStalledIterations && gradient.norm() > target) {
-      const bool exact = gradient.norm() <= kExactHessianBelow * result.gradient_scale;
-      stalled = newton.iterate(y, value, gradient, exact) ? 0 : stalled + 1;
+      const bool near_minimum = gradient.norm() <= kExactHessianBelow * result.gradient_scale;
+      stalled = newton.iterate(y, value, gradient, near_minimum) ? 0 : stalled + 1;
       ++iterations;
       // The gradient norm may rise for a step: the bar never goes back.
       done = std::max(done, fraction_done(next, stepping, gradient.norm(), result.gradient_scale, tolerance));

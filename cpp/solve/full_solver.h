@@ -13,11 +13,14 @@
 // factors ∇²F + τD once (D the normalised lumped mass per coordinate, floored at 1e-6 of its mean;
 // CHOLMOD's analysis of the pattern is kept for the whole solve), the shift τ adapted to how
 // well the quadratic model predicted the decrease (Levenberg–Marquardt with Nielsen's update:
-// shrunk after a good step, grown after a poor one, grown tenfold when the factorisation finds the
-// matrix not positive definite, never below 1e-8 of the Hessian's scale so that a free component's
-// rigid motions stay regularised). A large τ shortens the step where curvature is low (flaps)
-// and leaves it Newton's where curvature is high, unlike a line search, which would shorten it
-// everywhere. The step is then backtracked (Armijo) when F does not decrease enough.
+// shrunk after a good step, grown after a poor one — at least by the factor the line search cut the
+// step by — and tenfold when the factorisation finds the matrix not positive definite, never below
+// 1e-8 of the Hessian's scale so that a free component's rigid motions stay regularised). A large
+// τ shortens the step where curvature is low (flaps) and leaves it Newton's where curvature is
+// high, unlike a line search, which would shorten it everywhere. The step is then backtracked
+// (Armijo) when F does not decrease enough. The Hessian is the projected one (each element's made
+// semidefinite) far from the minimum, and the exact one near it wherever it factors at the current
+// τ (quadratic convergence).
 //
 // Load steps: from rest, the handles' transforms are followed from the identity (each handle
 // turning about its centre, the mean of its rest vertices, its centre moving in a straight

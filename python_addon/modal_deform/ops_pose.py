@@ -83,13 +83,8 @@ keeps the pose, Esc restores the mesh as it was"""
         except FAILURES as error:  # e.g. a controller deleted while posing
             self.report({"ERROR"}, str(error))
             return self._end(context, "CANCEL")
-        stats = self.pose.stats
-        state = posing.state(stats)
-        if state == "stalled":
-            state = f"stalled: {posing.STALLED_HINT}"
         if self.area is not None:
-            self.area.header_text_set(f"Modal Deform: {state}, {stats['iterations']} iterations, energy "
-                                      f"{stats['energy']:.5g}, {self.tick_ms:.1f} ms per update")
+            self.area.header_text_set(posing.header_text(self.pose.stats, self.tick_ms))
         return {"PASS_THROUGH"}
 
     def _end(self, context, how):

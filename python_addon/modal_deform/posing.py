@@ -70,6 +70,16 @@ def state(stats):
 STALLED_HINT = "the solver cannot follow this pose (no step lowers its energy); ease the controllers back or re-bake"
 
 
+def header_text(stats, tick_ms):
+    """The interactive pose's header line: how the last update's solve ended, with the hint when it
+    stalled, its iterations, energy and time."""
+    ended = state(stats)
+    if ended == "stalled":
+        ended = f"stalled: {STALLED_HINT}"
+    return (f"Modal Deform: {ended}, {stats['iterations']} iterations, energy {stats['energy']:.5g}, "
+            f"{tick_ms:.1f} ms per update")
+
+
 class ShapeKeyState:
     """What a shape key of obj looks like now, to put it back exactly (Esc): whether the mesh had
     shape keys, the key's positions, value and mute, the active key and solo display."""

@@ -66,3 +66,11 @@ def test_headless_script_names_a_missing_object(run_blender):
 
 def test_refine_polishes_the_pose_and_a_cancel_changes_nothing(run_blender):
     assert "REFINE_OK" in run_blender("refine.py").stdout
+
+
+def test_a_stalled_solve_is_shown_to_the_artist(run_blender):
+    out = run_blender("stalled_pose.py").stdout
+    assert "STALL_SHOWN_OK" in out
+    before, after = out.split("SOLVE_WITH_STALL")
+    assert "Stalled after" not in before, before[-2000:]
+    assert "Warning: Stalled after" in after and "the solver cannot follow this pose" in after, after[-2000:]

@@ -20,8 +20,6 @@ from .bake import PROXY_ABOVE, Basis
 #: The most vertices ReducedSolver.refine takes: the size bake takes without a proxy.
 REFINE_MAX_VERTICES = PROXY_ABOVE
 
-#: The most Newton iterations Refine spends from its start before it also solves from rest.
-REFINE_ITERATIONS_FROM_START = 40
 
 #: The default handle stiffness μ: stiff enough that handles land within a small fraction of a
 #: percent of the model's size in the test poses, soft enough to keep BFGS well conditioned.
@@ -167,7 +165,7 @@ class ReducedSolver:
         transforms. ``progress(stage, fraction) -> bool`` is called from time to time (False
         cancels: ``Cancelled``). Returns (positions (n, 3) float64, stats) with the stats of
         ``solve_full`` ("initial_energy" is the objective at the start). When the solve from the
-        start does not converge within ``REFINE_ITERATIONS_FROM_START`` iterations, the solve from
+        start does not converge (it stalled at a kink, or spent ``max_iterations``), the solve from
         rest (in load steps) is run as well and its answer returned if it converged or is lower:
         stats["from_rest"] says so (iterations, factorisations and seconds then count both solves).
 
@@ -198,9 +196,7 @@ class ReducedSolver:
                               membrane=basis.membrane, tolerance=tolerance, max_iterations=iterations,
                               initial=initial, progress=report, return_stats=True)
 
-        # From a good start Newton converges in a few dozen iterations; from a poor one it stalls
-        # at a kink, and the iterations beyond these would be lost.
-        X, stats = solve(start, min(max_iterations, REFINE_ITERATIONS_FROM_START), (0.0, 0.5))
+        X, stats = solve(start, max_iterations, (0.0, 0.5))
         stats["from_rest"] = False
         if stats["converged"] and progress:
             progress("solve", 1.0)
