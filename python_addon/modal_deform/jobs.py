@@ -1,7 +1,12 @@
 """The work the long operators drive, apart from their Blender UI plumbing: a bake of the mesh on a
-thread (BakeJob), Refine on a thread (RefineJob) and an animation bake a frame at a time
-(AnimationJob). They read the object when made and change it only in finish() (AnimationJob: in
-step(), taken back by cancel()); cancel() leaves it as it was.
+thread (BakeJob), Refine on a thread (RefineJob) and an animation bake a frame at a time on the main
+thread (AnimationJob). They read the object when made and change it only in finish() (AnimationJob:
+in tick(), taken back by cancel() and by a failure); cancel() leaves it as it was.
+
+Every job offers what ops_common.JobOperator drives: start(); tick() on the operator's timer (every
+tick_seconds), False once the job has ended; overall (the fraction done); cancel(); run() (all of
+it at once, for execute); finish() on the main thread, returning (level, message) for the report and
+setting `written` when it changed the object.
 
 Bake animation writes one shape key per frame, keyed to show on its frame only, so the result plays
 back and renders without the add-on: frame f shows shape key "Modal Deform f" (value 1 at f, 0 at
@@ -31,6 +36,8 @@ class _ThreadJob:
 
     _thread = None
     thread_name = None
+    tick_seconds = 0.1
+    written = False
 
     def _progress(self, stage, fraction):
         self.stage, self.fraction = stage, fraction
@@ -54,6 +61,9 @@ class _ThreadJob:
     @property
     def done(self):
         return self._thread is None or not self._thread.is_alive()
+
+    def tick(self):
+        return not self.done
 
 
 class BakeJob(_ThreadJob):
@@ -97,6 +107,7 @@ class BakeJob(_ThreadJob):
         if obj is None or obj.type != "MESH" or storage.fingerprint(obj.data) != self.fingerprint:
             return "WARNING", f"'{self.object_name}' changed during the bake: the result was discarded, bake again"
         storage.store(obj, self.basis, self.fingerprint, self.seconds, self.energy)
+        self.written = True
         basis = self.basis
         message = (f"Baked '{obj.name}' in {self.seconds:.1f} s: {basis.dimension} dimensions, ghost "
                    f"{len(basis.ghost_vertices)} vertices")
@@ -130,7 +141,6 @@ class RefineJob(_ThreadJob):
         self.X = self.stats = self.error = None
         self.seconds = 0.0
         self.cancelling = False
-        self.written = False  # finish() wrote the shape key
 
     @property
     def overall(self):
@@ -168,7 +178,10 @@ def frame_key_name(frame):
 
 
 class AnimationJob:
-    """Solves frames one at a time (step()); finish() or cancel() afterwards."""
+    """Solves the frames one per tick() into new shape keys; finish() keys them, cancel() (or a
+    failure) takes them away."""
+
+    tick_seconds = 0.01
 
     def __init__(self, context, obj, frames, refine=False):
         self.pose = posing.Pose(context, obj)
@@ -177,16 +190,39 @@ class AnimationJob:
         self.refined = None
         self.obj, self.scene, self.frames = obj, context.scene, list(frames)
         self.frame_before = self.scene.frame_current
-        self.done = 0
+        self.frames_done = 0
         self.created = []  # (frame, key name as created: a new key may get a ".001" suffix)
         self.basis_created = obj.data.shape_keys is None
         self.unconverged = 0
+        self.cancelling = self.written = False
+        self.error = None
 
-    def step(self):
-        """Solve the next frame into a new shape key; returns False when every frame is done."""
-        if self.done == len(self.frames):
+    @property
+    def overall(self):
+        return self.frames_done / len(self.frames) if self.frames else 1.0
+
+    def start(self):
+        """Nothing to start: the frames are solved on the main thread, one per tick()."""
+
+    def tick(self):
+        """Solve the next frame into a new shape key; False once the job has ended (every frame done,
+        cancelled, or failed: self.error, with what it added taken away)."""
+        if self.cancelling or self.error is not None or self.frames_done == len(self.frames):
             return False
-        frame = self.frames[self.done]
+        try:
+            self._solve_frame(self.frames[self.frames_done])
+        except Exception as error:  # reported by finish(), as the thread jobs' are
+            self.error = error
+            self._take_back()
+            return False
+        self.frames_done += 1
+        return True
+
+    def run(self):
+        while self.tick():
+            pass
+
+    def _solve_frame(self, frame):
         self.scene.frame_set(frame)
         self.pose.follow_controllers()
         converged = self.pose.converge()["converged"]
@@ -203,11 +239,14 @@ class AnimationJob:
             self.pose.write(block)
         else:
             mesh_io.write_shape_key(self.obj.data, block, self.refined.astype(np.float32))
-        self.done += 1
-        return True
 
     def finish(self):
-        """Replace the keys of an earlier animation bake with the new ones and key their values."""
+        """Replace the keys of an earlier animation bake with the new ones and key their values.
+        Returns (level, message) for a report."""
+        if self.cancelling:
+            return "WARNING", "Animation bake cancelled: nothing changed"
+        if self.error is not None:
+            return "ERROR", f"Animation bake failed: {self.error}"
         obj = self.obj
         blocks = obj.data.shape_keys.key_blocks
         new_names = {name for _, name in self.created}
@@ -226,13 +265,23 @@ class AnimationJob:
             for point in curve.keyframe_points:
                 point.interpolation = "CONSTANT"
         self.scene.frame_set(self.frame_before)
+        self.written = True
+        message = f"Baked {len(self.frames)} frames into shape keys"
+        if self.unconverged:
+            return "WARNING", f"{message}; {self.unconverged} did not converge"
+        return "INFO", message
 
     def cancel(self):
         """Take away everything this job added."""
+        self.cancelling = True
+        self._take_back()
+
+    def _take_back(self):
         names = [name for _, name in self.created]
         if self.basis_created and self.obj.data.shape_keys is not None:
             names.append(self.obj.data.shape_keys.reference_key.name)
         mesh_io.remove_shape_keys(self.obj, names)
+        self.created = []
         self.scene.frame_set(self.frame_before)
 
 

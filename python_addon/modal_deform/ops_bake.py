@@ -3,10 +3,10 @@ import bpy
 
 from . import handles, storage
 from .jobs import BakeJob
-from .ops_common import ThreadJobOperator, mesh_poll
+from .ops_common import JobOperator, mesh_poll
 
 
-class MODAL_DEFORM_OT_bake(ThreadJobOperator, bpy.types.Operator):
+class MODAL_DEFORM_OT_bake(JobOperator, bpy.types.Operator):
     """Compute the deformation basis of the mesh (vibration modes, modal derivatives, ghost) and keep it in \
 the file. Esc cancels"""
     bl_idname = "modal_deform.bake"
@@ -22,11 +22,6 @@ the file. Esc cancels"""
         job = self.job
         action = "cancelling" if job.cancelling else f"{job.stage} {100 * job.fraction:.0f}%"
         return f"Modal Deform: baking '{job.object_name}': {action}"
-
-    def _finish(self):
-        level, message = self.job.finish()
-        self.report({level}, message)
-        return {"FINISHED"} if level == "INFO" else {"CANCELLED"}
 
 
 class MODAL_DEFORM_OT_clear_basis(bpy.types.Operator):

@@ -21,30 +21,33 @@ def mesh_poll(cls, context):
     return True
 
 
-class ThreadJobOperator:
-    """What the bake and Refine operators share: a jobs job run at once (execute) or on its thread
-    (invoke) with a progress bar and status text on a timer, Esc to cancel, the result reported when
-    the thread ends. Subclasses give _job(context) (raising one of FAILURES for the artist),
-    _status() (the status text) and _finish() (report; the operator's return value)."""
+class JobOperator:
+    """The lifecycle of the long operators (bake, Refine, animation bake) around a jobs job: run at
+    once (execute), or (invoke) started and ticked on a timer with a progress bar and status text,
+    Esc to cancel, and the job's report when it ends. Subclasses give _job(context) (raising one of
+    FAILURES for the artist) and _status() (the status text); the operator finishes when the job
+    changed the object and is cancelled otherwise."""
 
-    def execute(self, context):
+    def _start(self, context):
         try:
             self.job = self._job(context)
         except FAILURES as error:
             self.report({"ERROR"}, str(error))
+            return False
+        return True
+
+    def execute(self, context):
+        if not self._start(context):
             return {"CANCELLED"}
         self.job.run()
         return self._finish()
 
     def invoke(self, context, event):
-        try:
-            self.job = self._job(context)
-        except FAILURES as error:
-            self.report({"ERROR"}, str(error))
+        if not self._start(context):
             return {"CANCELLED"}
         self.job.start()
         wm = context.window_manager
-        self.timer = wm.event_timer_add(0.1, window=context.window)
+        self.timer = wm.event_timer_add(self.job.tick_seconds, window=context.window)
         wm.progress_begin(0, 1000)
         wm.modal_handler_add(self)
         self._show(context)
@@ -52,14 +55,15 @@ class ThreadJobOperator:
 
     def _show(self, context):
         context.window_manager.progress_update(int(1000 * self.job.overall))
-        context.workspace.status_text_set(f"{self._status()}   (Esc: cancel)")
+        if context.workspace is not None:
+            context.workspace.status_text_set(f"{self._status()}   (Esc: cancel)")
 
     def modal(self, context, event):
         if event.type == "ESC" and event.value == "PRESS":
             self.job.cancel()
         if event.type != "TIMER":
             return {"RUNNING_MODAL"} if event.type == "ESC" else {"PASS_THROUGH"}
-        if not self.job.done:
+        if self.job.tick():
             self._show(context)
             return {"RUNNING_MODAL"}
         self._stop(context)
@@ -67,6 +71,11 @@ class ThreadJobOperator:
         for area in context.screen.areas:
             area.tag_redraw()
         return result
+
+    def _finish(self):
+        level, message = self.job.finish()
+        self.report({level}, message)
+        return {"FINISHED"} if self.job.written else {"CANCELLED"}
 
     def _stop(self, context):
         wm = context.window_manager

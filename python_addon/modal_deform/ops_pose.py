@@ -6,7 +6,7 @@ import bpy
 
 from . import handles, mesh_io, posing
 from .jobs import RefineJob
-from .ops_common import FAILURES, ThreadJobOperator, mesh_poll
+from .ops_common import FAILURES, JobOperator, mesh_poll
 
 
 # The running interactive pose, so the right-click menu's items can end it.
@@ -175,7 +175,7 @@ class MODAL_DEFORM_OT_solve(bpy.types.Operator):
         return {"FINISHED"}
 
 
-class MODAL_DEFORM_OT_refine(ThreadJobOperator, bpy.types.Operator):
+class MODAL_DEFORM_OT_refine(JobOperator, bpy.types.Operator):
     """Solve the pose for the controllers as they are, then polish it on the full mesh (Newton's method) into \
 the "Modal Deform" shape key: the exact physically based shape, for a final frame. Takes seconds; Esc cancels"""
     bl_idname = "modal_deform.refine"
@@ -195,11 +195,6 @@ the "Modal Deform" shape key: the exact physically based shape, for a final fram
         for warning in job.pose.warnings:
             self.report({"WARNING"}, warning)
         return job
-
-    def _finish(self):
-        level, message = self.job.finish()
-        self.report({level}, message)
-        return {"FINISHED"} if self.job.written else {"CANCELLED"}
 
     def _status(self):
         job = self.job

@@ -20,6 +20,26 @@ controller.location.y += 0.5
 controller.keyframe_insert("location", frame=10)
 scene = bpy.context.scene
 scene.frame_set(3)
+
+# The job the operator ticks on its timer: cancelled (Esc) after three frames, or failing on the
+# third, it takes away what it added and says so; the mesh and the frame are as they were.
+before = support.mesh_state(obj)
+job = jobs.AnimationJob(bpy.context, obj, range(1, 11))
+job.start()
+assert job.tick() and job.tick() and job.tick() and job.overall == 0.3
+assert len(obj.data.shape_keys.key_blocks) == 4  # the reference key and three frames
+job.cancel()
+assert not job.tick()
+assert job.finish() == ("WARNING", "Animation bake cancelled: nothing changed") and not job.written
+assert support.mesh_state(obj) == before and scene.frame_current == 3
+
+job = jobs.AnimationJob(bpy.context, obj, range(1, 11))
+converge = job.pose.converge
+job.pose.converge = lambda: converge() if job.frames_done < 2 else 1 / 0
+job.run()
+level, message = job.finish()
+assert level == "ERROR" and message == "Animation bake failed: division by zero" and not job.written, message
+assert support.mesh_state(obj) == before and scene.frame_current == 3
 assert bpy.ops.modal_deform.bake_animation(frame_start=1, frame_end=10) == {"FINISHED"}
 assert scene.frame_current == 3
 names = [b.name for b in obj.data.shape_keys.key_blocks]

@@ -2,8 +2,8 @@
 
 Bake Suzanne, add a handle, start the Pose operator from the sidebar's context, grab the controller
 with a simulated G + mouse motion + click, let the timer solve, check the mesh followed; Esc
-restores the mesh; the converged pose equals the Solve operator's; undo takes a bake back;
-disabling the add-on mid-pose restores as Esc does.
+restores the mesh; the converged pose equals the Solve operator's; undo takes a bake back; Esc
+takes an animation bake's frames back; disabling the add-on mid-pose restores as Esc does.
 Each step runs from bpy.app.timers so Blender handles the simulated events in between.
 Writes OUTPUT/result.json ({"ok": bool, "log": [...]}) and screenshots, then quits.
 """
@@ -244,6 +244,20 @@ def steps():
     undone = key_positions(obj, posing.POSE_KEY).tobytes()
     assert undone == solved.tobytes(), "Ctrl+Z did not take the applied pose back to the solved one"
     say("saving while posing wrote a consistent file; Enter applied and Ctrl+Z took it back")
+
+    # Bake Animation as the button does: a frame per timer tick with progress; Esc takes every frame
+    # key back.
+    keys = [(b.name, b.mute) for b in obj.data.shape_keys.key_blocks]
+    with override():
+        assert bpy.ops.modal_deform.bake_animation("INVOKE_DEFAULT", frame_start=1, frame_end=1000) == {"RUNNING_MODAL"}
+    yield 0.5
+    assert len(obj.data.shape_keys.key_blocks) > len(keys), "the animation bake made no frame"
+    window.event_simulate(type="ESC", value="PRESS", x=x, y=y)
+    window.event_simulate(type="ESC", value="RELEASE", x=x, y=y)
+    yield 0.3
+    assert [(b.name, b.mute) for b in obj.data.shape_keys.key_blocks] == keys, "Esc left frame keys behind"
+    assert base_positions(obj).tobytes() == rest.tobytes()
+    say("animation bake cancelled with Esc: its frame keys went")
 
     # Disabling the add-on while posing ends the pose as Esc does (Solve's key was there before).
     before = key_positions(obj, posing.POSE_KEY).tobytes()
