@@ -46,18 +46,8 @@ def mesh(name):
 
 def poses(V):
     """Handles (both ends, 15% of the length each) and {pose name: transforms} of a mesh."""
-    lo, hi = V.min(axis=0), V.max(axis=0)
-    a = int(np.argmax(hi - lo))
-    side, up = (a + 1) % 3, (a + 2) % 3
-    length = hi[a] - lo[a]
-    handles = [np.flatnonzero(V[:, a] < lo[a] + 0.15 * length), np.flatnonzero(V[:, a] > hi[a] - 0.15 * length)]
-    centre = V[handles[1]].mean(axis=0)
-    axis, up_axis, shift = np.zeros(3), np.zeros(3), np.zeros(3)
-    axis[a], up_axis[up] = 1.0, 1.0
-    shift[side], shift[up] = 0.09 * length, 0.045 * length
-    out = {f"turn {d}": [np.eye(4), shapes.rigid_transform(axis, np.radians(d), centre, shift)] for d in TURNS}
-    out[f"bend {BEND}"] = [np.eye(4), shapes.rigid_transform(up_axis, np.radians(BEND), centre)]
-    return handles, out
+    handles, named = shapes.end_turns(V, TURNS, BEND)
+    return handles, {pose.name.replace("_", " "): pose.at(1.0) for pose in named}
 
 
 def from_rest(V, F, handles, transforms):

@@ -171,6 +171,28 @@ def end_pull(V):
     return handles, (Pose("pull", "far 10% turned by 0.6 rad and moved by a quarter of the length", at, 6),)
 
 
+def end_turns(V, turns=(30, 90, 170), bend=90):
+    """Handles of a scan along its longest bounding-box axis, the 15% at each end, and poses of its
+    high end (Refine's, bench/refine.py): "turn_<d>" turns it by d degrees about the long axis and
+    moves it by 9% of the length sideways and 4.5% up; "bend_<bend>" turns it about the up axis."""
+    lo, hi = V.min(axis=0), V.max(axis=0)
+    a = int(np.argmax(hi - lo))
+    side, up = (a + 1) % 3, (a + 2) % 3
+    length = hi[a] - lo[a]
+    handles = [np.flatnonzero(V[:, a] < lo[a] + 0.15 * length), np.flatnonzero(V[:, a] > hi[a] - 0.15 * length)]
+    centre = V[handles[1]].mean(axis=0)
+    along, up_axis, shift = np.eye(3)[a], np.eye(3)[up], 0.09 * length * np.eye(3)[side] + 0.045 * length * np.eye(3)[up]
+
+    def motion(axis, degrees, moved):
+        return lambda t: [np.eye(4), rigid_transform(axis, t * np.radians(degrees), centre, t * moved)]
+    poses = tuple(Pose(f"turn_{d}", f"far end turned by {d} deg about the long axis and moved", motion(along, d, shift),
+                       max(2, round(d / 15))) for d in turns)
+    if bend:
+        poses += (Pose(f"bend_{bend}", f"far end turned by {bend} deg about the up axis",
+                       motion(up_axis, bend, np.zeros(3)), max(2, round(bend / 15))),)
+    return handles, poses
+
+
 def scan(name):
     """A shared scan (read in place, in its own units) with the end_pull handles and pose."""
     V, F = mdc.read_mesh(SHARED_MESHES / _SCAN_FILES[name])
