@@ -139,7 +139,7 @@ class GhostInBackground {
   std::future<Ghost> ghost_;
 };
 
-void check_options(const BakeOptions& o) {
+void check_options(const BakeOptions& o, Eigen::Index num_vertices) {
   if (o.modes < 1) throw InputError(message("modes: expected at least 1, got ", o.modes));
   if (o.derivatives < 0) throw InputError(message("derivatives: expected 0 or more, got ", o.derivatives));
   if (o.ghost < 4) throw InputError(message("ghost: a ghost needs at least 4 vertices, got ", o.ghost));
@@ -151,6 +151,8 @@ void check_options(const BakeOptions& o) {
                              "bake it with derivatives = 0, or use the shells energy (asked for ", o.derivatives, ")"));
   require_weight(o.bending, "bending");
   require_weight(o.membrane, "membrane");
+  require_stiffness_paint(o.paint, num_vertices);
+  require_paintable(o.energy, o.paint);
 }
 
 // One stage of the bake: reported to the bar at its start and end, and its wall time added to
@@ -178,6 +180,8 @@ Basis rest_state(const VerticesRef& V, const FacesRef& F, const BakeOptions& opt
   basis.scale = scale;
   basis.bending = options.bending;
   basis.membrane = options.membrane;
+  basis.stiffness_weights = options.paint.weights;
+  basis.max_stiffness = options.paint.max_stiffness;
   return basis;
 }
 
@@ -186,6 +190,7 @@ struct Simulated {
   Attachment attachment;
   RowMatrixX3d V;        // #S by 3
   Eigen::VectorXd mass;  // #S
+  StiffnessPaint paint;  // the painted stiffness of the simulated vertices
   int num_rigid = 0;     // 6 per simulated component
   int flexible = 0;      // modes besides the rigid motions
   Eigen::Index size() const { return V.rows(); }
@@ -205,6 +210,8 @@ Simulated simulated_submesh(const VerticesRef& V, const FacesRef& F, const BakeO
     sim.V.row(s) = basis.scale * V.row(simulated[static_cast<size_t>(s)]);
     sim.mass[s] = basis.scale * basis.scale * basis.mass[simulated[static_cast<size_t>(s)]];
   }
+  sim.paint.max_stiffness = options.paint.max_stiffness;
+  if (options.paint.weights.size() > 0) sim.paint.weights = options.paint.weights(simulated);
   const int components = sim.attachment.num_components;
   sim.num_rigid = 6 * components;
   if (options.modes <= sim.num_rigid)
@@ -229,7 +236,8 @@ Stiffness stiffness_at_rest(const Simulated& sim, const BakeOptions& options, Ba
   return stage("hessian", basis, progress, [&] {
     Stiffness stiffness;
     if (options.energy == EnergyKind::kShells) {
-      stiffness.shells = std::make_unique<DiscreteShells>(sim.V, sim.attachment.faces, options.bending, options.membrane);
+      stiffness.shells = std::make_unique<DiscreteShells>(sim.V, sim.attachment.faces, options.bending, options.membrane,
+                                                          sim.paint);
       stiffness.K = stiffness.shells->hessian(stiffness.shells->rest());
     } else {
       const Arap arap(sim.V, sim.attachment.faces);
@@ -395,14 +403,18 @@ Basis bake_on_proxy(const VerticesRef& V, const FacesRef& F, const BakeOptions& 
   });
   const Ghost proxy =
       stage("proxy", timed, progress, [&] { return ghost_mesh(V, F, fine.mass, options.proxy, &as_proxy); });
-  Basis basis = rest_state(proxy.V, proxy.F, options, fine.scale);
+  // The proxy's elements carry the fine paint's means (restrict_to_ghost).
+  BakeOptions on_proxy = options;
+  on_proxy.paint = restrict_to_ghost(proxy.map, static_cast<int>(proxy.V.rows()), fine.mass, options.paint);
+  Basis basis = rest_state(proxy.V, proxy.F, on_proxy, fine.scale);
   basis.timings = timed.timings;
-  basis = bake_stages(proxy.V, proxy.F, options, std::move(basis), progress);
+  basis = bake_stages(proxy.V, proxy.F, on_proxy, std::move(basis), progress);
   stage("prolongation", basis, progress, [&] {
     basis.prolongation = prolongation_to_proxy(V, proxy.V, proxy.F, proxy.map);
     basis.ghost_map = basis.ghost_map(proxy.map).eval();
     basis.rest = fine.rest;
     basis.mass = fine.mass;
+    basis.stiffness_weights = fine.stiffness_weights;
   });
   return basis;
 }
@@ -411,7 +423,7 @@ Basis bake_on_proxy(const VerticesRef& V, const FacesRef& F, const BakeOptions& 
 
 Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Progress& progress) {
   try {
-    check_options(options);
+    check_options(options, V.rows());
     validate_mesh(V, F);
     Basis basis = options.proxy_above > 0 && V.rows() > options.proxy_above
                       ? bake_on_proxy(V, F, options, progress)

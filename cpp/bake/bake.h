@@ -72,13 +72,17 @@ struct BakeOptions {
   // edge collapse, and its basis prolongated to the fine vertices (prolongation.h).
   int proxy_above = 0;
   int proxy = 50000;
+  // Stiffness painted per vertex (shells only): every stage that sees the energy sees it, a proxy
+  // with its fine vertices' means; the basis keeps the weights for the solver's ghost.
+  StiffnessPaint paint = {};
 };
 
 // The reduced space of (V #V by 3, F #F by 3, any length unit) per the pipeline above: a Basis in
 // the mesh's units with num_modes = modes + num_floppy and r = num_modes + derivatives − dropped
 // columns. Throws InputError for a bad mesh or option (naming it), among them: modes not above the
 // rigid motions of the simulated components (6 each), more derivatives than pairs of the modes
-// that are neither rigid nor zero, "arap" with derivatives; NumericalError when a solver fails;
+// that are neither rigid nor zero, "arap" with derivatives or with painted stiffness, paint that
+// require_stiffness_paint refuses; NumericalError when a solver fails;
 // OutOfMemory when the memory the bake needs (bake_memory.h, estimated once CHOLMOD has analysed
 // K and before the numeric factorisation) is more than is available, or an allocation fails;
 // Cancelled when `progress` says stop.

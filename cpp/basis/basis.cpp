@@ -5,6 +5,7 @@
 
 #include "mesh/mesh_check.h"
 #include "mesh/normalization.h"
+#include "reduction/ghost.h"
 #include "util/errors.h"
 #include "util/require_positions.h"
 #include "util/require_weight.h"
@@ -63,6 +64,10 @@ Eigen::Matrix<double, 3, Eigen::Dynamic> Basis::vertex_rows(int v) const {
   return rows;
 }
 
+StiffnessPaint ghost_paint(const Basis& b) {
+  return restrict_to_ghost(b.ghost_map, static_cast<int>(b.ghost_vertices.rows()), b.mass, b.paint());
+}
+
 void validate_basis(const Basis& b) {
   const Eigen::Index n = b.rest.rows(), r = b.vectors.cols(), g = b.ghost_vertices.rows();
   require(n > 0, "rest has no vertices");
@@ -90,6 +95,7 @@ void validate_basis(const Basis& b) {
   require_shared([&] {
     require_weight(b.bending, "bending");
     require_weight(b.membrane, "membrane");
+    require_stiffness_paint(b.paint(), n);
   });
   require(b.num_dropped >= 0, "num_dropped is negative");
   require_shared([&] { require_vertices(b.rest, "rest"); });

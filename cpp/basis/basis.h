@@ -9,6 +9,7 @@
 #include <map>
 #include <string>
 
+#include "energy/stiffness_paint.h"
 #include "reduction/prolongation.h"
 #include "util/types.h"
 
@@ -42,6 +43,10 @@ struct Basis {
   double scale = 1.0;
   double bending = 1.0;
   double membrane = 1.0;
+  // The painted material (stiffness_weights.h): #V weights in [0, 1] (empty: uniform) and the
+  // multiplier of the energy's weights where a weight is 1.
+  Eigen::VectorXd stiffness_weights;
+  double max_stiffness = 1.0;
   // Derivative vectors dropped by the orthonormalisation as numerically dependent.
   int num_dropped = 0;
   // Seconds spent in each stage of the bake, by stage name.
@@ -52,9 +57,38 @@ struct Basis {
   // Vertices the rows of `vectors` belong to: the proxy's, or the fine mesh's own.
   int num_basis_vertices() const { return static_cast<int>(vectors.rows() / 3); }
   bool on_proxy() const { return !prolongation.empty(); }
+  StiffnessPaint paint() const { return {stiffness_weights, max_stiffness}; }
   // The 3 by r rows of the fine basis at fine vertex v (in double): P U's rows on a proxy.
   Eigen::Matrix<double, 3, Eigen::Dynamic> vertex_rows(int v) const;
 };
+
+// The stored fields of a Basis, in storage order: the one table the bindings (keyword
+// constructor, read-only views) and the Python storage (modal_deform.core.bake: dtypes, shapes,
+// format versions) follow. Calls visit(name, since, field) with `since` the storage format version
+// that introduced the field (a basis stored before it has the field's default) and `field` an
+// accessor b -> b.member, const when b is.
+template <typename Visit>
+void for_each_stored_field(Visit&& visit) {
+  visit("rest", 1, [](auto& b) -> auto& { return b.rest; });
+  visit("mass", 1, [](auto& b) -> auto& { return b.mass; });
+  visit("vectors", 1, [](auto& b) -> auto& { return b.vectors; });
+  visit("num_rigid", 1, [](auto& b) -> auto& { return b.num_rigid; });
+  visit("num_modes", 1, [](auto& b) -> auto& { return b.num_modes; });
+  visit("num_floppy", 1, [](auto& b) -> auto& { return b.num_floppy; });
+  visit("eigenvalues", 1, [](auto& b) -> auto& { return b.eigenvalues; });
+  visit("ghost_vertices", 1, [](auto& b) -> auto& { return b.ghost_vertices; });
+  visit("ghost_faces", 1, [](auto& b) -> auto& { return b.ghost_faces; });
+  visit("ghost_map", 1, [](auto& b) -> auto& { return b.ghost_map; });
+  visit("ghost_vectors", 1, [](auto& b) -> auto& { return b.ghost_vectors; });
+  visit("scale", 1, [](auto& b) -> auto& { return b.scale; });
+  visit("bending", 1, [](auto& b) -> auto& { return b.bending; });
+  visit("membrane", 1, [](auto& b) -> auto& { return b.membrane; });
+  visit("num_dropped", 1, [](auto& b) -> auto& { return b.num_dropped; });
+  visit("prolongation_vertices", 2, [](auto& b) -> auto& { return b.prolongation.vertices; });
+  visit("prolongation_weights", 2, [](auto& b) -> auto& { return b.prolongation.weights; });
+  visit("stiffness_weights", 3, [](auto& b) -> auto& { return b.stiffness_weights; });
+  visit("max_stiffness", 3, [](auto& b) -> auto& { return b.max_stiffness; });
+}
 
 // Throws InputError naming the first array that is missing, of the wrong shape, non-finite or
 // out of range, or inconsistent with the others. Stored bases are untrusted: a .blend may be
@@ -63,7 +97,10 @@ struct Basis {
 // coordinates within require_positions's range, scale = normalizing_scale(rest), ghost vertices
 // inside the bounding box of rest forming a usable mesh, and ghost vector entries no larger than
 // the largest entry of their column of vectors (they are weighted means of them); a prolongation's
-// proxy vertices in range and its weights barycentric.
+// proxy vertices in range and its weights barycentric; the painted stiffness as the bake takes it.
 void validate_basis(const Basis& basis);
+
+// The painted stiffness of the basis's ghost (restrict_to_ghost of the fine weights).
+StiffnessPaint ghost_paint(const Basis& basis);
 
 }  // namespace modal_deform

@@ -34,8 +34,8 @@ ReducedSolver::ReducedSolver(const Basis& basis, const Handles& handles, const V
                              EnergyKind energy, bool warm_start)
     : basis_(checked(basis)),
       num_handles_(static_cast<int>(handles.size())),
-      energy_(
-          make_energy(energy, basis.scale * basis.ghost_vertices, basis.ghost_faces, basis.bending, basis.membrane)),
+      energy_(make_energy(energy, basis.scale * basis.ghost_vertices, basis.ghost_faces, basis.bending,
+                          basis.membrane, ghost_paint(basis))),
       ghost_rest_(basis.scale * flatten(basis.ghost_vertices)),
       ghost_vectors_(basis.scale * basis.ghost_vectors),
       handle_term_(HandleTerm(basis.rest, basis.mass, handles,

@@ -6,7 +6,7 @@
 //   f(q) = E_ghost(s (x̄_s + U_s q)) + E_C(q)
 //
 // E_ghost is the discrete shells energy with the basis's weights, or ARAP, of the ghost mesh
-// scaled by s; E_C the handle term with stiffness μ (handle_term.h). An iteration costs one or a
+// scaled by s, its painted stiffness the ghost vertices' means of the fine weights; E_C the handle term with stiffness μ (handle_term.h). An iteration costs one or a
 // few evaluations of E_ghost and its gradient (O(#ghost vertices · r)) plus O(r²) for BFGS and
 // the handles, whatever the size of the fine mesh; only positions() touches the fine mesh.
 //

@@ -56,6 +56,14 @@ def values(x, name, length=None):
     return x
 
 
+def stiffness_weights(w, num_vertices):
+    """(num_vertices,) float64 weights painted per vertex, or (0,) for None (a uniform material);
+    their values are checked natively."""
+    if w is None:
+        return np.zeros(0)
+    return values(w, "stiffness_weights", num_vertices)
+
+
 def labels(x, length, name="labels"):
     """(length,) int32 from integer input."""
     x = np.asarray(x)
