@@ -57,9 +57,9 @@ def values(x, name, length=None):
 
 
 def stiffness_weights(w, num_vertices):
-    """(num_vertices,) float64 weights painted per vertex, or (0,) for None (a uniform material);
-    their values are checked natively."""
-    if w is None:
+    """(num_vertices,) float64 weights painted per vertex, or (0,) for None or no weights (a
+    uniform material, as a basis baked without paint stores it); values are checked natively."""
+    if w is None or np.size(w) == 0:
         return np.zeros(0)
     return values(w, "stiffness_weights", num_vertices)
 

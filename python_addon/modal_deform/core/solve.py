@@ -163,7 +163,7 @@ class ReducedSolver:
         ``F`` (m, 3): the fine mesh's triangles (the basis keeps only its rest positions).
         ``initial`` (n, 3): where to start, by default the reduced pose ``positions()``; an
         animation passes the previous frame's refined answer. Same objective as ``solve``: the
-        handles, weights, stiffness, energy (with the basis's material weights) and the current
+        handles, weights, stiffness, energy (with the basis's material weights, painted ones too) and the current
         transforms. ``progress(stage, fraction) -> bool`` is called from time to time (False
         cancels: ``Cancelled``). Returns (positions (n, 3) float64, stats) with the stats of
         ``solve_full`` ("initial_energy" is the objective at the start). When the solve from the
@@ -195,7 +195,8 @@ class ReducedSolver:
             report = progress and (lambda stage, fraction: progress(stage, share[0] + share[1] * fraction))
             return solve_full(basis.rest, F, problem["handles"], self._transforms, stiffness=problem["stiffness"],
                               weights=problem["weights"], energy=problem["energy"], bending=basis.bending,
-                              membrane=basis.membrane, tolerance=tolerance, max_iterations=iterations,
+                              membrane=basis.membrane, stiffness_weights=basis.stiffness_weights,
+                              max_stiffness=basis.max_stiffness, tolerance=tolerance, max_iterations=iterations,
                               initial=initial, progress=report, return_stats=True)
 
         # From a good start Newton converges in a few dozen iterations; from a poor one it stalls
