@@ -67,6 +67,9 @@ class ModalDeformBakeStatus(bpy.types.PropertyGroup):
     num_vertices: IntProperty(name="Vertices", description="Vertex count of the mesh at the bake")
     topology_hash: StringProperty(name="Topology Hash", description="Faces of the mesh at the bake")
     rest_hash: StringProperty(name="Rest Hash", description="Vertex positions of the mesh at the bake")
+    stiffness_group: StringProperty(name="Stiffness Group", description="The stiffness vertex group of the bake")
+    paint_hash: StringProperty(
+        name="Paint Hash", description="Weights of the stiffness vertex group at the bake (empty: uniform)")
 
 
 class ModalDeformSettings(bpy.types.PropertyGroup):
@@ -103,6 +106,14 @@ class ModalDeformSettings(bpy.types.PropertyGroup):
         name="Membrane", default=1.0, min=0.0, soft_max=10.0,
         description="Discrete Shells: weight of the stretching terms (edge lengths, triangle areas); higher "
                     "keeps the surface's size, so poses stretch less and bend more")
+    stiffness_group: StringProperty(
+        name="Stiffness Group",
+        description="Vertex group painting where the surface is stiffer (Discrete Shells): each element's bending "
+                    "and membrane weights are multiplied by 1 + (Max - 1) times its vertices' mean weight, as "
+                    "Cloth does; empty for a uniform material. Painting it anew makes the bake stale")
+    max_stiffness: FloatProperty(
+        name="Max Stiffness", default=100.0, min=1.0, max=1e4, soft_max=1000.0,
+        description="How many times stiffer than the material a vertex of weight 1 in the stiffness group is")
     stiffness: FloatProperty(
         name="Stiffness", default=1000.0, min=1e-3, soft_min=1.0, soft_max=1e5,
         description="How hard the handles pull their vertices toward the controllers: higher follows the "

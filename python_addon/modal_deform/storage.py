@@ -13,7 +13,8 @@ their shapes in "shapes", 0-d values as plain ID properties. Reading back is a z
 ``np.frombuffer`` of each property; ``Basis.from_arrays`` checks everything.
 
 Staleness: the vertex count, a hash of the faces' corners and a hash of the rest positions at the
-bake, compared with the mesh now.
+bake, compared with the mesh now; and the stiffness vertex group with a hash of its weights
+(painting anew, choosing another group or deleting it makes the basis stale).
 """
 import collections
 import hashlib
@@ -33,12 +34,39 @@ _BAKE_ID = "bake_id"
 # Loaded bases by bake id, most recent last: a pose, a solve and the preview share one load.
 _bases = collections.OrderedDict()
 _CACHED_BASES = 2
-# Mesh fingerprints for the panel by mesh pointer, dropped when the depsgraph reports new geometry.
+# Mesh fingerprints for the panel by mesh pointer, and paint hashes by (mesh pointer, group name),
+# dropped when the depsgraph reports new geometry (weight painting is a geometry update).
 _fingerprints = {}
+_paint_hashes = {}
 
 
 class NotReady(Exception):
     """The object cannot be posed: not baked, edited since the bake, or its stored basis damaged."""
+
+
+Paint = collections.namedtuple("Paint", "group weights hash")
+Paint.__doc__ = """The painted stiffness of an object: its stiffness vertex group's name ("" for none),
+weights (#V,) float64 (None for none) and their hash ("" for none)."""
+
+
+def paint(obj):
+    """obj's painted stiffness now (Paint). Raises ValueError when the stiffness vertex group named
+    in its settings no longer exists."""
+    group = obj.modal_deform.stiffness_group
+    if not group:
+        return Paint("", None, "")
+    weights = mesh_io.group_weights(obj, group)
+    if weights is None:
+        raise ValueError(f"'{obj.name}': the stiffness vertex group '{group}' does not exist (deleted or "
+                         f"renamed?): choose another one or clear it for a uniform material")
+    return Paint(group, weights, _digest(weights))
+
+
+def _paint_hash(obj, group, cached):
+    key = (obj.data.as_pointer(), group)
+    if not cached or key not in _paint_hashes:
+        _paint_hashes[key] = _digest(mesh_io.group_weights(obj, group))
+    return _paint_hashes[key]
 
 
 def _digest(*arrays):
@@ -76,11 +104,19 @@ def stale_reason(obj, cached=False):
         return "faces changed"
     if rest != status.rest_hash:
         return "vertices moved"
+    group = obj.modal_deform.stiffness_group
+    if group != status.stiffness_group:
+        return f"stiffness group '{group}', the bake had '{status.stiffness_group}'"
+    if group and obj.vertex_groups.get(group) is None:
+        return f"stiffness group '{group}' was deleted"
+    if group and _paint_hash(obj, group, cached) != status.paint_hash:
+        return "stiffness weights painted anew"
     return ""
 
 
-def store(obj, basis, mesh_fingerprint, seconds, energy):
-    """Keep `basis` (baked from obj's mesh with `mesh_fingerprint`) in the .blend as obj's basis."""
+def store(obj, basis, mesh_fingerprint, painted, seconds, energy):
+    """Keep `basis` (baked from obj's mesh with `mesh_fingerprint` and the Paint `painted`) in the
+    .blend as obj's basis."""
     arrays = basis.to_arrays()
     block = bpy.data.palettes.new(PREFIX + obj.name)
     block.use_fake_user = False  # palettes get one by default; this one lives as long as its objects
@@ -110,6 +146,7 @@ def store(obj, basis, mesh_fingerprint, seconds, energy):
     status.baked_at = time.strftime("%Y-%m-%d %H:%M")
     status.seconds = seconds
     status.num_vertices, status.topology_hash, status.rest_hash = mesh_fingerprint
+    status.stiffness_group, status.paint_hash = painted.group, painted.hash
     _remember(bake_id, basis)
 
 
@@ -175,13 +212,17 @@ def ready_basis(obj):
 def _forget_geometry(scene, depsgraph):
     for update in depsgraph.updates:
         if update.is_updated_geometry and isinstance(update.id, bpy.types.Mesh):
-            _fingerprints.pop(update.id.original.as_pointer(), None)
+            mesh = update.id.original.as_pointer()
+            _fingerprints.pop(mesh, None)
+            for key in [key for key in _paint_hashes if key[0] == mesh]:
+                del _paint_hashes[key]
 
 
 @bpy.app.handlers.persistent
 def _forget_everything(*args):
     _bases.clear()
     _fingerprints.clear()
+    _paint_hashes.clear()
 
 
 def register():
