@@ -25,6 +25,7 @@
 #include "reduction/ghost.h"
 #include "reduction/orthonormalize.h"
 #include "reduction/prolongation.h"
+#include "reduction/region.h"
 #include "util/errors.h"
 #include "util/require_weight.h"
 #include "util/stopwatch.h"
@@ -182,6 +183,8 @@ Basis rest_state(const VerticesRef& V, const FacesRef& F, const BakeOptions& opt
   basis.membrane = options.membrane;
   basis.stiffness_weights = options.paint.weights;
   basis.max_stiffness = options.paint.max_stiffness;
+  basis.region = options.region;
+  std::sort(basis.region.begin(), basis.region.end());
   return basis;
 }
 
@@ -190,18 +193,44 @@ struct Simulated {
   Attachment attachment;
   RowMatrixX3d V;        // #S by 3
   Eigen::VectorXd mass;  // #S
-  StiffnessPaint paint;  // the painted stiffness of the simulated vertices
-  int num_rigid = 0;     // 6 per simulated component
+  // A region bake's clamped vertices (#C by 3, after the simulated ones in attachment.faces); the
+  // energy sees them, the eigenproblem does not (region.h). Empty otherwise.
+  RowMatrixX3d clamped;
+  StiffnessPaint paint;  // the painted stiffness of the simulated vertices, then the clamped ones
+  int num_rigid = 0;     // 6 per simulated component (none in a region: its boundary is fixed)
   int flexible = 0;      // modes besides the rigid motions
   Eigen::Index size() const { return V.rows(); }
+  // The rest positions the energy is built on: the simulated vertices, then the clamped ones.
+  RowMatrixX3d energy_vertices() const {
+    RowMatrixX3d all(V.rows() + clamped.rows(), 3);
+    all << V, clamped;
+    return all;
+  }
 };
+
+// 2 for a region bake: the region's free vertices are simulated, those outside it on a face with
+// them are clamped (region.h), and nothing is attached.
+Attachment region_attachment(const RegionMesh& region, Eigen::Index num_vertices) {
+  Attachment attachment;
+  attachment.simulated.assign(region.vertices.begin(), region.vertices.begin() + region.num_free);
+  attachment.submesh_index = Eigen::VectorXi::Constant(num_vertices, -1);
+  for (int s = 0; s < region.num_free; ++s) attachment.submesh_index[region.vertices[static_cast<size_t>(s)]] = s;
+  attachment.faces = region.faces;
+  attachment.component = Eigen::VectorXi::Zero(region.num_free);
+  return attachment;
+}
 
 // 2. Which vertices are simulated and which follow them (attachment.h); refuses mode counts the
 // submesh cannot give.
 Simulated simulated_submesh(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Basis& basis,
                             Progress& progress) {
   Simulated sim;
-  sim.attachment = stage("attachment", basis, progress, [&] { return attach(V, F); });
+  RegionMesh region;
+  sim.attachment = stage("attachment", basis, progress, [&] {
+    if (options.region.size() == 0) return attach(V, F);
+    region = region_mesh(F, basis.mass, options.region);
+    return region_attachment(region, V.rows());
+  });
   const std::vector<int>& simulated = sim.attachment.simulated;
   const auto S = static_cast<Eigen::Index>(simulated.size());
   sim.V.resize(S, 3);
@@ -210,8 +239,13 @@ Simulated simulated_submesh(const VerticesRef& V, const FacesRef& F, const BakeO
     sim.V.row(s) = basis.scale * V.row(simulated[static_cast<size_t>(s)]);
     sim.mass[s] = basis.scale * basis.scale * basis.mass[simulated[static_cast<size_t>(s)]];
   }
+  const std::vector<int> clamped(region.vertices.begin() + region.num_free, region.vertices.end());
+  sim.clamped = basis.scale * V(clamped, Eigen::all);
   sim.paint.max_stiffness = options.paint.max_stiffness;
-  if (options.paint.weights.size() > 0) sim.paint.weights = options.paint.weights(simulated);
+  if (options.paint.weights.size() > 0) {
+    sim.paint.weights.resize(S + static_cast<Eigen::Index>(clamped.size()));
+    sim.paint.weights << options.paint.weights(simulated), options.paint.weights(clamped);
+  }
   const int components = sim.attachment.num_components;
   sim.num_rigid = 6 * components;
   if (options.modes <= sim.num_rigid)
@@ -235,14 +269,17 @@ struct Stiffness {
 Stiffness stiffness_at_rest(const Simulated& sim, const BakeOptions& options, Basis& basis, Progress& progress) {
   return stage("hessian", basis, progress, [&] {
     Stiffness stiffness;
+    const RowMatrixX3d V = sim.energy_vertices();
     if (options.energy == EnergyKind::kShells) {
-      stiffness.shells = std::make_unique<DiscreteShells>(sim.V, sim.attachment.faces, options.bending, options.membrane,
-                                                          sim.paint);
+      stiffness.shells =
+          std::make_unique<DiscreteShells>(V, sim.attachment.faces, options.bending, options.membrane, sim.paint);
       stiffness.K = stiffness.shells->hessian(stiffness.shells->rest());
     } else {
-      const Arap arap(sim.V, sim.attachment.faces);
+      const Arap arap(V, sim.attachment.faces);
       stiffness.K = arap.hessian(arap.rest());
     }
+    // A region's clamped vertices do not move: the block of the simulated ones (a fixed boundary).
+    if (sim.clamped.rows() > 0) stiffness.K = SparseMatrix(stiffness.K.topLeftCorner(3 * sim.size(), 3 * sim.size()));
     return stiffness;
   });
 }
@@ -307,13 +344,15 @@ Eigen::MatrixXd derivative_stage(const Simulated& sim, Stiffness& stiffness, con
   phi.rightCols(sim.flexible) = modes.vectors.rightCols(sim.flexible);
   const std::vector<std::array<int, 2>> pairs =
       derivative_pairs(components_moved(phi, sim.attachment.component), options.derivatives);
+  // Modes are zero at a region's clamped vertices, which the energy has after the simulated ones.
+  phi.conservativeResizeLike(Eigen::MatrixXd::Zero(3 * (S + sim.clamped.rows()), phi.cols()));
   const DiscreteShells& shells = *stiffness.shells;
   stage("third derivatives", basis, progress, [&] {
     for (size_t first = 0; first < pairs.size(); first += kPairsPerPass) {
       progress.report("third derivatives", static_cast<double>(first) / pairs.size());
       const size_t last = std::min(pairs.size(), first + kPairsPerPass);
       const RowMatrixXd batch = shells.third_batch(shells.rest(), phi, {pairs.begin() + first, pairs.begin() + last});
-      for_row_blocks(batch.rows(), [&](Eigen::Index row, Eigen::Index rows) {
+      for_row_blocks(derivatives.rows(), [&](Eigen::Index row, Eigen::Index rows) {
         derivatives.block(row, static_cast<Eigen::Index>(first), rows, batch.cols()) = batch.middleRows(row, rows);
       });
     }
@@ -363,7 +402,7 @@ Eigen::MatrixXd orthonormal_basis(const Simulated& sim, const Eigen::MatrixXd& r
 void fine_and_ghost_vectors(Eigen::MatrixXd U, const Attachment& attachment, Ghost coarse, Basis& basis,
                             Progress& progress) {
   stage("assembly", basis, progress, [&] {
-    if (!attachment.followers.empty()) U = extend_to_attached(attachment, U);
+    if (U.rows() < basis.rest.size()) U = extend_to_attached(attachment, U);
     U /= basis.scale;
     basis.vectors = U.cast<float>();
   });
@@ -380,7 +419,8 @@ Basis bake_stages(const VerticesRef& V, const FacesRef& F, const BakeOptions& op
                   Progress& progress) {
   const Simulated sim = simulated_submesh(V, F, options, basis, progress);
   Stiffness stiffness = stiffness_at_rest(sim, options, basis, progress);
-  const Eigen::MatrixXd rigid = rigid_motions(sim.V, sim.attachment.component, sim.mass);
+  const Eigen::MatrixXd rigid = sim.num_rigid > 0 ? rigid_motions(sim.V, sim.attachment.component, sim.mass)
+                                                  : Eigen::MatrixXd(3 * sim.size(), 0);
   CholmodLLT factor(3);  // one factorisation for the modes and the derivative solves
   Ghost coarse = order_beside_the_ghost(V, F, sim, stiffness.K, options, factor, basis, progress);
   const Modes modes = vibration_stage(V, sim, stiffness.K, rigid, factor, basis, progress);
@@ -425,7 +465,7 @@ Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, 
   try {
     check_options(options, V.rows());
     validate_mesh(V, F);
-    Basis basis = options.proxy_above > 0 && V.rows() > options.proxy_above
+    Basis basis = options.proxy_above > 0 && V.rows() > options.proxy_above && options.region.size() == 0
                       ? bake_on_proxy(V, F, options, progress)
                       : bake_stages(V, F, options, rest_state(V, F, options, normalizing_scale(V)), progress);
     validate_basis(basis);

@@ -47,6 +47,9 @@ struct Basis {
   // multiplier of the energy's weights where a weight is 1.
   Eigen::VectorXd stiffness_weights;
   double max_stiffness = 1.0;
+  // A region bake's region (region.h): its fine vertices, ascending; empty for the whole mesh.
+  // The rows of vectors of every other vertex are zero.
+  Eigen::VectorXi region;
   // Derivative vectors dropped by the orthonormalisation as numerically dependent.
   int num_dropped = 0;
   // Seconds spent in each stage of the bake, by stage name.
@@ -88,6 +91,7 @@ void for_each_stored_field(Visit&& visit) {
   visit("prolongation_weights", 2, [](auto& b) -> auto& { return b.prolongation.weights; });
   visit("stiffness_weights", 3, [](auto& b) -> auto& { return b.stiffness_weights; });
   visit("max_stiffness", 3, [](auto& b) -> auto& { return b.max_stiffness; });
+  visit("region", 3, [](auto& b) -> auto& { return b.region; });
 }
 
 // Throws InputError naming the first array that is missing, of the wrong shape, non-finite or
@@ -97,7 +101,8 @@ void for_each_stored_field(Visit&& visit) {
 // coordinates within require_positions's range, scale = normalizing_scale(rest), ghost vertices
 // inside the bounding box of rest forming a usable mesh, and ghost vector entries no larger than
 // the largest entry of their column of vectors (they are weighted means of them); a prolongation's
-// proxy vertices in range and its weights barycentric; the painted stiffness as the bake takes it.
+// proxy vertices in range and its weights barycentric; the painted stiffness as the bake takes it;
+// a region's vertices ascending and in range, not on a proxy, with zero rows outside it.
 void validate_basis(const Basis& basis);
 
 // The painted stiffness of the basis's ghost (restrict_to_ghost of the fine weights).

@@ -89,17 +89,18 @@ void bind_bake(py::module_& m) {
       "bake",
       [](const VerticesRef& V, const FacesRef& F, int modes, int derivatives, int ghost, const std::string& energy,
          double bending, double membrane, bool rotation_pairs, int proxy_above, int proxy,
-         const Eigen::VectorXd& stiffness_weights, double max_stiffness, const py::object& progress) {
-        const BakeOptions options{modes,       derivatives, ghost, energy_kind(energy),
-                                  bending,     membrane,    rotation_pairs,
-                                  proxy_above, proxy,       StiffnessPaint{stiffness_weights, max_stiffness}};
+         const Eigen::VectorXd& stiffness_weights, double max_stiffness, const Eigen::VectorXi& region,
+         const py::object& progress) {
+        const BakeOptions options{modes,    derivatives,    ghost,       energy_kind(energy),
+                                  bending,  membrane,       rotation_pairs, proxy_above,
+                                  proxy,    StiffnessPaint{stiffness_weights, max_stiffness}, region};
         Progress reporter(python_progress(progress));
         py::gil_scoped_release release;
         return bake(V, F, options, reporter);
       },
       py::arg("V"), py::arg("F"), py::arg("modes"), py::arg("derivatives"), py::arg("ghost"), py::arg("energy"),
       py::arg("bending"), py::arg("membrane"), py::arg("rotation_pairs"), py::arg("proxy_above"), py::arg("proxy"),
-      py::arg("stiffness_weights"), py::arg("max_stiffness"), py::arg("progress"));
+      py::arg("stiffness_weights"), py::arg("max_stiffness"), py::arg("region"), py::arg("progress"));
 }
 
 }  // namespace modal_deform

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "reduction/region.h"
 #include "util/errors.h"
 #include "util/require_positions.h"
 #include "util/require_weight.h"
@@ -42,6 +43,7 @@ ReducedSolver::ReducedSolver(const Basis& basis, const Handles& handles, const V
                               checked_handle_weights(handles, weights, basis.num_vertices()),
                               checked_stiffness(stiffness) * std::pow(basis.scale, 4)),
                    [&basis](int v) { return basis.vertex_rows(v); }, basis.dimension()) {
+  require_handles_in_region(handles, basis.region);
   const Eigen::Index r = basis.dimension();
   if (warm_start) {
     const SparseMatrix K = energy_->hessian(ghost_rest_);

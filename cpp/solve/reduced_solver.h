@@ -46,7 +46,7 @@ class ReducedSolver {
  public:
   // basis: validated here (validate_basis); it must outlive the solver, which keeps a reference
   // to its fine arrays. handles, weights: see checked_handle_weights (fine vertex indices; empty
-  // weights mean 1). stiffness: μ > 0. energy: evaluated on the ghost. warm_start false starts
+  // weights mean 1), inside the basis's region if it has one (require_handles_in_region). stiffness: μ > 0. energy: evaluated on the ghost. warm_start false starts
   // BFGS from the identity instead of the rest Hessian (for comparison). The solver starts at
   // rest with identity transforms.
   ReducedSolver(const Basis& basis, const Handles& handles, const VectorRef& weights, double stiffness,

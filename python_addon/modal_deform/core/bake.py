@@ -51,7 +51,8 @@ class Basis:
     are the rest mesh's positions and lumped masses (mesh units), ``scale`` the factor from mesh
     units to the normalised frame, ``bending`` and ``membrane`` the energy's weights, and
     ``stiffness_weights`` (n,) float64 (or (0,): uniform) with ``max_stiffness`` their painting per
-    vertex (see ``bake``), which the solver's ghost takes over as means.
+    vertex (see ``bake``), which the solver's ghost takes over as means. ``region`` (k,) int32: a
+    region bake's vertices, ascending ((0,) for the whole mesh); all rows of other vertices are 0.
 
     A dense mesh baked on a proxy (``on_proxy``) keeps the proxy's basis: ``vectors`` is then
     (3p, r) over its ``num_basis_vertices`` = p vertices, and each fine vertex i moves with
@@ -169,7 +170,8 @@ def _flag(value, name):
 
 
 def bake(V, F, modes=20, derivatives=52, ghost=1000, energy="shells", bending=1.0, membrane=1.0, progress=None,
-         rotation_pairs=True, proxy=PROXY, proxy_above=PROXY_ABOVE, stiffness_weights=None, max_stiffness=100.0):
+         rotation_pairs=True, proxy=PROXY, proxy_above=PROXY_ABOVE, stiffness_weights=None, max_stiffness=100.0,
+         region=None):
     """Bake the reduced space of the triangle mesh (V (n, 3), F (m, 3)) for posing.
 
     modes: vibration modes, the rigid motions of the simulated components (6 each) included;
@@ -189,6 +191,11 @@ def bake(V, F, modes=20, derivatives=52, ghost=1000, energy="shells", bending=1.
     is multiplied by 1 + (max_stiffness − 1) × the mean weight of its vertices (max_stiffness in
     [1, 1e4]); the modes, derivatives, proxy and ghost all see it, and so does the solver (shells
     only; all-zero weights give the plain bake).
+    region: None (the whole mesh moves) or the indices of the vertices that may move: every other
+    vertex stays exactly at rest (its rows of the basis are zero), the faces around the region
+    hold it as a fixed boundary, and all the modes and derivatives are spent inside it (no rigid
+    motions, but for a part of the region that touches nothing outside: its come as zero modes).
+    Handles must lie in it. Never on a proxy (``Basis.region`` keeps it, ascending).
     ``progress(stage, fraction)`` is called
     at least every second or so (not during a CHOLMOD factorisation, about 2 s at 100k vertices);
     returning False raises ``Cancelled``, and an exception it raises propagates.
@@ -199,6 +206,10 @@ def bake(V, F, modes=20, derivatives=52, ghost=1000, energy="shells", bending=1.
     the rigid motions, and get no modal derivatives.
     """
     V, F = _arrays.vertices(V), _arrays.faces(F)
+    if region is not None:
+        region = _arrays.indices(region, "region")
+        if not region.size:
+            raise ValueError("region: it has no vertices; give the vertices that may move, or None for the whole mesh")
     if not isinstance(energy, str):
         raise ValueError(f"energy: expected \"shells\" or \"arap\", got {energy!r}")
     if progress is not None and not callable(progress):
@@ -209,10 +220,12 @@ def bake(V, F, modes=20, derivatives=52, ghost=1000, energy="shells", bending=1.
                           0 if proxy is None else _count(proxy_above, "proxy_above", 1),
                           4 if proxy is None else _count(proxy, "proxy", 4),
                           _arrays.stiffness_weights(stiffness_weights, len(V)),
-                          _arrays.number(max_stiffness, "max_stiffness"), progress)
+                          _arrays.number(max_stiffness, "max_stiffness"),
+                          np.zeros(0, np.int32) if region is None else region, progress)
     basis = Basis(native)
     if basis.num_floppy:
         warnings.warn(f"the mesh is floppy: it has {basis.num_floppy} zero modes besides its rigid motions "
-                      f"(mechanisms, e.g. flaps at non-manifold edges or vertices); they are in the basis on top "
-                      f"of the {modes} modes asked for, without modal derivatives", stacklevel=2)
+                      f"(mechanisms, e.g. flaps at non-manifold edges or vertices, or the rigid motions of a part of "
+                      f"the region that touches nothing outside it); they are in the basis on top of the {modes} "
+                      f"modes asked for, without modal derivatives", stacklevel=2)
     return basis
