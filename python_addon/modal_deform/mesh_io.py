@@ -53,11 +53,15 @@ def group_weights(obj, group_name):
     return weights
 
 
+def members(weights):
+    """Sorted int32 indices of the vertices with a weight above 0 (of group_weights)."""
+    return np.flatnonzero(weights > 0.0).astype(np.int32)
+
+
 def group_vertices(obj, group_name):
-    """Sorted int32 indices of the vertices with a weight above 0 in the vertex group, or None when
-    the object has no group of that name (group_weights)."""
+    """The members of the vertex group, or None when the object has no group of that name."""
     weights = group_weights(obj, group_name)
-    return None if weights is None else np.flatnonzero(weights > 0.0).astype(np.int32)
+    return None if weights is None else members(weights)
 
 
 def selected_vertices(mesh):

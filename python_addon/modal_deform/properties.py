@@ -68,8 +68,11 @@ class ModalDeformBakeStatus(bpy.types.PropertyGroup):
     topology_hash: StringProperty(name="Topology Hash", description="Faces of the mesh at the bake")
     rest_hash: StringProperty(name="Rest Hash", description="Vertex positions of the mesh at the bake")
     stiffness_group: StringProperty(name="Stiffness Group", description="The stiffness vertex group of the bake")
-    paint_hash: StringProperty(
-        name="Paint Hash", description="Weights of the stiffness vertex group at the bake (empty: uniform)")
+    stiffness_group_hash: StringProperty(
+        name="Stiffness Hash", description="Weights of the stiffness vertex group at the bake (empty: uniform)")
+    region_group: StringProperty(name="Region Group", description="The region vertex group of the bake")
+    region_group_hash: StringProperty(
+        name="Region Hash", description="Weights of the region vertex group at the bake (empty: the whole mesh)")
 
 
 class ModalDeformSettings(bpy.types.PropertyGroup):
@@ -114,6 +117,12 @@ class ModalDeformSettings(bpy.types.PropertyGroup):
     max_stiffness: FloatProperty(
         name="Max Stiffness", default=100.0, min=1.0, max=1e4, soft_max=1000.0,
         description="How many times stiffer than the material a vertex of weight 1 in the stiffness group is")
+    region_group: StringProperty(
+        name="Region Group",
+        description="Vertex group of the vertices that may move (weight above 0), as Laplacian Deform takes one: "
+                    "every other vertex stays exactly where it is, and the whole basis is spent inside the region, "
+                    "so a hand or a head of a dense character bakes quickly; handles must lie in it. Empty for the "
+                    "whole mesh")
     stiffness: FloatProperty(
         name="Stiffness", default=1000.0, min=1e-3, soft_min=1.0, soft_max=1e5,
         description="How hard the handles pull their vertices toward the controllers: higher follows the "

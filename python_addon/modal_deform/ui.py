@@ -77,6 +77,7 @@ class VIEW3D_PT_modal_deform_bake(_Panel, bpy.types.Panel):
         row = painted.row()
         row.enabled = bool(settings.stiffness_group)
         row.prop(settings, "max_stiffness", text="Max")
+        column.prop_search(settings, "region_group", obj, "vertex_groups", text="Region Group")
 
         box = layout.box()
         if settings.basis is None:
