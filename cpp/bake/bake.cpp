@@ -112,7 +112,7 @@ Modes flexible_modes(const SparseMatrix& K, const Eigen::VectorXd& mass, const E
 // bake stops early, the destructor cancels the ghost and waits, so nothing outlives the bake.
 class GhostInBackground {
  public:
-  GhostInBackground(const VerticesRef& V, const FacesRef& F, const Eigen::VectorXd& mass, int target)
+  GhostInBackground(const VerticesRef& V, const FacesRef& F, const VectorRef& mass, int target)
       : progress_([this](const std::string&, double fraction) {
           fraction_ = fraction;
           return !stop_.load();
@@ -196,6 +196,9 @@ struct Simulated {
   // A region bake's clamped vertices (#C by 3, after the simulated ones in attachment.faces); the
   // energy sees them, the eigenproblem does not (region.h). Empty otherwise.
   RowMatrixX3d clamped;
+  // A region bake's submesh: the fine indices of the simulated vertices, then the clamped ones.
+  // Empty otherwise.
+  std::vector<int> region_vertices;
   StiffnessPaint paint;  // the painted stiffness of the simulated vertices, then the clamped ones
   int num_rigid = 0;     // 6 per simulated component (none in a region: its boundary is fixed)
   int flexible = 0;      // modes besides the rigid motions
@@ -240,6 +243,7 @@ Simulated simulated_submesh(const VerticesRef& V, const FacesRef& F, const BakeO
     sim.mass[s] = basis.scale * basis.scale * basis.mass[simulated[static_cast<size_t>(s)]];
   }
   const std::vector<int> clamped(region.vertices.begin() + region.num_free, region.vertices.end());
+  sim.region_vertices = region.vertices;
   sim.clamped = basis.scale * V(clamped, Eigen::all);
   sim.paint.max_stiffness = options.paint.max_stiffness;
   if (options.paint.weights.size() > 0) {
@@ -284,13 +288,23 @@ Stiffness stiffness_at_rest(const Simulated& sim, const BakeOptions& options, Ba
   });
 }
 
-// 4. CHOLMOD orders K while the ghost of the whole mesh is simplified beside it (stage 8 uses
+// What the ghost simplifies (mesh units): the whole mesh, or a region bake's submesh (its
+// simulated vertices, then the clamped ones, Simulated::region_vertices), so that all of the
+// ghost's vertices are spent where the mesh moves.
+struct GhostSource {
+  VerticesRef V;
+  FacesRef F;
+  VectorRef mass;
+};
+
+// 4. CHOLMOD orders K while the ghost of what moves (GhostSource) is simplified beside it (stage 8 uses
 // it). Analysed here rather than inside the eigensolver's first factorisation, so the bar moves
 // between the two (CHOLMOD reports nothing during either), and so that the factor's size is known
 // before the numeric factorisation: what cannot fit is refused at once, not half a minute later.
-Ghost order_beside_the_ghost(const VerticesRef& V, const FacesRef& F, const Simulated& sim, const SparseMatrix& K,
-                             const BakeOptions& options, CholmodLLT& factor, Basis& basis, Progress& progress) {
-  GhostInBackground ghost(V, F, basis.mass, options.ghost);
+Ghost order_beside_the_ghost(const VerticesRef& V, const GhostSource& source, const Simulated& sim,
+                             const SparseMatrix& K, const BakeOptions& options, CholmodLLT& factor, Basis& basis,
+                             Progress& progress) {
+  GhostInBackground ghost(source.V, source.F, source.mass, options.ghost);
   progress.report("factorisation", 0.0);
   try {
     factor.analyze(K);
@@ -398,19 +412,36 @@ Eigen::MatrixXd orthonormal_basis(const Simulated& sim, const Eigen::MatrixXd& r
 }
 
 // 8. The fine basis (attached rows added, mesh units, single precision) and the ghost's,
-// restricted from the double-precision one (rigid motions stay exact).
-void fine_and_ghost_vectors(Eigen::MatrixXd U, const Attachment& attachment, Ghost coarse, Basis& basis,
-                            Progress& progress) {
+// restricted from the double-precision one (rigid motions stay exact), with the ghost's painted
+// stiffness. A region's ghost is its submesh's: restricted from the submesh's rows, and the
+// vertices outside the submesh, which never move, map to ghost vertex 0 (the solver reads only
+// the ghost's own arrays).
+void fine_and_ghost_vectors(Eigen::MatrixXd U, const Simulated& sim, const GhostSource& source, Ghost coarse,
+                            const StiffnessPaint& paint, Basis& basis, Progress& progress) {
   stage("assembly", basis, progress, [&] {
-    if (U.rows() < basis.rest.size()) U = extend_to_attached(attachment, U);
+    if (U.rows() < basis.rest.size()) U = extend_to_attached(sim.attachment, U);
     U /= basis.scale;
     basis.vectors = U.cast<float>();
   });
   stage("ghost", basis, progress, [&] {
-    basis.ghost_vectors = restrict_to_ghost(coarse, basis.mass, U);
+    const int g = static_cast<int>(coarse.V.rows());
+    const std::vector<int>& sub = sim.region_vertices;
+    if (sub.empty()) {
+      basis.ghost_vectors = restrict_to_ghost(coarse, source.mass, U);
+      basis.ghost_stiffness_weights = restrict_to_ghost(coarse.map, g, source.mass, paint).weights;
+      basis.ghost_map = std::move(coarse.map);
+    } else {
+      Eigen::MatrixXd rows(3 * static_cast<Eigen::Index>(sub.size()), U.cols());
+      for (size_t i = 0; i < sub.size(); ++i) rows.middleRows<3>(3 * static_cast<Eigen::Index>(i)) = U.middleRows<3>(3 * static_cast<Eigen::Index>(sub[i]));
+      basis.ghost_vectors = restrict_to_ghost(coarse, source.mass, rows);
+      StiffnessPaint on_submesh{Eigen::VectorXd(), paint.max_stiffness};
+      if (paint.weights.size() > 0) on_submesh.weights = paint.weights(sub);
+      basis.ghost_stiffness_weights = restrict_to_ghost(coarse.map, g, source.mass, on_submesh).weights;
+      basis.ghost_map = Eigen::VectorXi::Zero(basis.rest.rows());
+      basis.ghost_map(sub) = coarse.map;
+    }
     basis.ghost_vertices = std::move(coarse.V);
     basis.ghost_faces = std::move(coarse.F);
-    basis.ghost_map = std::move(coarse.map);
   });
 }
 
@@ -422,12 +453,18 @@ Basis bake_stages(const VerticesRef& V, const FacesRef& F, const BakeOptions& op
   const Eigen::MatrixXd rigid = sim.num_rigid > 0 ? rigid_motions(sim.V, sim.attachment.component, sim.mass)
                                                   : Eigen::MatrixXd(3 * sim.size(), 0);
   CholmodLLT factor(3);  // one factorisation for the modes and the derivative solves
-  Ghost coarse = order_beside_the_ghost(V, F, sim, stiffness.K, options, factor, basis, progress);
+  const RowMatrixX3d region_V = V(sim.region_vertices, Eigen::all);
+  const RowMatrixX3i region_F = sim.attachment.faces;
+  const Eigen::VectorXd region_mass = basis.mass(sim.region_vertices);
+  const bool in_region = !sim.region_vertices.empty();
+  const GhostSource source{in_region ? VerticesRef(region_V) : V, in_region ? FacesRef(region_F) : F,
+                           in_region ? VectorRef(region_mass) : VectorRef(basis.mass)};
+  Ghost coarse = order_beside_the_ghost(V, source, sim, stiffness.K, options, factor, basis, progress);
   const Modes modes = vibration_stage(V, sim, stiffness.K, rigid, factor, basis, progress);
   Eigen::MatrixXd derivatives = derivative_stage(sim, stiffness, rigid, modes, options, factor, basis, progress);
   basis.timings["factorisation"] = factor.seconds();
   Eigen::MatrixXd U = orthonormal_basis(sim, rigid, modes, std::move(derivatives), options, basis, progress);
-  fine_and_ghost_vectors(std::move(U), sim.attachment, std::move(coarse), basis, progress);
+  fine_and_ghost_vectors(std::move(U), sim, source, std::move(coarse), options.paint, basis, progress);
   return basis;
 }
 

@@ -6,7 +6,6 @@
 
 #include "mesh/mesh_check.h"
 #include "mesh/normalization.h"
-#include "reduction/ghost.h"
 #include "util/errors.h"
 #include "util/require_positions.h"
 #include "util/require_weight.h"
@@ -82,10 +81,6 @@ Eigen::Matrix<double, 3, Eigen::Dynamic> Basis::vertex_rows(int v) const {
   return rows;
 }
 
-StiffnessPaint ghost_paint(const Basis& b) {
-  return restrict_to_ghost(b.ghost_map, static_cast<int>(b.ghost_vertices.rows()), b.mass, b.paint());
-}
-
 void validate_basis(const Basis& b) {
   const Eigen::Index n = b.rest.rows(), r = b.vectors.cols(), g = b.ghost_vertices.rows();
   require(n > 0, "rest has no vertices");
@@ -114,7 +109,10 @@ void validate_basis(const Basis& b) {
     require_weight(b.bending, "bending");
     require_weight(b.membrane, "membrane");
     require_stiffness_paint(b.paint(), n);
+    require_stiffness_paint(ghost_paint(b), g, "ghost_stiffness_weights");
   });
+  require((b.stiffness_weights.size() == 0) == (b.ghost_stiffness_weights.size() == 0),
+          "ghost_stiffness_weights: the ghost is painted when and only when the mesh is");
   require(b.num_dropped >= 0, "num_dropped is negative");
   require_shared([&] { require_vertices(b.rest, "rest"); });
   const double extent = bounding_box_extent(b.rest);

@@ -33,12 +33,16 @@ struct Basis {
   Eigen::VectorXd eigenvalues;  // num_modes, ascending (normalised frame)
   // Empty, or for a basis baked on a proxy the map from the proxy's vertices to the fine ones.
   Prolongation prolongation;
-  // Ghost: #G by 3 rest positions, #H by 3 triangles, #V fine vertex -> ghost vertex, and
+  // Ghost: #G by 3 rest positions, #H by 3 triangles, #V fine vertex -> ghost vertex (a region
+  // bake's: its submesh's; every vertex outside maps to 0), and
   // 3g by r restricted basis (mass-weighted means over each ghost vertex's preimage).
   RowMatrixX3d ghost_vertices;
   RowMatrixX3i ghost_faces;
   Eigen::VectorXi ghost_map;
   Eigen::MatrixXd ghost_vectors;
+  // #G: the painted stiffness of the ghost (mass-weighted means of the fine weights over each
+  // ghost vertex's preimage, restrict_to_ghost), empty when stiffness_weights is.
+  Eigen::VectorXd ghost_stiffness_weights;
   // Energy the basis was built for and the scale of the normalised frame.
   double scale = 1.0;
   double bending = 1.0;
@@ -92,6 +96,7 @@ void for_each_stored_field(Visit&& visit) {
   visit("stiffness_weights", 3, [](auto& b) -> auto& { return b.stiffness_weights; });
   visit("max_stiffness", 3, [](auto& b) -> auto& { return b.max_stiffness; });
   visit("region", 3, [](auto& b) -> auto& { return b.region; });
+  visit("ghost_stiffness_weights", 3, [](auto& b) -> auto& { return b.ghost_stiffness_weights; });
 }
 
 // Throws InputError naming the first array that is missing, of the wrong shape, non-finite or
@@ -105,7 +110,9 @@ void for_each_stored_field(Visit&& visit) {
 // a region's vertices ascending and in range, not on a proxy, with zero rows outside it.
 void validate_basis(const Basis& basis);
 
-// The painted stiffness of the basis's ghost (restrict_to_ghost of the fine weights).
-StiffnessPaint ghost_paint(const Basis& basis);
+// The painted stiffness of the basis's ghost.
+inline StiffnessPaint ghost_paint(const Basis& basis) {
+  return {basis.ghost_stiffness_weights, basis.max_stiffness};
+}
 
 }  // namespace modal_deform

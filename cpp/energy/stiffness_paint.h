@@ -39,7 +39,8 @@ struct StiffnessPaint {
 
 // Throws InputError naming what is wrong: max_stiffness outside [1, kMaxStiffness] (NaN too),
 // weights neither empty nor one per vertex (num_vertices), or a weight that is not a number in
-// [0, 1] (naming the first such vertex).
-void require_stiffness_paint(const StiffnessPaint& paint, Eigen::Index num_vertices);
+// [0, 1] (naming the first such vertex). `name` names the weights in the messages.
+void require_stiffness_paint(const StiffnessPaint& paint, Eigen::Index num_vertices,
+                             const char* name = "stiffness_weights");
 
 }  // namespace modal_deform

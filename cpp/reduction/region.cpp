@@ -8,7 +8,7 @@ namespace modal_deform {
 
 RegionMesh region_mesh(const FacesRef& F, const VectorRef& mass, const Eigen::Ref<const Eigen::VectorXi>& region) {
   const Eigen::Index n = mass.size();
-  // 1: in the region, 2: free (in the region, with mass), 3: clamped.
+  // 1: in the region, 2: free (in the region, with mass), 3 and 4: clamped (below).
   std::vector<char> kind(static_cast<size_t>(n), 0);
   for (Eigen::Index i = 0; i < region.size(); ++i) {
     const int v = region[i];
@@ -19,20 +19,32 @@ RegionMesh region_mesh(const FacesRef& F, const VectorRef& mass, const Eigen::Re
   if (region.size() == n)
     throw InputError("region: it holds every vertex, so nothing is clamped; bake without a region instead");
   RegionMesh mesh;
-  std::vector<int> faces;
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    if (kind[F(f, 0)] != 2 && kind[F(f, 1)] != 2 && kind[F(f, 2)] != 2) continue;
-    faces.push_back(static_cast<int>(f));
+  // The first ring (3): vertices on a face with a free vertex. The faces on them hold every term
+  // that moves: a bending term spans the two faces of an edge, and a face with a free vertex
+  // shares its edges with faces that may have none.
+  // The second ring (4): the other vertices of those faces. Both rings are clamped.
+  const auto touches = [&](Eigen::Index f, char low, char high) {
     for (int k = 0; k < 3; ++k)
-      if (kind[F(f, k)] != 2) kind[F(f, k)] = 3;
-  }
+      if (kind[F(f, k)] >= low && kind[F(f, k)] <= high) return true;
+    return false;
+  };
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    if (touches(f, 2, 2))
+      for (int k = 0; k < 3; ++k)
+        if (kind[F(f, k)] != 2) kind[F(f, k)] = 3;
+  std::vector<int> faces;
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    if (touches(f, 2, 3)) faces.push_back(static_cast<int>(f));
+  for (int f : faces)
+    for (int k = 0; k < 3; ++k)
+      if (kind[F(f, k)] < 2) kind[F(f, k)] = 4;
   std::vector<int> local(static_cast<size_t>(n), -1);
-  for (const char wanted : {2, 3})
+  for (const bool free : {true, false})
     for (int v = 0; v < n; ++v)
-      if (kind[v] == wanted) {
+      if (free ? kind[v] == 2 : kind[v] >= 3) {
         local[v] = static_cast<int>(mesh.vertices.size());
         mesh.vertices.push_back(v);
-        if (wanted == 2) ++mesh.num_free;
+        if (free) ++mesh.num_free;
       }
   if (mesh.num_free == 0)
     throw InputError("region: no vertex of it is left free (each lies on no face with area); paint the region on "
