@@ -86,3 +86,15 @@ def test_bad_regions_are_refused_naming_them(tube):
                            (arrays["region"][1:], "vectors: vertex %d lies outside the region" % region[0])]:
         with pytest.raises(ValueError, match=message):
             mdc.Basis.from_arrays({**arrays, "region": value})
+
+
+def test_the_solver_minimises_the_whole_mesh_energy_with_the_outside_held(tube):
+    """The region's ghost (its submesh, here whole) holds every term that moves, the bending terms
+    across its boundary ring included: its energy at any q is the whole mesh's."""
+    V, F, region = tube
+    basis = mdc.bake(V, F, modes=12, derivatives=20, ghost=1000, region=region)
+    q = np.random.default_rng(2).normal(scale=0.02, size=basis.dimension)
+    f1, f2 = (mdc.ReducedSolver(basis, [region[-10:]], stiffness=mu).objective(q)[0] for mu in (1.0, 2.0))
+    s = basis.scale
+    X = s * (V.reshape(-1) + basis.vectors.astype(np.float64) @ q)
+    assert 2 * f1 - f2 == pytest.approx(mdc.DiscreteShells(s * V, F).value(X), rel=1e-6)

@@ -46,7 +46,8 @@ class Basis:
     motions). ``num_floppy`` modes after the rigid ones are zero modes of a floppy mesh
     (mechanisms, e.g. flaps at non-manifold vertices); ``num_dropped`` derivatives were dropped as
     numerically dependent. ``ghost_vertices`` (g, 3), ``ghost_faces`` (h, 3) int32 and
-    ``ghost_map`` (n,) int32 describe the ghost, ``ghost_vectors`` (3g, r) the restricted basis.
+    ``ghost_map`` (n,) int32 describe the ghost (a region bake's ghost is its submesh's, and the
+    vertices outside that map to 0), ``ghost_vectors`` (3g, r) the restricted basis.
     ``timings`` maps each bake stage to seconds. ``rest`` (n, 3) float64 and ``mass`` (n,) float64
     are the rest mesh's positions and lumped masses (mesh units), ``scale`` the factor from mesh
     units to the normalised frame, ``bending`` and ``membrane`` the energy's weights, and
