@@ -297,8 +297,8 @@ struct GhostSource {
   VectorRef mass;
 };
 
-// 4. CHOLMOD orders K while the ghost of what moves (GhostSource) is simplified beside it (stage 8 uses
-// it). Analysed here rather than inside the eigensolver's first factorisation, so the bar moves
+// 4. CHOLMOD orders K while the ghost of what moves (GhostSource) is simplified beside it (stage
+// 8 uses it). Analysed here rather than inside the eigensolver's first factorisation, so the bar moves
 // between the two (CHOLMOD reports nothing during either), and so that the factor's size is known
 // before the numeric factorisation: what cannot fit is refused at once, not half a minute later.
 Ghost order_beside_the_ghost(const VerticesRef& V, const GhostSource& source, const Simulated& sim,
@@ -432,7 +432,8 @@ void fine_and_ghost_vectors(Eigen::MatrixXd U, const Simulated& sim, const Ghost
       basis.ghost_map = std::move(coarse.map);
     } else {
       Eigen::MatrixXd rows(3 * static_cast<Eigen::Index>(sub.size()), U.cols());
-      for (size_t i = 0; i < sub.size(); ++i) rows.middleRows<3>(3 * static_cast<Eigen::Index>(i)) = U.middleRows<3>(3 * static_cast<Eigen::Index>(sub[i]));
+      for (size_t i = 0; i < sub.size(); ++i)
+        rows.middleRows<3>(3 * static_cast<Eigen::Index>(i)) = U.middleRows<3>(3 * static_cast<Eigen::Index>(sub[i]));
       basis.ghost_vectors = restrict_to_ghost(coarse, source.mass, rows);
       StiffnessPaint on_submesh{Eigen::VectorXd(), paint.max_stiffness};
       if (paint.weights.size() > 0) on_submesh.weights = paint.weights(sub);
