@@ -29,7 +29,7 @@ assert basis.num_rigid == 0
 # A handle outside the ear: refused, naming the region.
 outside = support.add_handle(obj, V[:, 2] < -0.7)
 outside.controller = None
-support.expect_error(bpy.ops.modal_deform.solve, "lies outside the basis's region")
+support.expect_error(bpy.ops.modal_deform.solve, "vertices outside the region the basis was baked with")
 bpy.ops.modal_deform.remove_handle()
 tip = support.add_handle(obj, V[:, 0] > 1.25)
 tip.controller.matrix_world = Matrix.Translation((0.0, 0.0, 0.3)) @ tip.controller.matrix_world
