@@ -152,3 +152,22 @@ def test_the_paint_is_stored_and_checked(bar):
            if name not in ("stiffness_weights", "max_stiffness", "region", "ghost_stiffness_weights")}
     old["format_version"] = np.array(2, dtype=np.int32)
     assert mdc.Basis.from_arrays(old).stiffness_weights.shape == (0,)
+
+
+def test_a_proxy_bake_carries_the_paint(bar):
+    """A mesh baked on a proxy: the proxy's elements and the ghost's take the fine weights' means,
+    and the basis keeps the fine weights; the stiff middle still holds."""
+    V, F, ends, transforms = bar
+    middle = (V[:, 2] > 2) & (V[:, 2] < 4)
+    basis = mdc.bake(V, F, modes=16, derivatives=40, ghost=150, proxy=200, proxy_above=250,
+                     stiffness_weights=middle.astype(float), max_stiffness=100.0)
+    assert basis.on_proxy and basis.num_basis_vertices < len(V)
+    np.testing.assert_array_equal(basis.stiffness_weights, middle.astype(float))
+    ghost_weights = basis.ghost_stiffness_weights
+    assert ghost_weights.shape == (len(basis.ghost_vertices),) and 0 < ghost_weights.mean() < 1
+    solver = mdc.ReducedSolver(basis, ends, stiffness=1e3)
+    solver.set_transforms(transforms)
+    solver.solve(max_iterations=400, tolerance=1e-9)
+    uniform = pose(V, F, ends, transforms)
+    posed = solver.positions().astype(np.float64)
+    assert rigid_deviation(V[middle], posed[middle]) < 0.2 * rigid_deviation(V[middle], uniform[middle])
