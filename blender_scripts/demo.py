@@ -5,8 +5,14 @@ with the same handles.
 
     blender -b --factory-startup --python blender_scripts/demo.py -- --output out
 
-Writes OUTPUT/demo.png (Cycles on the CPU: rest, Modal Deform, Laplacian Deform side by side) and
-OUTPUT/demo.blend, ready to pose: select the mesh, Sidebar > Modal Deform > Pose, then move the
+A second row shows what vertex groups paint (issue 24): a finger of three stiff phalanges and soft
+knuckles (a Stiffness Group) curled by its tip against the same tube of uniform material, and
+Suzanne's left ear baked as a Region Group and pulled up while every other vertex stays exactly
+where it was.
+
+Writes OUTPUT/demo.png (Cycles on the CPU: rest, Modal Deform, Laplacian Deform side by side; below
+them the uniform and the painted finger and the ear) and OUTPUT/demo.blend (Suzanne alone), ready to
+pose: select the mesh, Sidebar > Modal Deform > Pose, then move the
 Empties with G/R. Prints the bake time, the time per interactive update and how much each result
 stretches the surface.
 """
@@ -98,6 +104,88 @@ def edge_strain(mesh, rest, posed):
     return strain.mean(), strain.max()
 
 
+def curled_finger(mdc, name, painted, x):
+    """A tube along z (a finger 2 long) at `x`, held at its base ring and its tip ring curled by 60°
+    about each knuckle (about the y axis, seen from the camera); with `painted`, a Stiffness Group
+    makes its three phalanges 100 times stiffer than its two knuckles. Returns the object, posed."""
+    V, F = mdc.cylinder(24, 60, 0.16, 2.0)
+    V[:, 0] += x
+    obj = bpy.data.objects.new(name, bpy.data.meshes.new(name))
+    obj.data.from_pydata([tuple(v) for v in V], [], [tuple(f) for f in F])
+    bpy.context.scene.collection.objects.link(obj)
+    obj.location.z = -1.0
+    knuckles = [(0.6, 0.8), (1.3, 1.5)]
+    settings = obj.modal_deform
+    settings.modes, settings.derivatives, settings.ghost = 16, 40, 1000
+    if painted:
+        group = obj.vertex_groups.new(name="Phalanges")
+        soft = np.zeros(len(V), bool)
+        for low, high in knuckles:
+            soft |= (V[:, 2] > low) & (V[:, 2] < high)
+        group.add([int(i) for i in np.flatnonzero(~soft)], 1.0, "REPLACE")
+        settings.stiffness_group, settings.max_stiffness = "Phalanges", 100.0
+    bpy.context.view_layer.objects.active = obj
+    assert bpy.ops.modal_deform.bake() == {"FINISHED"}
+    add_handle(obj, V[:, 2] < 1e-6).controller = None
+    tip = add_handle(obj, V[:, 2] > 2 - 1e-6)
+    curl = Matrix()
+    for low, high in reversed(knuckles):
+        pivot = obj.matrix_world @ Vector((x, 0.0, (low + high) / 2))
+        curl = Matrix.Translation(pivot) @ Matrix.Rotation(math.radians(60), 4, "Y") @ \
+            Matrix.Translation(-pivot) @ curl
+    tip.controller.matrix_world = curl @ tip.controller.matrix_world
+    bpy.context.view_layer.update()
+    assert bpy.ops.modal_deform.solve() == {"FINISHED"}
+    obj.data.polygons.foreach_set("use_smooth", [True] * len(obj.data.polygons))
+    return obj
+
+
+def pulled_ear(suzanne, V):
+    """A copy of Suzanne whose left ear (x > 0.75) alone is baked as a Region Group and pulled up
+    and out by its tip; every other vertex stays exactly at rest. Returns the object, posed."""
+    ear = bpy.data.objects.new("Ear", suzanne.data.copy())
+    ear.matrix_world = suzanne.matrix_world
+    ear.shape_key_clear()
+    bpy.context.scene.collection.objects.link(ear)
+    region = ear.vertex_groups.new(name="Ear")
+    region.add([int(i) for i in np.flatnonzero(V[:, 0] > 0.75)], 1.0, "REPLACE")
+    ear.modal_deform.region_group = "Ear"
+    ear.modal_deform.modes, ear.modal_deform.derivatives, ear.modal_deform.ghost = 16, 40, 1000
+    bpy.context.view_layer.objects.active = ear
+    assert bpy.ops.modal_deform.bake() == {"FINISHED"}
+    tip = add_handle(ear, V[:, 0] > 1.25)
+    tip.controller.matrix_world = Matrix.Translation((0.15, 0.0, 0.35)) @ tip.controller.matrix_world
+    bpy.context.view_layer.update()
+    assert bpy.ops.modal_deform.solve() == {"FINISHED"}
+    return ear
+
+
+def painted_row(mdc, posing, suzanne, V, output):
+    """The second row (issue 24): the uniform finger, the painted finger, Suzanne's pulled ear,
+    each alone in the row's stage. Returns their pixels left to right."""
+    objects = [curled_finger(mdc, "Uniform finger", False, 0.0), curled_finger(mdc, "Painted finger", True, 0.0),
+               pulled_ear(suzanne, V)]
+    ear = objects[2].data
+    posed = np.empty(3 * len(ear.vertices), np.float32)
+    ear.shape_keys.key_blocks[posing.POSE_KEY].data.foreach_get("co", posed)
+    outside = V[:, 0] <= 0.75
+    print(f"Region: the ear's tip moved by {np.abs(posed.reshape(-1, 3) - V).max():.2f}; the "
+          f"{int(outside.sum())} vertices outside the ear moved by "
+          f"{np.abs(posed.reshape(-1, 3)[outside] - V[outside]).max():g}")
+    pictures = []
+    for shown in objects:
+        for obj in objects + [suzanne]:
+            obj.hide_render = obj is not shown
+        pictures.append(render(output / f"demo_{shown.name.lower().replace(' ', '_')}.png"))
+    for obj in objects:
+        for handle in obj.modal_deform.handles:
+            if handle.controller is not None:
+                bpy.data.objects.remove(handle.controller)
+        bpy.data.objects.remove(obj)
+    suzanne.hide_render = False
+    return pictures
+
+
 def main():
     args = arguments()
     addon = enable_addon().__name__
@@ -155,12 +243,14 @@ def main():
     ours = render(output / "demo_after.png")
     suzanne.hide_render, laplacian.hide_render = True, False
     theirs = render(output / "demo_laplacian.png")
-    side_by_side([rest, ours, theirs], output / "demo.png")
-    print(f"rendered {output / 'demo.png'} (rest, Modal Deform, Laplacian Deform) in {time.perf_counter() - start:.1f} s")
     # The file keeps Suzanne alone, ready to pose.
-    suzanne.hide_render = False
     bpy.data.objects.remove(laplacian)
     bpy.data.objects.remove(hook)
+    below = painted_row(mdc, posing, suzanne, V, output)
+    side_by_side([np.concatenate([row[i] for row in (below, [rest, ours, theirs])], axis=0) for i in range(3)],
+                 output / "demo.png")
+    print(f"rendered {output / 'demo.png'} (rest, Modal Deform, Laplacian Deform; the uniform and the painted "
+          f"finger, the ear) in {time.perf_counter() - start:.1f} s")
 
     bpy.context.view_layer.objects.active = suzanne
     for obj in bpy.context.view_layer.objects:

@@ -25,6 +25,7 @@
 #include "reduction/ghost.h"
 #include "reduction/orthonormalize.h"
 #include "reduction/prolongation.h"
+#include "reduction/region.h"
 #include "util/errors.h"
 #include "util/require_weight.h"
 #include "util/stopwatch.h"
@@ -111,7 +112,7 @@ Modes flexible_modes(const SparseMatrix& K, const Eigen::VectorXd& mass, const E
 // bake stops early, the destructor cancels the ghost and waits, so nothing outlives the bake.
 class GhostInBackground {
  public:
-  GhostInBackground(const VerticesRef& V, const FacesRef& F, const Eigen::VectorXd& mass, int target)
+  GhostInBackground(const VerticesRef& V, const FacesRef& F, const VectorRef& mass, int target)
       : progress_([this](const std::string&, double fraction) {
           fraction_ = fraction;
           return !stop_.load();
@@ -139,7 +140,7 @@ class GhostInBackground {
   std::future<Ghost> ghost_;
 };
 
-void check_options(const BakeOptions& o) {
+void check_options(const BakeOptions& o, Eigen::Index num_vertices) {
   if (o.modes < 1) throw InputError(message("modes: expected at least 1, got ", o.modes));
   if (o.derivatives < 0) throw InputError(message("derivatives: expected 0 or more, got ", o.derivatives));
   if (o.ghost < 4) throw InputError(message("ghost: a ghost needs at least 4 vertices, got ", o.ghost));
@@ -151,6 +152,8 @@ void check_options(const BakeOptions& o) {
                              "bake it with derivatives = 0, or use the shells energy (asked for ", o.derivatives, ")"));
   require_weight(o.bending, "bending");
   require_weight(o.membrane, "membrane");
+  require_stiffness_paint(o.paint, num_vertices);
+  require_paintable(o.energy, o.paint);
 }
 
 // One stage of the bake: reported to the bar at its start and end, and its wall time added to
@@ -178,6 +181,10 @@ Basis rest_state(const VerticesRef& V, const FacesRef& F, const BakeOptions& opt
   basis.scale = scale;
   basis.bending = options.bending;
   basis.membrane = options.membrane;
+  basis.stiffness_weights = options.paint.weights;
+  basis.max_stiffness = options.paint.max_stiffness;
+  basis.region = options.region;
+  std::sort(basis.region.begin(), basis.region.end());
   return basis;
 }
 
@@ -186,17 +193,47 @@ struct Simulated {
   Attachment attachment;
   RowMatrixX3d V;        // #S by 3
   Eigen::VectorXd mass;  // #S
-  int num_rigid = 0;     // 6 per simulated component
+  // A region bake's clamped vertices (#C by 3, after the simulated ones in attachment.faces); the
+  // energy sees them, the eigenproblem does not (region.h). Empty otherwise.
+  RowMatrixX3d clamped;
+  // A region bake's submesh: the fine indices of the simulated vertices, then the clamped ones.
+  // Empty otherwise.
+  std::vector<int> region_vertices;
+  StiffnessPaint paint;  // the painted stiffness of the simulated vertices, then the clamped ones
+  int num_rigid = 0;     // 6 per simulated component (none in a region: its boundary is fixed)
   int flexible = 0;      // modes besides the rigid motions
   Eigen::Index size() const { return V.rows(); }
+  // The rest positions the energy is built on: the simulated vertices, then the clamped ones.
+  RowMatrixX3d energy_vertices() const {
+    RowMatrixX3d all(V.rows() + clamped.rows(), 3);
+    all << V, clamped;
+    return all;
+  }
 };
+
+// 2 for a region bake: the region's free vertices are simulated, those outside it on a face with
+// them are clamped (region.h), and nothing is attached.
+Attachment region_attachment(const RegionMesh& region, Eigen::Index num_vertices) {
+  Attachment attachment;
+  attachment.simulated.assign(region.vertices.begin(), region.vertices.begin() + region.num_free);
+  attachment.submesh_index = Eigen::VectorXi::Constant(num_vertices, -1);
+  for (int s = 0; s < region.num_free; ++s) attachment.submesh_index[region.vertices[static_cast<size_t>(s)]] = s;
+  attachment.faces = region.faces;
+  attachment.component = Eigen::VectorXi::Zero(region.num_free);
+  return attachment;
+}
 
 // 2. Which vertices are simulated and which follow them (attachment.h); refuses mode counts the
 // submesh cannot give.
 Simulated simulated_submesh(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Basis& basis,
                             Progress& progress) {
   Simulated sim;
-  sim.attachment = stage("attachment", basis, progress, [&] { return attach(V, F); });
+  RegionMesh region;
+  sim.attachment = stage("attachment", basis, progress, [&] {
+    if (options.region.size() == 0) return attach(V, F);
+    region = region_mesh(F, basis.mass, options.region);
+    return region_attachment(region, V.rows());
+  });
   const std::vector<int>& simulated = sim.attachment.simulated;
   const auto S = static_cast<Eigen::Index>(simulated.size());
   sim.V.resize(S, 3);
@@ -204,6 +241,14 @@ Simulated simulated_submesh(const VerticesRef& V, const FacesRef& F, const BakeO
   for (Eigen::Index s = 0; s < S; ++s) {
     sim.V.row(s) = basis.scale * V.row(simulated[static_cast<size_t>(s)]);
     sim.mass[s] = basis.scale * basis.scale * basis.mass[simulated[static_cast<size_t>(s)]];
+  }
+  const std::vector<int> clamped(region.vertices.begin() + region.num_free, region.vertices.end());
+  sim.region_vertices = region.vertices;
+  sim.clamped = basis.scale * V(clamped, Eigen::all);
+  sim.paint.max_stiffness = options.paint.max_stiffness;
+  if (options.paint.weights.size() > 0) {
+    sim.paint.weights.resize(S + static_cast<Eigen::Index>(clamped.size()));
+    sim.paint.weights << options.paint.weights(simulated), options.paint.weights(clamped);
   }
   const int components = sim.attachment.num_components;
   sim.num_rigid = 6 * components;
@@ -228,24 +273,38 @@ struct Stiffness {
 Stiffness stiffness_at_rest(const Simulated& sim, const BakeOptions& options, Basis& basis, Progress& progress) {
   return stage("hessian", basis, progress, [&] {
     Stiffness stiffness;
+    const RowMatrixX3d V = sim.energy_vertices();
     if (options.energy == EnergyKind::kShells) {
-      stiffness.shells = std::make_unique<DiscreteShells>(sim.V, sim.attachment.faces, options.bending, options.membrane);
+      stiffness.shells =
+          std::make_unique<DiscreteShells>(V, sim.attachment.faces, options.bending, options.membrane, sim.paint);
       stiffness.K = stiffness.shells->hessian(stiffness.shells->rest());
     } else {
-      const Arap arap(sim.V, sim.attachment.faces);
+      const Arap arap(V, sim.attachment.faces);
       stiffness.K = arap.hessian(arap.rest());
     }
+    // A region's clamped vertices do not move: the block of the simulated ones (a fixed boundary).
+    if (sim.clamped.rows() > 0) stiffness.K = SparseMatrix(stiffness.K.topLeftCorner(3 * sim.size(), 3 * sim.size()));
     return stiffness;
   });
 }
 
-// 4. CHOLMOD orders K while the ghost of the whole mesh is simplified beside it (stage 8 uses
-// it). Analysed here rather than inside the eigensolver's first factorisation, so the bar moves
+// What the ghost simplifies (mesh units): the whole mesh, or a region bake's submesh (its
+// simulated vertices, then the clamped ones, Simulated::region_vertices), so that all of the
+// ghost's vertices are spent where the mesh moves.
+struct GhostSource {
+  VerticesRef V;
+  FacesRef F;
+  VectorRef mass;
+};
+
+// 4. CHOLMOD orders K while the ghost of what moves (GhostSource) is simplified beside it (stage
+// 8 uses it). Analysed here rather than inside the eigensolver's first factorisation, so the bar moves
 // between the two (CHOLMOD reports nothing during either), and so that the factor's size is known
 // before the numeric factorisation: what cannot fit is refused at once, not half a minute later.
-Ghost order_beside_the_ghost(const VerticesRef& V, const FacesRef& F, const Simulated& sim, const SparseMatrix& K,
-                             const BakeOptions& options, CholmodLLT& factor, Basis& basis, Progress& progress) {
-  GhostInBackground ghost(V, F, basis.mass, options.ghost);
+Ghost order_beside_the_ghost(const VerticesRef& V, const GhostSource& source, const Simulated& sim,
+                             const SparseMatrix& K, const BakeOptions& options, CholmodLLT& factor, Basis& basis,
+                             Progress& progress) {
+  GhostInBackground ghost(source.V, source.F, source.mass, options.ghost);
   progress.report("factorisation", 0.0);
   try {
     factor.analyze(K);
@@ -299,13 +358,15 @@ Eigen::MatrixXd derivative_stage(const Simulated& sim, Stiffness& stiffness, con
   phi.rightCols(sim.flexible) = modes.vectors.rightCols(sim.flexible);
   const std::vector<std::array<int, 2>> pairs =
       derivative_pairs(components_moved(phi, sim.attachment.component), options.derivatives);
+  // Modes are zero at a region's clamped vertices, which the energy has after the simulated ones.
+  phi.conservativeResizeLike(Eigen::MatrixXd::Zero(3 * (S + sim.clamped.rows()), phi.cols()));
   const DiscreteShells& shells = *stiffness.shells;
   stage("third derivatives", basis, progress, [&] {
     for (size_t first = 0; first < pairs.size(); first += kPairsPerPass) {
       progress.report("third derivatives", static_cast<double>(first) / pairs.size());
       const size_t last = std::min(pairs.size(), first + kPairsPerPass);
       const RowMatrixXd batch = shells.third_batch(shells.rest(), phi, {pairs.begin() + first, pairs.begin() + last});
-      for_row_blocks(batch.rows(), [&](Eigen::Index row, Eigen::Index rows) {
+      for_row_blocks(derivatives.rows(), [&](Eigen::Index row, Eigen::Index rows) {
         derivatives.block(row, static_cast<Eigen::Index>(first), rows, batch.cols()) = batch.middleRows(row, rows);
       });
     }
@@ -351,19 +412,37 @@ Eigen::MatrixXd orthonormal_basis(const Simulated& sim, const Eigen::MatrixXd& r
 }
 
 // 8. The fine basis (attached rows added, mesh units, single precision) and the ghost's,
-// restricted from the double-precision one (rigid motions stay exact).
-void fine_and_ghost_vectors(Eigen::MatrixXd U, const Attachment& attachment, Ghost coarse, Basis& basis,
-                            Progress& progress) {
+// restricted from the double-precision one (rigid motions stay exact), with the ghost's painted
+// stiffness. A region's ghost is its submesh's: restricted from the submesh's rows, and the
+// vertices outside the submesh, which never move, map to ghost vertex 0 (the solver reads only
+// the ghost's own arrays).
+void fine_and_ghost_vectors(Eigen::MatrixXd U, const Simulated& sim, const GhostSource& source, Ghost coarse,
+                            const StiffnessPaint& paint, Basis& basis, Progress& progress) {
   stage("assembly", basis, progress, [&] {
-    if (!attachment.followers.empty()) U = extend_to_attached(attachment, U);
+    if (U.rows() < basis.rest.size()) U = extend_to_attached(sim.attachment, U);
     U /= basis.scale;
     basis.vectors = U.cast<float>();
   });
   stage("ghost", basis, progress, [&] {
-    basis.ghost_vectors = restrict_to_ghost(coarse, basis.mass, U);
+    const int g = static_cast<int>(coarse.V.rows());
+    const std::vector<int>& sub = sim.region_vertices;
+    if (sub.empty()) {
+      basis.ghost_vectors = restrict_to_ghost(coarse, source.mass, U);
+      basis.ghost_stiffness_weights = restrict_to_ghost(coarse.map, g, source.mass, paint).weights;
+      basis.ghost_map = std::move(coarse.map);
+    } else {
+      Eigen::MatrixXd rows(3 * static_cast<Eigen::Index>(sub.size()), U.cols());
+      for (size_t i = 0; i < sub.size(); ++i)
+        rows.middleRows<3>(3 * static_cast<Eigen::Index>(i)) = U.middleRows<3>(3 * static_cast<Eigen::Index>(sub[i]));
+      basis.ghost_vectors = restrict_to_ghost(coarse, source.mass, rows);
+      StiffnessPaint on_submesh{Eigen::VectorXd(), paint.max_stiffness};
+      if (paint.weights.size() > 0) on_submesh.weights = paint.weights(sub);
+      basis.ghost_stiffness_weights = restrict_to_ghost(coarse.map, g, source.mass, on_submesh).weights;
+      basis.ghost_map = Eigen::VectorXi::Zero(basis.rest.rows());
+      basis.ghost_map(sub) = coarse.map;
+    }
     basis.ghost_vertices = std::move(coarse.V);
     basis.ghost_faces = std::move(coarse.F);
-    basis.ghost_map = std::move(coarse.map);
   });
 }
 
@@ -372,14 +451,21 @@ Basis bake_stages(const VerticesRef& V, const FacesRef& F, const BakeOptions& op
                   Progress& progress) {
   const Simulated sim = simulated_submesh(V, F, options, basis, progress);
   Stiffness stiffness = stiffness_at_rest(sim, options, basis, progress);
-  const Eigen::MatrixXd rigid = rigid_motions(sim.V, sim.attachment.component, sim.mass);
+  const Eigen::MatrixXd rigid = sim.num_rigid > 0 ? rigid_motions(sim.V, sim.attachment.component, sim.mass)
+                                                  : Eigen::MatrixXd(3 * sim.size(), 0);
   CholmodLLT factor(3);  // one factorisation for the modes and the derivative solves
-  Ghost coarse = order_beside_the_ghost(V, F, sim, stiffness.K, options, factor, basis, progress);
+  const RowMatrixX3d region_V = V(sim.region_vertices, Eigen::all);
+  const RowMatrixX3i region_F = sim.attachment.faces;
+  const Eigen::VectorXd region_mass = basis.mass(sim.region_vertices);
+  const bool in_region = !sim.region_vertices.empty();
+  const GhostSource source{in_region ? VerticesRef(region_V) : V, in_region ? FacesRef(region_F) : F,
+                           in_region ? VectorRef(region_mass) : VectorRef(basis.mass)};
+  Ghost coarse = order_beside_the_ghost(V, source, sim, stiffness.K, options, factor, basis, progress);
   const Modes modes = vibration_stage(V, sim, stiffness.K, rigid, factor, basis, progress);
   Eigen::MatrixXd derivatives = derivative_stage(sim, stiffness, rigid, modes, options, factor, basis, progress);
   basis.timings["factorisation"] = factor.seconds();
   Eigen::MatrixXd U = orthonormal_basis(sim, rigid, modes, std::move(derivatives), options, basis, progress);
-  fine_and_ghost_vectors(std::move(U), sim.attachment, std::move(coarse), basis, progress);
+  fine_and_ghost_vectors(std::move(U), sim, source, std::move(coarse), options.paint, basis, progress);
   return basis;
 }
 
@@ -395,14 +481,18 @@ Basis bake_on_proxy(const VerticesRef& V, const FacesRef& F, const BakeOptions& 
   });
   const Ghost proxy =
       stage("proxy", timed, progress, [&] { return ghost_mesh(V, F, fine.mass, options.proxy, &as_proxy); });
-  Basis basis = rest_state(proxy.V, proxy.F, options, fine.scale);
+  // The proxy's elements carry the fine paint's means (restrict_to_ghost).
+  BakeOptions on_proxy = options;
+  on_proxy.paint = restrict_to_ghost(proxy.map, static_cast<int>(proxy.V.rows()), fine.mass, options.paint);
+  Basis basis = rest_state(proxy.V, proxy.F, on_proxy, fine.scale);
   basis.timings = timed.timings;
-  basis = bake_stages(proxy.V, proxy.F, options, std::move(basis), progress);
+  basis = bake_stages(proxy.V, proxy.F, on_proxy, std::move(basis), progress);
   stage("prolongation", basis, progress, [&] {
     basis.prolongation = prolongation_to_proxy(V, proxy.V, proxy.F, proxy.map);
     basis.ghost_map = basis.ghost_map(proxy.map).eval();
     basis.rest = fine.rest;
     basis.mass = fine.mass;
+    basis.stiffness_weights = fine.stiffness_weights;
   });
   return basis;
 }
@@ -411,9 +501,9 @@ Basis bake_on_proxy(const VerticesRef& V, const FacesRef& F, const BakeOptions& 
 
 Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Progress& progress) {
   try {
-    check_options(options);
+    check_options(options, V.rows());
     validate_mesh(V, F);
-    Basis basis = options.proxy_above > 0 && V.rows() > options.proxy_above
+    Basis basis = options.proxy_above > 0 && V.rows() > options.proxy_above && options.region.size() == 0
                       ? bake_on_proxy(V, F, options, progress)
                       : bake_stages(V, F, options, rest_state(V, F, options, normalizing_scale(V)), progress);
     validate_basis(basis);

@@ -24,6 +24,11 @@
 //   6. Attached rows, conversion to mesh units (x = x̄ + U q), float32 vectors.
 //   7. Ghost: edge collapse of the whole mesh to about `ghost` vertices, the basis restricted.
 //
+// A region (options.region) changes steps 2 and 3: the simulated vertices are the region's, the
+// energy is that of the faces touching it with the vertices outside clamped, K and M are the
+// blocks of the simulated vertices, there are no rigid motions (a free part of the region has
+// them as zero modes), and the rows of the vertices outside are zero (region.h).
+//
 // A mesh of more than options.proxy_above vertices goes through steps 2 to 7 as a proxy: the fine
 // mesh simplified by the same edge collapse to about options.proxy vertices ("proxy"), baked in the
 // fine mesh's normalised frame; then each fine vertex gets its barycentric weights on the nearest
@@ -72,13 +77,20 @@ struct BakeOptions {
   // edge collapse, and its basis prolongated to the fine vertices (prolongation.h).
   int proxy_above = 0;
   int proxy = 50000;
+  // Stiffness painted per vertex (shells only): every stage that sees the energy sees it, a proxy
+  // with its fine vertices' means; the basis keeps the weights for the solver's ghost.
+  StiffnessPaint paint = {};
+  // Fine vertex indices that may move (any order; empty: the whole mesh). Every other vertex
+  // stays at rest, clamped (region.h); a region bake is never on a proxy.
+  Eigen::VectorXi region = {};
 };
 
 // The reduced space of (V #V by 3, F #F by 3, any length unit) per the pipeline above: a Basis in
 // the mesh's units with num_modes = modes + num_floppy and r = num_modes + derivatives − dropped
 // columns. Throws InputError for a bad mesh or option (naming it), among them: modes not above the
 // rigid motions of the simulated components (6 each), more derivatives than pairs of the modes
-// that are neither rigid nor zero, "arap" with derivatives; NumericalError when a solver fails;
+// that are neither rigid nor zero, "arap" with derivatives or with painted stiffness, paint that
+// require_stiffness_paint refuses; NumericalError when a solver fails;
 // OutOfMemory when the memory the bake needs (bake_memory.h, estimated once CHOLMOD has analysed
 // K and before the numeric factorisation) is more than is available, or an allocation fails;
 // Cancelled when `progress` says stop.

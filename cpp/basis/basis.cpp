@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "mesh/mesh_check.h"
 #include "mesh/normalization.h"
@@ -52,6 +53,23 @@ void require_prolongation(const Prolongation& P, Eigen::Index n, Eigen::Index ve
   }
 }
 
+// A region bake's region: vertices ascending and in range, a basis of the mesh itself (not on a
+// proxy) whose rows outside the region are zero.
+void require_region(const Basis& b) {
+  const Eigen::Index n = b.rest.rows();
+  require(!b.on_proxy(), "region: a region bake is never on a proxy, but this basis has a prolongation");
+  std::vector<char> inside(static_cast<size_t>(n), 0);
+  for (Eigen::Index i = 0; i < b.region.size(); ++i) {
+    if (b.region[i] < 0 || b.region[i] >= n || (i > 0 && b.region[i] <= b.region[i - 1]))
+      require(false, message("region[", i, "] = ", b.region[i], " is not a vertex above region[", i - 1,
+                             "] (the region is ascending, in [0, ", n, "))"));
+    inside[b.region[i]] = 1;
+  }
+  for (Eigen::Index v = 0; v < n; ++v)
+    if (!inside[v] && !b.vectors.middleRows<3>(3 * v).isZero(0))
+      require(false, message("vectors: vertex ", v, " lies outside the region but has non-zero rows"));
+}
+
 }  // namespace
 
 Eigen::Matrix<double, 3, Eigen::Dynamic> Basis::vertex_rows(int v) const {
@@ -90,7 +108,11 @@ void validate_basis(const Basis& b) {
   require_shared([&] {
     require_weight(b.bending, "bending");
     require_weight(b.membrane, "membrane");
+    require_stiffness_paint(b.paint(), n);
+    require_stiffness_paint(ghost_paint(b), g, "ghost_stiffness_weights");
   });
+  require((b.stiffness_weights.size() == 0) == (b.ghost_stiffness_weights.size() == 0),
+          "ghost_stiffness_weights: the ghost is painted when and only when the mesh is");
   require(b.num_dropped >= 0, "num_dropped is negative");
   require_shared([&] { require_vertices(b.rest, "rest"); });
   const double extent = bounding_box_extent(b.rest);
@@ -100,6 +122,7 @@ void validate_basis(const Basis& b) {
   require_finite(b.mass, "mass");
   require((b.mass.array() >= 0).all(), "mass has negative entries");
   require_finite(b.vectors, "vectors");
+  if (b.region.size() > 0) require_region(b);
   require_finite(b.eigenvalues, "eigenvalues");
   require_shared([&] { require_positions(flatten(b.ghost_vertices), b.ghost_vertices.size(), "ghost_vertices"); });
   require_finite(b.ghost_vectors, "ghost_vectors");

@@ -4,6 +4,7 @@
 #include <pybind11/stl.h>
 
 #include <string>
+#include <type_traits>
 #include <utility>
 
 #include "bindings/bindings.h"
@@ -14,62 +15,71 @@ namespace py = pybind11;
 
 namespace modal_deform {
 
+namespace {
+
+// How a stored field of the Basis looks in numpy: dtype, number of dimensions, a fixed number of
+// columns (0: any) and whether it is column-major. Scalars are 0-d.
+template <typename T, typename = void>
+struct StoredLayout {
+  using Scalar = T;
+  static constexpr int ndim = 0, columns = 0;
+  static constexpr bool fortran = false;
+};
+
+template <typename T>
+struct StoredLayout<T, std::enable_if_t<std::is_base_of_v<Eigen::EigenBase<T>, T>>> {
+  using Scalar = typename T::Scalar;
+  static constexpr bool vector = T::IsVectorAtCompileTime;
+  static constexpr int ndim = vector ? 1 : 2;
+  static constexpr int columns = vector || T::ColsAtCompileTime == Eigen::Dynamic ? 0 : T::ColsAtCompileTime;
+  static constexpr bool fortran = !vector && !T::IsRowMajor;
+};
+
+// The type of a stored field, from its accessor.
+template <typename Field>
+using FieldType = std::decay_t<decltype(std::declval<Field>()(std::declval<Basis&>()))>;
+
+}  // namespace
+
 void bind_bake(py::module_& m) {
-  // Getters return const references: with def_property_readonly's reference_internal policy they
-  // become read-only numpy views that keep the Basis alive.
-  py::class_<Basis>(m, "Basis")
-      .def(py::init([](RowMatrixX3d rest, Eigen::VectorXd mass, RowMatrixXf vectors, int num_rigid, int num_modes,
-                       int num_floppy, Eigen::VectorXd eigenvalues, RowMatrixX3d ghost_vertices,
-                       RowMatrixX3i ghost_faces, Eigen::VectorXi ghost_map, Eigen::MatrixXd ghost_vectors, double scale,
-                       double bending, double membrane, int num_dropped, RowMatrixX3i prolongation_vertices,
-                       RowMatrixX3f prolongation_weights) {
-             // Arrays arrive as copies (modal_deform.core checks their dtypes first); validated
-             // before anything reads them.
-             Basis b;
-             b.rest = std::move(rest);
-             b.mass = std::move(mass);
-             b.vectors = std::move(vectors);
-             b.num_rigid = num_rigid;
-             b.num_modes = num_modes;
-             b.num_floppy = num_floppy;
-             b.eigenvalues = std::move(eigenvalues);
-             b.ghost_vertices = std::move(ghost_vertices);
-             b.ghost_faces = std::move(ghost_faces);
-             b.ghost_map = std::move(ghost_map);
-             b.ghost_vectors = std::move(ghost_vectors);
-             b.scale = scale;
-             b.bending = bending;
-             b.membrane = membrane;
-             b.num_dropped = num_dropped;
-             b.prolongation.vertices = std::move(prolongation_vertices);
-             b.prolongation.weights = std::move(prolongation_weights);
-             validate_basis(b);
-             return b;
-           }),
-           py::arg("rest"), py::arg("mass"), py::arg("vectors"), py::arg("num_rigid"), py::arg("num_modes"),
-           py::arg("num_floppy"), py::arg("eigenvalues"), py::arg("ghost_vertices"), py::arg("ghost_faces"),
-           py::arg("ghost_map"), py::arg("ghost_vectors"), py::arg("scale"), py::arg("bending"), py::arg("membrane"),
-           py::arg("num_dropped"), py::arg("prolongation_vertices"), py::arg("prolongation_weights"))
-      .def_property_readonly("rest", [](const Basis& b) -> const RowMatrixX3d& { return b.rest; })
-      .def_property_readonly("mass", [](const Basis& b) -> const Eigen::VectorXd& { return b.mass; })
-      .def_property_readonly("vectors", [](const Basis& b) -> const RowMatrixXf& { return b.vectors; })
-      .def_property_readonly("eigenvalues", [](const Basis& b) -> const Eigen::VectorXd& { return b.eigenvalues; })
-      .def_property_readonly("ghost_vertices", [](const Basis& b) -> const RowMatrixX3d& { return b.ghost_vertices; })
-      .def_property_readonly("ghost_faces", [](const Basis& b) -> const RowMatrixX3i& { return b.ghost_faces; })
-      .def_property_readonly("ghost_map", [](const Basis& b) -> const Eigen::VectorXi& { return b.ghost_map; })
-      .def_property_readonly("ghost_vectors", [](const Basis& b) -> const Eigen::MatrixXd& { return b.ghost_vectors; })
-      .def_readonly("num_rigid", &Basis::num_rigid)
-      .def_readonly("num_modes", &Basis::num_modes)
-      .def_readonly("num_floppy", &Basis::num_floppy)
-      .def_readonly("num_dropped", &Basis::num_dropped)
-      .def_readonly("scale", &Basis::scale)
-      .def_readonly("bending", &Basis::bending)
-      .def_readonly("membrane", &Basis::membrane)
-      .def_property_readonly("prolongation_vertices",
-                             [](const Basis& b) -> const RowMatrixX3i& { return b.prolongation.vertices; })
-      .def_property_readonly("prolongation_weights",
-                             [](const Basis& b) -> const RowMatrixX3f& { return b.prolongation.weights; })
-      .def_property_readonly("num_basis_vertices", &Basis::num_basis_vertices)
+  py::class_<Basis> basis(m, "Basis");
+  // The keyword constructor, one read-only property per stored field, and the schema that
+  // modal_deform.core stores and checks them by, all from for_each_stored_field.
+  basis.def(py::init([](const py::kwargs& fields) {
+    // Arrays arrive as copies (modal_deform.core checks their dtypes and dimensions first); a field
+    // left out keeps its default (a basis stored before it existed); validated before anything
+    // reads them.
+    Basis b;
+    int known = 0;
+    for_each_stored_field([&](const char* name, int, auto field) {
+      if (!fields.contains(name)) return;
+      field(b) = fields[name].template cast<FieldType<decltype(field)>>();
+      ++known;
+    });
+    if (known != static_cast<int>(fields.size()))
+      for (const auto& item : fields) {
+        bool stored = false;
+        const auto key = item.first.cast<std::string>();
+        for_each_stored_field([&](const char* name, int, auto) { stored = stored || key == name; });
+        if (!stored) throw InputError(message("basis: ", key, " is not a field of a basis"));
+      }
+    validate_basis(b);
+    return b;
+  }));
+  py::list schema;
+  for_each_stored_field([&](const char* name, int since, auto field) {
+    using T = FieldType<decltype(field)>;
+    using Layout = StoredLayout<T>;
+    schema.append(py::dict(py::arg("name") = name, py::arg("since") = since,
+                           py::arg("dtype") = py::dtype::of<typename Layout::Scalar>(),
+                           py::arg("ndim") = Layout::ndim, py::arg("columns") = Layout::columns,
+                           py::arg("fortran") = Layout::fortran));
+    // Const references: with def_property_readonly's reference_internal policy arrays become
+    // read-only numpy views that keep the Basis alive.
+    basis.def_property_readonly(name, [field](const Basis& b) -> const T& { return field(b); });
+  });
+  basis.attr("schema") = schema;
+  basis.def_property_readonly("num_basis_vertices", &Basis::num_basis_vertices)
       .def_property_readonly("on_proxy", &Basis::on_proxy)
       .def_readonly("timings", &Basis::timings)
       .def_property_readonly("dimension", &Basis::dimension)
@@ -79,16 +89,18 @@ void bind_bake(py::module_& m) {
       "bake",
       [](const VerticesRef& V, const FacesRef& F, int modes, int derivatives, int ghost, const std::string& energy,
          double bending, double membrane, bool rotation_pairs, int proxy_above, int proxy,
+         const Eigen::VectorXd& stiffness_weights, double max_stiffness, const Eigen::VectorXi& region,
          const py::object& progress) {
-        const BakeOptions options{modes,   derivatives, ghost,          energy_kind(energy), bending,
-                                  membrane, rotation_pairs, proxy_above, proxy};
+        const BakeOptions options{modes,    derivatives,    ghost,       energy_kind(energy),
+                                  bending,  membrane,       rotation_pairs, proxy_above,
+                                  proxy,    StiffnessPaint{stiffness_weights, max_stiffness}, region};
         Progress reporter(python_progress(progress));
         py::gil_scoped_release release;
         return bake(V, F, options, reporter);
       },
       py::arg("V"), py::arg("F"), py::arg("modes"), py::arg("derivatives"), py::arg("ghost"), py::arg("energy"),
       py::arg("bending"), py::arg("membrane"), py::arg("rotation_pairs"), py::arg("proxy_above"), py::arg("proxy"),
-      py::arg("progress"));
+      py::arg("stiffness_weights"), py::arg("max_stiffness"), py::arg("region"), py::arg("progress"));
 }
 
 }  // namespace modal_deform

@@ -34,8 +34,12 @@ void bind_energy(py::module_& m) {
   py::class_<Arap, Energy>(m, "Arap")
       .def(py::init<const VerticesRef&, const FacesRef&>(), py::arg("V"), py::arg("F"), release);
   py::class_<DiscreteShells, Energy>(m, "DiscreteShells")
-      .def(py::init<const VerticesRef&, const FacesRef&, double, double>(), py::arg("V"), py::arg("F"),
-           py::arg("bending") = 1.0, py::arg("membrane") = 1.0, release)
+      .def(py::init([](const VerticesRef& V, const FacesRef& F, double bending, double membrane,
+                       const Eigen::VectorXd& stiffness_weights, double max_stiffness) {
+             return DiscreteShells(V, F, bending, membrane, {stiffness_weights, max_stiffness});
+           }),
+           py::arg("V"), py::arg("F"), py::arg("bending"), py::arg("membrane"), py::arg("stiffness_weights"),
+           py::arg("max_stiffness"), release)
       .def("third_batch", &DiscreteShells::third_batch, py::arg("x"), py::arg("Phi"), py::arg("pairs"), release)
       .def_property_readonly("term_counts", [](const DiscreteShells& energy) {
         const auto counts = energy.term_counts();

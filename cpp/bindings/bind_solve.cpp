@@ -79,12 +79,14 @@ void bind_solve(py::module_& m) {
       "solve_full",
       [](const VerticesRef& V, const FacesRef& F, const std::vector<Eigen::VectorXi>& handles,
          const Transforms& transforms, const VectorRef& weights, double stiffness, const std::string& energy,
-         double bending, double membrane, double tolerance, int max_iterations,
-         const std::optional<RowMatrixX3d>& initial, const py::object& progress) {
+         double bending, double membrane, const Eigen::VectorXd& stiffness_weights, double max_stiffness,
+         double tolerance, int max_iterations, const std::optional<RowMatrixX3d>& initial,
+         const py::object& progress) {
         FullSolveOptions options;
         options.energy = energy_kind(energy);
         options.bending = bending;
         options.membrane = membrane;
+        options.paint = {stiffness_weights, max_stiffness};
         options.tolerance = tolerance;
         options.max_iterations = max_iterations;
         options.progress = python_progress(progress);
@@ -103,7 +105,8 @@ void bind_solve(py::module_& m) {
         return py::make_tuple(std::move(result.positions), stats);
       },
       py::arg("V"), py::arg("F"), py::arg("handles"), py::arg("transforms"), py::arg("weights"), py::arg("stiffness"),
-      py::arg("energy"), py::arg("bending"), py::arg("membrane"), py::arg("tolerance"), py::arg("max_iterations"),
+      py::arg("energy"), py::arg("bending"), py::arg("membrane"), py::arg("stiffness_weights"),
+      py::arg("max_stiffness"), py::arg("tolerance"), py::arg("max_iterations"),
       py::arg("initial"), py::arg("progress"));
 }
 

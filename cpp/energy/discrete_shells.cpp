@@ -361,10 +361,12 @@ void DiscreteShells::for_each_term(int part, Visit&& visit) const {
   for_each_set([&](const auto& set) { visit_part(set, part, visit); });
 }
 
-DiscreteShells::DiscreteShells(const VerticesRef& V, const FacesRef& F, double bending, double membrane) {
+DiscreteShells::DiscreteShells(const VerticesRef& V, const FacesRef& F, double bending, double membrane,
+                               const StiffnessPaint& paint) {
   validate_mesh(V, F);
   require_weight(bending, "bending");
   require_weight(membrane, "membrane");
+  require_stiffness_paint(paint, V.rows());
   rest_ = flatten(V);
   const double* x = rest_.data();
   const int n = static_cast<int>(V.rows());
@@ -385,7 +387,7 @@ DiscreteShells::DiscreteShells(const VerticesRef& V, const FacesRef& F, double b
     const double length = EdgeLength::measure(EdgeLength::frame(r));
     if (length <= tiny) continue;
     term.rest_length = length;
-    term.weight = membrane / length;
+    term.weight = paint.factor(term.vertices) * membrane / length;
     term.collapsed_length = kCollapse * length;
     edges_.terms.push_back(term);
   }
@@ -398,8 +400,9 @@ DiscreteShells::DiscreteShells(const VerticesRef& V, const FacesRef& F, double b
     const auto frame = TriangleArea::frame(r);
     area[f] = TriangleArea::measure(frame);
     term.rest_area = area[f];
-    term.weight = bounded_weight(membrane / area[f], squared_gradient_norm<TriangleTerm>(frame),
-                                 membrane * kEquilateralTriangleStiffness);
+    const double stretching = paint.factor(term.vertices) * membrane;
+    term.weight = bounded_weight(stretching / area[f], squared_gradient_norm<TriangleTerm>(frame),
+                                 stretching * kEquilateralTriangleStiffness);
     term.collapsed_norm = kCollapse * frame.norm;
     triangles_.terms.push_back(term);
   }
@@ -412,8 +415,9 @@ DiscreteShells::DiscreteShells(const VerticesRef& V, const FacesRef& F, double b
     const auto [cos_rest, sin_rest] = DihedralAngle::measure(frame);
     term.cos_rest = cos_rest;
     term.sin_rest = sin_rest;
-    term.weight = bounded_weight(3 * bending * frame.aa / (area[hinge.faces[0]] + area[hinge.faces[1]]),
-                                 squared_gradient_norm<HingeTerm>(frame), bending * equilateral_hinge_stiffness(frame.aa));
+    const double bend = paint.factor(term.vertices) * bending;
+    term.weight = bounded_weight(3 * bend * frame.aa / (area[hinge.faces[0]] + area[hinge.faces[1]]),
+                                 squared_gradient_norm<HingeTerm>(frame), bend * equilateral_hinge_stiffness(frame.aa));
     term.rest_n1n1 = frame.n1n1;
     term.rest_n2n2 = frame.n2n2;
     hinges_.terms.push_back(term);

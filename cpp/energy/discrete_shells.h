@@ -6,7 +6,8 @@
 //   E_L = ½ Σ_edges (‖e‖ − ‖ē‖)² / ‖ē‖
 //   E_A = ½ Σ_triangles (A − Ā)² / Ā
 //
-// Barred quantities are measured on the rest mesh. The three parts have different units (E_F
+// Barred quantities are measured on the rest mesh. α and β may be painted per element
+// (stiffness_paint.h). The three parts have different units (E_F
 // none, E_L length, E_A length²), which is why the paper scales every model to a longest
 // bounding-box edge of 10 (normalization.h) before α and β apply; this class takes V as given.
 //
@@ -73,6 +74,7 @@
 
 #include "energy/energy.h"
 #include "energy/shell_elements.h"
+#include "energy/stiffness_paint.h"
 #include "energy/vertex_partition.h"
 #include "linalg/block_sparsity.h"
 
@@ -129,8 +131,10 @@ class DiscreteShells final : public Energy {
   static constexpr int kParallelElements = 20000;
 
   // V: #V by 3 rest positions; F: #F by 3 triangles; bending (α) and membrane (β) weights,
-  // finite and ≥ 0. Throws InputError for an unusable mesh (validate_mesh) or a bad weight.
-  DiscreteShells(const VerticesRef& V, const FacesRef& F, double bending = 1.0, double membrane = 1.0);
+  // finite and ≥ 0, each element's multiplied by its factor of `paint` (stiffness_paint.h).
+  // Throws InputError for an unusable mesh (validate_mesh), a bad weight or paint.
+  DiscreteShells(const VerticesRef& V, const FacesRef& F, double bending = 1.0, double membrane = 1.0,
+                 const StiffnessPaint& paint = {});
 
   int num_vertices() const override { return static_cast<int>(rest_.size() / 3); }
   const Eigen::VectorXd& rest() const override { return rest_; }

@@ -12,10 +12,17 @@ EnergyKind energy_kind(const std::string& name) {
   throw InputError(message("energy: expected \"shells\" or \"arap\", got \"", name, "\""));
 }
 
+void require_paintable(EnergyKind kind, const StiffnessPaint& paint) {
+  if (kind == EnergyKind::kArap && !paint.uniform())
+    throw InputError("stiffness_weights: the ARAP energy has no painted stiffness (its energy is per vertex "
+                     "neighbourhood, not per element); use the shells energy, or no stiffness weights");
+}
+
 std::unique_ptr<Energy> make_energy(EnergyKind kind, const VerticesRef& V, const FacesRef& F, double bending,
-                                    double membrane) {
+                                    double membrane, const StiffnessPaint& paint) {
+  require_paintable(kind, paint);
   if (kind == EnergyKind::kArap) return std::make_unique<Arap>(V, F);
-  return std::make_unique<DiscreteShells>(V, F, bending, membrane);
+  return std::make_unique<DiscreteShells>(V, F, bending, membrane, paint);
 }
 
 }  // namespace modal_deform

@@ -170,7 +170,7 @@ Eigen::MatrixXd extend_to_attached(const Attachment& attachment, const Eigen::Re
   if (U.rows() != 3 * S)
     throw InputError(message("U: expected ", 3 * S, " rows (3 per simulated vertex), got ", U.rows()));
   const Eigen::Index n = attachment.submesh_index.size();
-  Eigen::MatrixXd out(3 * n, U.cols());
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(3 * n, U.cols());
 #pragma omp parallel for schedule(static)
   for (Eigen::Index j = 0; j < U.cols(); ++j) {
     for (Eigen::Index s = 0; s < S; ++s)

@@ -24,13 +24,16 @@ Ghost ghost_mesh(const VerticesRef& V, const FacesRef& F, const VectorRef& mass,
   return ghost;
 }
 
-Eigen::MatrixXd restrict_to_ghost(const Eigen::Ref<const Eigen::VectorXi>& map, int num_ghost,
-                                  const VectorRef& fine_mass, const Eigen::Ref<const Eigen::MatrixXd>& U) {
+namespace {
+
+// The weight of each fine vertex in the mean over its ghost vertex's preimage: its share of the
+// preimage's mass, or 1 / its size when the preimage has no mass. m/m is exactly 1, so a
+// preimage of one vertex restricts to that vertex's values unchanged.
+Eigen::VectorXd mean_weights(const Eigen::Ref<const Eigen::VectorXi>& map, int num_ghost, const VectorRef& fine_mass) {
   const Eigen::Index n = map.size();
   if (num_ghost < 1) throw InputError(message("num_ghost: expected at least 1 ghost vertex, got ", num_ghost));
   if (fine_mass.size() != n)
     throw InputError(message("mass: expected ", n, " values (one per fine vertex), got ", fine_mass.size()));
-  if (U.rows() != 3 * n) throw InputError(message("U: expected ", 3 * n, " rows (3 per fine vertex), got ", U.rows()));
   std::vector<double> cluster_mass(num_ghost, 0.0);
   std::vector<int> cluster_size(num_ghost, 0);
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -43,13 +46,21 @@ Eigen::MatrixXd restrict_to_ghost(const Eigen::Ref<const Eigen::VectorXi>& map, 
   }
   for (int s = 0; s < num_ghost; ++s)
     if (cluster_size[s] == 0) throw InputError(message("map: no fine vertex maps to ghost vertex ", s));
-  // The weight of each fine vertex in its cluster's mean; m/m is exactly 1, so a cluster of one
-  // vertex restricts to that vertex's values unchanged.
   Eigen::VectorXd weight(n);
   for (Eigen::Index i = 0; i < n; ++i) {
     const int s = map[i];
     weight[i] = cluster_mass[s] > 0 ? fine_mass[i] / cluster_mass[s] : 1.0 / cluster_size[s];
   }
+  return weight;
+}
+
+}  // namespace
+
+Eigen::MatrixXd restrict_to_ghost(const Eigen::Ref<const Eigen::VectorXi>& map, int num_ghost,
+                                  const VectorRef& fine_mass, const Eigen::Ref<const Eigen::MatrixXd>& U) {
+  const Eigen::Index n = map.size();
+  if (U.rows() != 3 * n) throw InputError(message("U: expected ", 3 * n, " rows (3 per fine vertex), got ", U.rows()));
+  const Eigen::VectorXd weight = mean_weights(map, num_ghost, fine_mass);
   Eigen::MatrixXd restricted = Eigen::MatrixXd::Zero(3 * num_ghost, U.cols());
 #pragma omp parallel for schedule(static)
   for (Eigen::Index j = 0; j < U.cols(); ++j) {
@@ -70,6 +81,21 @@ Eigen::MatrixXd restrict_to_ghost(const Eigen::Ref<const Eigen::VectorXi>& map, 
       for (Eigen::Index i = 0; i < U.rows(); ++i)
         if (!std::isfinite(U(i, j))) throw InputError(message("U[", i, ", ", j, "]: not a finite number"));
   return restricted;
+}
+
+StiffnessPaint restrict_to_ghost(const Eigen::Ref<const Eigen::VectorXi>& map, int num_ghost,
+                                 const VectorRef& fine_mass, const StiffnessPaint& paint) {
+  StiffnessPaint coarse{Eigen::VectorXd(), paint.max_stiffness};
+  if (paint.weights.size() == 0) return coarse;
+  if (paint.weights.size() != map.size())
+    throw InputError(message("stiffness_weights: expected ", map.size(), " values (one per fine vertex), got ",
+                             paint.weights.size()));
+  const Eigen::VectorXd weight = mean_weights(map, num_ghost, fine_mass);
+  coarse.weights = Eigen::VectorXd::Zero(num_ghost);
+  for (Eigen::Index i = 0; i < map.size(); ++i) coarse.weights[map[i]] += weight[i] * paint.weights[i];
+  // Means of weights in [0, 1], but for rounding.
+  coarse.weights = coarse.weights.cwiseMax(0.0).cwiseMin(1.0);
+  return coarse;
 }
 
 }  // namespace modal_deform

@@ -6,6 +6,7 @@
 // of a rigid motion of the fine mesh is the same rigid motion of the ghost.
 #pragma once
 
+#include "energy/stiffness_paint.h"
 #include "util/progress.h"
 #include "util/types.h"
 
@@ -36,5 +37,11 @@ inline Eigen::MatrixXd restrict_to_ghost(const Ghost& ghost, const VectorRef& fi
                                          const Eigen::Ref<const Eigen::MatrixXd>& U) {
   return restrict_to_ghost(ghost.map, static_cast<int>(ghost.V.rows()), fine_mass, U);
 }
+
+// The painted stiffness of the ghost (or of a proxy): each ghost vertex's weight is the
+// `fine_mass`-weighted mean of its fine vertices' weights, so its elements are as stiff as the fine
+// ones around them on average (the factor is linear in the weights, stiffness_paint.h).
+StiffnessPaint restrict_to_ghost(const Eigen::Ref<const Eigen::VectorXi>& map, int num_ghost,
+                                 const VectorRef& fine_mass, const StiffnessPaint& paint);
 
 }  // namespace modal_deform

@@ -51,7 +51,7 @@ class PoseObjective {
                 double stiffness, const FullSolveOptions& options)
       : scale_(normalizing_scale(V)),
         rest_(scale_ * V),
-        energy_(make_energy(options.energy, rest_, F, options.bending, options.membrane)),
+        energy_(make_energy(options.energy, rest_, F, options.bending, options.membrane, options.paint)),
         handle_term_(rest_, scale_ * scale_ * lumped_mass(V, F), handles, weights, stiffness),
         faces_(F) {
     const int n = static_cast<int>(V.rows());

@@ -6,7 +6,7 @@
 //
 //   F(y) = E(y) + μ Σ_h w_h Σ_{i∈h} s²m_i ‖y_i − s (R_h x̄_i + t_h)‖²
 //
-// with E the discrete shells energy (bending, membrane) or ARAP of the rest mesh s V, and m_i the
+// with E the discrete shells energy (bending, membrane, painted stiffness) or ARAP of the rest mesh s V, and m_i the
 // lumped masses of (V, F): the reduced solver's objective with U = I and no ghost.
 //
 // Globalisation (what makes it converge on scans with floppy flaps and fins): each iteration
@@ -54,6 +54,7 @@ struct FullSolveOptions {
   int max_iterations = 300;  // ≥ 0: Newton iterations at most, all load steps together
   // Called as ("solve", fraction done) at most every 0.1 s; returning false cancels (Cancelled).
   ProgressCallback progress = nullptr;
+  StiffnessPaint paint = {};  // the shells weights painted per vertex (stiffness_paint.h; not with ARAP)
 };
 
 struct FullSolveResult {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "reduction/region.h"
 #include "util/errors.h"
 #include "util/require_positions.h"
 #include "util/require_weight.h"
@@ -34,14 +35,15 @@ ReducedSolver::ReducedSolver(const Basis& basis, const Handles& handles, const V
                              EnergyKind energy, bool warm_start)
     : basis_(checked(basis)),
       num_handles_(static_cast<int>(handles.size())),
-      energy_(
-          make_energy(energy, basis.scale * basis.ghost_vertices, basis.ghost_faces, basis.bending, basis.membrane)),
+      energy_(make_energy(energy, basis.scale * basis.ghost_vertices, basis.ghost_faces, basis.bending,
+                          basis.membrane, ghost_paint(basis))),
       ghost_rest_(basis.scale * flatten(basis.ghost_vertices)),
       ghost_vectors_(basis.scale * basis.ghost_vectors),
       handle_term_(HandleTerm(basis.rest, basis.mass, handles,
                               checked_handle_weights(handles, weights, basis.num_vertices()),
                               checked_stiffness(stiffness) * std::pow(basis.scale, 4)),
                    [&basis](int v) { return basis.vertex_rows(v); }, basis.dimension()) {
+  require_handles_in_region(handles, basis.region);
   const Eigen::Index r = basis.dimension();
   if (warm_start) {
     const SparseMatrix K = energy_->hessian(ghost_rest_);

@@ -6,7 +6,7 @@
 //   f(q) = E_ghost(s (x̄_s + U_s q)) + E_C(q)
 //
 // E_ghost is the discrete shells energy with the basis's weights, or ARAP, of the ghost mesh
-// scaled by s; E_C the handle term with stiffness μ (handle_term.h). An iteration costs one or a
+// scaled by s, its painted stiffness the ghost vertices' means of the fine weights; E_C the handle term with stiffness μ (handle_term.h). An iteration costs one or a
 // few evaluations of E_ghost and its gradient (O(#ghost vertices · r)) plus O(r²) for BFGS and
 // the handles, whatever the size of the fine mesh; only positions() touches the fine mesh.
 //
@@ -46,7 +46,7 @@ class ReducedSolver {
  public:
   // basis: validated here (validate_basis); it must outlive the solver, which keeps a reference
   // to its fine arrays. handles, weights: see checked_handle_weights (fine vertex indices; empty
-  // weights mean 1). stiffness: μ > 0. energy: evaluated on the ghost. warm_start false starts
+  // weights mean 1), inside the basis's region if it has one (require_handles_in_region). stiffness: μ > 0. energy: evaluated on the ghost. warm_start false starts
   // BFGS from the identity instead of the rest Hessian (for comparison). The solver starts at
   // rest with identity transforms.
   ReducedSolver(const Basis& basis, const Handles& handles, const VectorRef& weights, double stiffness,

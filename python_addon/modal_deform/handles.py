@@ -50,12 +50,13 @@ def bind(obj, handle):
         handle.bound_controller = handle.controller.name
 
 
-def resolve(obj, scene, rest):
+def resolve(obj, scene, rest, region=None):
     """The usable handles of obj as Handle tuples, and warnings (overlaps, vanished controllers).
 
-    rest: #V by 3 rest positions (for the handles' centres). Raises HandleError naming the first
-    handle that cannot be used: no vertex group, a missing or empty group, a group covering every
-    vertex (nothing left to deform), a controller no longer in the scene.
+    rest: #V by 3 rest positions (for the handles' centres); region: the sorted vertices a region
+    bake lets move (None or empty: all). Raises HandleError naming the first handle that cannot be
+    used: no vertex group, a missing or empty group, a group covering every vertex (nothing left to
+    deform) or reaching outside the region, a controller no longer in the scene.
     """
     items = obj.modal_deform.handles
     if not items:
@@ -73,6 +74,12 @@ def resolve(obj, scene, rest):
         if indices.size == len(rest):
             raise HandleError(f"{label}: vertex group '{item.vertex_group}' holds every vertex, so nothing is left "
                               f"to deform")
+        if region is not None and region.size:
+            outside = indices[~np.isin(indices, region, assume_unique=True)]
+            if outside.size:
+                raise HandleError(f"{label}: vertex group '{item.vertex_group}' has {outside.size} vertices outside "
+                                  f"the region the basis was baked with (vertex {outside[0]} first), which alone "
+                                  f"moves: keep the handle inside the region, or re-bake with a region that holds it")
         controller = item.controller
         if controller is not None and scene.objects.get(controller.name) != controller:
             raise HandleError(f"{label}: controller '{controller.name}' is not in the scene (deleted?): assign "

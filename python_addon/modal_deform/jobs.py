@@ -78,9 +78,13 @@ class BakeJob(_ThreadJob):
         self.V = mesh_io.positions(obj.data)
         self.F = mesh_io.triangles(obj.data)
         self.fingerprint = storage.fingerprint(obj.data)
+        self.vertex_groups = storage.groups(obj)
+        region = self.vertex_groups.weights["region_group"]
         self.options = dict(modes=settings.modes, derivatives=settings.derivatives if self.energy == "SHELLS" else 0,
                             ghost=settings.ghost, energy=self.energy.lower(), bending=settings.bending,
-                            membrane=settings.membrane,
+                            membrane=settings.membrane, stiffness_weights=self.vertex_groups.weights["stiffness_group"],
+                            max_stiffness=settings.max_stiffness,
+                            region=None if region is None else mesh_io.members(region),
                             proxy=settings.proxy if settings.proxy_above else None, proxy_above=settings.proxy_above)
         self.stage, self.fraction = "starting", 0.0
         self.basis = self.error = None
@@ -106,7 +110,7 @@ class BakeJob(_ThreadJob):
         obj = bpy.data.objects.get(self.object_name)
         if obj is None or obj.type != "MESH" or storage.fingerprint(obj.data) != self.fingerprint:
             return "WARNING", f"'{self.object_name}' changed during the bake: the result was discarded, bake again"
-        storage.store(obj, self.basis, self.fingerprint, self.seconds, self.energy)
+        storage.store(obj, self.basis, self.fingerprint, self.vertex_groups, self.seconds, self.energy)
         self.written = True
         basis = self.basis
         message = (f"Baked '{obj.name}' in {self.seconds:.1f} s: {basis.dimension} dimensions, ghost "

@@ -34,19 +34,34 @@ def face_corners(mesh):
     return totals, corners
 
 
-def group_vertices(obj, group_name):
-    """Sorted int32 indices of the vertices with a weight above 0 in the vertex group, or None when
-    the object has no group of that name.
+def group_weights(obj, group_name):
+    """(#V,) float64 weights of the vertex group, 0 for the vertices not in it, or None when the
+    object has no group of that name.
 
     Blender has no bulk access to group weights: this walks the vertices once (about 0.1 s for
-    100k vertices), so callers read a handle set once, not per update.
+    100k vertices), so callers read a group once, not per update.
     """
     group = obj.vertex_groups.get(group_name)
     if group is None:
         return None
     index = group.index
-    members = [v.index for v in obj.data.vertices for g in v.groups if g.group == index and g.weight > 0.0]
-    return np.array(members, dtype=np.int32)
+    weights = np.zeros(len(obj.data.vertices))
+    for v in obj.data.vertices:
+        for g in v.groups:
+            if g.group == index:
+                weights[v.index] = g.weight
+    return weights
+
+
+def members(weights):
+    """Sorted int32 indices of the vertices with a weight above 0 (of group_weights)."""
+    return np.flatnonzero(weights > 0.0).astype(np.int32)
+
+
+def group_vertices(obj, group_name):
+    """The members of the vertex group, or None when the object has no group of that name."""
+    weights = group_weights(obj, group_name)
+    return None if weights is None else members(weights)
 
 
 def selected_vertices(mesh):

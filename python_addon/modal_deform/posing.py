@@ -24,7 +24,7 @@ class Pose:
         settings = obj.modal_deform
         self.obj = obj
         self.basis = storage.ready_basis(obj)
-        self.handles, self.warnings = handles.resolve(obj, context.scene, self.basis.rest)
+        self.handles, self.warnings = handles.resolve(obj, context.scene, self.basis.rest, self.basis.region)
         self.solver = mdc.ReducedSolver(self.basis, [h.indices for h in self.handles], stiffness=settings.stiffness,
                                         weights=[h.weight for h in self.handles],
                                         energy=settings.status.energy.lower())

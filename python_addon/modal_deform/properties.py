@@ -67,6 +67,12 @@ class ModalDeformBakeStatus(bpy.types.PropertyGroup):
     num_vertices: IntProperty(name="Vertices", description="Vertex count of the mesh at the bake")
     topology_hash: StringProperty(name="Topology Hash", description="Faces of the mesh at the bake")
     rest_hash: StringProperty(name="Rest Hash", description="Vertex positions of the mesh at the bake")
+    stiffness_group: StringProperty(name="Stiffness Group", description="The stiffness vertex group of the bake")
+    stiffness_group_hash: StringProperty(
+        name="Stiffness Hash", description="Weights of the stiffness vertex group at the bake (empty: uniform)")
+    region_group: StringProperty(name="Region Group", description="The region vertex group of the bake")
+    region_group_hash: StringProperty(
+        name="Region Hash", description="Weights of the region vertex group at the bake (empty: the whole mesh)")
 
 
 class ModalDeformSettings(bpy.types.PropertyGroup):
@@ -103,6 +109,20 @@ class ModalDeformSettings(bpy.types.PropertyGroup):
         name="Membrane", default=1.0, min=0.0, soft_max=10.0,
         description="Discrete Shells: weight of the stretching terms (edge lengths, triangle areas); higher "
                     "keeps the surface's size, so poses stretch less and bend more")
+    stiffness_group: StringProperty(
+        name="Stiffness Group",
+        description="Vertex group painting where the surface is stiffer (Discrete Shells): each element's bending "
+                    "and membrane weights are multiplied by 1 + (Max - 1) times its vertices' mean weight, as "
+                    "Cloth does; empty for a uniform material. Painting it anew makes the bake stale")
+    max_stiffness: FloatProperty(
+        name="Max Stiffness", default=100.0, min=1.0, max=1e4, soft_max=1000.0,
+        description="How many times stiffer than the material a vertex of weight 1 in the stiffness group is")
+    region_group: StringProperty(
+        name="Region Group",
+        description="Vertex group of the vertices that may move (weight above 0), as Laplacian Deform takes one: "
+                    "every other vertex stays exactly where it is, and the whole basis is spent inside the region, "
+                    "so a hand or a head of a dense character bakes quickly; handles must lie in it. Empty for the "
+                    "whole mesh")
     stiffness: FloatProperty(
         name="Stiffness", default=1000.0, min=1e-3, soft_min=1.0, soft_max=1e5,
         description="How hard the handles pull their vertices toward the controllers: higher follows the "

@@ -13,7 +13,8 @@ their shapes in "shapes", 0-d values as plain ID properties. Reading back is a z
 ``np.frombuffer`` of each property; ``Basis.from_arrays`` checks everything.
 
 Staleness: the vertex count, a hash of the faces' corners and a hash of the rest positions at the
-bake, compared with the mesh now.
+bake, compared with the mesh now; and the stiffness and region vertex groups with hashes of their
+weights (painting anew, choosing another group or deleting it makes the basis stale).
 """
 import collections
 import hashlib
@@ -33,12 +34,47 @@ _BAKE_ID = "bake_id"
 # Loaded bases by bake id, most recent last: a pose, a solve and the preview share one load.
 _bases = collections.OrderedDict()
 _CACHED_BASES = 2
-# Mesh fingerprints for the panel by mesh pointer, dropped when the depsgraph reports new geometry.
+# Mesh fingerprints for the panel by mesh pointer, and vertex group hashes by (mesh pointer, group
+# name), dropped when the depsgraph reports new geometry (weight painting is a geometry update).
 _fingerprints = {}
+_group_hashes = {}
 
 
 class NotReady(Exception):
     """The object cannot be posed: not baked, edited since the bake, or its stored basis damaged."""
+
+
+#: The vertex groups a bake reads, by their setting on Object.modal_deform (and the status property
+#: keeping the name at the bake): what each is for, as the messages name it.
+GROUPS = {"stiffness_group": "stiffness", "region_group": "region"}
+
+Groups = collections.namedtuple("Groups", "names weights hashes")
+Groups.__doc__ = """The vertex groups a bake reads (GROUPS), each by its setting: names ("" for none),
+weights (#V,) float64 (None for none) and hashes of the weights ("" for none)."""
+
+
+def groups(obj):
+    """obj's bake vertex groups now (Groups). Raises ValueError naming a group that is set but no
+    longer exists."""
+    names, weights, hashes = {}, {}, {}
+    for setting, purpose in GROUPS.items():
+        name = getattr(obj.modal_deform, setting)
+        names[setting], weights[setting], hashes[setting] = name, None, ""
+        if not name:
+            continue
+        weights[setting] = mesh_io.group_weights(obj, name)
+        if weights[setting] is None:
+            raise ValueError(f"'{obj.name}': the {purpose} vertex group '{name}' does not exist (deleted or "
+                             f"renamed?): choose another one or clear it")
+        hashes[setting] = _digest(weights[setting])
+    return Groups(names, weights, hashes)
+
+
+def _group_hash(obj, group, cached):
+    key = (obj.data.as_pointer(), group)
+    if not cached or key not in _group_hashes:
+        _group_hashes[key] = _digest(mesh_io.group_weights(obj, group))
+    return _group_hashes[key]
 
 
 def _digest(*arrays):
@@ -76,11 +112,20 @@ def stale_reason(obj, cached=False):
         return "faces changed"
     if rest != status.rest_hash:
         return "vertices moved"
+    for setting, purpose in GROUPS.items():
+        group, baked = getattr(obj.modal_deform, setting), getattr(status, setting)
+        if group != baked:
+            return f"{purpose} group '{group}', the bake had '{baked}'"
+        if group and obj.vertex_groups.get(group) is None:
+            return f"{purpose} group '{group}' was deleted"
+        if group and _group_hash(obj, group, cached) != getattr(status, setting + "_hash"):
+            return f"{purpose} weights painted anew"
     return ""
 
 
-def store(obj, basis, mesh_fingerprint, seconds, energy):
-    """Keep `basis` (baked from obj's mesh with `mesh_fingerprint`) in the .blend as obj's basis."""
+def store(obj, basis, mesh_fingerprint, vertex_groups, seconds, energy):
+    """Keep `basis` (baked from obj's mesh with `mesh_fingerprint` and the Groups `vertex_groups`)
+    in the .blend as obj's basis."""
     arrays = basis.to_arrays()
     block = bpy.data.palettes.new(PREFIX + obj.name)
     block.use_fake_user = False  # palettes get one by default; this one lives as long as its objects
@@ -110,6 +155,9 @@ def store(obj, basis, mesh_fingerprint, seconds, energy):
     status.baked_at = time.strftime("%Y-%m-%d %H:%M")
     status.seconds = seconds
     status.num_vertices, status.topology_hash, status.rest_hash = mesh_fingerprint
+    for setting in GROUPS:
+        setattr(status, setting, vertex_groups.names[setting])
+        setattr(status, setting + "_hash", vertex_groups.hashes[setting])
     _remember(bake_id, basis)
 
 
@@ -175,13 +223,17 @@ def ready_basis(obj):
 def _forget_geometry(scene, depsgraph):
     for update in depsgraph.updates:
         if update.is_updated_geometry and isinstance(update.id, bpy.types.Mesh):
-            _fingerprints.pop(update.id.original.as_pointer(), None)
+            mesh = update.id.original.as_pointer()
+            _fingerprints.pop(mesh, None)
+            for key in [key for key in _group_hashes if key[0] == mesh]:
+                del _group_hashes[key]
 
 
 @bpy.app.handlers.persistent
 def _forget_everything(*args):
     _bases.clear()
     _fingerprints.clear()
+    _group_hashes.clear()
 
 
 def register():

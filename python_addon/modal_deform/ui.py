@@ -71,6 +71,13 @@ class VIEW3D_PT_modal_deform_bake(_Panel, bpy.types.Panel):
         shells.enabled = settings.energy == "SHELLS"
         shells.prop(settings, "bending")
         shells.prop(settings, "membrane")
+        # Laid out as Cloth's stiffness group: the group, then its Max.
+        painted = column.column(align=True)
+        painted.prop_search(settings, "stiffness_group", obj, "vertex_groups", text="Stiffness Group")
+        row = painted.row()
+        row.enabled = bool(settings.stiffness_group)
+        row.prop(settings, "max_stiffness", text="Max")
+        column.prop_search(settings, "region_group", obj, "vertex_groups", text="Region Group")
 
         box = layout.box()
         if settings.basis is None:

@@ -23,6 +23,16 @@ def test_suzanne_follows_strong_poses(run_blender):
     assert "STRONG_POSES_OK" in run_blender("strong_pose.py").stdout
 
 
+def test_painted_stiffness_is_stored_reloaded_and_posed(run_blender, tmp_path):
+    assert "PAINTED_OK" in run_blender("painted_stiffness.py").stdout
+    assert "PAINTED_RELOADED" in run_blender("painted_reload.py", blend=tmp_path / "painted.blend").stdout
+
+
+def test_region_bake_leaves_the_rest_exactly_still(run_blender, tmp_path):
+    assert "REGION_OK" in run_blender("region_bake.py").stdout
+    assert "REGION_RELOADED" in run_blender("region_reload.py", blend=tmp_path / "region.blend").stdout
+
+
 def test_stale_mesh_and_bad_handles_are_refused(run_blender):
     assert "STALE_OK" in run_blender("stale_and_bad_handles.py").stdout
 

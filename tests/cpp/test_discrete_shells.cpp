@@ -520,6 +520,34 @@ TEST(DiscreteShells, WeightsScaleTheirTermsLinearly) {
   EXPECT_LT((t - (2.5 * tb + 0.3 * tm)).norm(), 1e-13 * t.norm());
 }
 
+// Painted stiffness (stiffness_paint.h): all weights 1 is max_stiffness times the material, all 0
+// the material itself, and a painted part counts only in the elements touching it.
+TEST(DiscreteShells, PaintedStiffnessScalesEachElementByItsVerticesMeanWeight) {
+  const TriangleMesh tube = cylinder(8, 6, 1.0, 3.0);
+  const Eigen::Index n = tube.V.rows();
+  const DiscreteShells plain(tube.V, tube.F, 1.5, 0.5);
+  const DiscreteShells stiff(tube.V, tube.F, 1.5, 0.5, {Eigen::VectorXd::Ones(n), 40.0});
+  const DiscreteShells zero(tube.V, tube.F, 1.5, 0.5, {Eigen::VectorXd::Zero(n), 40.0});
+  const Eigen::VectorXd x = flat(bent(tube.V));
+  EXPECT_NEAR(stiff.value(x), 40.0 * plain.value(x), 1e-12 * stiff.value(x));
+  EXPECT_EQ(zero.value(x), plain.value(x));
+  // Vertex 0 painted: only the terms it is in stiffen; moving a vertex far from it costs as before.
+  Eigen::VectorXd weights = Eigen::VectorXd::Zero(n);
+  weights[0] = 1.0;
+  const DiscreteShells one(tube.V, tube.F, 1.5, 0.5, {weights, 40.0});
+  Eigen::VectorXd near = plain.rest(), far = plain.rest();
+  near[0] += 0.1;
+  far[3 * (n - 1)] += 0.1;
+  EXPECT_EQ(one.value(far), plain.value(far));
+  EXPECT_GT(one.value(near), 5.0 * plain.value(near));
+  EXPECT_LT(one.value(near), 40.0 * plain.value(near));
+  expect_input_error([&] { DiscreteShells(tube.V, tube.F, 1, 1, {Eigen::VectorXd::Zero(n - 1), 2.0}); },
+                     "stiffness_weights: expected one weight per vertex");
+  weights[4] = -1e-3;
+  expect_input_error([&] { DiscreteShells(tube.V, tube.F, 1, 1, {weights, 2.0}); }, "stiffness_weights[4]");
+  expect_input_error([&] { DiscreteShells(tube.V, tube.F, 1, 1, {Eigen::VectorXd(), 0.9}); }, "max_stiffness");
+}
+
 // Each vertex sums its contributions in element order however many threads share the work.
 TEST(DiscreteShells, ResultsDoNotDependOnTheNumberOfThreads) {
   const TriangleMesh dragon = normalized(shared_mesh("dragon_vrip_res4.ply.gz"));

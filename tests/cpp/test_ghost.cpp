@@ -326,6 +326,22 @@ TEST(Ghost, RestrictionIsTheMassWeightedMeanPerCoordinate) {
   }
 }
 
+TEST(Ghost, PaintedStiffnessRestrictsToTheMassWeightedMeanWeight) {
+  Eigen::VectorXi map(4);
+  map << 0, 1, 0, 0;
+  Eigen::VectorXd mass(4), weights(4);
+  mass << 1, 0, 3, 0;
+  weights << 0.2, 0.7, 1.0, 0.0;
+  const StiffnessPaint coarse = restrict_to_ghost(map, 2, mass, StiffnessPaint{weights, 30.0});
+  ASSERT_EQ(coarse.weights.size(), 2);
+  EXPECT_DOUBLE_EQ(coarse.weights[0], (0.2 + 3.0) / 4.0);
+  EXPECT_DOUBLE_EQ(coarse.weights[1], 0.7);
+  EXPECT_EQ(coarse.max_stiffness, 30.0);
+  EXPECT_EQ(restrict_to_ghost(map, 2, mass, StiffnessPaint{}).weights.size(), 0);
+  expect_input_error([&] { restrict_to_ghost(map, 2, mass, StiffnessPaint{weights.head(3), 2.0}); },
+                     "stiffness_weights");
+}
+
 TEST(Ghost, ProgressIsReportedOftenAndCancelStopsIt) {
   const TriangleMesh& dragon = shared_mesh("dragon_vrip_res3.ply.gz");
   const Eigen::VectorXd mass = lumped_mass(dragon.V, dragon.F);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <string>
+#include <vector>
 
 #include "energy/arap.h"
 #include "energy/discrete_shells.h"
@@ -305,6 +306,25 @@ void stored_basis(const std::uint8_t* data, std::size_t size) {
   b.bending = in.positive();
   b.membrane = in.positive();
   b.num_dropped = in.integer(-1, 1);
+  // Now and then painted (weights mostly in [0, 1], on the fine mesh and the ghost) or baked in a
+  // region (mostly ascending vertices, the rows outside mostly zero).
+  const auto weight = [&in] { return in.byte() > 250 ? in.number() : in.byte() / 255.0; };
+  if (in.byte() > 220) {
+    b.stiffness_weights.resize(std::max(0, n + off()));
+    for (Eigen::Index i = 0; i < b.stiffness_weights.size(); ++i) b.stiffness_weights[i] = weight();
+    b.ghost_stiffness_weights.resize(std::max(0, g + off()));
+    for (Eigen::Index i = 0; i < b.ghost_stiffness_weights.size(); ++i) b.ghost_stiffness_weights[i] = weight();
+    b.max_stiffness = in.byte() > 250 ? in.number() : 1.0 + in.byte();
+  }
+  if (in.byte() > 220 && n > 0) {
+    std::vector<int> region;
+    for (int v = 0; v < n; ++v)
+      if (in.flag()) region.push_back(in.byte() > 250 ? in.integer(-1, n) : v);
+    b.region = Eigen::Map<const Eigen::VectorXi>(region.data(), static_cast<Eigen::Index>(region.size()));
+    for (int v = 0; v < n && b.vectors.rows() == 3 * n; ++v)
+      if (!std::binary_search(region.begin(), region.end(), v) && in.byte() < 250)
+        b.vectors.middleRows(3 * v, 3).setZero();
+  }
   if (!runs("validate_basis", [&] { validate_basis(b); })) return;
 
   const Handles handles = fuzz_handles(in, n, 2, 4);

@@ -56,6 +56,24 @@ def values(x, name, length=None):
     return x
 
 
+def stiffness_weights(w, num_vertices):
+    """(num_vertices,) float64 weights painted per vertex, or (0,) for None or no weights (a
+    uniform material, as a basis baked without paint stores it); values are checked natively."""
+    if w is None or np.size(w) == 0:
+        return np.zeros(0)
+    return values(w, "stiffness_weights", num_vertices)
+
+
+def indices(x, name):
+    """(k,) int32 vertex indices from integer input (ranges and repeats are checked natively)."""
+    x = np.asarray(x)
+    if x.ndim != 1 or (x.size and x.dtype.kind not in "iu"):
+        raise ValueError(f"{name}: expected a 1-d array of vertex indices, got dtype {x.dtype} and shape {x.shape}")
+    if x.size and (x.max() > np.iinfo(np.int32).max or x.min() < np.iinfo(np.int32).min):
+        raise ValueError(f"{name}: an index does not fit in 32 bits")
+    return np.ascontiguousarray(x, dtype=np.int32)
+
+
 def labels(x, length, name="labels"):
     """(length,) int32 from integer input."""
     x = np.asarray(x)

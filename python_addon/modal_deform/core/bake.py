@@ -17,7 +17,9 @@ import numpy as np
 from .. import _native
 from . import _arrays
 
-FORMAT_VERSION = 2  # 2: the prolongation of a basis baked on a proxy (version 1 has none)
+# 2: the prolongation of a basis baked on a proxy; 3: the painted stiffness (stiffness_weights,
+# max_stiffness). Each field's version comes from the native schema.
+FORMAT_VERSION = 3
 
 #: ``bake``'s defaults for dense meshes: more than PROXY_ABOVE vertices are baked on a proxy of
 #: about PROXY vertices. Measured on the shared 2-core machine (bench/multires.py, docs): the
@@ -27,29 +29,11 @@ FORMAT_VERSION = 2  # 2: the prolongation of a basis baked on a proxy (version 1
 PROXY_ABOVE = 150_000
 PROXY = 50_000
 
-# name: (dtype, number of dimensions) of each array to_arrays writes; shapes are checked
-# natively against each other (validate_basis).
-_ARRAYS = {
-    "format_version": (np.int32, 0),
-    "rest": (np.float64, 2),
-    "mass": (np.float64, 1),
-    "vectors": (np.float32, 2),
-    "num_rigid": (np.int32, 0),
-    "num_modes": (np.int32, 0),
-    "num_floppy": (np.int32, 0),
-    "eigenvalues": (np.float64, 1),
-    "ghost_vertices": (np.float64, 2),
-    "ghost_faces": (np.int32, 2),
-    "ghost_map": (np.int32, 1),
-    "ghost_vectors": (np.float64, 2),
-    "scale": (np.float64, 0),
-    "bending": (np.float64, 0),
-    "membrane": (np.float64, 0),
-    "num_dropped": (np.int32, 0),
-    "prolongation_vertices": (np.int32, 2),
-    "prolongation_weights": (np.float32, 2),
-}
-_SINCE_VERSION_2 = ("prolongation_vertices", "prolongation_weights")
+# The stored fields, one table: the native core's (cpp/basis/basis.h, for_each_stored_field), each
+# with its name, the format version that introduced it, dtype, number of dimensions, fixed number of
+# columns (0: any) and whether it is column-major. Shapes are checked natively against each other
+# (validate_basis).
+_SCHEMA = tuple(_native.Basis.schema)
 
 
 class Basis:
@@ -62,8 +46,14 @@ class Basis:
     motions). ``num_floppy`` modes after the rigid ones are zero modes of a floppy mesh
     (mechanisms, e.g. flaps at non-manifold vertices); ``num_dropped`` derivatives were dropped as
     numerically dependent. ``ghost_vertices`` (g, 3), ``ghost_faces`` (h, 3) int32 and
-    ``ghost_map`` (n,) int32 describe the ghost, ``ghost_vectors`` (3g, r) the restricted basis.
-    ``timings`` maps each bake stage to seconds.
+    ``ghost_map`` (n,) int32 describe the ghost (a region bake's ghost is its submesh's, and the
+    vertices outside that map to 0), ``ghost_vectors`` (3g, r) the restricted basis.
+    ``timings`` maps each bake stage to seconds. ``rest`` (n, 3) float64 and ``mass`` (n,) float64
+    are the rest mesh's positions and lumped masses (mesh units), ``scale`` the factor from mesh
+    units to the normalised frame, ``bending`` and ``membrane`` the energy's weights, and
+    ``stiffness_weights`` (n,) float64 (or (0,): uniform) with ``max_stiffness`` their painting per
+    vertex (see ``bake``), which the solver's ghost takes over as means. ``region`` (k,) int32: a
+    region bake's vertices, ascending ((0,) for the whole mesh); all rows of other vertices are 0.
 
     A dense mesh baked on a proxy (``on_proxy``) keeps the proxy's basis: ``vectors`` is then
     (3p, r) over its ``num_basis_vertices`` = p vertices, and each fine vertex i moves with
@@ -75,28 +65,12 @@ class Basis:
     def __init__(self, native):
         self._native = native
 
-    rest = property(lambda self: self._native.rest, doc="(n, 3) float64 rest positions")
-    mass = property(lambda self: self._native.mass, doc="(n,) float64 lumped vertex masses (mesh units)")
-    vectors = property(lambda self: self._native.vectors, doc="(3n, r) float32 basis vectors U")
-    eigenvalues = property(lambda self: self._native.eigenvalues, doc="(num_modes,) float64, ascending")
-    ghost_vertices = property(lambda self: self._native.ghost_vertices, doc="(g, 3) float64")
-    ghost_faces = property(lambda self: self._native.ghost_faces, doc="(h, 3) int32")
-    ghost_map = property(lambda self: self._native.ghost_map, doc="(n,) int32 fine vertex -> ghost vertex")
-    ghost_vectors = property(lambda self: self._native.ghost_vectors, doc="(3g, r) float64")
-    num_rigid = property(lambda self: self._native.num_rigid)
-    num_modes = property(lambda self: self._native.num_modes)
-    num_floppy = property(lambda self: self._native.num_floppy)
-    num_dropped = property(lambda self: self._native.num_dropped)
-    scale = property(lambda self: self._native.scale, doc="factor from mesh units to the normalised frame")
-    bending = property(lambda self: self._native.bending)
-    membrane = property(lambda self: self._native.membrane)
+    # The stored fields (_SCHEMA) are read-only views of the native basis, and so are these:
     dimension = property(lambda self: self._native.dimension, doc="r, the number of basis vectors")
     num_vertices = property(lambda self: self._native.num_vertices)
     on_proxy = property(lambda self: self._native.on_proxy, doc="baked on a proxy of the mesh")
     num_basis_vertices = property(lambda self: self._native.num_basis_vertices,
                                   doc="vertices of vectors' rows: the proxy's, or n")
-    prolongation_vertices = property(lambda self: self._native.prolongation_vertices, doc="(n, 3) or (0, 3) int32")
-    prolongation_weights = property(lambda self: self._native.prolongation_weights, doc="(n, 3) or (0, 3) float32")
 
     def fine_vectors(self, columns=slice(None)):
         """(3n, c) float32: the basis vectors ``columns`` (default all r) on the fine mesh: a view of
@@ -128,46 +102,59 @@ class Basis:
         """dict[str, np.ndarray] of copies, counts and scalars as 0-d arrays, with a format version:
         what from_arrays reads back bit for bit (timings are not kept)."""
         arrays = {"format_version": np.array(FORMAT_VERSION, dtype=np.int32)}
-        for name, (dtype, _) in _ARRAYS.items():
-            if name != "format_version":
-                arrays[name] = np.array(getattr(self, name), dtype=dtype)
+        for field in _SCHEMA:
+            arrays[field["name"]] = np.array(getattr(self, field["name"]), dtype=field["dtype"])
         return arrays
 
     @classmethod
     def from_arrays(cls, arrays):
-        """The Basis of a dict written by to_arrays, e.g. read back from a .blend file.
+        """The Basis of a dict written by to_arrays (of this format version or an earlier one),
+        e.g. read back from a .blend file.
 
         Every array is checked (dtype, number of dimensions, then natively its shape against the
         others, finiteness, index ranges and counts) before anything reads it; a ValueError names
-        the first offending array.
+        the first offending array. Fields newer than the stored version keep their defaults.
         """
         try:
             keys = set(arrays.keys())
         except AttributeError:
             raise ValueError(f"arrays: expected a dict of numpy arrays, got {type(arrays).__name__}") from None
-        checked = {}
-        for name, (dtype, ndim) in _ARRAYS.items():
-            if name not in keys and name in _SINCE_VERSION_2 and int(checked["format_version"]) == 1:
-                checked[name] = np.zeros((0, 3), dtype)  # a basis of the mesh itself
-                continue
+        if "format_version" not in keys:
+            raise ValueError("format_version: missing from the stored basis")
+        version = np.asarray(arrays["format_version"])
+        if version.dtype != np.int32 or version.ndim != 0:
+            raise ValueError(f"format_version: expected a 0-d int32, got {version.dtype} of shape {version.shape}")
+        version = int(version)
+        if not 1 <= version <= FORMAT_VERSION:
+            raise ValueError(f"format_version: this add-on reads versions 1 to {FORMAT_VERSION}, got {version}; "
+                             f"re-bake")
+        fields = {}
+        for field in _SCHEMA:
+            name = field["name"]
             if name not in keys:
+                if field["since"] > version:
+                    continue
                 raise ValueError(f"{name}: missing from the stored basis")
             a = np.asarray(arrays[name])
-            if a.dtype != dtype:
-                raise ValueError(f"{name}: expected dtype {np.dtype(dtype)}, got {a.dtype}")
-            if a.ndim != ndim:
-                raise ValueError(f"{name}: expected {ndim} dimensions, got shape {a.shape}")
-            checked[name] = a
-        version = int(checked.pop("format_version"))
-        if version not in (1, FORMAT_VERSION):
-            raise ValueError(f"format_version: this add-on reads versions 1 and {FORMAT_VERSION}, got {version}; re-bake")
-        for name in ("rest", "ghost_vertices", "ghost_faces") + _SINCE_VERSION_2:
-            if checked[name].shape[1] != 3:
-                raise ValueError(f"{name}: expected 3 columns, got shape {checked[name].shape}")
-        scalars = {name: a.item() for name, a in checked.items() if a.ndim == 0}
-        arrays = {name: np.ascontiguousarray(a) for name, a in checked.items() if a.ndim > 0}
-        arrays["ghost_vectors"] = np.asfortranarray(checked["ghost_vectors"])
-        return cls(_native.Basis(**arrays, **scalars))
+            if a.dtype != field["dtype"]:
+                raise ValueError(f"{name}: expected dtype {field['dtype']}, got {a.dtype}")
+            if a.ndim != field["ndim"]:
+                raise ValueError(f"{name}: expected {field['ndim']} dimensions, got shape {a.shape}")
+            if field["columns"] and a.shape[1] != field["columns"]:
+                raise ValueError(f"{name}: expected {field['columns']} columns, got shape {a.shape}")
+            if a.ndim == 0:
+                fields[name] = a.item()
+            else:
+                fields[name] = np.asfortranarray(a) if field["fortran"] else np.ascontiguousarray(a)
+        return cls(_native.Basis(**fields))
+
+
+def _stored_field(name):
+    return property(lambda self: getattr(self._native, name))
+
+
+for _field in _SCHEMA:
+    setattr(Basis, _field["name"], _stored_field(_field["name"]))
 
 
 def _count(value, name, minimum):
@@ -184,7 +171,8 @@ def _flag(value, name):
 
 
 def bake(V, F, modes=20, derivatives=52, ghost=1000, energy="shells", bending=1.0, membrane=1.0, progress=None,
-         rotation_pairs=True, proxy=PROXY, proxy_above=PROXY_ABOVE):
+         rotation_pairs=True, proxy=PROXY, proxy_above=PROXY_ABOVE, stiffness_weights=None, max_stiffness=100.0,
+         region=None):
     """Bake the reduced space of the triangle mesh (V (n, 3), F (m, 3)) for posing.
 
     modes: vibration modes, the rigid motions of the simulated components (6 each) included;
@@ -199,6 +187,16 @@ def bake(V, F, modes=20, derivatives=52, ghost=1000, energy="shells", bending=1.
     ``proxy_above``), made by the ghost's edge collapse, and its basis carried to every fine
     vertex by barycentric weights on the nearest proxy triangle (``Basis.on_proxy``; stages
     "proxy" and "prolongation"); ``proxy=None`` bakes any mesh as it is.
+    stiffness_weights: None (a uniform material) or (n,) weights in [0, 1] painted per vertex, as
+    Blender's Cloth takes stiffness from a vertex group: each element's bending and membrane weight
+    is multiplied by 1 + (max_stiffness − 1) × the mean weight of its vertices (max_stiffness in
+    [1, 1e4]); the modes, derivatives, proxy and ghost all see it, and so does the solver (shells
+    only; all-zero weights give the plain bake).
+    region: None (the whole mesh moves) or the indices of the vertices that may move: every other
+    vertex stays exactly at rest (its rows of the basis are zero), the faces around the region
+    hold it as a fixed boundary, and all the modes and derivatives are spent inside it (no rigid
+    motions, but for a part of the region that touches nothing outside: its come as zero modes).
+    Handles must lie in it. Never on a proxy (``Basis.region`` keeps it, ascending).
     ``progress(stage, fraction)`` is called
     at least every second or so (not during a CHOLMOD factorisation, about 2 s at 100k vertices);
     returning False raises ``Cancelled``, and an exception it raises propagates.
@@ -209,6 +207,10 @@ def bake(V, F, modes=20, derivatives=52, ghost=1000, energy="shells", bending=1.
     the rigid motions, and get no modal derivatives.
     """
     V, F = _arrays.vertices(V), _arrays.faces(F)
+    if region is not None:
+        region = _arrays.indices(region, "region")
+        if not region.size:
+            raise ValueError("region: it has no vertices; give the vertices that may move, or None for the whole mesh")
     if not isinstance(energy, str):
         raise ValueError(f"energy: expected \"shells\" or \"arap\", got {energy!r}")
     if progress is not None and not callable(progress):
@@ -217,10 +219,14 @@ def bake(V, F, modes=20, derivatives=52, ghost=1000, energy="shells", bending=1.
                           _count(ghost, "ghost", 4), energy, _arrays.number(bending, "bending"),
                           _arrays.number(membrane, "membrane"), _flag(rotation_pairs, "rotation_pairs"),
                           0 if proxy is None else _count(proxy_above, "proxy_above", 1),
-                          4 if proxy is None else _count(proxy, "proxy", 4), progress)
+                          4 if proxy is None else _count(proxy, "proxy", 4),
+                          _arrays.stiffness_weights(stiffness_weights, len(V)),
+                          _arrays.number(max_stiffness, "max_stiffness"),
+                          np.zeros(0, np.int32) if region is None else region, progress)
     basis = Basis(native)
     if basis.num_floppy:
         warnings.warn(f"the mesh is floppy: it has {basis.num_floppy} zero modes besides its rigid motions "
-                      f"(mechanisms, e.g. flaps at non-manifold edges or vertices); they are in the basis on top "
-                      f"of the {modes} modes asked for, without modal derivatives", stacklevel=2)
+                      f"(mechanisms, e.g. flaps at non-manifold edges or vertices, or the rigid motions of a part of "
+                      f"the region that touches nothing outside it); they are in the basis on top of the {modes} "
+                      f"modes asked for, without modal derivatives", stacklevel=2)
     return basis

@@ -56,15 +56,22 @@ class DiscreteShells(_Energy):
     triangle areas (over Ā); barred quantities are those of the rest mesh ``V``. ``bending`` is
     α and ``membrane`` β. The paper scales models to a longest bounding-box edge of 10 first.
 
-    V: (n, 3) rest positions, F: (m, 3) triangles. Raises ValueError for an unusable mesh or a
-    weight that is negative or not finite. Degenerate rest triangles and zero-length rest edges
+    Stiffness painted per vertex: ``stiffness_weights`` (n,) in [0, 1] (None: uniform) multiply each
+    element's α and β by 1 + (max_stiffness − 1) × the mean weight of its vertices (Blender Cloth's
+    convention), ``max_stiffness`` in [1, 1e4].
+
+    V: (n, 3) rest positions, F: (m, 3) triangles. Raises ValueError for an unusable mesh, a
+    weight that is negative or not finite, or bad stiffness weights (naming the vertex). Degenerate rest triangles and zero-length rest edges
     have no terms; non-manifold edges bend as if their sheets were welded pairwise.
     """
 
-    def __init__(self, V, F, bending=1.0, membrane=1.0):
+    def __init__(self, V, F, bending=1.0, membrane=1.0, stiffness_weights=None, max_stiffness=1.0):
+        V = _arrays.vertices(V)
         super().__init__(
-            _native.DiscreteShells(_arrays.vertices(V), _arrays.faces(F), _arrays.number(bending, "bending"),
-                                 _arrays.number(membrane, "membrane")))
+            _native.DiscreteShells(V, _arrays.faces(F), _arrays.number(bending, "bending"),
+                                   _arrays.number(membrane, "membrane"),
+                                   _arrays.stiffness_weights(stiffness_weights, len(V)),
+                                   _arrays.number(max_stiffness, "max_stiffness")))
 
     @property
     def term_counts(self):

@@ -161,7 +161,7 @@ class ReducedSolver:
         ``F`` (m, 3): the fine mesh's triangles (the basis keeps only its rest positions).
         ``initial`` (n, 3): where to start, by default the reduced pose ``positions()``; an
         animation passes the previous frame's refined answer. Same objective as ``solve``: the
-        handles, weights, stiffness, energy (with the basis's material weights) and the current
+        handles, weights, stiffness, energy (with the basis's material weights, painted ones too) and the current
         transforms. ``progress(stage, fraction) -> bool`` is called from time to time (False
         cancels: ``Cancelled``). Returns (positions (n, 3) float64, stats) with the stats of
         ``solve_full`` ("initial_energy" is the objective at the start). When the solve from the
@@ -193,7 +193,8 @@ class ReducedSolver:
             report = progress and (lambda stage, fraction: progress(stage, share[0] + share[1] * fraction))
             return solve_full(basis.rest, F, problem["handles"], self._transforms, stiffness=problem["stiffness"],
                               weights=problem["weights"], energy=problem["energy"], bending=basis.bending,
-                              membrane=basis.membrane, tolerance=tolerance, max_iterations=iterations,
+                              membrane=basis.membrane, stiffness_weights=basis.stiffness_weights,
+                              max_stiffness=basis.max_stiffness, tolerance=tolerance, max_iterations=iterations,
                               initial=initial, progress=report, return_stats=True)
 
         X, stats = solve(start, max_iterations, (0.0, 0.5))
@@ -239,11 +240,13 @@ class ReducedSolver:
 
 
 def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, energy="shells", bending=1.0,
-               membrane=1.0, tolerance=1e-8, max_iterations=300, initial=None, progress=None, return_stats=False):
+               membrane=1.0, tolerance=1e-8, max_iterations=300, initial=None, progress=None, return_stats=False,
+               stiffness_weights=None, max_stiffness=1.0):
     """The reference: Newton's method on the full mesh for the reduced solver's objective.
 
     V (n, 3), F (m, 3): the rest mesh; handles, transforms, weights, stiffness, energy as for
-    ReducedSolver, with ``bending`` and ``membrane`` the shells weights. From rest, large motions
+    ReducedSolver, with ``bending`` and ``membrane`` the shells weights, ``stiffness_weights`` and
+    ``max_stiffness`` their painting per vertex as for ``bake``. From rest, large motions
     are taken in load steps (the first turning each handle by at most 30° and moving its centre by
     at most a tenth of the bounding-box diagonal, later ones longer or shorter as the previous
     converged fast or slowly); with ``initial`` (n, 3) the solve starts there in one step
@@ -265,7 +268,9 @@ def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, ene
         raise ValueError(f"progress: expected a callable or None, got {type(progress).__name__}")
     X, stats = _native.solve_full(V, F, handles, _transforms(transforms, len(handles)), _weights(weights, len(handles)),
                                   _arrays.number(stiffness, "stiffness"), str(energy), _arrays.number(bending, "bending"),
-                                  _arrays.number(membrane, "membrane"), _arrays.number(tolerance, "tolerance"),
+                                  _arrays.number(membrane, "membrane"),
+                                  _arrays.stiffness_weights(stiffness_weights, len(V)),
+                                  _arrays.number(max_stiffness, "max_stiffness"), _arrays.number(tolerance, "tolerance"),
                                   max_iterations,
                                   None if initial is None else _arrays.vertices(initial, "initial"), progress)
     return (X, stats) if return_stats else X
