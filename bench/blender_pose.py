@@ -11,14 +11,16 @@ Laplacian result is added to each mesh file for the renders.
 In bpy (Blender 4.2+ as a Python module), with the add-on installed from the extension zip:
 
     BLENDER_USER_RESOURCES=$(mktemp -d) .venv/bpy-4.5/bin/python tests/blender/bpy_session.py \
-        --extension dist/modal_deform-0.1.0-linux_x64.zip bench/blender_pose.py -- --pose-only
+        --extension dist/modal_deform-0.1.0-blender_4.2_to_5.0-linux_x64.zip bench/blender_pose.py -- --pose-only
 
-One update is what the Pose operator does per timer tick, each step timed: controller matrices →
-set_transforms → 10 BFGS iterations → positions(out=float32) → shape key foreach_set →
-mesh.update(). Blender then evaluates the mesh for display ("evaluate": view_layer.update()).
-Medians over the updates, with the controller moving a little each time.
+One update is what the Pose operator does per timer tick, through its own calls, each timed:
+controller matrices → set_transforms → BFGS within the object's time budget → the fine positions
+written by the solver straight into the shape key's array → mesh.update(). Blender then evaluates
+the mesh for display ("evaluate": view_layer.update()). Medians over the updates, with the
+controller moving a little each time.
 """
 import argparse
+import ctypes
 import json
 import math
 import os
@@ -101,14 +103,18 @@ def mesh_object(name, V, F):
 
 
 def time_updates(obj, controller, updates):
-    """Per-step medians (ms) of `updates` pose updates while the controller turns and slides."""
-    handles, mesh_io, posing = addon("handles", "mesh_io", "posing")
+    """Medians (ms) of `updates` pose updates while the controller turns and slides, each made of
+    the Pose operator's own calls per timer tick: follow_controllers (controller matrices and
+    set_transforms), step (BFGS within the object's time budget), write (the pose into the shape
+    key, Blender's array written by the solver, and mesh.update()); then Blender's evaluation
+    ("evaluate", view_layer.update())."""
+    posing = addon("posing")
     pose = posing.Pose(bpy.context, obj)
     state = posing.ShapeKeyState(obj, posing.POSE_KEY)
     block = state.ensure()
     size = max(obj.dimensions)
-    steps = {name: [] for name in ("controllers", "set_transforms", "solve", "positions", "write", "tick",
-                                   "evaluate")}
+    budget = obj.modal_deform.budget
+    steps = {name: [] for name in ("controllers", "solve", "write", "tick", "evaluate")}
     iterations = []
     start_matrix = controller.matrix_world.copy()
     for i in range(updates):
@@ -116,31 +122,61 @@ def time_updates(obj, controller, updates):
                                    @ Matrix.Rotation(math.radians(1.0 * i), 4, "X"))
         bpy.context.view_layer.update()
         tick = time.perf_counter()
+        pose.follow_controllers()
+        steps["controllers"].append(milliseconds(tick))
         t = time.perf_counter()
-        transforms = handles.transforms(obj, pose.handles)
-        steps["controllers"].append(milliseconds(t))
-        t = time.perf_counter()
-        pose.solver.set_transforms(transforms)
-        steps["set_transforms"].append(milliseconds(t))
-        t = time.perf_counter()
-        # A tolerance no iterate meets: the 10 iterations a tick may spend (fewer only when BFGS stalls).
-        iterations.append(pose.solver.solve(max_iterations=10, tolerance=1e-12)["iterations"])
+        iterations.append(pose.step(budget)["iterations"])
         steps["solve"].append(milliseconds(t))
         t = time.perf_counter()
-        pose.solver.positions(pose.out)
-        steps["positions"].append(milliseconds(t))
-        t = time.perf_counter()
-        mesh_io.write_shape_key(obj.data, block, pose.out)
+        pose.write(block)
         steps["write"].append(milliseconds(t))
         steps["tick"].append(milliseconds(tick))
         t = time.perf_counter()
         bpy.context.view_layer.update()
         steps["evaluate"].append(milliseconds(t))
-    controller.matrix_world = start_matrix
-    state.restore()
     result = {name: float(np.median(values)) for name, values in steps.items()}
     result["iterations"] = float(np.median(iterations))
+    result["budget_ms"] = budget
+    controller.matrix_world = start_matrix
+    state.restore()
     return result
+
+
+def blender_paths(V, F, updates):
+    """Blender's own cost (ms, medians) of the two ways to show a pose of a mesh of this size: into a
+    shape key on top of "Basis" (what posing does) or into the vertex positions of a mesh without
+    shape keys. Each update writes a new pose into Blender's array ("write", the tag included:
+    mesh.update()) and evaluates ("evaluate"); on a mesh of its own, the posed object untouched."""
+    mesh_io = addon("mesh_io")
+    obj = mesh_object("Paths", V, F)
+    mesh = obj.data
+    rest = np.asarray(V, np.float32)
+    size = float(np.ptp(rest, axis=0).max())
+
+    def measure(array):
+        write, evaluate = [], []
+        for i in range(updates):
+            t = time.perf_counter()
+            target = array()
+            np.copyto(target, rest)
+            target[:, 2] += 0.001 * size * (i + 1)
+            mesh.update()
+            write.append(milliseconds(t))
+            t = time.perf_counter()
+            bpy.context.view_layer.update()
+            evaluate.append(milliseconds(t))
+        return {"write": float(np.median(write)), "evaluate": float(np.median(evaluate))}
+
+    def positions():
+        address = mesh.attributes["position"].data[0].as_pointer()
+        return np.ctypeslib.as_array((ctypes.c_float * rest.size).from_address(address)).reshape(rest.shape)
+
+    figures = {"positions": measure(positions)}
+    block, _ = mesh_io.shape_key(obj, "Pose")
+    block.value = 1.0
+    figures["shape_key"] = measure(lambda: mesh_io.shape_key_co(mesh, block))
+    bpy.data.meshes.remove(mesh)
+    return figures
 
 
 def time_shape_key_update(obj, block, repeats=10):
@@ -309,6 +345,10 @@ def main():
               f"update {figures['tick']:.1f} ms ({figures['iterations']:.0f} iterations), Blender's evaluation "
               f"{figures['evaluate']:.1f} ms", flush=True)
     results["blender"] = bpy.app.version_string
+    if bpy.app.version >= (3, 5, 0):  # vertex positions as the "position" attribute (3.4: MVert structs)
+        results["paths"] = blender_paths(V, addon("mesh_io").triangles(obj.data), args.updates)
+        print("Blender alone, ms: " + ", ".join(f"{name} write {f['write']:.2f} + evaluate {f['evaluate']:.2f}"
+                                                for name, f in results["paths"].items()), flush=True)
     if not args.pose_only:
         with tempfile.TemporaryDirectory() as folder:
             results["storage"] = storage_figures(obj, folder)
@@ -321,11 +361,10 @@ def main():
 
     print(f"\nPose update on {mesh} ({len(V)} vertices), headless Blender {bpy.app.version_string}, shared 2-core "
           "machine; ms, medians")
-    print(f"{'dims':>5} {'ctrl':>6} {'set':>6} {'solve':>6} {'map':>6} {'write':>6} {'tick':>6} {'eval':>6} "
-          f"{'iters':>5} {'bake s':>7}")
+    print(f"{'dims':>5} {'ctrl':>6} {'solve':>6} {'write':>6} {'tick':>6} {'eval':>6} {'iters':>5} {'bake s':>7}")
     for dims, f in results["bases"].items():
-        print(f"{dims:>5} {f['controllers']:6.2f} {f['set_transforms']:6.2f} {f['solve']:6.2f} {f['positions']:6.2f} "
-              f"{f['write']:6.2f} {f['tick']:6.2f} {f['evaluate']:6.1f} {f['iterations']:5.0f} {f['bake_s']:7.1f}")
+        print(f"{dims:>5} {f['controllers']:6.2f} {f['solve']:6.2f} {f['write']:6.2f} {f['tick']:6.2f} "
+              f"{f['evaluate']:6.1f} {f['iterations']:5.0f} {f['bake_s']:7.1f}")
     if not args.pose_only:
         lap = results["laplacian_deform"]
         print(f"\nLaplacian Deform, Suzanne {lap['vertices']} vertices: bind {lap['bind_s']:.1f} s, "

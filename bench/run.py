@@ -24,7 +24,7 @@ Experiments (each writes bench/results/<name>.json: machine, commit, command, pa
                a raw-scan-like 23k dragon, turned by 30, 90, 170 degrees and bent (bench/refine.py)
   blender      the add-on's pose update in headless Blender and Blender's Laplacian Deform
                (bench/blender_pose.py), in Debian's 3.4.1 app from the source tree
-  bpy_pose     the pose update alone at 100k and 1.6M vertices in bpy 4.5 and 5.3 (.venv/bpy-<version>,
+  bpy_pose     the pose update alone at 100k, 400k and 1.6M vertices in bpy 4.5 and 5.3 (.venv/bpy-<version>,
                made by `make bench`) with the add-on installed from its extension zip (`make addon`)
   renders      Cycles renders of the accuracy experiment's bar and cylinder poses
                (blender_scripts/render_figures.py; needs accuracy's meshes from the same run)
@@ -107,17 +107,18 @@ def blender(quick):
 
 
 def bpy_pose(quick):
-    """The installed extension alone, in the Blenders artists run: 100k vertices and 1.6M on a proxy."""
+    """The installed extension alone, in the Blenders artists run: the dragon (100k vertices) and the
+    dragon subdivided once (400k) and twice (1.6M), the last two baked on a proxy."""
     runs = []
     with tempfile.TemporaryDirectory() as folder:
         for version in BPY_VERSIONS:
-            for subdivide in (0,) if quick else (0, 2):
+            for subdivide in (0,) if quick else (0, 1, 2):
                 out = pathlib.Path(folder) / f"bpy-{version}-{subdivide}.json"
                 in_bpy(version, common.ROOT / "bench" / "blender_pose.py",
                        ["--output", str(out), "--pose-only", "--subdivide", str(subdivide),
                         "--updates", "3" if quick else "15", *(["--quick"] if quick else [])], folder)
                 runs.append(json.loads(out.read_text()))
-    return {"blenders": BPY_VERSIONS, "subdivisions": [0] if quick else [0, 2]}, {"runs": runs}
+    return {"blenders": BPY_VERSIONS, "subdivisions": [0] if quick else [0, 1, 2]}, {"runs": runs}
 
 
 def renders(quick):

@@ -2,7 +2,7 @@
 result into a shape key. Shared by the interactive pose, the solve and the animation bake.
 
 Per update: controller matrices → set_transforms → solve (within a time budget) →
-positions(out=preallocated float32) → shape key (mesh_io.write_shape_key) → mesh.update().
+positions(out=the shape key's own array, mesh_io.shape_key_co) → mesh.update().
 """
 import numpy as np
 
@@ -28,7 +28,6 @@ class Pose:
         self.solver = mdc.ReducedSolver(self.basis, [h.indices for h in self.handles], stiffness=settings.stiffness,
                                         weights=[h.weight for h in self.handles],
                                         energy=settings.status.energy.lower())
-        self.out = np.empty((self.basis.num_vertices, 3), np.float32)
         self._transforms = None
         self.stats = {"iterations": 0, "energy": 0.0, "converged": False, "stalled": False}
 
@@ -54,9 +53,11 @@ class Pose:
         return stats
 
     def write(self, block):
-        """x̄ + U q into the shape key `block` of the object's mesh."""
-        self.solver.positions(self.out)
-        mesh_io.write_shape_key(self.obj.data, block, self.out)
+        """x̄ + U q into the shape key `block` of the object's mesh: the solver writes (in parallel)
+        straight into Blender's array, which saves a copy of 19 MB per update at 1.6M vertices."""
+        mesh = self.obj.data
+        self.solver.positions(mesh_io.shape_key_co(mesh, block))
+        mesh.update()
 
 
 def state(stats):
