@@ -105,13 +105,12 @@ def mesh_object(name, V, F):
 def time_updates(obj, controller, updates):
     """Medians (ms) of `updates` pose updates while the controller turns and slides, each made of
     the Pose operator's own calls per timer tick: follow_controllers (controller matrices and
-    set_transforms), step (BFGS within the object's time budget), write (the pose into the shape
-    key, Blender's array written by the solver, and mesh.update()); then Blender's evaluation
-    ("evaluate", view_layer.update())."""
+    set_transforms), step (BFGS within the object's time budget), write (the pose written by the
+    solver into Blender's array where the operator shows it, posing.display, and mesh.update());
+    then Blender's evaluation ("evaluate", view_layer.update())."""
     posing = addon("posing")
     pose = posing.Pose(bpy.context, obj)
-    state = posing.ShapeKeyState(obj, posing.POSE_KEY)
-    block = state.ensure()
+    shown = posing.display(obj)
     size = max(obj.dimensions)
     budget = obj.modal_deform.budget
     steps = {name: [] for name in ("controllers", "solve", "write", "tick", "evaluate")}
@@ -128,7 +127,7 @@ def time_updates(obj, controller, updates):
         iterations.append(pose.step(budget)["iterations"])
         steps["solve"].append(milliseconds(t))
         t = time.perf_counter()
-        pose.write(block)
+        pose.write(shown.array())
         steps["write"].append(milliseconds(t))
         steps["tick"].append(milliseconds(tick))
         t = time.perf_counter()
@@ -137,8 +136,9 @@ def time_updates(obj, controller, updates):
     result = {name: float(np.median(values)) for name, values in steps.items()}
     result["iterations"] = float(np.median(iterations))
     result["budget_ms"] = budget
+    result["display"] = type(shown).__name__
     controller.matrix_world = start_matrix
-    state.restore()
+    shown.restore()
     return result
 
 
