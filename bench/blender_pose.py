@@ -20,7 +20,6 @@ the mesh for display ("evaluate": view_layer.update()). Medians over the updates
 controller moving a little each time.
 """
 import argparse
-import ctypes
 import json
 import math
 import os
@@ -102,19 +101,23 @@ def mesh_object(name, V, F):
     return obj
 
 
-def time_updates(obj, controller, updates):
-    """Medians (ms) of `updates` pose updates while the controller turns and slides, each made of
-    the Pose operator's own calls per timer tick: follow_controllers (controller matrices and
-    set_transforms), step (BFGS within the object's time budget), write (the pose written by the
-    solver into Blender's array where the operator shows it, posing.display, and mesh.update());
-    then Blender's evaluation ("evaluate", view_layer.update())."""
+STEPS = ("controllers", "solve", "write", "tick", "evaluate", "iterations")
+#: Where the pose is shown while posing (posing.display): the mesh as it is (no shape keys: the
+#: vertex positions), or with a "Basis" key added, as an artist's keys would be (the shape key).
+DISPLAYS = ("positions", "shape_key")
+
+
+def time_updates(obj, controller, updates, steps):
+    """`updates` pose updates while the controller turns and slides, each made of the Pose
+    operator's own calls per timer tick, appended to steps[name] in ms: follow_controllers
+    ("controllers": matrices and set_transforms), step ("solve": BFGS within the object's time
+    budget), write (the pose written by the solver into Blender's array where the operator shows
+    it, posing.display, and mesh.update()); then Blender's evaluation ("evaluate",
+    view_layer.update())."""
     posing = addon("posing")
     pose = posing.Pose(bpy.context, obj)
     shown = posing.display(obj)
     size = max(obj.dimensions)
-    budget = obj.modal_deform.budget
-    steps = {name: [] for name in ("controllers", "solve", "write", "tick", "evaluate")}
-    iterations = []
     start_matrix = controller.matrix_world.copy()
     for i in range(updates):
         controller.matrix_world = (Matrix.Translation((0.0, 0.01 * size * i, 0.005 * size * i)) @ start_matrix
@@ -124,7 +127,7 @@ def time_updates(obj, controller, updates):
         pose.follow_controllers()
         steps["controllers"].append(milliseconds(tick))
         t = time.perf_counter()
-        iterations.append(pose.step(budget)["iterations"])
+        steps["iterations"].append(pose.step(obj.modal_deform.budget)["iterations"])
         steps["solve"].append(milliseconds(t))
         t = time.perf_counter()
         pose.write(shown.array())
@@ -133,49 +136,24 @@ def time_updates(obj, controller, updates):
         t = time.perf_counter()
         bpy.context.view_layer.update()
         steps["evaluate"].append(milliseconds(t))
-    result = {name: float(np.median(values)) for name, values in steps.items()}
-    result["iterations"] = float(np.median(iterations))
-    result["budget_ms"] = budget
-    result["display"] = type(shown).__name__
     controller.matrix_world = start_matrix
     shown.restore()
-    return result
 
 
-def blender_paths(V, F, updates):
-    """Blender's own cost (ms, medians) of the two ways to show a pose of a mesh of this size: into a
-    shape key on top of "Basis" (what posing does) or into the vertex positions of a mesh without
-    shape keys. Each update writes a new pose into Blender's array ("write", the tag included:
-    mesh.update()) and evaluates ("evaluate"); on a mesh of its own, the posed object untouched."""
-    mesh_io = addon("mesh_io")
-    obj = mesh_object("Paths", V, F)
-    mesh = obj.data
-    rest = np.asarray(V, np.float32)
-    size = float(np.ptp(rest, axis=0).max())
-
-    def measure(array):
-        write, evaluate = [], []
-        for i in range(updates):
-            t = time.perf_counter()
-            target = array()
-            np.copyto(target, rest)
-            target[:, 2] += 0.001 * size * (i + 1)
-            mesh.update()
-            write.append(milliseconds(t))
-            t = time.perf_counter()
-            bpy.context.view_layer.update()
-            evaluate.append(milliseconds(t))
-        return {"write": float(np.median(write)), "evaluate": float(np.median(evaluate))}
-
-    def positions():
-        address = mesh.attributes["position"].data[0].as_pointer()
-        return np.ctypeslib.as_array((ctypes.c_float * rest.size).from_address(address)).reshape(rest.shape)
-
-    figures = {"positions": measure(positions)}
-    block, _ = mesh_io.shape_key(obj, "Pose")
-    block.value = 1.0
-    figures["shape_key"] = measure(lambda: mesh_io.shape_key_co(mesh, block))
-    bpy.data.meshes.remove(mesh)
+def time_displays(obj, controller, updates, rounds=2):
+    """Medians of time_updates for each of DISPLAYS, taken in turn `rounds` times (A B A B), so that
+    both see the shared machine alike."""
+    steps = {display: {name: [] for name in STEPS} for display in DISPLAYS}
+    for _ in range(rounds):
+        for display in DISPLAYS:
+            if display == "shape_key":
+                obj.shape_key_add(name="Basis")
+            time_updates(obj, controller, updates, steps[display])
+            if display == "shape_key":
+                obj.shape_key_clear()
+    figures = {display: {name: float(np.median(values)) for name, values in s.items()} for display, s in steps.items()}
+    for f in figures.values():
+        f["update"] = f["tick"] + f["evaluate"]
     return figures
 
 
@@ -337,18 +315,13 @@ def main():
         bpy.ops.modal_deform.bake()
         bake = time.perf_counter() - t
         dimension = settings.status.dimension
-        figures = time_updates(obj, moving.controller, args.updates)
-        figures["bake_s"] = bake
+        figures = time_displays(obj, moving.controller, args.updates)
+        figures.update(bake_s=bake, proxy_vertices=settings.status.proxy_vertices)
         results["bases"][str(dimension)] = figures
-        figures["proxy_vertices"] = settings.status.proxy_vertices
         print(f"{dimension} dimensions: baked in {bake:.1f} s (proxy {settings.status.proxy_vertices} vertices); "
-              f"update {figures['tick']:.1f} ms ({figures['iterations']:.0f} iterations), Blender's evaluation "
-              f"{figures['evaluate']:.1f} ms", flush=True)
+              + "; ".join(f"{display}: ours {figures[display]['tick']:.1f} ms + Blender's evaluation "
+                          f"{figures[display]['evaluate']:.1f} ms" for display in DISPLAYS), flush=True)
     results["blender"] = bpy.app.version_string
-    if bpy.app.version >= (3, 5, 0):  # vertex positions as the "position" attribute (3.4: MVert structs)
-        results["paths"] = blender_paths(V, addon("mesh_io").triangles(obj.data), args.updates)
-        print("Blender alone, ms: " + ", ".join(f"{name} write {f['write']:.2f} + evaluate {f['evaluate']:.2f}"
-                                                for name, f in results["paths"].items()), flush=True)
     if not args.pose_only:
         with tempfile.TemporaryDirectory() as folder:
             results["storage"] = storage_figures(obj, folder)
@@ -361,15 +334,18 @@ def main():
 
     print(f"\nPose update on {mesh} ({len(V)} vertices), headless Blender {bpy.app.version_string}, shared 2-core "
           "machine; ms, medians")
-    print(f"{'dims':>5} {'ctrl':>6} {'solve':>6} {'write':>6} {'tick':>6} {'eval':>6} {'iters':>5} {'bake s':>7}")
-    for dims, f in results["bases"].items():
-        print(f"{dims:>5} {f['controllers']:6.2f} {f['solve']:6.2f} {f['write']:6.2f} {f['tick']:6.2f} "
-              f"{f['evaluate']:6.1f} {f['iterations']:5.0f} {f['bake_s']:7.1f}")
+    print(f"{'dims':>5} {'display':>10} {'ctrl':>6} {'solve':>6} {'write':>6} {'tick':>6} {'eval':>6} {'iters':>5}")
+    for dims, b in results["bases"].items():
+        for display in DISPLAYS:
+            f = b[display]
+            print(f"{dims:>5} {display:>10} {f['controllers']:6.2f} {f['solve']:6.2f} {f['write']:6.2f} "
+                  f"{f['tick']:6.2f} {f['evaluate']:6.1f} {f['iterations']:5.0f}")
     if not args.pose_only:
         lap = results["laplacian_deform"]
         print(f"\nLaplacian Deform, Suzanne {lap['vertices']} vertices: bind {lap['bind_s']:.1f} s, "
               f"{lap['update_ms']:.0f} ms per update (solved: {lap['solved']})")
-        for dims, f in results["bases"].items():
+        for dims, b in results["bases"].items():
+            f = b["positions"]  # what a mesh without shape keys gets, as the Laplacian Deform's mesh has none
             f["laplacian_ratio_tick"] = lap["update_ms"] / f["tick"]
             f["laplacian_ratio_tick_and_evaluate"] = lap["update_ms"] / (f["tick"] + f["evaluate"])
             print(f"  ratio to Modal Deform at {dims} dims: {f['laplacian_ratio_tick']:.0f}x per tick, "
