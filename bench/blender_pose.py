@@ -107,13 +107,13 @@ STEPS = ("controllers", "solve", "write", "tick", "evaluate", "iterations")
 DISPLAYS = ("positions", "shape_key")
 
 
-def time_updates(obj, controller, updates, steps):
+def time_updates(obj, controller, updates, steps, draw=None):
     """`updates` pose updates while the controller turns and slides, each made of the Pose
     operator's own calls per timer tick, appended to steps[name] in ms: follow_controllers
     ("controllers": matrices and set_transforms), step ("solve": BFGS within the object's time
     budget), write (the pose written by the solver into Blender's array where the operator shows
     it, posing.display, and mesh.update()); then Blender's evaluation ("evaluate",
-    view_layer.update())."""
+    view_layer.update()) and, given `draw`, what draw() takes ("draw")."""
     posing = addon("posing")
     pose = posing.Pose(bpy.context, obj)
     shown = posing.display(obj)
@@ -136,19 +136,24 @@ def time_updates(obj, controller, updates, steps):
         t = time.perf_counter()
         bpy.context.view_layer.update()
         steps["evaluate"].append(milliseconds(t))
+        if draw is not None:
+            t = time.perf_counter()
+            draw()
+            steps["draw"].append(milliseconds(t))
     controller.matrix_world = start_matrix
     shown.restore()
 
 
-def time_displays(obj, controller, updates, rounds=2):
+def time_displays(obj, controller, updates, rounds=2, draw=None):
     """Medians of time_updates for each of DISPLAYS, taken in turn `rounds` times (A B A B), so that
     both see the shared machine alike."""
-    steps = {display: {name: [] for name in STEPS} for display in DISPLAYS}
+    names = STEPS + (("draw",) if draw else ())
+    steps = {display: {name: [] for name in names} for display in DISPLAYS}
     for _ in range(rounds):
         for display in DISPLAYS:
             if display == "shape_key":
                 obj.shape_key_add(name="Basis")
-            time_updates(obj, controller, updates, steps[display])
+            time_updates(obj, controller, updates, steps[display], draw)
             if display == "shape_key":
                 obj.shape_key_clear()
     figures = {display: {name: float(np.median(values)) for name, values in s.items()} for display, s in steps.items()}
@@ -361,4 +366,5 @@ def main():
     print(f"wrote {output}")
 
 
-main()
+if __name__ == "__main__":  # imported by bench/viewport_frames.py for its meshes and updates
+    main()

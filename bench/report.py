@@ -419,6 +419,23 @@ def plot_update_time(runs):
     save_figure(fig, "update_time")
 
 
+def section_viewport_frames(result):
+    out = ["## The viewport's frame while posing (issue 23)", "",
+           "`bench/viewport_frames.py` in Debian's Blender 3.4.1 app with a window under Xvfb: software OpenGL "
+           "(llvmpipe), so the drawing is far slower than on a GPU and these are figures to know, not targets. A "
+           "frame is the pose update as above (ours, Blender's evaluation) and then the viewport drawn and swapped "
+           "(`wm.redraw_timer`, \"draw\": normals, GPU buffers, drawing). Medians, ms.", ""]
+    rows = []
+    for run in result["figures"]["runs"]:
+        for display, label in DISPLAYS.items():
+            f = run["displays"][display]
+            rows.append([run["vertices"], run["dimension"], label, f"{f['tick']:.1f}", f"{f['evaluate']:.1f}",
+                         f"{f['draw']:.0f}", f"{f['frame']:.0f}"])
+    out.append(table(["vertices", "dims", "display", "ours", "evaluate (Blender)", "draw (Blender)", "frame"], rows))
+    out += ["", provenance(result)]
+    return "\n".join(out)
+
+
 def section_native(result):
     out = ["## Native benchmarks (Google Benchmark)", "",
            f"`{result['parameters']['binary']}` (bench/bench_*.cpp); real time per iteration and the counters "
@@ -587,9 +604,9 @@ def section_refine(result):
 
 SECTIONS = (("table1", section_table1), ("accuracy", section_accuracy), ("renders", section_renders),
             ("convergence", section_convergence), ("taylor", section_taylor), ("blender", section_blender),
-            ("bpy_pose", section_bpy_pose), ("native", section_native), ("bake_limit", section_bake_limit),
-            ("raw_scan", section_raw_scan), ("multires", section_multires), ("strong_poses", section_strong_poses),
-            ("refine", section_refine))
+            ("bpy_pose", section_bpy_pose), ("viewport_frames", section_viewport_frames), ("native", section_native),
+            ("bake_limit", section_bake_limit), ("raw_scan", section_raw_scan), ("multires", section_multires),
+            ("strong_poses", section_strong_poses), ("refine", section_refine))
 
 
 def write():

@@ -26,6 +26,8 @@ Experiments (each writes bench/results/<name>.json: machine, commit, command, pa
                (bench/blender_pose.py), in Debian's 3.4.1 app from the source tree
   bpy_pose     the pose update alone at 100k, 400k and 1.6M vertices in bpy 4.5 and 5.3 (.venv/bpy-<version>,
                made by `make bench`) with the add-on installed from its extension zip (`make addon`)
+  viewport_frames  the frame while posing in a real viewport: Debian's 3.4.1 app under Xvfb (software
+               OpenGL), the dragon at 100k and 1.6M vertices (bench/viewport_frames.py)
   renders      Cycles renders of the accuracy experiment's bar and cylinder poses
                (blender_scripts/render_figures.py; needs accuracy's meshes from the same run)
 --quick runs tiny sizes (the smoke test): results go to bench/results/tmp/, the report is not
@@ -48,7 +50,7 @@ import report  # noqa: E402
 
 PYTHON_EXPERIMENTS = ("table1", "accuracy", "convergence", "taylor", "bake_limit", "raw_scan", "multires",
                       "strong_poses", "refine")
-EXPERIMENTS = ("native",) + PYTHON_EXPERIMENTS + ("blender", "bpy_pose", "renders")
+EXPERIMENTS = ("native",) + PYTHON_EXPERIMENTS + ("blender", "bpy_pose", "viewport_frames", "renders")
 NATIVE_IN_TABLE1 = "BM_Bake|BM_BfgsIteration|BM_Positions"
 BLENDER = ["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python"]
 BPY_VERSIONS = ("4.5", "5.3")
@@ -119,6 +121,24 @@ def bpy_pose(quick):
                         "--updates", "3" if quick else "15", *(["--quick"] if quick else [])], folder)
                 runs.append(json.loads(out.read_text()))
     return {"blenders": BPY_VERSIONS, "subdivisions": [0] if quick else [0, 1, 2]}, {"runs": runs}
+
+
+def viewport_frames(quick):
+    """The viewport's frame while posing, at 100k and 1.6M vertices (quick: 100k on a small basis)."""
+    runs = []
+    sizes = [["--modes", "8", "--derivatives", "8", "--proxy-above", "50000", "--proxy", "10000"]] if quick else \
+        [["--subdivide", "0"], ["--subdivide", "2"]]
+    with tempfile.TemporaryDirectory() as folder:
+        for i, size in enumerate(sizes):
+            out = pathlib.Path(folder) / f"frames-{i}.json"
+            subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x800x24", "blender", "--factory-startup", "--python",
+                            str(common.ROOT / "bench" / "viewport_frames.py"), "--", str(out), "--updates",
+                            "2" if quick else "3", *size], check=True, cwd=common.ROOT)
+            run = json.loads(out.read_text())
+            if not run["ok"]:
+                raise RuntimeError("\n".join(run["log"]))
+            runs.append(run)
+    return {"sizes": sizes, "updates": 2 if quick else 3}, {"runs": runs}
 
 
 def renders(quick):
