@@ -5,10 +5,11 @@ with a simulated G + mouse motion + click, let the timer solve, check the mesh f
 its vertex positions: Suzanne has no shape keys); Esc restores the mesh; saving mid-pose writes
 the rest mesh and the pose in its shape key; entering Edit Mode mid-pose keeps the pose in the key
 and edits the rest mesh; the converged pose equals the Solve operator's; undo takes a bake back;
-disabling the add-on mid-pose restores as Esc does.
+disabling the add-on mid-pose restores as Esc does (from the shape key and from the positions).
 Each step runs from bpy.app.timers so Blender handles the simulated events in between.
 Writes OUTPUT/result.json ({"ok": bool, "log": [...]}) and screenshots, then quits.
 """
+import importlib
 import json
 import os
 import sys
@@ -323,6 +324,22 @@ def steps():
     assert base_positions(obj).tobytes() == rest.tobytes()
     yield 0.5
     say("disabling the add-on mid-pose restored the shape key")
+
+    # And with the pose in the vertex positions (no shape keys): the rest mesh comes back exactly.
+    addon_utils.enable("modal_deform", default_set=True)
+    posing = importlib.import_module("modal_deform.posing")
+    obj.shape_key_clear()
+    with override():
+        assert bpy.ops.modal_deform.pose("INVOKE_DEFAULT") == {"RUNNING_MODAL"}
+    controller.location.z -= 0.3
+    yield 0.5
+    assert type(posing.running.shown) is posing.PositionsDisplay
+    assert np.abs(base_positions(obj) - rest).max() > 0.05, "the pose did not follow the controller"
+    addon_utils.disable("modal_deform", default_set=True)
+    assert posing.running is None, "disabling the add-on left the pose running"
+    assert base_positions(obj).tobytes() == rest.tobytes(), "disabling did not restore the vertex positions"
+    assert obj.data.shape_keys is None and obj.data.get(posing.POSING_FLAG) is None
+    say("disabling the add-on mid-pose restored the vertex positions")
 
 
 def drive(generator=steps()):
