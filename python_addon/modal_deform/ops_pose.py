@@ -69,6 +69,8 @@ keeps the pose, Esc restores the mesh as it was"""
         start = time.perf_counter()
         try:
             moved = self.pose.follow_controllers()
+            if not self.shown.shows_pose():  # shape keys added mid-pose: the pose goes on in the key
+                self.shown = self.shown.keep(self.pose)
             if moved or not self.pose.stats["converged"]:
                 self.pose.step(obj.modal_deform.budget)
                 self.pose.write(self.shown.array())

@@ -148,6 +148,9 @@ class ShapeKeyDisplay:
         mesh = self.obj.data
         return mesh_io.shape_key_co(mesh, mesh.shape_keys.key_blocks[self.name])
 
+    def shows_pose(self):
+        return True
+
     def keep(self, pose):
         """The pose stays in the key, where it is; returns the display that shows it from now on."""
         return self
@@ -170,6 +173,10 @@ class PositionsDisplay:
     def array(self):
         return mesh_io.vertex_positions(self.obj.data)
 
+    def shows_pose(self):
+        """False once the artist added shape keys mid-pose: Blender then shows them, not the positions."""
+        return self.obj.data.shape_keys is None
+
     def keep(self, pose):
         """The rest back into the positions and the pose into the "Modal Deform" shape key; returns
         the ShapeKeyDisplay that shows it from now on. Edit Mode and Sculpt Mode take the mesh's
@@ -186,10 +193,18 @@ class PositionsDisplay:
         return shown
 
     def restore(self):
-        mesh = self.obj.data
-        mesh_io.vertex_positions(mesh)[...] = self.rest
-        del mesh[POSING_FLAG]
-        mesh.update()
+        _put_rest_back(self.obj.data, self.rest)
+
+
+def _put_rest_back(mesh, rest):
+    """The rest (#V by 3) back into the positions of a mesh posed by a PositionsDisplay, and into its
+    reference shape key if the artist added shape keys mid-pose (the first one copies the positions,
+    which held the pose); the flag goes."""
+    mesh_io.vertex_positions(mesh)[...] = rest
+    if mesh.shape_keys is not None:
+        mesh_io.shape_key_co(mesh, mesh.shape_keys.reference_key)[...] = rest
+    del mesh[POSING_FLAG]
+    mesh.update()
 
 
 def recover():
@@ -209,10 +224,8 @@ def recover():
         if len(rest) != len(mesh.vertices):
             print(f"Modal Deform: '{obj.name}' was saved while posing and its mesh no longer fits its basis")
             continue
-        co = mesh_io.vertex_positions(mesh)
-        pose = co.copy()
-        co[...] = rest
-        del mesh[POSING_FLAG]
+        pose = mesh_io.vertex_positions(mesh).copy()
+        _put_rest_back(mesh, rest)
         block, _ = mesh_io.shape_key(obj, POSE_KEY)
         block.value, block.mute = 1.0, False
         mesh_io.write_shape_key(mesh, block, pose)

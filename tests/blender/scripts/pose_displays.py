@@ -1,6 +1,7 @@
 """Where the interactive pose shows the pose, and what it leaves behind: a mesh without shape keys
 is posed in its vertex positions (Blender blends no keys), kept into the "Modal Deform" key with
-the rest restored bit for bit, and looks the same through its modifiers either way; a mesh with
+the rest restored bit for bit, and looks the same through its modifiers either way; a shape key
+added mid-pose (a copy of the posed positions) gets the rest as its reference; a mesh with
 the artist's shape keys is posed in the key and gets them back untouched; a mesh written mid-pose
 by a path without save handlers (an undo step of a controller's move, autosave, a crash file) is
 repaired after undo and after loading: rest from the stored basis, pose into the key."""
@@ -63,6 +64,19 @@ assert obj.data.get(posing.POSING_FLAG) is None
 bpy.context.view_layer.update()
 difference = np.abs(evaluated_positions(obj) - shown_through_modifiers).max()
 assert difference < 1e-5, f"the kept pose looks different through the modifiers ({difference})"
+
+# The artist adds a shape key mid-pose: the first one copies the positions, which hold the pose;
+# kept, the reference key holds the rest again.
+obj.shape_key_clear()
+shown = posing.display(obj)
+pose = pose_shown(shown)
+posed = support.positions(obj)
+obj.shape_key_add(name="Basis")
+assert not shown.shows_pose()
+shown = shown.keep(pose)
+assert support.positions(obj).tobytes() == rest.tobytes()
+assert support.key_positions(obj, "Basis").tobytes() == rest.tobytes()
+assert support.key_positions(obj, posing.POSE_KEY).tobytes() == posed.tobytes()
 print("POSITIONS_OK")
 
 # The artist's own shape key: posed in the key, the artist's key and the mesh as they were after Esc.
