@@ -11,12 +11,13 @@ Laplacian result is added to each mesh file for the renders.
 In bpy (Blender 4.2+ as a Python module), with the add-on installed from the extension zip:
 
     BLENDER_USER_RESOURCES=$(mktemp -d) .venv/bpy-4.5/bin/python tests/blender/bpy_session.py \
-        --extension dist/modal_deform-0.1.0-linux_x64.zip bench/blender_pose.py -- --pose-only
+        --extension dist/modal_deform-0.1.0-blender_4.2_to_5.0-linux_x64.zip bench/blender_pose.py -- --pose-only
 
-One update is what the Pose operator does per timer tick, each step timed: controller matrices →
-set_transforms → 10 BFGS iterations → positions(out=float32) → shape key foreach_set →
-mesh.update(). Blender then evaluates the mesh for display ("evaluate": view_layer.update()).
-Medians over the updates, with the controller moving a little each time.
+One update is what the Pose operator does per timer tick, through its own calls, each timed:
+controller matrices → set_transforms → BFGS within the object's time budget → the fine positions
+written by the solver straight into the shape key's array → mesh.update(). Blender then evaluates
+the mesh for display ("evaluate": view_layer.update()). Medians over the updates, with the
+controller moving a little each time.
 """
 import argparse
 import json
@@ -100,47 +101,65 @@ def mesh_object(name, V, F):
     return obj
 
 
-def time_updates(obj, controller, updates):
-    """Per-step medians (ms) of `updates` pose updates while the controller turns and slides."""
-    handles, mesh_io, posing = addon("handles", "mesh_io", "posing")
+STEPS = ("controllers", "solve", "write", "tick", "evaluate", "iterations")
+#: Where the pose is shown while posing (posing.display): the mesh as it is (no shape keys: the
+#: vertex positions), or with a "Basis" key added, as an artist's keys would be (the shape key).
+DISPLAYS = ("positions", "shape_key")
+
+
+def time_updates(obj, controller, updates, steps, draw=None):
+    """`updates` pose updates while the controller turns and slides, each made of the Pose
+    operator's own calls per timer tick, appended to steps[name] in ms: follow_controllers
+    ("controllers": matrices and set_transforms), step ("solve": BFGS within the object's time
+    budget), write (the pose written by the solver into Blender's array where the operator shows
+    it, posing.display, and mesh.update()); then Blender's evaluation ("evaluate",
+    view_layer.update()) and, given `draw`, what draw() takes ("draw")."""
+    posing = addon("posing")
     pose = posing.Pose(bpy.context, obj)
-    state = posing.ShapeKeyState(obj, posing.POSE_KEY)
-    block = state.ensure()
+    shown = posing.display(obj)
     size = max(obj.dimensions)
-    steps = {name: [] for name in ("controllers", "set_transforms", "solve", "positions", "write", "tick",
-                                   "evaluate")}
-    iterations = []
     start_matrix = controller.matrix_world.copy()
     for i in range(updates):
         controller.matrix_world = (Matrix.Translation((0.0, 0.01 * size * i, 0.005 * size * i)) @ start_matrix
                                    @ Matrix.Rotation(math.radians(1.0 * i), 4, "X"))
         bpy.context.view_layer.update()
         tick = time.perf_counter()
+        pose.follow_controllers()
+        steps["controllers"].append(milliseconds(tick))
         t = time.perf_counter()
-        transforms = handles.transforms(obj, pose.handles)
-        steps["controllers"].append(milliseconds(t))
-        t = time.perf_counter()
-        pose.solver.set_transforms(transforms)
-        steps["set_transforms"].append(milliseconds(t))
-        t = time.perf_counter()
-        # A tolerance no iterate meets: the 10 iterations a tick may spend (fewer only when BFGS stalls).
-        iterations.append(pose.solver.solve(max_iterations=10, tolerance=1e-12)["iterations"])
+        steps["iterations"].append(pose.step(obj.modal_deform.budget)["iterations"])
         steps["solve"].append(milliseconds(t))
         t = time.perf_counter()
-        pose.solver.positions(pose.out)
-        steps["positions"].append(milliseconds(t))
-        t = time.perf_counter()
-        mesh_io.write_shape_key(obj.data, block, pose.out)
+        pose.write(shown.array())
         steps["write"].append(milliseconds(t))
         steps["tick"].append(milliseconds(tick))
         t = time.perf_counter()
         bpy.context.view_layer.update()
         steps["evaluate"].append(milliseconds(t))
+        if draw is not None:
+            t = time.perf_counter()
+            draw()
+            steps["draw"].append(milliseconds(t))
     controller.matrix_world = start_matrix
-    state.restore()
-    result = {name: float(np.median(values)) for name, values in steps.items()}
-    result["iterations"] = float(np.median(iterations))
-    return result
+    shown.restore()
+
+
+def time_displays(obj, controller, updates, rounds=2, draw=None):
+    """Medians of time_updates for each of DISPLAYS, taken in turn `rounds` times (A B A B), so that
+    both see the shared machine alike."""
+    names = STEPS + (("draw",) if draw else ())
+    steps = {display: {name: [] for name in names} for display in DISPLAYS}
+    for _ in range(rounds):
+        for display in DISPLAYS:
+            if display == "shape_key":
+                obj.shape_key_add(name="Basis")
+            time_updates(obj, controller, updates, steps[display], draw)
+            if display == "shape_key":
+                obj.shape_key_clear()
+    figures = {display: {name: float(np.median(values)) for name, values in s.items()} for display, s in steps.items()}
+    for f in figures.values():
+        f["update"] = f["tick"] + f["evaluate"]
+    return figures
 
 
 def time_shape_key_update(obj, block, repeats=10):
@@ -301,13 +320,12 @@ def main():
         bpy.ops.modal_deform.bake()
         bake = time.perf_counter() - t
         dimension = settings.status.dimension
-        figures = time_updates(obj, moving.controller, args.updates)
-        figures["bake_s"] = bake
+        figures = time_displays(obj, moving.controller, args.updates)
+        figures.update(bake_s=bake, proxy_vertices=settings.status.proxy_vertices)
         results["bases"][str(dimension)] = figures
-        figures["proxy_vertices"] = settings.status.proxy_vertices
         print(f"{dimension} dimensions: baked in {bake:.1f} s (proxy {settings.status.proxy_vertices} vertices); "
-              f"update {figures['tick']:.1f} ms ({figures['iterations']:.0f} iterations), Blender's evaluation "
-              f"{figures['evaluate']:.1f} ms", flush=True)
+              + "; ".join(f"{display}: ours {figures[display]['tick']:.1f} ms + Blender's evaluation "
+                          f"{figures[display]['evaluate']:.1f} ms" for display in DISPLAYS), flush=True)
     results["blender"] = bpy.app.version_string
     if not args.pose_only:
         with tempfile.TemporaryDirectory() as folder:
@@ -321,16 +339,18 @@ def main():
 
     print(f"\nPose update on {mesh} ({len(V)} vertices), headless Blender {bpy.app.version_string}, shared 2-core "
           "machine; ms, medians")
-    print(f"{'dims':>5} {'ctrl':>6} {'set':>6} {'solve':>6} {'map':>6} {'write':>6} {'tick':>6} {'eval':>6} "
-          f"{'iters':>5} {'bake s':>7}")
-    for dims, f in results["bases"].items():
-        print(f"{dims:>5} {f['controllers']:6.2f} {f['set_transforms']:6.2f} {f['solve']:6.2f} {f['positions']:6.2f} "
-              f"{f['write']:6.2f} {f['tick']:6.2f} {f['evaluate']:6.1f} {f['iterations']:5.0f} {f['bake_s']:7.1f}")
+    print(f"{'dims':>5} {'display':>10} {'ctrl':>6} {'solve':>6} {'write':>6} {'tick':>6} {'eval':>6} {'iters':>5}")
+    for dims, b in results["bases"].items():
+        for display in DISPLAYS:
+            f = b[display]
+            print(f"{dims:>5} {display:>10} {f['controllers']:6.2f} {f['solve']:6.2f} {f['write']:6.2f} "
+                  f"{f['tick']:6.2f} {f['evaluate']:6.1f} {f['iterations']:5.0f}")
     if not args.pose_only:
         lap = results["laplacian_deform"]
         print(f"\nLaplacian Deform, Suzanne {lap['vertices']} vertices: bind {lap['bind_s']:.1f} s, "
               f"{lap['update_ms']:.0f} ms per update (solved: {lap['solved']})")
-        for dims, f in results["bases"].items():
+        for dims, b in results["bases"].items():
+            f = b["positions"]  # what a mesh without shape keys gets, as the Laplacian Deform's mesh has none
             f["laplacian_ratio_tick"] = lap["update_ms"] / f["tick"]
             f["laplacian_ratio_tick_and_evaluate"] = lap["update_ms"] / (f["tick"] + f["evaluate"])
             print(f"  ratio to Modal Deform at {dims} dims: {f['laplacian_ratio_tick']:.0f}x per tick, "
@@ -346,4 +366,5 @@ def main():
     print(f"wrote {output}")
 
 
-main()
+if __name__ == "__main__":  # imported by bench/viewport_frames.py for its meshes and updates
+    main()

@@ -26,8 +26,10 @@ Experiments (each writes bench/results/<name>.json: machine, commit, command, pa
                dimensions, and that nothing outside the region moves (bench/region.py)
   blender      the add-on's pose update in headless Blender and Blender's Laplacian Deform
                (bench/blender_pose.py), in Debian's 3.4.1 app from the source tree
-  bpy_pose     the pose update alone at 100k and 1.6M vertices in bpy 4.5 and 5.3 (.venv/bpy-<version>,
+  bpy_pose     the pose update alone at 100k, 400k and 1.6M vertices in bpy 4.5 and 5.3 (.venv/bpy-<version>,
                made by `make bench`) with the add-on installed from its extension zip (`make addon`)
+  viewport_frames  the frame while posing in a real viewport: Debian's 3.4.1 app under Xvfb (software
+               OpenGL), the dragon at 100k and 1.6M vertices (bench/viewport_frames.py)
   renders      Cycles renders of the accuracy experiment's bar and cylinder poses
                (blender_scripts/render_figures.py; needs accuracy's meshes from the same run)
 --quick runs tiny sizes (the smoke test): results go to bench/results/tmp/, the report is not
@@ -50,7 +52,7 @@ import report  # noqa: E402
 
 PYTHON_EXPERIMENTS = ("table1", "accuracy", "convergence", "taylor", "bake_limit", "raw_scan", "multires",
                       "strong_poses", "refine", "region")
-EXPERIMENTS = ("native",) + PYTHON_EXPERIMENTS + ("blender", "bpy_pose", "renders")
+EXPERIMENTS = ("native",) + PYTHON_EXPERIMENTS + ("blender", "bpy_pose", "viewport_frames", "renders")
 NATIVE_IN_TABLE1 = "BM_Bake|BM_BfgsIteration|BM_Positions"
 BLENDER = ["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python"]
 BPY_VERSIONS = ("4.5", "5.3")
@@ -97,8 +99,9 @@ def blender(quick):
     with tempfile.TemporaryDirectory() as folder:
         out = pathlib.Path(folder) / "blender_pose.json"
         extra = ["--updates", "3", "--quick"] if quick else []
-        subprocess.run(BLENDER + [str(pose), "--", "--output", str(out), "--shapes", str(common.MESHES), *extra],
-                       check=True, cwd=common.ROOT)
+        # The comparison on the accuracy experiment's meshes when they are there (make bench runs it first).
+        shapes = ["--shapes", str(common.MESHES)] if common.MESHES.is_dir() else []
+        subprocess.run(BLENDER + [str(pose), "--", "--output", str(out), *shapes, *extra], check=True, cwd=common.ROOT)
         raw = json.loads(out.read_text())
         if not quick:  # the dragon subdivided twice (1.6M vertices), baked on a proxy: pose updates only
             dense = pathlib.Path(folder) / "blender_dense.json"
@@ -109,17 +112,36 @@ def blender(quick):
 
 
 def bpy_pose(quick):
-    """The installed extension alone, in the Blenders artists run: 100k vertices and 1.6M on a proxy."""
+    """The installed extension alone, in the Blenders artists run: the dragon (100k vertices) and the
+    dragon subdivided once (400k) and twice (1.6M), the last two baked on a proxy."""
     runs = []
     with tempfile.TemporaryDirectory() as folder:
         for version in BPY_VERSIONS:
-            for subdivide in (0,) if quick else (0, 2):
+            for subdivide in (0,) if quick else (0, 1, 2):
                 out = pathlib.Path(folder) / f"bpy-{version}-{subdivide}.json"
                 in_bpy(version, common.ROOT / "bench" / "blender_pose.py",
                        ["--output", str(out), "--pose-only", "--subdivide", str(subdivide),
                         "--updates", "3" if quick else "15", *(["--quick"] if quick else [])], folder)
                 runs.append(json.loads(out.read_text()))
-    return {"blenders": BPY_VERSIONS, "subdivisions": [0] if quick else [0, 2]}, {"runs": runs}
+    return {"blenders": BPY_VERSIONS, "subdivisions": [0] if quick else [0, 1, 2]}, {"runs": runs}
+
+
+def viewport_frames(quick):
+    """The viewport's frame while posing, at 100k and 1.6M vertices (quick: 100k on a small basis)."""
+    runs = []
+    sizes = [["--modes", "8", "--derivatives", "8", "--proxy-above", "50000", "--proxy", "10000"]] if quick else \
+        [["--subdivide", "0"], ["--subdivide", "2"]]
+    with tempfile.TemporaryDirectory() as folder:
+        for i, size in enumerate(sizes):
+            out = pathlib.Path(folder) / f"frames-{i}.json"
+            subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x800x24", "blender", "--factory-startup", "--python",
+                            str(common.ROOT / "bench" / "viewport_frames.py"), "--", str(out), "--updates",
+                            "2" if quick else "3", *size], check=True, cwd=common.ROOT)
+            run = json.loads(out.read_text())
+            if not run["ok"]:
+                raise RuntimeError("\n".join(run["log"]))
+            runs.append(run)
+    return {"sizes": sizes, "updates": 2 if quick else 3}, {"runs": runs}
 
 
 def renders(quick):

@@ -67,16 +67,15 @@ def interactive_updates(posing, obj, count):
     controllers -> solver within its budget -> shape key) after the controllers were placed: the
     first updates solve toward them, the later ones find the pose converged."""
     pose = posing.Pose(bpy.context, obj)
-    state = posing.ShapeKeyState(obj, posing.POSE_KEY)
-    block = state.ensure()
+    shown = posing.display(obj)
     times = []
     for _ in range(count):
         start = time.perf_counter()
         pose.follow_controllers()
         pose.step(obj.modal_deform.budget)
-        pose.write(block)
+        pose.write(shown.array())
         times.append(1e3 * (time.perf_counter() - start))
-    state.restore()
+    shown.restore()
     return times
 
 

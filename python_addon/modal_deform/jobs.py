@@ -240,7 +240,7 @@ class AnimationJob:
         block.value = 0.0
         self.created.append((frame, block.name))
         if self.refined is None:
-            self.pose.write(block)
+            self.pose.write(mesh_io.shape_key_co(self.obj.data, block))
         else:
             mesh_io.write_shape_key(self.obj.data, block, self.refined.astype(np.float32))
 

@@ -1,6 +1,7 @@
-"""numpy arrays from a Blender mesh, and shape keys written back; the mesh itself is never changed.
+"""numpy arrays from a Blender mesh, and shape keys written back.
 
 Positions are the base mesh's (``vertices.co``), the rest state every bake and pose starts from.
+Only an interactive pose writes them, and puts them back when it ends (posing.PositionsDisplay).
 """
 import ctypes
 
@@ -105,21 +106,51 @@ def remove_shape_keys(obj, names):
             obj.shape_key_remove(block)
 
 
-def write_shape_key(mesh, block, co):
-    """Write float32 positions (#V by 3 or 3#V) into the shape key `block` of `mesh` and tag it for
-    redraw.
+def _float3_view(items):
+    """A writeable #items by 3 float32 view of the Blender array behind the RNA collection `items`
+    (a shape key's points, a mesh's vertices), each item starting with its float[3] position. The
+    stride is the distance between the first two items: 12 bytes for a float[3] array, 16 for
+    Blender 3.4's MVert."""
+    count = len(items)
+    if not count:
+        return np.empty((0, 3), np.float32)
+    address = items[0].as_pointer()
+    stride = items[1].as_pointer() - address if count > 1 else 12
+    memory = (ctypes.c_char * (stride * (count - 1) + 12)).from_address(address)
+    return np.ndarray((count, 3), np.float32, buffer=memory, strides=(stride, 4))
+
+
+def shape_key_co(mesh, block):
+    """The positions of the shape key `block` of `mesh`: a writeable #V by 3 float32 view of
+    Blender's own array, for the solver to write the pose straight into (no array and copy between).
 
     A mesh's shape key keeps its positions as one contiguous float[3] array per key, which
-    ``block.data[0]`` points at. Copying into it directly takes 0.05 ms for 126k vertices where
+    ``block.data[0]`` points at. Writing into it directly takes 0.05 ms for 126k vertices where
     ``foreach_set`` takes 5.5 ms (it goes through RNA item by item): a tenth of the pose's frame
     budget. The length is checked against the mesh every time, and the address read anew, so a
-    key reallocated since (undo, edit) is never written through an old pointer.
+    key reallocated since (undo, edit) is never written through an old pointer: use the view at
+    once, never keep it.
     """
-    co = np.asarray(co, np.float32).reshape(-1, 3)
     count = len(block.data)
-    if count != len(co) or count != len(mesh.vertices) or block.id_data != mesh.shape_keys:
-        raise ValueError(f"shape key '{block.name}' has {count} points for {len(co)} positions: the mesh changed")
-    if count:
-        address = block.data[0].as_pointer()
-        np.copyto(np.ctypeslib.as_array((ctypes.c_float * (3 * count)).from_address(address)).reshape(count, 3), co)
+    if count != len(mesh.vertices) or block.id_data != mesh.shape_keys:
+        raise ValueError(f"shape key '{block.name}' has {count} points for {len(mesh.vertices)} vertices: "
+                         f"the mesh changed")
+    return _float3_view(block.data)
+
+
+def vertex_positions(mesh):
+    """The mesh's own vertex positions (the base mesh): a writeable #V by 3 float32 view of
+    Blender's array, contiguous from Blender 3.5 on (the "position" attribute), strided in 3.4 (the
+    co of each MVert). Read anew from the mesh each time, like shape_key_co: use at once."""
+    return _float3_view(mesh.vertices)
+
+
+def write_shape_key(mesh, block, co):
+    """Write float32 positions (#V by 3 or 3#V) into the shape key `block` of `mesh` and tag it for
+    redraw."""
+    co = np.asarray(co, np.float32).reshape(-1, 3)
+    target = shape_key_co(mesh, block)
+    if len(co) != len(target):
+        raise ValueError(f"shape key '{block.name}' has {len(target)} points for {len(co)} positions: the mesh changed")
+    np.copyto(target, co)
     mesh.update()

@@ -1,13 +1,14 @@
 """What the operators share: the poll of operators that act on a mesh (or a controller of one),
 and the errors they report to the artist instead of raising."""
-from . import handles, storage
+from . import handles, posing, storage
 
 #: Errors with a message for the artist: not baked or stale, a bad handle, a bad option.
 FAILURES = (storage.NotReady, handles.HandleError, ValueError, RuntimeError)
 
 
 def mesh_poll(cls, context):
-    """The mesh object's operators: a mesh or its controller active, in Object Mode, not linked."""
+    """The mesh object's operators: a mesh or its controller active, in Object Mode, not linked, not
+    being posed (its positions may hold the pose)."""
     obj = handles.owner(context.object)
     if obj is None:
         cls.poll_message_set("Select a mesh object (or a controller of one)")
@@ -17,6 +18,9 @@ def mesh_poll(cls, context):
         return False
     if obj.library is not None or obj.data.library is not None:
         cls.poll_message_set("The object is linked from a library")
+        return False
+    if posing.is_posing(obj):
+        cls.poll_message_set("Posing: Enter applies the pose, Esc cancels it")
         return False
     return True
 

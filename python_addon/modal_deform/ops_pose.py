@@ -9,10 +9,6 @@ from .jobs import RefineJob
 from .ops_common import FAILURES, JobOperator, mesh_poll
 
 
-# The running interactive pose, so the right-click menu's items can end it.
-_running = None
-
-
 class MODAL_DEFORM_OT_pose(bpy.types.Operator):
     """Pose interactively: move the controllers (G, R) and the mesh follows. Enter or right-click > Apply \
 keeps the pose, Esc restores the mesh as it was"""
@@ -23,7 +19,6 @@ keeps the pose, Esc restores the mesh as it was"""
     poll = classmethod(mesh_poll)
 
     def invoke(self, context, event):
-        global _running
         obj = handles.owner(context.object)
         try:
             self.pose = posing.Pose(context, obj)
@@ -32,9 +27,7 @@ keeps the pose, Esc restores the mesh as it was"""
             return {"CANCELLED"}
         for warning in self.pose.warnings:
             self.report({"WARNING"}, warning)
-        self.state = posing.ShapeKeyState(obj, posing.POSE_KEY)
-        self.block = self.state.ensure()
-        self.block_name = self.block.name
+        self.shown = posing.display(obj)
         self.area = context.area
         self.request = None
         self.tick_ms = 0.0
@@ -43,7 +36,7 @@ keeps the pose, Esc restores the mesh as it was"""
         wm.modal_handler_add(self)
         context.workspace.status_text_set(
             "Modal Deform: move the controllers (G, R)   Enter: apply   Esc: cancel   Right-click: menu")
-        _running = self
+        posing.running = self
         return {"RUNNING_MODAL"}
 
     def modal(self, context, event):
@@ -76,9 +69,11 @@ keeps the pose, Esc restores the mesh as it was"""
         start = time.perf_counter()
         try:
             moved = self.pose.follow_controllers()
+            if not self.shown.shows_pose():  # shape keys added mid-pose: the pose goes on in the key
+                self.shown = self.shown.keep(self.pose)
             if moved or not self.pose.stats["converged"]:
                 self.pose.step(obj.modal_deform.budget)
-                self.pose.write(self.block)
+                self.pose.write(self.shown.array())
                 self.tick_ms = 1e3 * (time.perf_counter() - start)
         except FAILURES as error:  # e.g. a controller deleted while posing
             self.report({"ERROR"}, str(error))
@@ -88,8 +83,7 @@ keeps the pose, Esc restores the mesh as it was"""
         return {"PASS_THROUGH"}
 
     def _end(self, context, how):
-        global _running
-        _running = None
+        posing.running = None
         context.window_manager.event_timer_remove(self.timer)
         if context.workspace is not None:
             context.workspace.status_text_set(None)
@@ -97,7 +91,9 @@ keeps the pose, Esc restores the mesh as it was"""
             if self.area is not None:
                 self.area.header_text_set(None)
             if how == "CANCEL":
-                self.state.restore()
+                self.shown.restore()
+            else:
+                self.shown = self.shown.keep(self.pose)
         except ReferenceError:  # the object (or the screen) went away while posing: nothing to restore
             return {"CANCELLED"}
         return {"CANCELLED"} if how == "CANCEL" else {"FINISHED"}
@@ -119,10 +115,10 @@ class MODAL_DEFORM_OT_pose_end(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return _running is not None
+        return posing.running is not None
 
     def execute(self, context):
-        _running.request = self.how
+        posing.running.request = self.how
         return {"FINISHED"}
 
 
@@ -163,7 +159,7 @@ class MODAL_DEFORM_OT_solve(bpy.types.Operator):
             self.report({"WARNING"}, warning)
         block, _ = mesh_io.shape_key(obj, posing.POSE_KEY)
         block.value, block.mute = 1.0, False
-        pose.write(block)
+        pose.write(mesh_io.shape_key_co(obj.data, block))
         state = posing.state(stats)
         summary = f"after {stats['iterations']} iterations in {stats['ms']:.0f} ms (energy {stats['energy']:.5g})"
         if state == "converged":
@@ -224,13 +220,46 @@ CLASSES = (MODAL_DEFORM_OT_pose, MODAL_DEFORM_OT_pose_end, MODAL_DEFORM_MT_pose,
            MODAL_DEFORM_OT_reset)
 
 
-register, _unregister_classes = bpy.utils.register_classes_factory(CLASSES)
+_register_classes, _unregister_classes = bpy.utils.register_classes_factory(CLASSES)
+
+
+@bpy.app.handlers.persistent
+def _keep_before_save(*args):
+    """A file saved mid-pose holds the rest mesh and the pose in its shape key: a pose shown in the
+    vertex positions moves into the key first, and the pose goes on there."""
+    if posing.running is not None:
+        try:
+            posing.running.shown = posing.running.shown.keep(posing.running.pose)
+        except ReferenceError:  # its object went away: the pose ends at its next event
+            pass
+
+
+@bpy.app.handlers.persistent
+def _recover_after_undo_or_load(*args):
+    """Undo, redo or a file loaded replaced the data: a pose under way ends (its next event) and
+    meshes written mid-pose are repaired (posing.recover)."""
+    if posing.running is not None:
+        posing.running.request = "CANCEL"
+    posing.recover()
+
+
+_HANDLERS = ((bpy.app.handlers.save_pre, _keep_before_save), (bpy.app.handlers.undo_post, _recover_after_undo_or_load),
+             (bpy.app.handlers.redo_post, _recover_after_undo_or_load),
+             (bpy.app.handlers.load_post, _recover_after_undo_or_load))
+
+
+def register():
+    _register_classes()
+    for handlers, handler in _HANDLERS:
+        handlers.append(handler)
 
 
 def unregister():
     """Disabling the add-on mid-pose ends the pose as Esc does: Blender drops the modal handler of
     an unregistered operator without calling it, which would leave its timer, header text and
-    half-made shape key behind."""
-    if _running is not None:
-        _running._end(bpy.context, "CANCEL")
+    half-made shape key (or posed vertex positions) behind."""
+    if posing.running is not None:
+        posing.running._end(bpy.context, "CANCEL")
+    for handlers, handler in _HANDLERS:
+        handlers.remove(handler)
     _unregister_classes()

@@ -1,7 +1,7 @@
 """The sidebar (View3D > N > Modal Deform): bake settings and status, handles, pose, animation, preview."""
 import bpy
 
-from . import handles, ops_preview, storage
+from . import handles, ops_preview, posing, storage
 
 
 class MODAL_DEFORM_UL_handles(bpy.types.UIList):
@@ -15,6 +15,12 @@ class MODAL_DEFORM_UL_handles(bpy.types.UIList):
         else:
             row.label(text="pinned", icon="PINNED")
         row.prop(item, "weight", text="", emboss=False)
+
+
+def stale_reason(obj):
+    """storage.stale_reason from the cache, or "" while obj is posed: the pose may be in its
+    positions, and each update would make the panels hash the whole mesh again."""
+    return "" if posing.is_posing(obj) else storage.stale_reason(obj, cached=True)
 
 
 class _Panel:
@@ -37,7 +43,7 @@ class VIEW3D_PT_modal_deform(_Panel, bpy.types.Panel):
         if settings.basis is None:
             layout.label(text="Not baked: set the basis up and Bake", icon="INFO")
             return
-        reason = storage.stale_reason(obj, cached=True)
+        reason = stale_reason(obj)
         if reason:
             layout.alert = True
             layout.label(text=f"Mesh edited after the bake ({reason}): re-bake", icon="ERROR")
@@ -92,7 +98,7 @@ class VIEW3D_PT_modal_deform_bake(_Panel, bpy.types.Panel):
             box.label(text=f"Baked {status.baked_at} in {status.seconds:.1f} s")
             if status.num_floppy:
                 box.label(text=f"{status.num_floppy} floppy zero modes (non-manifold flaps)", icon="INFO")
-            reason = storage.stale_reason(obj, cached=True)
+            reason = stale_reason(obj)
             if reason:
                 row = box.row()
                 row.alert = True

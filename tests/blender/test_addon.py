@@ -33,6 +33,12 @@ def test_region_bake_leaves_the_rest_exactly_still(run_blender, tmp_path):
     assert "REGION_RELOADED" in run_blender("region_reload.py", blend=tmp_path / "region.blend").stdout
 
 
+def test_pose_shown_in_positions_or_key_and_repaired_after_undo_or_load(run_blender):
+    out = run_blender("pose_displays.py").stdout
+    for stage in ("POSITIONS_OK", "SHAPE_KEYS_OK", "UNDO_OK", "LOAD_OK"):
+        assert stage in out, stage
+
+
 def test_stale_mesh_and_bad_handles_are_refused(run_blender):
     assert "STALE_OK" in run_blender("stale_and_bad_handles.py").stdout
 

@@ -1,12 +1,16 @@
 """Blender with a window (under Xvfb, --enable-event-simulate): pose through the UI as an artist does.
 
 Bake Suzanne, add a handle, start the Pose operator from the sidebar's context, grab the controller
-with a simulated G + mouse motion + click, let the timer solve, check the mesh followed; Esc
-restores the mesh; the converged pose equals the Solve operator's; undo takes a bake back; Esc
-takes an animation bake's frames back; disabling the add-on mid-pose restores as Esc does.
+with a simulated G + mouse motion + click, let the timer solve, check the mesh followed (shown in
+its vertex positions: Suzanne has no shape keys); Esc restores the mesh; saving mid-pose writes
+the rest mesh and the pose in its shape key; entering Edit Mode mid-pose keeps the pose in the key
+and edits the rest mesh; the converged pose equals the Solve operator's; undo takes a bake back; Esc
+takes an animation bake's frames back; disabling the add-on mid-pose restores as Esc does (from the
+shape key and from the positions).
 Each step runs from bpy.app.timers so Blender handles the simulated events in between.
 Writes OUTPUT/result.json ({"ok": bool, "log": [...]}) and screenshots, then quits.
 """
+import importlib
 import json
 import os
 import sys
@@ -163,7 +167,7 @@ def steps():
         controller.select_set(True)
         bpy.context.view_layer.objects.active = controller
     yield 0.3
-    assert ops_pose._running is not None
+    assert posing.running is not None
     x, y = region.x + region.width // 2, region.y + region.height // 2
     window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x, y=y)
     yield 0.1
@@ -180,13 +184,15 @@ def steps():
     assert np.linalg.norm(moved) > 0.1, f"the grab did not move the controller ({moved})"
     say("controller moved by", np.round(moved, 3).tolist())
 
-    # The timer solves until converged, writing the shape key; the mesh follows the controller.
-    yield from wait_until(lambda: ops_pose._running.pose.stats["converged"], 30)
-    pose = key_positions(obj, posing.POSE_KEY)
+    # The timer solves until converged; the mesh follows the controller. Suzanne has no shape keys:
+    # the pose is shown in its vertex positions, the mesh flagged as posed meanwhile.
+    yield from wait_until(lambda: posing.running.pose.stats["converged"], 30)
+    assert type(posing.running.shown) is posing.PositionsDisplay
+    assert obj.data.shape_keys is None and obj.data.get(posing.POSING_FLAG)
+    pose = base_positions(obj)
     followed = pose[group].mean(axis=0) - rest[group].mean(axis=0)
     assert np.linalg.norm(followed - moved) < 0.05 * np.linalg.norm(moved), (followed, moved)
-    assert base_positions(obj).tobytes() == rest.tobytes(), "posing wrote to the base mesh"
-    say("mesh followed by", np.round(followed, 3).tolist(), "at", f"{ops_pose._running.tick_ms:.1f} ms per update")
+    say("mesh followed by", np.round(followed, 3).tolist(), "at", f"{posing.running.tick_ms:.1f} ms per update")
     show_sidebar_tab()
     yield 0.5
     screenshot("pose.png")
@@ -195,10 +201,71 @@ def steps():
     window.event_simulate(type="ESC", value="PRESS", x=x, y=y)
     window.event_simulate(type="ESC", value="RELEASE", x=x, y=y)
     yield 0.3
-    assert ops_pose._running is None, "Esc did not end the pose"
+    assert posing.running is None, "Esc did not end the pose"
     assert obj.data.shape_keys is None, "Esc left shape keys behind"
     assert base_positions(obj).tobytes() == rest.tobytes()
+    assert obj.data.get(posing.POSING_FLAG) is None
     say("Esc restored the mesh")
+
+    # Saving while the pose is in the vertex positions: the file has the rest mesh and the pose in
+    # its shape key, and the pose goes on in the key; Esc then takes the keys away again.
+    placed = controller.location.copy()
+    with override():
+        assert bpy.ops.modal_deform.pose("INVOKE_DEFAULT") == {"RUNNING_MODAL"}
+    controller.location.x += 0.2
+    yield 0.5
+    posed = base_positions(obj)
+    assert np.abs(posed - rest).max() > 0.05, "the pose did not follow the controller"
+    saved = os.path.join(output, "saved_while_posing_positions.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=saved, copy=True)
+    assert base_positions(obj).tobytes() == rest.tobytes(), "saving left the pose in the base mesh"
+    with bpy.data.libraries.load(saved) as (data_from, data_to):
+        data_to.objects = [obj.name]
+    copy = data_to.objects[0]
+    assert base_positions(copy).tobytes() == rest.tobytes(), "the saved base mesh is not the rest mesh"
+    assert copy.data.get(posing.POSING_FLAG) is None
+    assert np.abs(key_positions(copy, posing.POSE_KEY) - posed).max() < 1e-5, "the saved pose is not the pose"
+    bpy.data.objects.remove(copy)
+    controller.location.x -= 0.1
+    yield 0.5
+    assert np.abs(key_positions(obj, posing.POSE_KEY) - posed).max() > 0.01, "the pose stopped after saving"
+    window.event_simulate(type="ESC", value="PRESS", x=x, y=y)
+    window.event_simulate(type="ESC", value="RELEASE", x=x, y=y)
+    yield 0.3
+    assert posing.running is None and obj.data.shape_keys is None
+    assert base_positions(obj).tobytes() == rest.tobytes()
+    say("saving mid-pose wrote the rest mesh and the pose's key; Esc restored the mesh")
+
+    # Tab into Edit Mode while the pose is in the vertex positions: the pose goes into the shape key
+    # and Edit Mode edits the rest mesh.
+    with override():
+        assert bpy.ops.modal_deform.pose("INVOKE_DEFAULT") == {"RUNNING_MODAL"}
+    controller.location.x += 0.1
+    yield 0.5
+    posed = base_positions(obj)
+    with override():
+        controller.select_set(False)
+        obj.select_set(True)
+        bpy.context.view_layer.objects.active = obj
+    window.event_simulate(type="TAB", value="PRESS", x=x, y=y)
+    window.event_simulate(type="TAB", value="RELEASE", x=x, y=y)
+    yield 0.5
+    assert posing.running is None, "Edit Mode did not end the pose"
+    assert obj.mode == "EDIT"
+    with override():
+        bpy.ops.object.mode_set(mode="OBJECT")
+    assert base_positions(obj).tobytes() == rest.tobytes(), "Edit Mode took the pose for the rest mesh"
+    assert key_positions(obj, "Basis").tobytes() == rest.tobytes()
+    assert np.abs(key_positions(obj, posing.POSE_KEY) - posed).max() < 0.05, "the pose was not kept"
+    assert obj.data.get(posing.POSING_FLAG) is None
+    obj.shape_key_clear()
+    controller.location = placed
+    with override():
+        for o in bpy.context.view_layer.objects:
+            o.select_set(False)
+        controller.select_set(True)
+        bpy.context.view_layer.objects.active = controller
+    say("Edit Mode mid-pose kept the pose in the key and edits the rest mesh")
 
     # The Solve operator at convergence gives the pose the interactive one converged to.
     with override():
@@ -233,7 +300,7 @@ def steps():
     window.event_simulate(type="RET", value="PRESS", x=x, y=y)
     window.event_simulate(type="RET", value="RELEASE", x=x, y=y)
     yield 0.3
-    assert ops_pose._running is None, "Enter did not end the pose"
+    assert posing.running is None, "Enter did not end the pose"
     assert key_positions(obj, posing.POSE_KEY).tobytes() != key_positions(obj, "Basis").tobytes()
     window.event_simulate(type="Z", value="PRESS", x=x, y=y, ctrl=True)
     window.event_simulate(type="Z", value="RELEASE", x=x, y=y, ctrl=True)
@@ -267,11 +334,27 @@ def steps():
     yield 0.5
     assert key_positions(obj, posing.POSE_KEY).tobytes() != before, "the pose did not follow the controller"
     addon_utils.disable("modal_deform", default_set=True)
-    assert ops_pose._running is None, "disabling the add-on left the pose running"
+    assert posing.running is None, "disabling the add-on left the pose running"
     assert key_positions(obj, posing.POSE_KEY).tobytes() == before, "disabling did not restore the shape key"
     assert base_positions(obj).tobytes() == rest.tobytes()
     yield 0.5
     say("disabling the add-on mid-pose restored the shape key")
+
+    # And with the pose in the vertex positions (no shape keys): the rest mesh comes back exactly.
+    addon_utils.enable("modal_deform", default_set=True)
+    posing = importlib.import_module("modal_deform.posing")
+    obj.shape_key_clear()
+    with override():
+        assert bpy.ops.modal_deform.pose("INVOKE_DEFAULT") == {"RUNNING_MODAL"}
+    controller.location.z -= 0.3
+    yield 0.5
+    assert type(posing.running.shown) is posing.PositionsDisplay
+    assert np.abs(base_positions(obj) - rest).max() > 0.05, "the pose did not follow the controller"
+    addon_utils.disable("modal_deform", default_set=True)
+    assert posing.running is None, "disabling the add-on left the pose running"
+    assert base_positions(obj).tobytes() == rest.tobytes(), "disabling did not restore the vertex positions"
+    assert obj.data.shape_keys is None and obj.data.get(posing.POSING_FLAG) is None
+    say("disabling the add-on mid-pose restored the vertex positions")
 
 
 def drive(generator=steps()):
