@@ -526,7 +526,11 @@ def section_strong_poses(result):
             if not full["converged"]:
                 return "not converged: no reference"
             return f"{full['gap'][pose]:.3f} ({100 * full['gap'][pose] / full['energy']:.1f}%)"
-        minimum = f"{full['energy']:.3f} ({full['iterations']} it, {full['seconds']:.0f} s)" if full and "gap" in full else ""
+        minimum = ""
+        if full and "gap" in full:
+            minimum = (f"{full['energy']:.3f}" if full["converged"] else
+                       f"NOT converged (from {full['gap']['own'] + full['energy']:.4g} to {full['energy']:.4g})")
+            minimum += f", {full['iterations']} it, {full['seconds']:.0f} s"
         rows.append([degrees, "yes" if r["fine"]["converged"] else "NO", r["fine"]["stalled_calls"],
                      r["fine"]["calls_without_progress"], f"{r['fine']['energy']:.3f}", f"{r['own']['energy']:.3f}",
                      minimum, gap("fine"), gap("own"), f"{100 * r['rms']:.2f}%", f"{r['fine']['difference_error']:.1e}"])
