@@ -153,18 +153,25 @@ def bar(nx=12, nz=120):
     return Shape("bar", V, F, _rod_handles(V, 10.0), poses, view=(1.0, -0.35, -0.3))
 
 
+def end_handles(V, fraction):
+    """Handles on the `fraction` of a scan's length at each end of its longest bounding-box axis
+    (low end first); with the (long, side, up) axes as unit vectors, the length and the high end's
+    centre."""
+    lo, hi = V.min(axis=0), V.max(axis=0)
+    a = int(np.argmax(hi - lo))
+    length = hi[a] - lo[a]
+    handles = [np.flatnonzero(V[:, a] < lo[a] + fraction * length),
+               np.flatnonzero(V[:, a] > hi[a] - fraction * length)]
+    axes = np.eye(3)[[a, (a + 1) % 3, (a + 2) % 3]]
+    return handles, axes, length, V[handles[1]].mean(axis=0)
+
+
 def end_pull(V):
     """Handles of a scan along its longest bounding-box axis: the 10% at its low end held, the
     10% at its high end; the pose turns that end by 0.6 rad about the up axis and moves it by a
     quarter of the length sideways (as bench/bench_solve.cpp poses the dragon)."""
-    lo, hi = V.min(axis=0), V.max(axis=0)
-    a = int(np.argmax(hi - lo))
-    side, up = (a + 1) % 3, (a + 2) % 3
-    length = hi[a] - lo[a]
-    handles = [np.flatnonzero(V[:, a] < lo[a] + 0.1 * length), np.flatnonzero(V[:, a] > hi[a] - 0.1 * length)]
-    centre = V[handles[1]].mean(axis=0)
-    axis, shift = np.zeros(3), np.zeros(3)
-    axis[up], shift[side] = 1.0, 0.25 * length
+    handles, (_, side, up), length, centre = end_handles(V, 0.1)
+    axis, shift = up, 0.25 * length * side
 
     def at(t):
         return [np.eye(4), rigid_transform(axis, 0.6 * t, centre, t * shift)]
@@ -175,13 +182,8 @@ def end_turns(V, turns=(30, 90, 170), bend=90):
     """Handles of a scan along its longest bounding-box axis, the 15% at each end, and poses of its
     high end (Refine's, bench/refine.py): "turn_<d>" turns it by d degrees about the long axis and
     moves it by 9% of the length sideways and 4.5% up; "bend_<bend>" turns it about the up axis."""
-    lo, hi = V.min(axis=0), V.max(axis=0)
-    a = int(np.argmax(hi - lo))
-    side, up = (a + 1) % 3, (a + 2) % 3
-    length = hi[a] - lo[a]
-    handles = [np.flatnonzero(V[:, a] < lo[a] + 0.15 * length), np.flatnonzero(V[:, a] > hi[a] - 0.15 * length)]
-    centre = V[handles[1]].mean(axis=0)
-    along, up_axis, shift = np.eye(3)[a], np.eye(3)[up], 0.09 * length * np.eye(3)[side] + 0.045 * length * np.eye(3)[up]
+    handles, (along, side, up_axis), length, centre = end_handles(V, 0.15)
+    shift = 0.09 * length * side + 0.045 * length * up_axis
 
     def motion(axis, degrees, moved):
         return lambda t: [np.eye(4), rigid_transform(axis, t * np.radians(degrees), centre, t * moved)]

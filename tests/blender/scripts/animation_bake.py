@@ -8,13 +8,8 @@ import numpy as np  # noqa: E402
 import support  # noqa: E402
 
 jobs = support.enable_addon("jobs")
-obj = support.suzanne(1)
-obj.modal_deform.modes, obj.modal_deform.derivatives, obj.modal_deform.ghost = 15, 20, 400
-assert bpy.ops.modal_deform.bake() == {"FINISHED"}
-V = support.positions(obj)
-top = support.add_handle(obj, V[:, 2] > 0.5)
-support.add_handle(obj, V[:, 2] < -0.5).controller = None
-controller = top.controller
+obj, V = support.baked_suzanne(1, 15, 20, 400)
+controller = support.top_and_bottom_handles(obj, V).controller
 controller.keyframe_insert("location", frame=1)
 controller.location.y += 0.5
 controller.keyframe_insert("location", frame=10)

@@ -17,12 +17,8 @@ from headless import evaluated_positions  # noqa: E402
 
 posing, storage = support.enable_addon("posing", "storage")
 
-obj = support.suzanne(1)
-obj.modal_deform.modes, obj.modal_deform.derivatives, obj.modal_deform.ghost = 12, 10, 300
-assert bpy.ops.modal_deform.bake() == {"FINISHED"}
-rest = support.positions(obj)
-support.add_handle(obj, rest[:, 2] > 0.5)
-support.add_handle(obj, rest[:, 2] < -0.5).controller = None
+obj, rest = support.baked_suzanne(1, 12, 10, 300)
+support.top_and_bottom_handles(obj, rest)
 controller = obj.modal_deform.handles[0].controller
 controller.matrix_world = Matrix.Translation((0.3, 0.0, 0.2)) @ controller.matrix_world
 obj.modifiers.new("Subdivision", "SUBSURF").levels = 1

@@ -10,12 +10,8 @@ import support  # noqa: E402
 
 jobs, core = support.enable_addon("jobs", "core")
 # Suzanne unsubdivided (507 vertices): the full solves stay short in each of the four Blenders tested.
-obj = support.suzanne(0)  # the eyes are free components: no handle holds them
-obj.modal_deform.modes, obj.modal_deform.derivatives, obj.modal_deform.ghost = 15, 40, 300
-assert bpy.ops.modal_deform.bake() == {"FINISHED"}
-rest = support.positions(obj)
-top = support.add_handle(obj, rest[:, 2] > 0.5)
-support.add_handle(obj, rest[:, 2] < -0.5).controller = None
+obj, rest = support.baked_suzanne(0, 15, 40, 300)  # the eyes are free components: no handle holds them
+top = support.top_and_bottom_handles(obj, rest)
 top.controller.location.y += 0.15
 top.controller.rotation_euler.x += 0.2
 assert bpy.ops.modal_deform.solve() == {"FINISHED"}

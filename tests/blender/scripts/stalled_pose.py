@@ -9,12 +9,8 @@ import bpy  # noqa: E402
 import support  # noqa: E402
 
 posing, core = support.enable_addon("posing", "core")
-obj = support.suzanne(0)
-obj.modal_deform.modes, obj.modal_deform.derivatives, obj.modal_deform.ghost = 10, 20, 300
-assert bpy.ops.modal_deform.bake() == {"FINISHED"}
-rest = support.positions(obj)
-top = support.add_handle(obj, rest[:, 2] > 0.5)
-support.add_handle(obj, rest[:, 2] < -0.5).controller = None
+obj, rest = support.baked_suzanne(0, 10, 20, 300)
+top = support.top_and_bottom_handles(obj, rest)
 top.controller.location.y += 0.15
 bpy.context.view_layer.update()
 

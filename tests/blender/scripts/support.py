@@ -42,6 +42,22 @@ def suzanne(levels=1):
     return obj
 
 
+def baked_suzanne(levels, modes, derivatives, ghost):
+    """suzanne(levels) baked through the operator with these settings; (obj, rest positions)."""
+    obj = suzanne(levels)
+    obj.modal_deform.modes, obj.modal_deform.derivatives, obj.modal_deform.ghost = modes, derivatives, ghost
+    assert bpy.ops.modal_deform.bake() == {"FINISHED"}
+    return obj, positions(obj)
+
+
+def top_and_bottom_handles(obj, rest):
+    """A handle on the top of the head (returned, its controller free to move) and one on the chin,
+    pinned where it is."""
+    top = add_handle(obj, rest[:, 2] > 0.5)
+    add_handle(obj, rest[:, 2] < -0.5).controller = None
+    return top
+
+
 def positions(obj):
     co = np.empty(3 * len(obj.data.vertices), np.float32)
     obj.data.vertices.foreach_get("co", co)
