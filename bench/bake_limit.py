@@ -12,6 +12,7 @@ import statistics
 import subprocess
 import tempfile
 
+import modal_deform.core as mdc
 from common import ROOT
 
 BINARY = ROOT / "build" / "bench" / "modal_deform_bench"
@@ -21,8 +22,8 @@ RUNS = 3
 TARGETS = {"seconds_67": 8.0, "seconds_130": 12.0, "ratio_67": 2.5, "peak_gb": 2.0}
 #: Block widths at which bench_bake.cpp times CHOLMOD's solves with the factor it made alone.
 SOLVE_WIDTHS = ("1", "8", "52")
-STAGE_KEYS = ("attachment", "hessian", "factorisation", "ghost", "modes", "third derivatives", "derivative solves",
-              "orthonormalisation", "assembly")
+#: The stages of a bake without a proxy.
+STAGE_KEYS = mdc.BAKE_STAGES[1:-1]
 
 
 def bake_in_fresh_process(benchmark_filter):

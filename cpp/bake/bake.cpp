@@ -126,10 +126,13 @@ class GhostInBackground {
   GhostInBackground(const GhostInBackground&) = delete;
   GhostInBackground& operator=(const GhostInBackground&) = delete;
 
-  // Waits for the ghost, passing its progress on to the bake's bar (which may cancel).
+  // Waits for the ghost, passing its progress on to the bake's bar (which may cancel): the stage is
+  // reported at least at its start and end, however soon the ghost was ready.
   Ghost get(Progress& progress) {
-    while (ghost_.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready)
-      progress.report("ghost", fraction_.load());
+    do {
+      progress.report(stages::kGhost, fraction_.load());
+    } while (ghost_.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready);
+    progress.report(stages::kGhost, 1.0);
     return ghost_.get();
   }
 
@@ -229,7 +232,7 @@ Simulated simulated_submesh(const VerticesRef& V, const FacesRef& F, const BakeO
                             Progress& progress) {
   Simulated sim;
   RegionMesh region;
-  sim.attachment = stage("attachment", basis, progress, [&] {
+  sim.attachment = stage(stages::kAttachment, basis, progress, [&] {
     if (options.region.size() == 0) return attach(V, F);
     region = region_mesh(F, basis.mass, options.region);
     return region_attachment(region, V.rows());
@@ -271,7 +274,7 @@ struct Stiffness {
 };
 
 Stiffness stiffness_at_rest(const Simulated& sim, const BakeOptions& options, Basis& basis, Progress& progress) {
-  return stage("hessian", basis, progress, [&] {
+  return stage(stages::kHessian, basis, progress, [&] {
     Stiffness stiffness;
     const RowMatrixX3d V = sim.energy_vertices();
     if (options.energy == EnergyKind::kShells) {
@@ -305,7 +308,7 @@ Ghost order_beside_the_ghost(const VerticesRef& V, const GhostSource& source, co
                              const SparseMatrix& K, const BakeOptions& options, CholmodLLT& factor, Basis& basis,
                              Progress& progress) {
   GhostInBackground ghost(source.V, source.F, source.mass, options.ghost);
-  progress.report("factorisation", 0.0);
+  progress.report(stages::kFactorisation, 0.0);
   try {
     factor.analyze(K);
   } catch (const OutOfMemory& e) {
@@ -315,8 +318,8 @@ Ghost order_beside_the_ghost(const VerticesRef& V, const GhostSource& source, co
   require_memory(estimate_bake_memory(V.rows(), sim.size(), static_cast<double>(K.nonZeros()), factor.factor_bytes(),
                                       options.modes, options.derivatives),
                  available_memory());
-  progress.report("factorisation", 1.0);
-  const Stopwatch stopwatch(basis.timings["ghost"]);  // the wait beyond the ordering
+  progress.report(stages::kFactorisation, 1.0);
+  const Stopwatch stopwatch(basis.timings[stages::kGhost]);  // the wait beyond the ordering
   return ghost.get(progress);
 }
 
@@ -327,7 +330,7 @@ Modes vibration_stage(const VerticesRef& V, const Simulated& sim, const SparseMa
   const double factoring = factor.seconds();
   Modes modes;
   {
-    const Stopwatch stopwatch(basis.timings["modes"]);
+    const Stopwatch stopwatch(basis.timings[stages::kModes]);
     try {
       modes = flexible_modes(K, sim.mass, rigid, sim.flexible, progress, factor);
     } catch (const NumericalError& e) {
@@ -337,7 +340,7 @@ Modes vibration_stage(const VerticesRef& V, const Simulated& sim, const SparseMa
                                    " at (", V(vertex, 0), ", ", V(vertex, 1), ", ", V(vertex, 2), ")"));
     }
   }
-  basis.timings["modes"] -= factor.seconds() - factoring;
+  basis.timings[stages::kModes] -= factor.seconds() - factoring;
   return modes;
 }
 
@@ -361,9 +364,9 @@ Eigen::MatrixXd derivative_stage(const Simulated& sim, Stiffness& stiffness, con
   // Modes are zero at a region's clamped vertices, which the energy has after the simulated ones.
   phi.conservativeResizeLike(Eigen::MatrixXd::Zero(3 * (S + sim.clamped.rows()), phi.cols()));
   const DiscreteShells& shells = *stiffness.shells;
-  stage("third derivatives", basis, progress, [&] {
+  stage(stages::kThirdDerivatives, basis, progress, [&] {
     for (size_t first = 0; first < pairs.size(); first += kPairsPerPass) {
-      progress.report("third derivatives", static_cast<double>(first) / pairs.size());
+      progress.report(stages::kThirdDerivatives, static_cast<double>(first) / pairs.size());
       const size_t last = std::min(pairs.size(), first + kPairsPerPass);
       const RowMatrixXd batch = shells.third_batch(shells.rest(), phi, {pairs.begin() + first, pairs.begin() + last});
       for_row_blocks(derivatives.rows(), [&](Eigen::Index row, Eigen::Index rows) {
@@ -377,7 +380,7 @@ Eigen::MatrixXd derivative_stage(const Simulated& sim, Stiffness& stiffness, con
   Eigen::MatrixXd kernel(3 * S, sim.num_rigid + num_zero);
   kernel.leftCols(sim.num_rigid) = rigid;
   kernel.rightCols(num_zero) = modes.vectors.leftCols(num_zero);
-  const Stopwatch stopwatch(basis.timings["derivative solves"]);
+  const Stopwatch stopwatch(basis.timings[stages::kDerivativeSolves]);
   return solve_in_range_shifted(stiffness.K, sim.mass, kernel, std::move(derivatives), factor, modes.shift,
                                 modes.known_eigenvalues, modes.known_vectors, &progress);
 }
@@ -395,7 +398,7 @@ Eigen::MatrixXd orthonormal_basis(const Simulated& sim, const Eigen::MatrixXd& r
   U.rightCols(options.derivatives) = derivatives;
   derivatives.resize(0, 0);
   {
-    const Stopwatch stopwatch(basis.timings["orthonormalisation"]);
+    const Stopwatch stopwatch(basis.timings[stages::kOrthonormalisation]);
     const std::vector<int> kept = orthonormalize(U, dof_masses(sim.mass), kDependentTolerance, &progress);
     for (int j = 0; j < leading; ++j)
       if (j >= static_cast<int>(kept.size()) || kept[static_cast<size_t>(j)] != j)
@@ -418,12 +421,10 @@ Eigen::MatrixXd orthonormal_basis(const Simulated& sim, const Eigen::MatrixXd& r
 // the ghost's own arrays).
 void fine_and_ghost_vectors(Eigen::MatrixXd U, const Simulated& sim, const GhostSource& source, Ghost coarse,
                             const StiffnessPaint& paint, Basis& basis, Progress& progress) {
-  stage("assembly", basis, progress, [&] {
+  stage(stages::kAssembly, basis, progress, [&] {
     if (U.rows() < basis.rest.size()) U = extend_to_attached(sim.attachment, U);
     U /= basis.scale;
     basis.vectors = U.cast<float>();
-  });
-  stage("ghost", basis, progress, [&] {
     const int g = static_cast<int>(coarse.V.rows());
     const std::vector<int>& sub = sim.region_vertices;
     if (sub.empty()) {
@@ -463,7 +464,7 @@ Basis bake_stages(const VerticesRef& V, const FacesRef& F, const BakeOptions& op
   Ghost coarse = order_beside_the_ghost(V, source, sim, stiffness.K, options, factor, basis, progress);
   const Modes modes = vibration_stage(V, sim, stiffness.K, rigid, factor, basis, progress);
   Eigen::MatrixXd derivatives = derivative_stage(sim, stiffness, rigid, modes, options, factor, basis, progress);
-  basis.timings["factorisation"] = factor.seconds();
+  basis.timings[stages::kFactorisation] = factor.seconds();
   Eigen::MatrixXd U = orthonormal_basis(sim, rigid, modes, std::move(derivatives), options, basis, progress);
   fine_and_ghost_vectors(std::move(U), sim, source, std::move(coarse), options.paint, basis, progress);
   return basis;
@@ -476,18 +477,18 @@ Basis bake_on_proxy(const VerticesRef& V, const FacesRef& F, const BakeOptions& 
   const Basis fine = rest_state(V, F, options, normalizing_scale(V));
   Basis timed;  // the proxy stage's time, until the proxy's basis exists
   Progress as_proxy([&progress](const std::string&, double fraction) {
-    progress.report("proxy", fraction);
+    progress.report(stages::kProxy, fraction);
     return true;
   });
   const Ghost proxy =
-      stage("proxy", timed, progress, [&] { return ghost_mesh(V, F, fine.mass, options.proxy, &as_proxy); });
+      stage(stages::kProxy, timed, progress, [&] { return ghost_mesh(V, F, fine.mass, options.proxy, &as_proxy); });
   // The proxy's elements carry the fine paint's means (restrict_to_ghost).
   BakeOptions on_proxy = options;
   on_proxy.paint = restrict_to_ghost(proxy.map, static_cast<int>(proxy.V.rows()), fine.mass, options.paint);
   Basis basis = rest_state(proxy.V, proxy.F, on_proxy, fine.scale);
   basis.timings = timed.timings;
   basis = bake_stages(proxy.V, proxy.F, on_proxy, std::move(basis), progress);
-  stage("prolongation", basis, progress, [&] {
+  stage(stages::kProlongation, basis, progress, [&] {
     basis.prolongation = prolongation_to_proxy(V, proxy.V, proxy.F, proxy.map);
     basis.ghost_map = basis.ghost_map(proxy.map).eval();
     basis.rest = fine.rest;

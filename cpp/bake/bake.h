@@ -36,12 +36,13 @@
 // proxy's vectors and the prolongation: memory and storage grow with the fine mesh only by
 // those weights.
 //
-// Stages are timed into Basis::timings ("attachment", "hessian", "factorisation" (CHOLMOD
-// analysis and numeric factorisation, done inside the modes), "modes" (the rest of them),
-// "third derivatives", "derivative solves", "orthonormalisation", "assembly" (step 6), "ghost"
-// (what the ghost adds: it is simplified on a thread of its own during steps 3 to 6), and for a
-// proxy bake "proxy" and "prolongation"; seconds)
-// and reported through Progress with the same names.
+// Stages (kBakeStages in util/progress.h, in the order they run) are timed into Basis::timings and
+// reported through Progress with the same names: for a proxy bake "proxy" first; "attachment",
+// "hessian", "factorisation" (CHOLMOD's analysis, reported before the ghost, and the numeric
+// factorisation inside the modes), "ghost" (the wait for the ghost beyond the analysis: it is
+// simplified on a thread of its own beside it), "modes" (the rest of them), "third derivatives",
+// "derivative solves", "orthonormalisation", "assembly" (steps 6 and 7: the fine and the ghost's
+// vectors); for a proxy bake "prolongation" last; seconds.
 // A cancel throws Cancelled at the next report and leaves nothing behind. CHOLMOD cannot report
 // during its analysis and factorisation (about 1 s and 2.5 s at 100k vertices), nor a blocked
 // solve during its right-hand sides (1 s for 47): the bar pauses there.

@@ -85,6 +85,10 @@ void bind_bake(py::module_& m) {
       .def_property_readonly("dimension", &Basis::dimension)
       .def_property_readonly("num_vertices", &Basis::num_vertices);
 
+  py::tuple stages(kBakeStages.size());
+  for (size_t i = 0; i < kBakeStages.size(); ++i) stages[i] = kBakeStages[i];
+  m.attr("BAKE_STAGES") = stages;
+
   m.def(
       "bake",
       [](const VerticesRef& V, const FacesRef& F, int modes, int derivatives, int ghost, const std::string& energy,

@@ -431,13 +431,13 @@ void Simplifier::collapse_in_rounds(int until, const std::function<void()>& repo
 }
 
 void Simplifier::simplify(int target, Progress* progress) {
-  if (progress) progress->report("ghost", 0.0);
+  if (progress) progress->report(stages::kGhost, 0.0);
   if (num_alive_ <= target) return;
   const int start = num_alive_;
   long pops = 0;
   auto report = [&] {
     if (progress && ++pops % kReportInterval == 0)
-      progress->report("ghost", double(start - num_alive_) / double(start - target));
+      progress->report(stages::kGhost, double(start - num_alive_) / double(start - target));
   };
   collapse_in_rounds(target < num_alive_ / kRoundsAbove ? kRoundsAbove * target : num_alive_, report);
   seed();
@@ -506,7 +506,7 @@ EdgeCollapse collapse_edges(const VerticesRef& V, const FacesRef& F, const Vecto
       throw InputError(message("mass[", i, "]: expected a finite value >= 0, got ", mass[i]));
 
   if (target >= V.rows()) {
-    if (progress) progress->report("ghost", 1.0);
+    if (progress) progress->report(stages::kGhost, 1.0);
     EdgeCollapse identity{V, F, Eigen::VectorXi::LinSpaced(V.rows(), 0, static_cast<int>(V.rows()) - 1)};
     return identity;
   }

@@ -101,7 +101,7 @@ Eigen::MatrixXd solve_by_blocks(const SparseMatrix& K, const VectorRef& mass, co
     });
     if (Z.cols()) add_dense_product(PB, Z, -gram.solve(inner_product(Z, PB)));
     const auto report = [&](double part) {
-      if (progress) progress->report("derivative solves", (static_cast<double>(first) + part * width) / B.cols());
+      if (progress) progress->report(stages::kDerivativeSolves, (static_cast<double>(first) + part * width) / B.cols());
     };
     auto X = Psi.middleCols(first, width);
     solve(PB, X, report);
@@ -129,7 +129,7 @@ Eigen::MatrixXd solve_with_pins(const SparseMatrix& K, const VectorRef& mass, co
                                 Progress* progress) {
   check_right_hand_sides(K, B);
   const Eigen::Index n = K.rows();
-  if (progress) progress->report("derivative solves", 0.0);
+  if (progress) progress->report(stages::kDerivativeSolves, 0.0);
 
   // With P b in the range of K, K ψ = P b has a solution with ψ = 0 at the pins (the pinned rows
   // of Z are invertible), and that solution also solves (K + w Σ eₛeₛᵀ) ψ = P b, which is definite:
@@ -245,7 +245,7 @@ Eigen::MatrixXd solve_in_range_shifted(const SparseMatrix& K, const VectorRef& m
                              modes.rows(), " by ", modes.cols()));
   if (eigenvalues.size() == 0 || !(eigenvalues.array() > 0).all() || !eigenvalues.allFinite() || !modes.allFinite())
     throw InputError("eigenvalues: expected at least one eigenpair, with finite positive eigenvalues");
-  if (progress) progress->report("derivative solves", 0.0);
+  if (progress) progress->report(stages::kDerivativeSolves, 0.0);
 
   // (K − σM)⁻¹ = Σ φφᵀ/(λ − σ) over the M-orthonormal eigenpairs, K⁺ = Σ φφᵀ/λ on the range.
   // The known pairs get the difference −σ/(λ(λ − σ)) added; on the others the error of each step

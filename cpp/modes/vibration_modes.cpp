@@ -93,7 +93,7 @@ class ShiftInvert {
     if (Z_.cols()) add_dense_product(Y, Z_, -inner_product(Z_, dof_mass_, Y));
     solves_ += static_cast<int>(X.cols());
     // The bar approaches 1 without reaching it: the number of solves is not known in advance.
-    if (progress_) progress_->report("modes", 1.0 - std::exp(-static_cast<double>(solves_) / expected_solves_));
+    if (progress_) progress_->report(stages::kModes, 1.0 - std::exp(-static_cast<double>(solves_) / expected_solves_));
     return Y;
   }
 
@@ -268,7 +268,7 @@ VibrationModes deflated_modes(const SparseMatrix& K, const VectorRef& mass, int 
 
   const int width = std::min(free, kBlockWidth);
   const Eigen::Index max_columns = std::min(free, std::max(kMaxColumnsPerMode * count, kMinColumns) + width);
-  if (progress) progress->report("modes", 0.0);
+  if (progress) progress->report(stages::kModes, 0.0);
   CholmodLLT own_factor(3);  // orders vertices, 3 DOFs each
   ShiftInvert T(K, m, Z, std::move(decoupled_stiffness), progress, 6 * count, factor ? *factor : own_factor);
   T.set_shift(sigma);
@@ -302,7 +302,7 @@ VibrationModes deflated_modes(const SparseMatrix& K, const VectorRef& mass, int 
                       rounding_levels(K, result.modes, m).array();
   result.shift = sigma;
   result.solves = T.solves();
-  if (progress) progress->report("modes", 1.0);
+  if (progress) progress->report(stages::kModes, 1.0);
   return result;
 }
 

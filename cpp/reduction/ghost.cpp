@@ -20,7 +20,7 @@ Ghost ghost_mesh(const VerticesRef& V, const FacesRef& F, const VectorRef& mass,
   const int num_ghost = static_cast<int>(collapse.V.rows());
   const Eigen::MatrixXd positions = restrict_to_ghost(ghost.map, num_ghost, mass, flatten(V));
   ghost.V = Eigen::Map<const RowMatrixX3d>(positions.data(), num_ghost, 3);
-  if (progress) progress->report("ghost", 1.0);
+  if (progress) progress->report(stages::kGhost, 1.0);
   return ghost;
 }
 

@@ -72,7 +72,7 @@ std::vector<int> orthonormalize(Eigen::MatrixXd& U, const VectorRef& dof_mass, d
   if (!(tolerance >= 0 && tolerance < 1)) throw InputError(message("tolerance: expected [0, 1), got ", tolerance));
   std::vector<int> kept_columns;
   Eigen::Index done = 0;  // columns of Q so far: U's leading columns
-  if (progress) progress->report("orthonormalisation", 0.0);
+  if (progress) progress->report(stages::kOrthonormalisation, 0.0);
   for (Eigen::Index first = 0; first < U.cols(); first += kBlockColumns) {
     const Eigen::Index width = std::min(kBlockColumns, U.cols() - first);
     Eigen::MatrixXd X = U.middleCols(first, width);
@@ -95,7 +95,7 @@ std::vector<int> orthonormalize(Eigen::MatrixXd& U, const VectorRef& dof_mass, d
     U.middleCols(done, Y.cols()) = Y;
     done += Y.cols();
     for (int k : kept) kept_columns.push_back(static_cast<int>(first) + k);
-    if (progress) progress->report("orthonormalisation", static_cast<double>(first + width) / U.cols());
+    if (progress) progress->report(stages::kOrthonormalisation, static_cast<double>(first + width) / U.cols());
   }
   U.conservativeResize(Eigen::NoChange, done);
   return kept_columns;

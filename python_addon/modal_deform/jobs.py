@@ -23,11 +23,6 @@ import numpy as np
 from . import core as mdc
 from . import mesh_io, posing, storage
 
-# The bake's stages in order (cpp/bake/bake.h), for one bar over the whole bake.
-STAGES = ("attachment", "hessian", "factorisation", "modes", "third derivatives", "derivative solves",
-          "orthonormalisation", "assembly", "ghost")
-
-
 class _ThreadJob:
     """Native work run by run() here or on a thread by start(); the native call releases the GIL, so
     Blender stays responsive. cancel() makes the next progress report stop it (Cancelled).
@@ -90,13 +85,16 @@ class BakeJob(_ThreadJob):
         self.basis = self.error = None
         self.seconds = 0.0
         self.cancelling = False
+        self.on_proxy = False
+
+    def _progress(self, stage, fraction):
+        self.on_proxy = self.on_proxy or stage == "proxy"  # a proxy, when there is one, comes first
+        return super()._progress(stage, fraction)
 
     @property
     def overall(self):
-        """Fraction of the whole bake done, counting each stage alike (their costs vary by mesh)."""
-        if self.stage not in STAGES:
-            return 0.0
-        return (STAGES.index(self.stage) + self.fraction) / len(STAGES)
+        """Fraction of the whole bake done."""
+        return mdc.bake_fraction(self.stage, self.fraction, self.on_proxy)
 
     def _work(self):
         self.basis = mdc.bake(self.V, self.F, progress=self._progress, **self.options)

@@ -228,6 +228,25 @@ def test_progress_is_frequent_and_a_floppy_mesh_warns(floppy_dragon):
     assert all(0.0 <= fraction <= 1.0 for _, fraction in calls)
 
 
+@pytest.mark.parametrize("on_proxy", [False, True])
+def test_one_bar_runs_forward_through_the_stages(on_proxy):
+    """The stages come in the order of BAKE_STAGES (the native core's list), so the bar made of
+    them only moves forward, to the end: on a dense mesh it fell back to 0 during the prolongation,
+    and jumped to the ghost and back while the ordering waited for it."""
+    V, F = mdc.bumpy_plane(40)
+    calls = []
+    basis = mdc.bake(V, F, modes=10, derivatives=4, ghost=100, proxy=400 if on_proxy else None, proxy_above=1000,
+                     progress=lambda stage, fraction: calls.append((stage, fraction)))
+    assert basis.on_proxy == on_proxy
+    order = [stage for i, (stage, _) in enumerate(calls) if i == 0 or calls[i - 1][0] != stage]
+    expected = mdc.BAKE_STAGES if on_proxy else mdc.BAKE_STAGES[1:-1]
+    assert order == [stage for stage in expected if stage in order], order
+    assert {"proxy", "prolongation"} <= set(order) if on_proxy else not {"proxy", "prolongation"} & set(order)
+    bar = [mdc.bake_fraction(stage, fraction, on_proxy) for stage, fraction in calls]
+    assert all(a <= b for a, b in zip(bar, bar[1:])), bar
+    assert bar[-1] == 1.0
+
+
 def test_cancel_stops_at_once(floppy_dragon):
     # The first report after the callback says stop ends the bake: nothing is reported after it.
     for stop_at in ("modes", "derivative solves", "ghost"):

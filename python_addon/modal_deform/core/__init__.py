@@ -7,7 +7,7 @@ shells, ARAP), ``modes`` (vibration modes, rigid motions, modal-derivative solve
 (the ghost), ``bake`` (the whole preprocess, mesh to Basis).
 """
 from .._native import Cancelled, OutOfMemoryError
-from .bake import PROXY, PROXY_ABOVE, Basis, bake
+from .bake import BAKE_STAGES, PROXY, PROXY_ABOVE, Basis, bake, bake_fraction
 from .energy import Arap, DiscreteShells
 from .mesh import bar, bumpy_plane, check, cylinder, grid, mass, read_mesh
 from .modes import rigid_motions, solve_in_range, vibration_modes
@@ -15,7 +15,7 @@ from .reduction import ghost_mesh, restrict_to_ghost
 from .solve import ReducedSolver, nearest_rigid, solve_full
 
 __all__ = [
-    "Arap", "Basis", "PROXY", "PROXY_ABOVE", "Cancelled", "DiscreteShells", "OutOfMemoryError", "bake", "bar", "bumpy_plane", "check", "cylinder",
+    "Arap", "BAKE_STAGES", "Basis", "PROXY", "PROXY_ABOVE", "Cancelled", "DiscreteShells", "OutOfMemoryError", "bake", "bake_fraction", "bar", "bumpy_plane", "check", "cylinder",
     "ghost_mesh", "grid", "mass", "read_mesh", "restrict_to_ghost", "rigid_motions", "solve_in_range",
     "vibration_modes",
 ]

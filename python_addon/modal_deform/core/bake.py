@@ -29,6 +29,20 @@ FORMAT_VERSION = 3
 PROXY_ABOVE = 150_000
 PROXY = 50_000
 
+#: The bake's stages in the order they run, the names its progress reports and ``Basis.timings``
+#: use (the native core's list). A bake without a proxy skips the first and the last.
+BAKE_STAGES = _native.BAKE_STAGES
+
+
+def bake_fraction(stage, fraction, on_proxy):
+    """Fraction of a whole bake done when it reports (stage, fraction), counting each of its stages
+    alike (their costs vary by mesh): for one progress bar, which then only moves forward. 0 before
+    the first report of a stage."""
+    stages = BAKE_STAGES if on_proxy else BAKE_STAGES[1:-1]
+    if stage not in stages:
+        return 0.0
+    return (stages.index(stage) + fraction) / len(stages)
+
 # The stored fields, one table: the native core's (cpp/basis/basis.h, for_each_stored_field), each
 # with its name, the format version that introduced it, dtype, number of dimensions, fixed number of
 # columns (0: any) and whether it is column-major. Shapes are checked natively against each other
