@@ -85,6 +85,20 @@ def dragon(name, subdivisions):
     return mesh_object("Dragon", V, F)
 
 
+def posed_dragon(name, subdivisions):
+    """The dragon as a mesh object with a handle on the 5% of its length at each end, the low end
+    pinned; (object, its vertex count, the high end's handle)."""
+    obj = dragon(name, subdivisions)
+    V = np.empty(3 * len(obj.data.vertices), np.float32)
+    obj.data.vertices.foreach_get("co", V)
+    V = V.reshape(-1, 3)
+    axis = int(np.argmax(np.ptp(V, axis=0)))
+    low, high = np.quantile(V[:, axis], [0.05, 0.95])
+    moving = add_handle(obj, V[:, axis] > high)
+    add_handle(obj, V[:, axis] < low).controller = None
+    return obj, len(V), moving
+
+
 def mesh_object(name, V, F):
     mesh = bpy.data.meshes.new(name)
     mesh.vertices.add(len(V))
@@ -299,18 +313,11 @@ def main():
     ADDON = enable_addon().__name__
     clear_scene()
     mesh = "dragon_vrip_res4" if args.quick else "dragon_vrip_res2"
-    obj = dragon(mesh, args.subdivide)
+    obj, vertices, moving = posed_dragon(mesh, args.subdivide)
     if args.subdivide:
         args.pose_only = True
         mesh = f"{mesh} subdivided {args.subdivide}x"
-    V = np.empty(3 * len(obj.data.vertices), np.float32)
-    obj.data.vertices.foreach_get("co", V)
-    V = V.reshape(-1, 3)
-    axis = int(np.argmax(np.ptp(V, axis=0)))
-    low, high = np.quantile(V[:, axis], [0.05, 0.95])
-    moving = add_handle(obj, V[:, axis] > high)
-    add_handle(obj, V[:, axis] < low).controller = None
-    results = {"mesh": mesh, "vertices": len(V), "bases": {}}
+    results = {"mesh": mesh, "vertices": vertices, "bases": {}}
     # dragon_vrip_res2 has 6 floppy zero modes on top of the modes asked for: 16 + 6 + 45 = 67 and
     # 20 + 6 + 104 = 130 dimensions (bench_solve.cpp bakes the same).
     for modes, derivatives in ((16, 45),) if args.subdivide else ((16, 45), (20, 104)):
@@ -337,7 +344,7 @@ def main():
                              "suzanne_subdivisions": 2 if args.quick else 4, "shapes": args.shapes,
                              "bases": "(16, 45) and (20, 104) modes, derivatives; 1k ghost"}
 
-    print(f"\nPose update on {mesh} ({len(V)} vertices), headless Blender {bpy.app.version_string}, shared 2-core "
+    print(f"\nPose update on {mesh} ({vertices} vertices), headless Blender {bpy.app.version_string}, shared 2-core "
           "machine; ms, medians")
     print(f"{'dims':>5} {'display':>10} {'ctrl':>6} {'solve':>6} {'write':>6} {'tick':>6} {'eval':>6} {'iters':>5}")
     for dims, b in results["bases"].items():

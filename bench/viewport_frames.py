@@ -18,12 +18,11 @@ import sys
 import traceback
 
 import bpy
-import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "bench"))
 import blender_pose  # noqa: E402 (found through the line above; blender_pose puts blender_scripts on the path)
-from headless import add_handle, enable_addon  # noqa: E402
+from headless import enable_addon  # noqa: E402
 
 argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
 parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -47,14 +46,7 @@ def view3d():
 def measure():
     blender_pose.ADDON = enable_addon().__name__
     blender_pose.clear_scene()
-    obj = blender_pose.dragon("dragon_vrip_res2", args.subdivide)
-    V = np.empty(3 * len(obj.data.vertices), np.float32)
-    obj.data.vertices.foreach_get("co", V)
-    V = V.reshape(-1, 3)
-    axis = int(np.argmax(np.ptp(V, axis=0)))
-    low, high = np.quantile(V[:, axis], [0.05, 0.95])
-    moving = add_handle(obj, V[:, axis] > high)
-    add_handle(obj, V[:, axis] < low).controller = None
+    obj, vertices, moving = blender_pose.posed_dragon("dragon_vrip_res2", args.subdivide)
     settings = obj.modal_deform
     settings.modes, settings.derivatives, settings.ghost = args.modes, args.derivatives, 1000
     if args.proxy_above is not None:
@@ -72,7 +64,7 @@ def measure():
         figures = blender_pose.time_displays(obj, moving.controller, args.updates, draw=draw)
     for f in figures.values():
         f["frame"] = f["update"] + f["draw"]
-    return {"vertices": len(V), "dimension": settings.status.dimension,
+    return {"vertices": vertices, "dimension": settings.status.dimension,
             "proxy_vertices": settings.status.proxy_vertices, "blender": bpy.app.version_string,
             "displays": figures}
 
