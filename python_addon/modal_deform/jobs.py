@@ -60,6 +60,22 @@ class _ThreadJob:
     def tick(self):
         return not self.done
 
+    def _unfinished(self, action):
+        """(level, message) when the job was cancelled or failed (`action` names it, e.g. "Bake"),
+        else None."""
+        if isinstance(self.error, mdc.Cancelled):
+            return "WARNING", f"{action} cancelled: nothing changed"
+        if self.error is not None:
+            return "ERROR", f"{action} failed: {self.error}"
+        return None
+
+    def _object_as_read(self):
+        """The job's object, or None when it was deleted or its mesh changed since the job read it."""
+        obj = bpy.data.objects.get(self.object_name)
+        if obj is None or obj.type != "MESH" or storage.fingerprint(obj.data) != self.fingerprint:
+            return None
+        return obj
+
 
 class BakeJob(_ThreadJob):
     """One bake of obj's mesh as it is now (read on the calling thread)."""
@@ -101,12 +117,11 @@ class BakeJob(_ThreadJob):
 
     def finish(self):
         """Store the basis on the object (main thread). Returns (level, message) for a report."""
-        if isinstance(self.error, mdc.Cancelled):
-            return "WARNING", "Bake cancelled: nothing changed"
-        if self.error is not None:
-            return "ERROR", f"Bake failed: {self.error}"
-        obj = bpy.data.objects.get(self.object_name)
-        if obj is None or obj.type != "MESH" or storage.fingerprint(obj.data) != self.fingerprint:
+        unfinished = self._unfinished("Bake")
+        if unfinished:
+            return unfinished
+        obj = self._object_as_read()
+        if obj is None:
             return "WARNING", f"'{self.object_name}' changed during the bake: the result was discarded, bake again"
         storage.store(obj, self.basis, self.fingerprint, self.vertex_groups, self.seconds, self.energy)
         self.written = True
@@ -154,16 +169,13 @@ class RefineJob(_ThreadJob):
 
     def finish(self):
         """Write the refined pose into the "Modal Deform" key (main thread). Returns (level, message)."""
-        if isinstance(self.error, mdc.Cancelled):
-            return "WARNING", "Refine cancelled: nothing changed"
-        if self.error is not None:
-            return "ERROR", f"Refine failed: {self.error}"
-        obj = bpy.data.objects.get(self.object_name)
-        if obj is None or obj.type != "MESH" or storage.fingerprint(obj.data) != self.fingerprint:
+        unfinished = self._unfinished("Refine")
+        if unfinished:
+            return unfinished
+        obj = self._object_as_read()
+        if obj is None:
             return "WARNING", f"'{self.object_name}' changed during Refine: the result was discarded"
-        block, _ = mesh_io.shape_key(obj, posing.POSE_KEY)
-        block.value, block.mute = 1.0, False
-        mesh_io.write_shape_key(obj.data, block, self.X.astype(np.float32))
+        mesh_io.write_shape_key(obj.data, posing.pose_key(obj)[0], self.X.astype(np.float32))
         self.written = True
         stats = self.stats
         outcome = "Refined" if stats["converged"] else "Refine did not converge"

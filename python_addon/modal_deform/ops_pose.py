@@ -157,9 +157,7 @@ class MODAL_DEFORM_OT_solve(bpy.types.Operator):
             return {"CANCELLED"}
         for warning in pose.warnings:
             self.report({"WARNING"}, warning)
-        block, _ = mesh_io.shape_key(obj, posing.POSE_KEY)
-        block.value, block.mute = 1.0, False
-        pose.write(mesh_io.shape_key_co(obj.data, block))
+        pose.write(mesh_io.shape_key_co(obj.data, posing.pose_key(obj)[0]))
         state = posing.state(stats)
         summary = f"after {stats['iterations']} iterations in {stats['ms']:.0f} ms (energy {stats['energy']:.5g})"
         if state == "converged":

@@ -96,14 +96,23 @@ def header_text(stats, tick_ms):
             f"{tick_ms:.1f} ms per update")
 
 
-class ShapeKeyState:
-    """What a shape key of obj looks like now, to put it back exactly (Esc): whether the mesh had
-    shape keys, the key's positions, value and mute, the active key and solo display."""
+def pose_key(obj):
+    """The "Modal Deform" shape key, created if needed (after a Basis key when the mesh has none),
+    shown at value 1; returns (key block, names of the keys created here)."""
+    block, created = mesh_io.shape_key(obj, POSE_KEY)
+    block.value, block.mute = 1.0, False
+    return block, created
 
-    def __init__(self, obj, name):
-        self.obj, self.name = obj, name
+
+class ShapeKeyState:
+    """What the "Modal Deform" shape key of obj looks like now, to put it back exactly (Esc):
+    whether the mesh had shape keys, the key's positions, value and mute, the active key and solo
+    display."""
+
+    def __init__(self, obj):
+        self.obj, self.name = obj, POSE_KEY
         keys = obj.data.shape_keys
-        block = keys.key_blocks.get(name) if keys else None
+        block = keys.key_blocks.get(POSE_KEY) if keys else None
         self.co = None
         if block is not None:
             self.co = np.empty(3 * len(block.data), np.float32)
@@ -114,9 +123,8 @@ class ShapeKeyState:
         self.created = []
 
     def ensure(self):
-        """The key, created if needed (with a Basis key when the mesh had none), shown at value 1."""
-        block, self.created = mesh_io.shape_key(self.obj, self.name)
-        block.value, block.mute = 1.0, False
+        """The key, created if needed (pose_key), shown at value 1."""
+        block, self.created = pose_key(self.obj)
         return block
 
     def restore(self):
@@ -151,7 +159,7 @@ class ShapeKeyDisplay:
 
     def __init__(self, obj):
         self.obj = obj
-        self.state = ShapeKeyState(obj, POSE_KEY)
+        self.state = ShapeKeyState(obj)
         self.name = self.state.ensure().name
 
     def array(self):
@@ -236,6 +244,4 @@ def recover():
             continue
         pose = mesh_io.vertex_positions(mesh).copy()
         _put_rest_back(mesh, rest)
-        block, _ = mesh_io.shape_key(obj, POSE_KEY)
-        block.value, block.mute = 1.0, False
-        mesh_io.write_shape_key(mesh, block, pose)
+        mesh_io.write_shape_key(mesh, pose_key(obj)[0], pose)
