@@ -116,21 +116,24 @@ def mesh_object(name, V, F):
 
 
 STEPS = ("controllers", "solve", "write", "tick", "evaluate", "iterations")
-#: Where the pose is shown while posing (posing.display): the mesh as it is (no shape keys: the
-#: vertex positions), or with a "Basis" key added, as an artist's keys would be (the shape key).
-DISPLAYS = ("positions", "shape_key")
+#: Where the pose is shown while posing, with the posing display that shows it: the mesh as it is
+#: (no shape keys: the vertex positions); with "Basis" and "Modal Deform" keys, as a mesh posed and
+#: kept before has them, posed in a stand-in without shape keys (posing.display's choice), or in
+#: the "Modal Deform" key (the path such a mesh took before, and one whose other keys show takes).
+DISPLAYS = {"positions": "PositionsDisplay", "stand_in": "StandInDisplay", "shape_key": "ShapeKeyDisplay"}
 
 
-def time_updates(obj, controller, updates, steps, draw=None):
+def time_updates(obj, controller, updates, steps, display, draw=None):
     """`updates` pose updates while the controller turns and slides, each made of the Pose
     operator's own calls per timer tick, appended to steps[name] in ms: follow_controllers
     ("controllers": matrices and set_transforms), step ("solve": BFGS within the object's time
-    budget), write (the pose written by the solver into Blender's array where the operator shows
-    it, posing.display, and mesh.update()); then Blender's evaluation ("evaluate",
+    budget), write (the pose written by the solver into Blender's array where the posing display
+    named `display` shows it, and mesh.update()); then Blender's evaluation ("evaluate",
     view_layer.update()) and, given `draw`, what draw() takes ("draw")."""
     posing = addon("posing")
     pose = posing.Pose(bpy.context, obj)
-    shown = posing.display(obj)
+    shown = posing.ShapeKeyDisplay(obj) if display == "ShapeKeyDisplay" else posing.display(obj)
+    assert type(shown).__name__ == display, f"posed in a {type(shown).__name__}, not a {display}"
     size = max(obj.dimensions)
     start_matrix = controller.matrix_world.copy()
     for i in range(updates):
@@ -159,18 +162,20 @@ def time_updates(obj, controller, updates, steps, draw=None):
 
 
 def time_displays(obj, controller, updates, rounds=2, draw=None):
-    """Medians of time_updates for each of DISPLAYS, taken in turn `rounds` times (A B A B), so that
-    both see the shared machine alike."""
+    """Medians of time_updates for each of DISPLAYS, taken in turn `rounds` times (A B C A B C), so
+    that all see the shared machine alike."""
+    pose_key = addon("posing").POSE_KEY
     names = STEPS + (("draw",) if draw else ())
-    steps = {display: {name: [] for name in names} for display in DISPLAYS}
+    steps = {name: {step: [] for step in names} for name in DISPLAYS}
     for _ in range(rounds):
-        for display in DISPLAYS:
-            if display == "shape_key":
+        for name, display in DISPLAYS.items():
+            if name != "positions":
                 obj.shape_key_add(name="Basis")
-            time_updates(obj, controller, updates, steps[display], draw)
-            if display == "shape_key":
+                obj.shape_key_add(name=pose_key).value = 1.0
+            time_updates(obj, controller, updates, steps[name], display, draw)
+            if name != "positions":
                 obj.shape_key_clear()
-    figures = {display: {name: float(np.median(values)) for name, values in s.items()} for display, s in steps.items()}
+    figures = {name: {step: float(np.median(values)) for step, values in s.items()} for name, s in steps.items()}
     for f in figures.values():
         f["update"] = f["tick"] + f["evaluate"]
     return figures
@@ -194,7 +199,7 @@ def storage_figures(obj, folder):
     """Load time and file sizes of the stored basis; the cost of keeping it on the Object instead."""
     posing, storage = addon("posing", "storage")
     figures = {}
-    state = posing.ShapeKeyState(obj, posing.POSE_KEY)
+    state = posing.ShapeKeyState(obj)
     key = state.ensure()
     figures["update_ms_basis_in_palette"] = time_shape_key_update(obj, key)
     obj["vectors_probe"] = np.frombuffer(obj.modal_deform.basis["vectors"], np.float32)

@@ -8,7 +8,7 @@ The dragon (100k vertices; subdivided N times: 400k, 1.6M) baked as the bench ba
 with the options), a handle moved every frame. A frame is the pose update of bench/blender_pose.py
 (the Pose operator's calls, Blender's evaluation), then the viewport drawn and swapped
 (wm.redraw_timer DRAW_WIN_SWAP): "draw" is what Blender does to show the new pose (normals, GPU
-buffers, drawing). Each display (vertex positions, shape key) in turn, A B A B; medians, ms.
+buffers, drawing). Each display (vertex positions, stand-in, shape key) in turn, A B C A B C; medians, ms.
 Writes OUTPUT.json ({"ok", "log", "vertices", "displays": {display: {step: ms}}}) and quits.
 """
 import argparse

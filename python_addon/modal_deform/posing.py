@@ -4,10 +4,11 @@ result into a shape key. Shared by the interactive pose, the solve and the anima
 Per update: controller matrices → set_transforms → solve (within a time budget) →
 positions(out=Blender's own array: a shape key's or the vertex positions) → mesh.update().
 
-While the interactive pose runs, where the pose is shown is a display: the "Modal Deform" shape
-key (ShapeKeyDisplay), or, on a mesh without shape keys, the vertex positions themselves
-(PositionsDisplay), which Blender evaluates without blending shape keys; either ends with the
-pose in the shape key (keep) or the mesh as it was (restore).
+While the interactive pose runs, where the pose is shown is a display: the vertex positions of a
+mesh without shape keys (PositionsDisplay), those of a copy without shape keys standing in for a
+mesh whose only key that moves it is the "Modal Deform" one (StandInDisplay: a mesh posed before),
+which Blender both evaluates without blending shape keys, or else the "Modal Deform" shape key
+(ShapeKeyDisplay); each ends with the pose in the shape key (keep) or the mesh as it was (restore).
 """
 import bpy
 import numpy as np
@@ -19,6 +20,9 @@ POSE_KEY = "Modal Deform"
 #: A mesh ID property: while it is set, the mesh's positions hold a pose and its rest is the
 #: stored basis's. A file or undo step written mid-pose carries it, and recover() repairs them.
 POSING_FLAG = "modal_deform_posing"
+#: A mesh ID property of a stand-in (StandInDisplay): the artist's mesh it stands in for. An ID
+#: property is a user, so that mesh is saved with a file written mid-pose, and recover() puts it back.
+STAND_IN_OF = "modal_deform_stand_in_of"
 #: The interactive pose under way (ops_pose's operator; it has .pose), or None.
 running = None
 #: The most BFGS iterations one update takes however much of its time budget is left: far more
@@ -150,8 +154,27 @@ def is_posing(obj):
 
 def display(obj):
     """Where the interactive pose shows the pose of obj: the vertex positions of a mesh without
-    shape keys, else the "Modal Deform" shape key."""
-    return PositionsDisplay(obj) if obj.data.shape_keys is None else ShapeKeyDisplay(obj)
+    shape keys, a stand-in's when only the "Modal Deform" key moves the mesh, else that key."""
+    if obj.data.shape_keys is None:
+        return PositionsDisplay(obj)
+    return StandInDisplay(obj) if only_pose_key_moves(obj, obj.data) else ShapeKeyDisplay(obj)
+
+
+def only_pose_key_moves(obj, mesh):
+    """Whether what Blender shows of obj with `mesh` (which has shape keys) is the reference key
+    moved by the "Modal Deform" key alone: relative keys, no key shown alone, the mesh used by obj
+    only (a stand-in shows the pose on obj only), the pose key relative to the reference key and not
+    limited to a vertex group, every other key muted or at 0."""
+    keys = mesh.shape_keys
+    if not keys.use_relative or obj.show_only_shape_key or mesh.users - mesh.use_fake_user != 1:
+        return False
+    for block in keys.key_blocks:
+        if block.name == POSE_KEY:
+            if block.relative_key != keys.reference_key or block.vertex_group:
+                return False
+        elif block != keys.reference_key and not block.mute and block.value != 0.0:
+            return False
+    return True
 
 
 class ShapeKeyDisplay:
@@ -177,7 +200,27 @@ class ShapeKeyDisplay:
         self.state.restore()
 
 
-class PositionsDisplay:
+class _TransientDisplay:
+    """A display that shows the pose where no result is kept (the vertex positions) and hands it to
+    the "Modal Deform" shape key when kept."""
+
+    def keep(self, pose):
+        """The mesh as it was, then the pose into the "Modal Deform" shape key; returns the
+        ShapeKeyDisplay that shows it from now on. Edit Mode and Sculpt Mode take the mesh's
+        positions for their own copy when entered: left for Object Mode first, and entered again
+        after, they take the rest and the key."""
+        mode = self.obj.mode
+        if mode != "OBJECT":
+            bpy.ops.object.mode_set(mode="OBJECT")
+        self.restore()
+        shown = ShapeKeyDisplay(self.obj)
+        pose.write(shown.array())
+        if mode != "OBJECT":
+            bpy.ops.object.mode_set(mode=mode)
+        return shown
+
+
+class PositionsDisplay(_TransientDisplay):
     """The pose in the vertex positions of a mesh without shape keys: with no shape keys to blend,
     Blender's evaluation of a 1.6M-vertex mesh takes 0.1 ms instead of 10 to 20 (docs/benchmarks.md).
     The rest positions are kept to put back; the mesh carries POSING_FLAG meanwhile, so a file or
@@ -195,23 +238,59 @@ class PositionsDisplay:
         """False once the artist added shape keys mid-pose: Blender then shows them, not the positions."""
         return self.obj.data.shape_keys is None
 
-    def keep(self, pose):
-        """The rest back into the positions and the pose into the "Modal Deform" shape key; returns
-        the ShapeKeyDisplay that shows it from now on. Edit Mode and Sculpt Mode take the mesh's
-        positions for their own copy when entered: left for Object Mode first, and entered again
-        after, they take the rest and the key."""
-        mode = self.obj.mode
-        if mode != "OBJECT":
-            bpy.ops.object.mode_set(mode="OBJECT")
-        self.restore()
-        shown = ShapeKeyDisplay(self.obj)
-        pose.write(shown.array())
-        if mode != "OBJECT":
-            bpy.ops.object.mode_set(mode=mode)
-        return shown
-
     def restore(self):
         _put_rest_back(self.obj.data, self.rest)
+
+
+class StandInDisplay(_TransientDisplay):
+    """The pose in the vertex positions of a copy of the mesh without its shape keys, standing in for
+    the mesh on obj while posing, when only the "Modal Deform" key moves it (only_pose_key_moves; a
+    mesh posed and kept before): Blender evaluates any mesh with shape keys, even all muted, in 13
+    ms at 1.6M vertices, a mesh without them in 0.2 (docs/benchmarks.md). The artist's mesh, its keys
+    and their animation are not touched until the pose is kept; restore() puts it back on obj."""
+
+    def __init__(self, obj):
+        self.obj, self.mesh = obj, obj.data
+        self.stand_in = self.mesh.copy()  # materials, attributes, vertex groups, UVs: what modifiers read
+        self.stand_in.name = f"{self.mesh.name} (posing)"
+        self.stand_in[STAND_IN_OF] = self.mesh
+        copied_keys = self.stand_in.shape_keys
+        obj.data = self.stand_in
+        obj.shape_key_clear()
+        try:  # Blender 3.4 and 4.5 count the copy's Key twice and keep it, ownerless (4.5 then refuses to save)
+            bpy.data.batch_remove([copied_keys])
+        except ReferenceError:  # cleared for good (5.x)
+            pass
+
+    def array(self):
+        return mesh_io.vertex_positions(self.stand_in)
+
+    def shows_pose(self):
+        """False once the artist added shape keys to the stand-in, or the mesh's other keys started
+        to move it (animated values): the pose then goes on in the "Modal Deform" key."""
+        return self.stand_in.shape_keys is None and only_pose_key_moves(self.obj, self.mesh)
+
+    def restore(self):
+        _put_mesh_back(self.obj, self.stand_in)
+
+
+def _put_mesh_back(obj, stand_in):
+    """The artist's mesh back on obj in place of `stand_in` (a StandInDisplay's), which goes, with
+    the shape keys the artist added to it mid-pose carried over as the same offsets from the mesh's
+    reference key (the stand-in's own reference copied the posed positions)."""
+    mesh = stand_in[STAND_IN_OF]
+    obj.data = mesh
+    added = stand_in.shape_keys
+    if added is not None:
+        start = mesh_io.shape_key_co(stand_in, added.reference_key)
+        rest = mesh_io.shape_key_co(mesh, mesh.shape_keys.reference_key)
+        for block in added.key_blocks:
+            if block != added.reference_key:
+                carried = obj.shape_key_add(name=block.name, from_mix=False)
+                carried.value, carried.mute = block.value, block.mute
+                mesh_io.write_shape_key(mesh, carried, rest + (mesh_io.shape_key_co(stand_in, block) - start))
+    bpy.data.meshes.remove(stand_in)
+    mesh.update()
 
 
 def _put_rest_back(mesh, rest):
@@ -226,22 +305,34 @@ def _put_rest_back(mesh, rest):
 
 
 def recover():
-    """Meshes written mid-pose by a PositionsDisplay (an undo step of a controller's move, autosave,
-    a crash file, a file saved by a path without save handlers) hold the pose in their positions:
-    their rest comes back from the stored basis and the pose goes into the "Modal Deform" shape key,
-    as if the pose had been kept. Meshes without a usable basis keep the flag and are reported."""
+    """Meshes written mid-pose by a PositionsDisplay or a StandInDisplay (an undo step of a
+    controller's move, autosave, a crash file, a file saved by a path without save handlers) hold
+    the pose in their positions: their rest comes back (from the stored basis, or the artist's mesh
+    in place of the stand-in) and the pose goes into the "Modal Deform" shape key, as if the pose
+    had been kept. Meshes without a usable basis keep the flag and are reported."""
     for obj in bpy.data.objects:
         mesh = obj.data
-        if obj.type != "MESH" or mesh.get(POSING_FLAG) is None or mesh.library is not None or is_posing(obj):
+        if obj.type != "MESH" or mesh.library is not None or is_posing(obj):
             continue
-        try:
-            rest = storage.load(obj).rest
-        except storage.NotReady as error:
-            print(f"Modal Deform: '{obj.name}' was saved while posing and cannot be repaired: {error}")
-            continue
-        if len(rest) != len(mesh.vertices):
-            print(f"Modal Deform: '{obj.name}' was saved while posing and its mesh no longer fits its basis")
-            continue
-        pose = mesh_io.vertex_positions(mesh).copy()
-        _put_rest_back(mesh, rest)
-        mesh_io.write_shape_key(mesh, pose_key(obj)[0], pose)
+        if mesh.get(STAND_IN_OF) is not None:
+            pose = mesh_io.vertex_positions(mesh).copy()
+            _put_mesh_back(obj, mesh)
+            mesh_io.write_shape_key(obj.data, pose_key(obj)[0], pose)
+        elif mesh.get(POSING_FLAG) is not None:
+            _recover_positions(obj)
+
+
+def _recover_positions(obj):
+    """recover() for a mesh posed by a PositionsDisplay."""
+    mesh = obj.data
+    try:
+        rest = storage.load(obj).rest
+    except storage.NotReady as error:
+        print(f"Modal Deform: '{obj.name}' was saved while posing and cannot be repaired: {error}")
+        return
+    if len(rest) != len(mesh.vertices):
+        print(f"Modal Deform: '{obj.name}' was saved while posing and its mesh no longer fits its basis")
+        return
+    pose = mesh_io.vertex_positions(mesh).copy()
+    _put_rest_back(mesh, rest)
+    mesh_io.write_shape_key(mesh, pose_key(obj)[0], pose)

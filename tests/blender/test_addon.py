@@ -35,7 +35,7 @@ def test_region_bake_leaves_the_rest_exactly_still(run_blender, tmp_path):
 
 def test_pose_shown_in_positions_or_key_and_repaired_after_undo_or_load(run_blender):
     out = run_blender("pose_displays.py").stdout
-    for stage in ("POSITIONS_OK", "SHAPE_KEYS_OK", "UNDO_OK", "LOAD_OK"):
+    for stage in ("POSITIONS_OK", "SHAPE_KEYS_OK", "UNDO_OK", "LOAD_OK", "STAND_IN_OK", "STAND_IN_UNDO_LOAD_OK"):
         assert stage in out, stage
 
 

@@ -123,3 +123,96 @@ assert support.positions(obj).tobytes() == rest.tobytes(), "loading left the pos
 assert support.key_positions(obj, posing.POSE_KEY).tobytes() == posed.tobytes()
 assert storage.stale_reason(obj) == "", "the repaired mesh does not fit its basis"
 print("LOAD_OK")
+
+# A mesh posed and kept before (here just repaired: "Basis" and "Modal Deform"), with an artist's
+# key at 0: posed in a stand-in without shape keys, the artist's mesh untouched; Esc puts it back.
+mesh = obj.data
+controller = obj.modal_deform.handles[0].controller
+smile = obj.shape_key_add(name="Smile")
+smile.data[0].co.z += 0.1
+smile.value = 0.0
+before = support.mesh_state(obj)
+shown = posing.display(obj)
+assert type(shown) is posing.StandInDisplay
+assert obj.data != mesh and obj.data.shape_keys is None and obj.data.get(posing.STAND_IN_OF) == mesh
+controller.matrix_world = Matrix.Translation((0.0, 0.2, 0.0)) @ controller.matrix_world
+bpy.context.view_layer.update()
+pose = pose_shown(shown)
+assert support.mesh_state(obj) != before
+shown.restore()
+assert obj.data == mesh and support.mesh_state(obj) == before, "Esc did not put the artist's mesh back"
+assert not [m for m in bpy.data.meshes if m.get(posing.STAND_IN_OF)], "the stand-in is left behind"
+
+# Kept: the pose in the key, the artist's keys and the rest as they were, the same through the
+# modifiers as it was shown.
+shown = posing.display(obj)
+pose = pose_shown(shown)
+posed = support.positions(obj)
+bpy.context.view_layer.update()
+shown_through_modifiers = evaluated_positions(obj)
+shown = shown.keep(pose)
+assert type(shown) is posing.ShapeKeyDisplay and obj.data == mesh
+assert support.key_positions(obj, posing.POSE_KEY).tobytes() == posed.tobytes()
+for name in ("Basis", "Smile"):
+    assert support.key_positions(obj, name).tobytes() == dict(
+        (n, c) for n, _, _, c in before["shape_keys"])[name], f"keeping the pose changed '{name}'"
+bpy.context.view_layer.update()
+difference = np.abs(evaluated_positions(obj) - shown_through_modifiers).max()
+assert difference < 1e-5, f"the kept pose looks different through the modifiers ({difference})"
+
+# The artist's key shown (at 0.5): posed in the key, as before.
+smile.value = 0.5
+shown = posing.display(obj)
+assert type(shown) is posing.ShapeKeyDisplay
+shown.restore()
+smile.value = 0.0
+
+# Mid-pose, the artist's key starts to show (an animated value): the pose goes on in the key. A
+# key added to the stand-in is carried over to the mesh as the same offset from its reference.
+shown = posing.display(obj)
+pose = pose_shown(shown)
+smile.value = 0.3
+assert not shown.shows_pose()
+smile.value = 0.0
+assert shown.shows_pose()
+obj.shape_key_add(name="Basis")
+frown = obj.shape_key_add(name="Frown")
+frown.data[0].co.x += 0.2
+frown.value = 0.7
+assert not shown.shows_pose()
+shown = shown.keep(pose)
+assert obj.data == mesh and obj.data.shape_keys.key_blocks["Frown"].value == np.float32(0.7)
+offset = support.key_positions(obj, "Frown") - support.key_positions(obj, "Basis")
+expected = np.zeros_like(offset)
+expected[0, 0] = 0.2
+assert np.abs(offset - expected).max() < 1e-5, "the key added mid-pose was not carried over"
+obj.shape_key_remove(obj.data.shape_keys.key_blocks["Frown"])
+print("STAND_IN_OK")
+
+# An undo step and a file written mid-pose hold the stand-in on the object: the artist's mesh comes
+# back on undo and on loading, with the pose in the key.
+bpy.ops.ed.undo_push(message="before posing")
+shown = posing.display(obj)
+assert type(shown) is posing.StandInDisplay
+pose = pose_shown(shown)
+posed = support.positions(obj)
+bpy.ops.ed.undo_push(message="controller moved while posing")
+shown.keep(pose)
+bpy.ops.ed.undo_push(message="pose kept")
+assert bpy.ops.ed.undo() == {"FINISHED"}
+obj = bpy.data.objects["Suzanne"]
+assert obj.data.name == "Suzanne" and obj.data.get(posing.STAND_IN_OF) is None, "undo left the stand-in"
+assert not [m for m in bpy.data.meshes if m.get(posing.STAND_IN_OF)]
+assert support.key_positions(obj, posing.POSE_KEY).tobytes() == posed.tobytes()
+shown = posing.display(obj)
+pose_shown(shown)
+posed = support.positions(obj)
+bpy.ops.wm.save_as_mainfile(filepath=path, copy=True)
+shown.restore()
+bpy.ops.wm.open_mainfile(filepath=path)
+obj = bpy.data.objects["Suzanne"]
+assert obj.data.name == "Suzanne" and not [m for m in bpy.data.meshes if m.get(posing.STAND_IN_OF)]
+assert support.key_positions(obj, posing.POSE_KEY).tobytes() == posed.tobytes()
+assert support.positions(obj).tobytes() == rest.tobytes()
+assert storage.stale_reason(obj) == "", "the mesh put back does not fit its basis"
+print("STAND_IN_UNDO_LOAD_OK")
