@@ -9,6 +9,7 @@
 #include "mesh/read_mesh.h"
 #include "bake/bake.h"
 #include "solve/full_solver.h"
+#include "solve/quantized_vectors.h"
 #include "solve/reduced_solver.h"
 
 namespace modal_deform {
@@ -125,6 +126,26 @@ void BM_Positions(benchmark::State& state) {
   state.SetBytesProcessed(state.iterations() * basis.vectors.size() * static_cast<int64_t>(sizeof(float)));
 }
 BENCHMARK(BM_Positions)->Arg(67)->Arg(130)->Unit(benchmark::kMillisecond);
+
+// x̄ + U q at 67 dimensions, the pose of BM_Positions, read from 16 bits within positions()'s
+// tolerance (Arg 16) or from float32 alone (Arg 32: tolerance 0 sends every block to float32, the
+// map as it was before the 16-bit copy). Run with --benchmark_enable_random_interleaving.
+void BM_MapBits(benchmark::State& state) {
+  const Basis& basis = dragon_basis(67);
+  const DragonPose pose(basis);
+  ReducedSolver solver(basis, pose.handles, Eigen::VectorXd(), 1000);
+  solver.set_transforms(pose.at(1));
+  solver.solve(20, 1e-6);
+  const Eigen::VectorXf q = solver.q().cast<float>();
+  const QuantizedVectors quantized(basis.vectors);
+  const double diagonal = (basis.rest.colwise().maxCoeff() - basis.rest.colwise().minCoeff()).norm();
+  const double tolerance = state.range(0) == 16 ? ReducedSolver::kMapTolerance * diagonal : 0.0;
+  Eigen::VectorXf out(3 * basis.num_vertices());
+  Eigen::Index from_float32 = 0;
+  for (auto _ : state) from_float32 = quantized.map(basis.vectors, q, basis.rest.data(), tolerance, out.data());
+  state.counters["blocks_from_float32"] = static_cast<double>(from_float32) / quantized.blocks();
+}
+BENCHMARK(BM_MapBits)->Arg(32)->Arg(16)->Unit(benchmark::kMillisecond);
 
 void run(benchmark::State& state, const Rod& rod) {
   const EnergyKind energy = state.range(0) == 0 ? EnergyKind::kShells : EnergyKind::kArap;

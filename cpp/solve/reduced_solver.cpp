@@ -24,10 +24,10 @@ const Basis& checked(const Basis& basis) {
   return basis;
 }
 
-// Rows of U per block of positions(): 64 vertices, 33 kB of float rows at r = 130, so a block's
-// rows stream through the cache once; threads only for meshes where they pay.
-constexpr Eigen::Index kBlockRows = 192;
-constexpr Eigen::Index kParallelRows = 3 * 4096;
+double bounding_box_diagonal(const RowMatrixX3d& V) {
+  if (V.rows() == 0) return 0;
+  return (V.colwise().maxCoeff() - V.colwise().minCoeff()).norm();
+}
 
 }  // namespace
 
@@ -42,7 +42,9 @@ ReducedSolver::ReducedSolver(const Basis& basis, const Handles& handles, const V
       handle_term_(HandleTerm(basis.rest, basis.mass, handles,
                               checked_handle_weights(handles, weights, basis.num_vertices()),
                               checked_stiffness(stiffness) * std::pow(basis.scale, 4)),
-                   [&basis](int v) { return basis.vertex_rows(v); }, basis.dimension()) {
+                   [&basis](int v) { return basis.vertex_rows(v); }, basis.dimension()),
+      quantized_vectors_(basis.vectors),
+      map_tolerance_(kMapTolerance * bounding_box_diagonal(basis.rest)) {
   require_handles_in_region(handles, basis.region);
   const Eigen::Index r = basis.dimension();
   if (warm_start) {
@@ -116,30 +118,14 @@ void ReducedSolver::positions(Eigen::Ref<Eigen::VectorXf> out) const {
   const Eigen::Index fine_rows = 3 * static_cast<Eigen::Index>(basis_.num_vertices());
   if (out.size() != fine_rows)
     throw InputError(message("out: expected ", fine_rows, " values (3 per vertex), got ", out.size()));
-  if (!basis_.on_proxy()) return map_to_basis_vertices(basis_.rest.data(), out.data());
-  // On a proxy: its displacement U q, then x̄ + P (U q) on the fine vertices.
-  map_to_basis_vertices(nullptr, proxy_displacement_.data());
-  prolongate_positions(basis_.prolongation, basis_.rest.data(), proxy_displacement_.data(), out.data());
-}
-
-void ReducedSolver::map_to_basis_vertices(const double* rest, float* out) const {
-  const RowMatrixXf& U = basis_.vectors;
-  const Eigen::Index rows = U.rows(), r = U.cols();
-  const float* q = q_float_.data();
-  const Eigen::Index blocks = (rows + kBlockRows - 1) / kBlockRows;
-  // One SIMD dot product per row (a third faster than Eigen's row-major product here, which
-  // stays below the memory bandwidth); x̄ is added in double and rounded once.
-#pragma omp parallel for schedule(static) if (rows >= kParallelRows)
-  for (Eigen::Index block = 0; block < blocks; ++block) {
-    const Eigen::Index end = std::min(rows, (block + 1) * kBlockRows);
-    for (Eigen::Index k = block * kBlockRows; k < end; ++k) {
-      const float* u = U.data() + k * r;
-      float dot = 0;
-#pragma omp simd reduction(+ : dot)
-      for (Eigen::Index j = 0; j < r; ++j) dot += u[j] * q[j];
-      out[k] = rest ? static_cast<float>(rest[k] + static_cast<double>(dot)) : dot;
-    }
+  if (!basis_.on_proxy()) {
+    quantized_vectors_.map(basis_.vectors, q_float_, basis_.rest.data(), map_tolerance_, out.data());
+    return;
   }
+  // On a proxy: its displacement U q, then x̄ + P (U q) on the fine vertices (convex weights: the
+  // displacement's error bound holds there too).
+  quantized_vectors_.map(basis_.vectors, q_float_, nullptr, map_tolerance_, proxy_displacement_.data());
+  prolongate_positions(basis_.prolongation, basis_.rest.data(), proxy_displacement_.data(), out.data());
 }
 
 }  // namespace modal_deform

@@ -28,6 +28,7 @@
 #include "basis/basis.h"
 #include "solve/bfgs.h"
 #include "solve/handle_term.h"
+#include "solve/quantized_vectors.h"
 
 namespace modal_deform {
 
@@ -44,6 +45,10 @@ struct ReducedSolveStats {
 
 class ReducedSolver {
  public:
+  // positions() is within this fraction of the rest's bounding-box diagonal of the float32 map: a
+  // third of what the pose may differ by (issue 23: 1e-4), far below what shows (60 µm on 2 m).
+  static constexpr double kMapTolerance = 3e-5;
+
   // basis: validated here (validate_basis); it must outlive the solver, which keeps a reference
   // to its fine arrays. handles, weights: see checked_handle_weights (fine vertex indices; empty
   // weights mean 1), inside the basis's region if it has one (require_handles_in_region). stiffness: μ > 0. energy: evaluated on the ghost. warm_start false starts
@@ -67,8 +72,9 @@ class ReducedSolver {
   void reset();
 
   // x̄ + U q on the fine mesh (3#V, interleaved, mesh units) in single precision, written into
-  // `out`; x̄ + P U q for a basis on a proxy (prolongation.h). Rows are split over threads in
-  // blocks; throws InputError for a wrong size.
+  // `out`; x̄ + P U q for a basis on a proxy (prolongation.h). U q is read from 16-bit vectors
+  // (QuantizedVectors), each coordinate within kMapTolerance of the bounding-box diagonal of the
+  // float32 map's. Rows are split over threads in blocks; throws InputError for a wrong size.
   void positions(Eigen::Ref<Eigen::VectorXf> out) const;
 
   // f(q) with ∇f(q) (r) written into `gradient`; +inf where a ghost coordinate leaves the range
@@ -88,8 +94,8 @@ class ReducedSolver {
   ReducedHandleTerm handle_term_;
   Eigen::MatrixXd initial_inverse_hessian_;
   Bfgs bfgs_;
-  // U q, plus x̄ when `rest` is given, on the basis's own vertices into `out` (3 per vertex).
-  void map_to_basis_vertices(const double* rest, float* out) const;
+  QuantizedVectors quantized_vectors_;  // U in 16 bits, for positions()
+  double map_tolerance_;                // kMapTolerance times the rest's bounding-box diagonal
 
   Eigen::VectorXf q_float_;  // q for positions()
   mutable Eigen::VectorXf proxy_displacement_;  // U q on a proxy's vertices, for positions()
