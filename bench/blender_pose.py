@@ -14,8 +14,9 @@ In bpy (Blender 4.2+ as a Python module), with the add-on installed from the ext
         --extension dist/modal_deform-0.1.0-blender_4.2_to_5.0-linux_x64.zip bench/blender_pose.py -- --pose-only
 
 One update is what the Pose operator does per timer tick, through its own calls, each timed:
-controller matrices → set_transforms → BFGS within the object's time budget → the fine positions
-written by the solver straight into the shape key's array → mesh.update(). Blender then evaluates
+controller matrices → set_transforms → BFGS within what the rest of the update leaves of a 60 fps
+frame (FrameBudget) → the fine positions written by the solver straight into Blender's array →
+mesh.update(). Blender then evaluates
 the mesh for display ("evaluate": view_layer.update()). Medians over the updates, with the
 controller moving a little each time.
 """
@@ -115,7 +116,7 @@ def mesh_object(name, V, F):
     return obj
 
 
-STEPS = ("controllers", "solve", "write", "tick", "evaluate", "iterations")
+STEPS = ("controllers", "budget", "solve", "write", "tick", "evaluate", "iterations")
 #: Where the pose is shown while posing, with the posing display that shows it: the mesh as it is
 #: (no shape keys: the vertex positions); with "Basis" and "Modal Deform" keys, as a mesh posed and
 #: kept before has them, posed in a stand-in without shape keys (posing.display's choice), or in
@@ -126,12 +127,14 @@ DISPLAYS = {"positions": "PositionsDisplay", "stand_in": "StandInDisplay", "shap
 def time_updates(obj, controller, updates, steps, display, draw=None):
     """`updates` pose updates while the controller turns and slides, each made of the Pose
     operator's own calls per timer tick, appended to steps[name] in ms: follow_controllers
-    ("controllers": matrices and set_transforms), step ("solve": BFGS within the object's time
-    budget), write (the pose written by the solver into Blender's array where the posing display
-    named `display` shows it, and mesh.update()); then Blender's evaluation ("evaluate",
-    view_layer.update()) and, given `draw`, what draw() takes ("draw")."""
-    posing = addon("posing")
+    ("controllers": matrices and set_transforms), step ("solve": BFGS within "budget", what the
+    rest of the last updates left of a 60 fps frame, at most the object's budget, as the operator's
+    FrameBudget gives it), write (the pose written by the solver into Blender's array where the
+    posing display named `display` shows it, and mesh.update()); then Blender's evaluation
+    ("evaluate", view_layer.update()) and, given `draw`, what draw() takes ("draw")."""
+    posing, mdc = addon("posing", "core")
     pose = posing.Pose(bpy.context, obj)
+    budget = mdc.FrameBudget(obj.modal_deform.budget)
     shown = posing.ShapeKeyDisplay(obj) if display == "ShapeKeyDisplay" else posing.display(obj)
     assert type(shown).__name__ == display, f"posed in a {type(shown).__name__}, not a {display}"
     size = max(obj.dimensions)
@@ -143,8 +146,9 @@ def time_updates(obj, controller, updates, steps, display, draw=None):
         tick = time.perf_counter()
         pose.follow_controllers()
         steps["controllers"].append(milliseconds(tick))
+        steps["budget"].append(budget.ms)
         t = time.perf_counter()
-        steps["iterations"].append(pose.step(obj.modal_deform.budget)["iterations"])
+        steps["iterations"].append(pose.step(budget.ms)["iterations"])
         steps["solve"].append(milliseconds(t))
         t = time.perf_counter()
         pose.write(shown.array())
@@ -157,6 +161,8 @@ def time_updates(obj, controller, updates, steps, display, draw=None):
             t = time.perf_counter()
             draw()
             steps["draw"].append(milliseconds(t))
+        budget.measured(steps["tick"][-1] - steps["solve"][-1] + steps["evaluate"][-1]
+                        + (steps["draw"][-1] if draw is not None else 0.0))
     controller.matrix_world = start_matrix
     shown.restore()
 
@@ -351,11 +357,13 @@ def main():
 
     print(f"\nPose update on {mesh} ({vertices} vertices), headless Blender {bpy.app.version_string}, shared 2-core "
           "machine; ms, medians")
-    print(f"{'dims':>5} {'display':>10} {'ctrl':>6} {'solve':>6} {'write':>6} {'tick':>6} {'eval':>6} {'iters':>5}")
+    print(f"{'dims':>5} {'display':>10} {'ctrl':>6} {'budget':>6} {'solve':>6} {'write':>6} {'tick':>6} {'eval':>6} "
+          f"{'iters':>5}")
     for dims, b in results["bases"].items():
         for display in DISPLAYS:
             f = b[display]
-            print(f"{dims:>5} {display:>10} {f['controllers']:6.2f} {f['solve']:6.2f} {f['write']:6.2f} "
+            print(f"{dims:>5} {display:>10} {f['controllers']:6.2f} {f['budget']:6.2f} {f['solve']:6.2f} "
+                  f"{f['write']:6.2f} "
                   f"{f['tick']:6.2f} {f['evaluate']:6.1f} {f['iterations']:5.0f}")
     if not args.pose_only:
         lap = results["laplacian_deform"]

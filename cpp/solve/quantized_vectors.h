@@ -11,12 +11,12 @@
 //   e_b(q) = Σ_j s_bj |q_j| / 65534,
 //
 // known per block for each q before mapping it. A block is stored column by column, so the map
-// multiplies and adds along its rows with no sum across a vector per row. A block whose bound exceeds the caller's tolerance
-// is mapped from the float32 rows instead: every coordinate is then within the tolerance of the
-// float32 map. Measured on the 100k dragon at 67 dimensions, a tolerance of 3e-5 of the diagonal
-// sends at most 0.6% of the blocks to float32 for poses up to a 90 degree turn (flaps of the scan,
-// which move far, carry the large bounds); per column instead of per block, 16 bits alone missed
-// 1e-4 of the diagonal there (2.2e-4), float16 by far (1.6e-3).
+// multiplies and adds along its rows with no sum across a vector per row. A block whose bound
+// exceeds the caller's tolerance is mapped from the float32 rows instead: every coordinate is then
+// within the tolerance of the float32 map. Measured on the 100k dragon at 67 dimensions, a
+// tolerance of 3e-5 of the diagonal sends at most 0.6% of the blocks to float32 for poses up to a
+// 90 degree turn (flaps of the scan, which move far, carry the large bounds); per column instead
+// of per block, 16 bits alone missed 1e-4 of the diagonal there (2.2e-4), float16 by far (1.6e-3).
 #pragma once
 
 #include <cstdint>

@@ -4,6 +4,7 @@ import time
 
 import bpy
 
+from . import core as mdc
 from . import handles, mesh_io, posing
 from .jobs import RefineJob
 from .ops_common import FAILURES, JobOperator, mesh_poll
@@ -31,6 +32,13 @@ keeps the pose, Esc restores the mesh as it was"""
         self.area = context.area
         self.request = None
         self.tick_ms = 0.0
+        # The solve gets what the rest of the update leaves of a 60 fps frame (FrameBudget): ours is
+        # timed in the tick, Blender's evaluation and drawing from the tick's end to the viewport's
+        # next draw (no viewport drawn: the artist's budget).
+        self.budget = mdc.FrameBudget(obj.modal_deform.budget)
+        self.written_at = self.drawn_at = None
+        self.rest_ms = 0.0
+        self.draw_handler = bpy.types.SpaceView3D.draw_handler_add(self._drawn, (), "WINDOW", "POST_PIXEL")
         wm = context.window_manager
         self.timer = wm.event_timer_add(1.0 / 60.0, window=context.window)
         wm.modal_handler_add(self)
@@ -57,7 +65,14 @@ keeps the pose, Esc restores the mesh as it was"""
                 return {"RUNNING_MODAL"}
         return {"PASS_THROUGH"}
 
+    def _drawn(self):
+        if self.written_at is not None and self.drawn_at is None:
+            self.drawn_at = time.perf_counter()
+
     def _tick(self, context):
+        if self.drawn_at is not None:  # the last update was drawn: all it took besides the solve is known
+            self.budget.measured(self.rest_ms + 1e3 * (self.drawn_at - self.written_at))
+            self.written_at = self.drawn_at = None
         obj = self.pose.obj
         try:
             obj.mode
@@ -72,9 +87,11 @@ keeps the pose, Esc restores the mesh as it was"""
             if not self.shown.shows_pose():  # shape keys added mid-pose: the pose goes on in the key
                 self.shown = self.shown.keep(self.pose)
             if moved or not self.pose.stats["converged"]:
-                self.pose.step(obj.modal_deform.budget)
+                solve_ms = self.pose.step(self.budget.ms)["ms"]
                 self.pose.write(self.shown.array())
-                self.tick_ms = 1e3 * (time.perf_counter() - start)
+                self.written_at, self.drawn_at = time.perf_counter(), None
+                self.tick_ms = 1e3 * (self.written_at - start)
+                self.rest_ms = self.tick_ms - solve_ms
         except FAILURES as error:  # e.g. a controller deleted while posing
             self.report({"ERROR"}, str(error))
             return self._end(context, "CANCEL")
@@ -85,6 +102,7 @@ keeps the pose, Esc restores the mesh as it was"""
     def _end(self, context, how):
         posing.running = None
         context.window_manager.event_timer_remove(self.timer)
+        bpy.types.SpaceView3D.draw_handler_remove(self.draw_handler, "WINDOW")
         if context.workspace is not None:
             context.workspace.status_text_set(None)
         try:

@@ -129,8 +129,9 @@ class ModalDeformSettings(bpy.types.PropertyGroup):
                     "controllers more exactly, lower lets the surface's energy hold them back")
     budget: FloatProperty(
         name="Milliseconds per Update", default=5.0, min=0.5, soft_max=50.0,
-        description="Milliseconds the interactive pose spends in the solver per update: more converge faster "
-                    "and lower the frame rate")
+        description="Milliseconds the interactive pose spends in the solver per update at most: more converge "
+                    "faster and may lower the frame rate. Less when the rest of the update (writing the mesh, "
+                    "Blender's evaluation and drawing) leaves less of a 60 fps frame")
     handles: CollectionProperty(type=ModalDeformHandle, name="Handles")
     active_handle: IntProperty(name="Active Handle", description="The handle shown below the list")
     basis: PointerProperty(

@@ -346,3 +346,52 @@ def test_positions_read_from_16_bits_stay_within_1e_4_of_the_diagonal(shared_mes
     moved = np.abs(float32_map - V).max()
     assert moved > 0.3 * diagonal, "not a strong pose"
     assert np.abs(solver.positions() - float32_map).max() < 1e-4 * diagonal
+
+
+def test_frame_budget_gives_the_solve_what_the_rest_of_the_update_leaves():
+    budget = mdc.FrameBudget(most_ms=15.0, least_ms=0.5)
+    assert budget.ms == 15.0  # nothing measured yet
+    budget.measured(4.0)
+    assert budget.ms == pytest.approx(1000 / 60 - 1.0 - 4.0)
+    for rest in [4.0, 30.0, 4.0, 4.0]:  # one slow redraw among them: the median holds
+        budget.measured(rest)
+    assert budget.ms == pytest.approx(1000 / 60 - 1.0 - 4.0)
+    for _ in range(3):
+        budget.measured(30.0)  # Blender takes the whole frame: one iteration's floor
+    assert budget.ms == 0.5
+    for _ in range(5):
+        budget.measured(0.1)
+    assert budget.ms == 15.0
+    for least, most in [(0.0, 5.0), (6.0, 5.0)]:
+        with pytest.raises(ValueError, match="least_ms"):
+            mdc.FrameBudget(most_ms=most, least_ms=least)
+
+
+def test_an_adapted_budget_reaches_the_same_pose_once_the_controller_stops(tube, tube_basis):
+    """The controller moves over 20 updates, then stops; ticks go on until converged, as the Pose
+    operator's do. With the budget cut to one iteration per update while Blender is slow, the pose
+    lags while the controller moves and ends within 1e-4 of the diagonal of the fixed budget's."""
+    V, _, handles, transforms = tube
+    path = [[np.eye(4), rigid([1, 0, 1], 0.8 * t, [0, 0, 3], [0.8 * t, 0, -0.3 * t])]
+            for t in np.linspace(0, 1, 21)[1:]]
+
+    def pose(budget_ms, measure):
+        solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0)
+        lag = []
+        for update, placement in enumerate(path):
+            solver.set_transforms(placement)
+            stats = solver.solve(max_iterations=1000, tolerance=1e-6, budget_ms=budget_ms())
+            measure(update)
+            lag.append(stats["converged"])
+        for _ in range(1000):
+            if solver.solve(max_iterations=1000, tolerance=1e-6, budget_ms=budget_ms())["converged"]:
+                return solver.positions(), lag
+        raise AssertionError("the pose did not converge once the controller stopped")
+
+    fixed, fixed_converged = pose(lambda: 5.0, lambda update: None)
+    adapted = mdc.FrameBudget(most_ms=5.0, least_ms=1e-6)
+    slow_blender = lambda update: adapted.measured(30.0 if update % 10 < 7 else 2.0)  # noqa: E731
+    ours, ours_converged = pose(lambda: adapted.ms, slow_blender)
+    assert sum(ours_converged) < sum(fixed_converged), "the adapted budget never cut the solve short"
+    diagonal = np.linalg.norm(np.ptp(V, axis=0))
+    assert np.abs(ours - fixed).max() < 1e-4 * diagonal

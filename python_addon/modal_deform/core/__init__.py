@@ -9,13 +9,14 @@ shells, ARAP), ``modes`` (vibration modes, rigid motions, modal-derivative solve
 from .._native import Cancelled, OutOfMemoryError
 from .bake import BAKE_STAGES, PROXY, PROXY_ABOVE, Basis, bake, bake_fraction
 from .energy import Arap, DiscreteShells
+from .frame_budget import FrameBudget
 from .mesh import bar, bumpy_plane, check, cylinder, grid, mass, read_mesh
 from .modes import rigid_motions, solve_in_range, vibration_modes
 from .reduction import ghost_mesh, restrict_to_ghost
 from .solve import ReducedSolver, nearest_rigid, solve_full
 
 __all__ = [
-    "Arap", "BAKE_STAGES", "Basis", "PROXY", "PROXY_ABOVE", "Cancelled", "DiscreteShells", "OutOfMemoryError", "bake", "bake_fraction", "bar", "bumpy_plane", "check", "cylinder",
+    "Arap", "BAKE_STAGES", "Basis", "FrameBudget", "PROXY", "PROXY_ABOVE", "Cancelled", "DiscreteShells", "OutOfMemoryError", "bake", "bake_fraction", "bar", "bumpy_plane", "check", "cylinder",
     "ghost_mesh", "grid", "mass", "read_mesh", "restrict_to_ghost", "rigid_motions", "solve_in_range",
     "vibration_modes",
 ]
