@@ -326,19 +326,23 @@ def steps():
     assert base_positions(obj).tobytes() == rest.tobytes()
     say("animation bake cancelled with Esc: its frame keys went")
 
-    # Disabling the add-on while posing ends the pose as Esc does (Solve's key was there before).
+    # Disabling the add-on while posing ends the pose as Esc does. Solve's key was there before, the
+    # only key that moves the mesh: posed in a stand-in, and the artist's mesh is put back.
     before = key_positions(obj, posing.POSE_KEY).tobytes()
+    mesh = obj.data
     with override():
         assert bpy.ops.modal_deform.pose("INVOKE_DEFAULT") == {"RUNNING_MODAL"}
     controller.location.z += 0.3
     yield 0.5
-    assert key_positions(obj, posing.POSE_KEY).tobytes() != before, "the pose did not follow the controller"
+    assert type(posing.running.shown) is posing.StandInDisplay and obj.data != mesh
+    assert base_positions(obj).tobytes() != rest.tobytes(), "the pose did not follow the controller"
     addon_utils.disable("modal_deform", default_set=True)
     assert posing.running is None, "disabling the add-on left the pose running"
-    assert key_positions(obj, posing.POSE_KEY).tobytes() == before, "disabling did not restore the shape key"
+    assert obj.data == mesh, "disabling did not put the artist's mesh back"
+    assert key_positions(obj, posing.POSE_KEY).tobytes() == before, "disabling changed the shape key"
     assert base_positions(obj).tobytes() == rest.tobytes()
     yield 0.5
-    say("disabling the add-on mid-pose restored the shape key")
+    say("disabling the add-on mid-pose put the artist's mesh back")
 
     # And with the pose in the vertex positions (no shape keys): the rest mesh comes back exactly.
     addon_utils.enable("modal_deform", default_set=True)
