@@ -254,13 +254,12 @@ class StandInDisplay(_TransientDisplay):
         self.stand_in = self.mesh.copy()  # materials, attributes, vertex groups, UVs: what modifiers read
         self.stand_in.name = f"{self.mesh.name} (posing)"
         self.stand_in[STAND_IN_OF] = self.mesh
-        copied_keys = self.stand_in.shape_keys
+        copied_keys = self.stand_in.shape_keys.name
         obj.data = self.stand_in
         obj.shape_key_clear()
-        try:  # Blender 3.4 and 4.5 count the copy's Key twice and keep it, ownerless (4.5 then refuses to save)
-            bpy.data.batch_remove([copied_keys])
-        except ReferenceError:  # cleared for good (5.x)
-            pass
+        left = bpy.data.shape_keys.get(copied_keys)
+        if left is not None:  # Blender 3.4 and 4.5 count the copy's Key twice and keep it (4.5 then refuses to save)
+            bpy.data.batch_remove([left])
 
     def array(self):
         return mesh_io.vertex_positions(self.stand_in)
