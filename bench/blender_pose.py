@@ -6,7 +6,7 @@ experiment's meshes): time per update, shells energy and error against the full 
 Laplacian result is added to each mesh file for the renders.
 
     blender -b --factory-startup --python bench/blender_pose.py -- --output bench/results/blender_pose.json \
-        [--shapes bench/results/tmp/meshes] [--quick] [--pose-only] [--subdivide 2]
+        [--shapes bench/results/tmp/meshes] [--quick] [--pose-only] [--subdivide 2 [--double]]
 
 In bpy (Blender 4.2+ as a Python module), with the add-on installed from the extension zip:
 
@@ -59,6 +59,9 @@ def arguments():
     parser.add_argument("--subdivide", type=int, default=0,
                         help="midpoint-subdivide the dragon this many times first (2: 1.6M vertices, baked on a "
                              "proxy; the 67-dimensional basis only, pose updates only)")
+    parser.add_argument("--double", action="store_true",
+                        help="then split as many edges as there are vertices (subdivision.split_edges): twice the "
+                             "vertices (with --subdivide 2: 3.2M)")
     return parser.parse_args(argv)
 
 
@@ -78,18 +81,20 @@ def milliseconds(start):
     return 1e3 * (time.perf_counter() - start)
 
 
-def dragon(name, subdivisions):
+def dragon(name, subdivisions, double=False):
     mdc = addon("core")
     V, F = mdc.read_mesh(MESHES / f"{name}.ply.gz")
     for _ in range(subdivisions):
         V, F = subdivision.midpoint_subdivide(V, F)
+    if double:
+        V, F = subdivision.split_edges(V, F, len(V))
     return mesh_object("Dragon", V, F)
 
 
-def posed_dragon(name, subdivisions):
-    """The dragon as a mesh object with a handle on the 5% of its length at each end, the low end
-    pinned; (object, its vertex count, the high end's handle)."""
-    obj = dragon(name, subdivisions)
+def posed_dragon(name, subdivisions, double=False):
+    """The dragon (subdivided, doubled: see arguments()) as a mesh object with a handle on the 5% of
+    its length at each end, the low end pinned; (object, its vertex count, the high end's handle)."""
+    obj = dragon(name, subdivisions, double)
     V = np.empty(3 * len(obj.data.vertices), np.float32)
     obj.data.vertices.foreach_get("co", V)
     V = V.reshape(-1, 3)
@@ -324,14 +329,14 @@ def main():
     ADDON = enable_addon().__name__
     clear_scene()
     mesh = "dragon_vrip_res4" if args.quick else "dragon_vrip_res2"
-    obj, vertices, moving = posed_dragon(mesh, args.subdivide)
-    if args.subdivide:
+    obj, vertices, moving = posed_dragon(mesh, args.subdivide, args.double)
+    if args.subdivide or args.double:
         args.pose_only = True
-        mesh = f"{mesh} subdivided {args.subdivide}x"
+        mesh = f"{mesh} subdivided {args.subdivide}x" + (", edges split to double" if args.double else "")
     results = {"mesh": mesh, "vertices": vertices, "bases": {}}
     # dragon_vrip_res2 has 6 floppy zero modes on top of the modes asked for: 16 + 6 + 45 = 67 and
     # 20 + 6 + 104 = 130 dimensions (bench_solve.cpp bakes the same).
-    for modes, derivatives in ((16, 45),) if args.subdivide else ((16, 45), (20, 104)):
+    for modes, derivatives in ((16, 45),) if args.subdivide or args.double else ((16, 45), (20, 104)):
         settings = obj.modal_deform
         settings.modes, settings.derivatives, settings.ghost = modes, derivatives, 1000
         t = time.perf_counter()

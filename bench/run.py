@@ -26,7 +26,7 @@ Experiments (each writes bench/results/<name>.json: machine, commit, command, pa
                dimensions, and that nothing outside the region moves (bench/region.py)
   blender      the add-on's pose update in headless Blender and Blender's Laplacian Deform
                (bench/blender_pose.py), in Debian's 3.4.1 app from the source tree
-  bpy_pose     the pose update alone at 100k, 400k and 1.6M vertices in bpy 4.5 and 5.3 (.venv/bpy-<version>,
+  bpy_pose     the pose update alone at 100k, 400k, 1.6M and 3.2M vertices in bpy 4.5 and 5.3 (.venv/bpy-<version>,
                made by `make bench`) with the add-on installed from its extension zip (`make addon`)
   viewport_frames  the frame while posing in a real viewport: Debian's 3.4.1 app under Xvfb (software
                OpenGL), the dragon at 100k and 1.6M vertices (bench/viewport_frames.py)
@@ -111,19 +111,26 @@ def blender(quick):
     return raw.pop("parameters"), raw
 
 
+#: The bpy_pose experiment's meshes: blender_pose.py's arguments for the dragon (100k vertices),
+#: subdivided once (400k) and twice (1.6M), and twice with as many edges split again (3.2M).
+DENSE_DRAGONS = (["--subdivide", "0"], ["--subdivide", "1"], ["--subdivide", "2"],
+                 ["--subdivide", "2", "--double"])
+
+
 def bpy_pose(quick):
-    """The installed extension alone, in the Blenders artists run: the dragon (100k vertices) and the
-    dragon subdivided once (400k) and twice (1.6M), the last two baked on a proxy."""
+    """The installed extension alone, in the Blenders artists run: the dragon at each of
+    DENSE_DRAGONS, all but the first baked on a proxy."""
     runs = []
+    sizes = DENSE_DRAGONS[:1] if quick else DENSE_DRAGONS
     with tempfile.TemporaryDirectory() as folder:
         for version in BPY_VERSIONS:
-            for subdivide in (0,) if quick else (0, 1, 2):
-                out = pathlib.Path(folder) / f"bpy-{version}-{subdivide}.json"
+            for i, size in enumerate(sizes):
+                out = pathlib.Path(folder) / f"bpy-{version}-{i}.json"
                 in_bpy(version, common.ROOT / "bench" / "blender_pose.py",
-                       ["--output", str(out), "--pose-only", "--subdivide", str(subdivide),
+                       ["--output", str(out), "--pose-only", *size,
                         "--updates", "3" if quick else "15", *(["--quick"] if quick else [])], folder)
                 runs.append(json.loads(out.read_text()))
-    return {"blenders": BPY_VERSIONS, "subdivisions": [0] if quick else [0, 1, 2]}, {"runs": runs}
+    return {"blenders": BPY_VERSIONS, "sizes": sizes}, {"runs": runs}
 
 
 def viewport_frames(quick):

@@ -35,6 +35,41 @@ def pose_shown(shown):
     return pose
 
 
+def keep_as_shown(shown, pose):
+    """shown.keep(pose), checked to look the same through the modifiers as the pose shown did."""
+    bpy.context.view_layer.update()
+    shown_through_modifiers = evaluated_positions(obj)
+    kept = shown.keep(pose)
+    bpy.context.view_layer.update()
+    difference = np.abs(evaluated_positions(obj) - shown_through_modifiers).max()
+    assert difference < 1e-5, f"the kept pose looks different through the modifiers ({difference})"
+    return kept
+
+
+def undone_to_mid_pose(display):
+    """A pose shown by a new display (of type `display`), an undo step pushed mid-pose (a
+    controller's move pushes one), the pose kept, then undone to that step; returns the object as
+    undo read it again and the pose."""
+    bpy.ops.ed.undo_push(message="before posing")
+    shown = posing.display(obj)
+    assert type(shown) is display
+    pose = pose_shown(shown)
+    posed = support.positions(obj)
+    bpy.ops.ed.undo_push(message="controller moved while posing")
+    shown.keep(pose)
+    bpy.ops.ed.undo_push(message="pose kept")
+    assert bpy.ops.ed.undo() == {"FINISHED"}
+    return bpy.data.objects["Suzanne"], posed
+
+
+def artists_key(value):
+    """The artist's own shape key "Smile" (one vertex raised), at `value`."""
+    smile = obj.shape_key_add(name="Smile")
+    smile.data[0].co.z += 0.1
+    smile.value = value
+    return smile
+
+
 # No shape keys: posed in the vertex positions, the mesh flagged meanwhile; Esc restores exactly.
 shown = posing.display(obj)
 assert type(shown) is posing.PositionsDisplay
@@ -49,17 +84,12 @@ assert support.positions(obj).tobytes() == rest.tobytes() and obj.data.get(posin
 shown = posing.display(obj)
 pose = pose_shown(shown)
 posed = support.positions(obj)
-bpy.context.view_layer.update()
-shown_through_modifiers = evaluated_positions(obj)
-shown = shown.keep(pose)
+shown = keep_as_shown(shown, pose)
 assert type(shown) is posing.ShapeKeyDisplay
 assert support.positions(obj).tobytes() == rest.tobytes()
 assert support.key_positions(obj, "Basis").tobytes() == rest.tobytes()
 assert support.key_positions(obj, posing.POSE_KEY).tobytes() == posed.tobytes()
 assert obj.data.get(posing.POSING_FLAG) is None
-bpy.context.view_layer.update()
-difference = np.abs(evaluated_positions(obj) - shown_through_modifiers).max()
-assert difference < 1e-5, f"the kept pose looks different through the modifiers ({difference})"
 
 # The artist adds a shape key mid-pose: the first one copies the positions, which hold the pose;
 # kept, the reference key holds the rest again.
@@ -78,9 +108,7 @@ print("POSITIONS_OK")
 # The artist's own shape key: posed in the key, the artist's key and the mesh as they were after Esc.
 obj.shape_key_clear()
 obj.shape_key_add(name="Basis")
-smile = obj.shape_key_add(name="Smile")
-smile.data[0].co.z += 0.1
-smile.value = 0.5
+artists_key(0.5)
 before = support.mesh_state(obj)
 shown = posing.display(obj)
 assert type(shown) is posing.ShapeKeyDisplay
@@ -93,15 +121,7 @@ print("SHAPE_KEYS_OK")
 
 # An undo step taken mid-pose (a controller's move pushes one) holds the pose in the positions:
 # undoing to it after the pose was kept repairs it.
-bpy.ops.ed.undo_push(message="before posing")
-shown = posing.display(obj)
-pose = pose_shown(shown)
-posed = support.positions(obj)
-bpy.ops.ed.undo_push(message="controller moved while posing")
-shown.keep(pose)
-bpy.ops.ed.undo_push(message="pose kept")
-assert bpy.ops.ed.undo() == {"FINISHED"}
-obj = bpy.data.objects["Suzanne"]  # undo re-reads the data
+obj, posed = undone_to_mid_pose(posing.PositionsDisplay)
 assert obj.data.get(posing.POSING_FLAG) is None, "undo left a posed mesh"
 assert support.positions(obj).tobytes() == rest.tobytes(), "undo left the pose in the base mesh"
 assert support.key_positions(obj, posing.POSE_KEY).tobytes() == posed.tobytes()
@@ -128,9 +148,7 @@ print("LOAD_OK")
 # key at 0: posed in a stand-in without shape keys, the artist's mesh untouched; Esc puts it back.
 mesh = obj.data
 controller = obj.modal_deform.handles[0].controller
-smile = obj.shape_key_add(name="Smile")
-smile.data[0].co.z += 0.1
-smile.value = 0.0
+smile = artists_key(0.0)
 before = support.mesh_state(obj)
 shown = posing.display(obj)
 assert type(shown) is posing.StandInDisplay
@@ -148,17 +166,12 @@ assert not [m for m in bpy.data.meshes if m.get(posing.STAND_IN_OF)], "the stand
 shown = posing.display(obj)
 pose = pose_shown(shown)
 posed = support.positions(obj)
-bpy.context.view_layer.update()
-shown_through_modifiers = evaluated_positions(obj)
-shown = shown.keep(pose)
+shown = keep_as_shown(shown, pose)
 assert type(shown) is posing.ShapeKeyDisplay and obj.data == mesh
 assert support.key_positions(obj, posing.POSE_KEY).tobytes() == posed.tobytes()
 for name in ("Basis", "Smile"):
     assert support.key_positions(obj, name).tobytes() == dict(
         (n, c) for n, _, _, c in before["shape_keys"])[name], f"keeping the pose changed '{name}'"
-bpy.context.view_layer.update()
-difference = np.abs(evaluated_positions(obj) - shown_through_modifiers).max()
-assert difference < 1e-5, f"the kept pose looks different through the modifiers ({difference})"
 
 # The artist's key shown (at 0.5): posed in the key, as before.
 smile.value = 0.5
@@ -191,16 +204,7 @@ print("STAND_IN_OK")
 
 # An undo step and a file written mid-pose hold the stand-in on the object: the artist's mesh comes
 # back on undo and on loading, with the pose in the key.
-bpy.ops.ed.undo_push(message="before posing")
-shown = posing.display(obj)
-assert type(shown) is posing.StandInDisplay
-pose = pose_shown(shown)
-posed = support.positions(obj)
-bpy.ops.ed.undo_push(message="controller moved while posing")
-shown.keep(pose)
-bpy.ops.ed.undo_push(message="pose kept")
-assert bpy.ops.ed.undo() == {"FINISHED"}
-obj = bpy.data.objects["Suzanne"]
+obj, posed = undone_to_mid_pose(posing.StandInDisplay)
 assert obj.data.name == "Suzanne" and obj.data.get(posing.STAND_IN_OF) is None, "undo left the stand-in"
 assert not [m for m in bpy.data.meshes if m.get(posing.STAND_IN_OF)]
 assert support.key_positions(obj, posing.POSE_KEY).tobytes() == posed.tobytes()
