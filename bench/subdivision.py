@@ -25,15 +25,18 @@ def midpoint_subdivide(V, F):
     return V, F.astype(np.int32)
 
 
-def split_edges(V, F, count, seed=0):
-    """A vertex on `count` edges drawn at random (the same for the same seed), the triangles
-    split to match (red-green refinement: one edge split, two triangles; two, three; three,
-    four), so vertex counts between midpoint subdivision's factors of 4 can be made (count =
-    len(V): twice the vertices). (V, F) -> (n + count vertices, faces); the first n are V."""
+def split_edges(V, F, count):
+    """A vertex on the `count` longest edges, the triangles split to match (red-green refinement:
+    one edge split, two triangles; two, three; three, four), so vertex counts between midpoint
+    subdivision's factors of 4 can be made (count = len(V): twice the vertices). Longest first, as
+    in longest-edge bisection, so no triangle is cut into slivers (random edges made a proxy of the
+    3.2M dragon whose stiffness matrix would not factor). (V, F) -> (n + count vertices, faces);
+    the first n are V."""
     F = np.asarray(F, dtype=np.int64)
     n = len(V)
     edges, index = _edges(F)
-    chosen = np.random.default_rng(seed).choice(len(edges), size=count, replace=False)
+    lengths = np.linalg.norm(V[edges[:, 0]] - V[edges[:, 1]], axis=1)
+    chosen = np.argpartition(-lengths, count - 1)[:count]
     midpoint = np.full(len(edges), -1, np.int64)
     midpoint[chosen] = n + np.arange(count)
     V = np.vstack([V, 0.5 * (V[edges[chosen, 0]] + V[edges[chosen, 1]])])
