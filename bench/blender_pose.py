@@ -62,6 +62,7 @@ def arguments():
     parser.add_argument("--double", action="store_true",
                         help="then split as many edges as there are vertices (subdivision.split_edges): twice the "
                              "vertices (with --subdivide 2: 3.2M)")
+    parser.add_argument("--proxy", type=int, help="the object's Proxy Size (default: the add-on's)")
     return parser.parse_args(argv)
 
 
@@ -339,6 +340,8 @@ def main():
     for modes, derivatives in ((16, 45),) if args.subdivide or args.double else ((16, 45), (20, 104)):
         settings = obj.modal_deform
         settings.modes, settings.derivatives, settings.ghost = modes, derivatives, 1000
+        if args.proxy is not None:
+            settings.proxy = args.proxy
         t = time.perf_counter()
         bpy.ops.modal_deform.bake()
         bake = time.perf_counter() - t

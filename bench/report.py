@@ -398,6 +398,12 @@ def section_bpy_pose(result):
                           f"**{'met' if update <= target else 'NOT met'}** ({update:.1f} ms)")
     out += ["", "Targets (issue 23, ours and Blender's evaluation, a mesh without shape keys): " + "; ".join(checks)
             + "."]
+    second = [f"{run['blender']}, {run['vertices']:,} vertices: {b['stand_in']['update']:.1f} ms against "
+              f"{b['shape_key']['update']:.1f}" for run in runs for b in [next(iter(run["bases"].values()))]
+              if "stand_in" in b]
+    if second:
+        out += ["", "A mesh posed before (keys Basis and Modal Deform), one update in a stand-in against the shape "
+                "key: " + "; ".join(second) + "."]
     plot_update_time(runs)
     out += ["", "![update time against vertex count](figures/update_time.png)", "", provenance(result)]
     return "\n".join(out)
