@@ -291,20 +291,36 @@ Stiffness stiffness_at_rest(const Simulated& sim, const BakeOptions& options, Ba
   });
 }
 
-// What the ghost simplifies (mesh units): the whole mesh, or a region bake's submesh (its
-// simulated vertices, then the clamped ones, Simulated::region_vertices), so that all of the
-// ghost's vertices are spent where the mesh moves.
-struct GhostSource {
-  VerticesRef V;
-  FacesRef F;
-  VectorRef mass;
+// The part of the mesh that moves (mesh units), with its masses: the whole mesh, or a region bake's
+// submesh (its free vertices, then the clamped ones: RegionMesh::vertices, and its faces). The
+// ghost and a proxy simplify it, so that all their vertices are spent where the mesh moves.
+class MovingPart {
+ public:
+  MovingPart(const VerticesRef& mesh_V, const FacesRef& mesh_F, const VectorRef& mesh_mass,
+             const std::vector<int>& submesh, const FacesRef& submesh_F)
+      : submesh_V_(mesh_V(submesh, Eigen::all)),
+        submesh_mass_(mesh_mass(submesh)),
+        V(submesh.empty() ? mesh_V : VerticesRef(submesh_V_)),
+        F(submesh.empty() ? mesh_F : submesh_F),
+        mass(submesh.empty() ? mesh_mass : VectorRef(submesh_mass_)) {}
+  MovingPart(const MovingPart&) = delete;
+  MovingPart& operator=(const MovingPart&) = delete;
+
+ private:
+  const RowMatrixX3d submesh_V_;
+  const Eigen::VectorXd submesh_mass_;
+
+ public:
+  const VerticesRef V;
+  const FacesRef F;
+  const VectorRef mass;
 };
 
-// 4. CHOLMOD orders K while the ghost of what moves (GhostSource) is simplified beside it (stage
+// 4. CHOLMOD orders K while the ghost of what moves (MovingPart) is simplified beside it (stage
 // 8 uses it). Analysed here rather than inside the eigensolver's first factorisation, so the bar moves
 // between the two (CHOLMOD reports nothing during either), and so that the factor's size is known
 // before the numeric factorisation: what cannot fit is refused at once, not half a minute later.
-Ghost order_beside_the_ghost(const VerticesRef& V, const GhostSource& source, const Simulated& sim,
+Ghost order_beside_the_ghost(const VerticesRef& V, const MovingPart& source, const Simulated& sim,
                              const SparseMatrix& K, const BakeOptions& options, CholmodLLT& factor, Basis& basis,
                              Progress& progress) {
   GhostInBackground ghost(source.V, source.F, source.mass, options.ghost);
@@ -419,7 +435,7 @@ Eigen::MatrixXd orthonormal_basis(const Simulated& sim, const Eigen::MatrixXd& r
 // stiffness. A region's ghost is its submesh's: restricted from the submesh's rows, and the
 // vertices outside the submesh, which never move, map to ghost vertex 0 (the solver reads only
 // the ghost's own arrays).
-void fine_and_ghost_vectors(Eigen::MatrixXd U, const Simulated& sim, const GhostSource& source, Ghost coarse,
+void fine_and_ghost_vectors(Eigen::MatrixXd U, const Simulated& sim, const MovingPart& source, Ghost coarse,
                             const StiffnessPaint& paint, Basis& basis, Progress& progress) {
   stage(stages::kAssembly, basis, progress, [&] {
     if (U.rows() < basis.rest.size()) U = extend_to_attached(sim.attachment, U);
@@ -455,12 +471,7 @@ Basis bake_stages(const VerticesRef& V, const FacesRef& F, const BakeOptions& op
   const Eigen::MatrixXd rigid = sim.num_rigid > 0 ? rigid_motions(sim.V, sim.attachment.component, sim.mass)
                                                   : Eigen::MatrixXd(3 * sim.size(), 0);
   CholmodLLT factor(3);  // one factorisation for the modes and the derivative solves
-  const RowMatrixX3d region_V = V(sim.region_vertices, Eigen::all);
-  const RowMatrixX3i region_F = sim.attachment.faces;
-  const Eigen::VectorXd region_mass = basis.mass(sim.region_vertices);
-  const bool in_region = !sim.region_vertices.empty();
-  const GhostSource source{in_region ? VerticesRef(region_V) : V, in_region ? FacesRef(region_F) : F,
-                           in_region ? VectorRef(region_mass) : VectorRef(basis.mass)};
+  const MovingPart source(V, F, basis.mass, sim.region_vertices, sim.attachment.faces);
   Ghost coarse = order_beside_the_ghost(V, source, sim, stiffness.K, options, factor, basis, progress);
   const Modes modes = vibration_stage(V, sim, stiffness.K, rigid, factor, basis, progress);
   Eigen::MatrixXd derivatives = derivative_stage(sim, stiffness, rigid, modes, options, factor, basis, progress);
@@ -470,30 +481,71 @@ Basis bake_stages(const VerticesRef& V, const FacesRef& F, const BakeOptions& op
   return basis;
 }
 
-// A dense mesh: the stages above on a proxy made by edge collapse of the fine mesh to about
-// options.proxy vertices, then the prolongation of the proxy's basis to the fine vertices
+// The proxy's region: the proxy vertices that only free vertices collapsed onto.
+Eigen::VectorXi proxy_region(const Ghost& proxy, const RegionMesh& region) {
+  std::vector<char> free(static_cast<size_t>(proxy.V.rows()), 0);
+  for (Eigen::Index s = 0; s < region.num_free; ++s) free[proxy.map[s]] = 1;
+  for (Eigen::Index s = region.num_free; s < proxy.map.size(); ++s) free[proxy.map[s]] = 0;
+  std::vector<int> vertices;
+  for (size_t p = 0; p < free.size(); ++p)
+    if (free[p]) vertices.push_back(static_cast<int>(p));
+  return Eigen::Map<const Eigen::VectorXi>(vertices.data(), static_cast<Eigen::Index>(vertices.size()));
+}
+
+// A dense mesh: the stages above on a proxy made by edge collapse to about options.proxy vertices
+// of the part that moves (MovingPart; a region's free and clamped vertices stay apart, so the line
+// between them stays in place), then the prolongation of the proxy's basis to the fine vertices
 // (prolongation.h); the ghost is the proxy's, reached from a fine vertex through its proxy vertex.
-Basis bake_on_proxy(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Progress& progress) {
-  const Basis fine = rest_state(V, F, options, normalizing_scale(V));
+// A region's proxy is baked as a region (its clamped vertices still), and every fine vertex but the
+// region's free ones is held at rest by a prolongation of zero weights.
+Basis bake_on_proxy(const VerticesRef& V, const FacesRef& F, const RegionMesh* region, const BakeOptions& options,
+                    Basis fine, Progress& progress) {
   Basis timed;  // the proxy stage's time, until the proxy's basis exists
   Progress as_proxy([&progress](const std::string&, double fraction) {
     progress.report(stages::kProxy, fraction);
     return true;
   });
-  const Ghost proxy =
-      stage(stages::kProxy, timed, progress, [&] { return ghost_mesh(V, F, fine.mass, options.proxy, &as_proxy); });
+  const MovingPart source(V, F, fine.mass, region ? region->vertices : std::vector<int>(),
+                          region ? FacesRef(region->faces) : F);
+  std::vector<char> sides;  // a region's: 1 for its free vertices, 0 for the clamped ones
+  if (region) {
+    sides.assign(region->vertices.size(), 0);
+    std::fill_n(sides.begin(), region->num_free, 1);
+  }
+  const Ghost proxy = stage(stages::kProxy, timed, progress, [&] {
+    return ghost_mesh(source.V, source.F, source.mass, options.proxy, &as_proxy, sides);
+  });
   // The proxy's elements carry the fine paint's means (restrict_to_ghost).
   BakeOptions on_proxy = options;
-  on_proxy.paint = restrict_to_ghost(proxy.map, static_cast<int>(proxy.V.rows()), fine.mass, options.paint);
+  const int num_proxy = static_cast<int>(proxy.V.rows());
+  StiffnessPaint paint = options.paint;
+  if (region && paint.weights.size() > 0) paint.weights = options.paint.weights(region->vertices).eval();
+  on_proxy.paint = restrict_to_ghost(proxy.map, num_proxy, source.mass, paint);
+  // A region with nothing clamped around it (a free component) is its whole proxy.
+  const bool clamped = region && region->num_free < static_cast<int>(region->vertices.size());
+  on_proxy.region = clamped ? proxy_region(proxy, *region) : Eigen::VectorXi();
   Basis basis = rest_state(proxy.V, proxy.F, on_proxy, fine.scale);
   basis.timings = timed.timings;
   basis = bake_stages(proxy.V, proxy.F, on_proxy, std::move(basis), progress);
   stage(stages::kProlongation, basis, progress, [&] {
-    basis.prolongation = prolongation_to_proxy(V, proxy.V, proxy.F, proxy.map);
-    basis.ghost_map = basis.ghost_map(proxy.map).eval();
-    basis.rest = fine.rest;
-    basis.mass = fine.mass;
-    basis.stiffness_weights = fine.stiffness_weights;
+    Prolongation onto_proxy = prolongation_to_proxy(source.V, proxy.V, proxy.F, proxy.map);
+    Eigen::VectorXi ghost_map = basis.ghost_map(proxy.map);
+    if (!region) {
+      basis.prolongation = std::move(onto_proxy);
+      basis.ghost_map = std::move(ghost_map);
+    } else {
+      basis.prolongation = held_at_rest(V.rows());
+      basis.ghost_map = Eigen::VectorXi::Zero(V.rows());
+      for (int s = 0; s < region->num_free; ++s) {
+        basis.prolongation.vertices.row(region->vertices[static_cast<size_t>(s)]) = onto_proxy.vertices.row(s);
+        basis.prolongation.weights.row(region->vertices[static_cast<size_t>(s)]) = onto_proxy.weights.row(s);
+      }
+      basis.ghost_map(region->vertices) = ghost_map;
+    }
+    basis.rest = std::move(fine.rest);
+    basis.mass = std::move(fine.mass);
+    basis.stiffness_weights = std::move(fine.stiffness_weights);
+    basis.region = std::move(fine.region);
   });
   return basis;
 }
@@ -504,9 +556,18 @@ Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, 
   try {
     check_options(options, V.rows());
     validate_mesh(V, F);
-    Basis basis = options.proxy_above > 0 && V.rows() > options.proxy_above && options.region.size() == 0
-                      ? bake_on_proxy(V, F, options, progress)
-                      : bake_stages(V, F, options, rest_state(V, F, options, normalizing_scale(V)), progress);
+    Basis fine = rest_state(V, F, options, normalizing_scale(V));
+    const bool proxies = options.proxy_above > 0;
+    Basis basis;
+    if (options.region.size() == 0) {
+      basis = proxies && V.rows() > options.proxy_above ? bake_on_proxy(V, F, nullptr, options, std::move(fine), progress)
+                                                        : bake_stages(V, F, options, std::move(fine), progress);
+    } else {
+      const RegionMesh region = region_mesh(F, fine.mass, options.region);
+      basis = proxies && region.num_free > options.proxy_above
+                  ? bake_on_proxy(V, F, &region, options, std::move(fine), progress)
+                  : bake_stages(V, F, options, std::move(fine), progress);
+    }
     validate_basis(basis);
     return basis;
   } catch (const std::bad_alloc&) {

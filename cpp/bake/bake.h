@@ -34,7 +34,9 @@
 // fine mesh's normalised frame; then each fine vertex gets its barycentric weights on the nearest
 // proxy triangle ("prolongation"). The Basis keeps the fine rest positions and masses, the
 // proxy's vectors and the prolongation: memory and storage grow with the fine mesh only by
-// those weights.
+// those weights. A region of more than options.proxy_above free vertices is baked so too: the proxy
+// is its submesh's, simplified with the free and clamped vertices kept apart (so the line between
+// them stays), baked as a region, and every fine vertex outside the region gets zero weights.
 //
 // Stages (kBakeStages in util/progress.h, in the order they run) are timed into Basis::timings and
 // reported through Progress with the same names: for a proxy bake "proxy" first; "attachment",
@@ -82,7 +84,7 @@ struct BakeOptions {
   // with its fine vertices' means; the basis keeps the weights for the solver's ghost.
   StiffnessPaint paint = {};
   // Fine vertex indices that may move (any order; empty: the whole mesh). Every other vertex
-  // stays at rest, clamped (region.h); a region bake is never on a proxy.
+  // stays at rest, clamped (region.h); the region's free vertices decide on a proxy.
   Eigen::VectorXi region = {};
 };
 
