@@ -41,6 +41,11 @@ constexpr double kRoundingFloor = 1e-12;
 // springs after the final inverse iteration, 1e-10 5e-13 (tests/cpp/test_vibration_modes.cpp
 // asks for 2.5e-11). On dragon_vrip_res2 each block of 8 takes the estimate down 30 to 60 times.
 constexpr double kEigenTolerance = 1e-10;
+// A Ritz estimate stops falling at the rounding of the largest ν: on the 5k dragon with its 9
+// zero modes undeflated (ν = 1.4e5), the estimates of the 60th mode (ν = 0.19) hovered at 2e-11 to
+// 6e-11, 1 to 2 ε ν_max, against a tolerance of 1.9e-11 over 700 Lanczos vectors. A pair whose
+// tolerance kEigenTolerance |ν| is below kRoundingReach ε ν_max is out of reach.
+constexpr double kRoundingReach = 10;
 // A new Lanczos direction whose M-norm is below this fraction of the largest one in its block is
 // dropped (the Krylov space has closed, up to rounding).
 constexpr double kDependentNorm = 1e-8;
@@ -112,13 +117,21 @@ class ShiftInvert {
 
 // The eigenvectors of T with the largest ν = 1/(λ − σ), by block Lanczos with full
 // reorthogonalisation in the M inner product. Stops when the Ritz residual ‖T y − ν y‖_M of each
-// of the `count` largest is below kEigenTolerance |ν|; throws NumericalError past max_columns.
+// of the `count` largest is below kEigenTolerance |ν|, or early for a caller that deflates zero
+// modes (see run); throws NumericalError past max_columns.
 class BlockLanczos {
  public:
   // dimension: of the space T acts on (DOFs with mass less the deflated kernel); max_columns:
-  // Lanczos vectors allowed, at most that.
-  BlockLanczos(ShiftInvert& T, const Eigen::VectorXd& m, Eigen::Index dimension, Eigen::Index max_columns)
-      : T_(T), m_(m), dimension_(dimension), Q_(m.size(), max_columns), H_(Eigen::MatrixXd::Zero(max_columns, max_columns)) {}
+  // Lanczos vectors allowed, at most that; zero_nu: the ν above which a pair is a zero mode that
+  // the caller deflates (infinity when it does not).
+  BlockLanczos(ShiftInvert& T, const Eigen::VectorXd& m, Eigen::Index dimension, Eigen::Index max_columns,
+               double zero_nu)
+      : T_(T),
+        m_(m),
+        dimension_(dimension),
+        zero_nu_(zero_nu),
+        Q_(m.size(), max_columns),
+        H_(Eigen::MatrixXd::Zero(max_columns, max_columns)) {}
 
   // R: the random start block (n by width). Returns the Ritz vectors (n by count, M-orthonormal)
   // of the `count` largest ν, descending.
@@ -146,10 +159,10 @@ class BlockLanczos {
         const Eigen::MatrixXd S = ritz.eigenvectors().rowwise().reverse().leftCols(count);
         const Eigen::VectorXd nu = ritz.eigenvalues().reverse().head(count);
         const Eigen::VectorXd estimate = (next * S.bottomRows(last - first)).colwise().norm();
+        const auto converged = (estimate.array() <= kEigenTolerance * nu.array().abs()).eval();
         // With `dimension` vectors the space is the whole problem and its Ritz pairs are exact
         // (small meshes).
-        if ((estimate.array() <= kEigenTolerance * nu.array().abs()).all() || next.rows() == 0 ||
-            last == dimension_)
+        if (converged.all() || next.rows() == 0 || last == dimension_ || zero_modes_stand_in_the_way(nu, converged))
           return Q_.leftCols(last) * S;
       }
       if (added == 0)
@@ -161,6 +174,17 @@ class BlockLanczos {
   }
 
  private:
+  // Zero modes left in T (a floppy mesh's) have ν about 1/|σ|, up to 1e6 times the wanted
+  // flexible modes', whose estimates then stop at the rounding of the largest ν, below their
+  // tolerance: true, once the zero modes have converged, when some unconverged pair is out of
+  // reach, so that the caller deflates them and solves again.
+  bool zero_modes_stand_in_the_way(const Eigen::VectorXd& nu, const Eigen::Array<bool, Eigen::Dynamic, 1>& converged) const {
+    const auto zero = (nu.array() >= zero_nu_).eval();
+    if (!zero.any() || (zero && !converged).any()) return false;
+    const double reach = kRoundingReach * std::numeric_limits<double>::epsilon() * nu.maxCoeff() / kEigenTolerance;
+    return (!converged && nu.array().abs() < reach).any();
+  }
+
   // W −= Q Qᵀ M W over the first `columns` of Q; returns the coefficients removed. W = T Q_j lies
   // in the span of the blocks j − 1, j and j + 1 but for what rounding lost: first the
   // recurrence's large parts along the last two blocks, then one pass over all of Q for the small
@@ -210,6 +234,7 @@ class BlockLanczos {
   ShiftInvert& T_;
   const Eigen::VectorXd& m_;
   Eigen::Index dimension_;
+  double zero_nu_;
   Eigen::MatrixXd Q_;  // the Lanczos vectors, columns_ of them so far
   Eigen::MatrixXd H_;  // Qᵀ M T Q
   Eigen::Index columns_ = 0;
@@ -248,7 +273,7 @@ Eigen::VectorXd rounding_levels(const SparseMatrix& K, const Eigen::MatrixXd& mo
 
 // Z: a checked kernel basis (see checked_kernel_basis), possibly empty.
 VibrationModes deflated_modes(const SparseMatrix& K, const VectorRef& mass, int count, const Eigen::MatrixXd& Z,
-                              Progress* progress, CholmodLLT* factor) {
+                              Progress* progress, CholmodLLT* factor, double zero_modes_below) {
   const Eigen::VectorXd m = dof_masses(mass);
   const int n = static_cast<int>(m.size());
   const int free = static_cast<int>((m.array() > 0).count() - Z.cols());
@@ -277,7 +302,9 @@ VibrationModes deflated_modes(const SparseMatrix& K, const VectorRef& mass, int 
   Eigen::MatrixXd R(n, width);
   for (Eigen::Index j = 0; j < width; ++j)
     for (int d = 0; d < n; ++d) R(d, j) = uniform(random);
-  BlockLanczos lanczos(T, m, free, max_columns);
+  const double zero_nu =
+      zero_modes_below > 0 ? 1 / (zero_modes_below - sigma) : std::numeric_limits<double>::infinity();
+  BlockLanczos lanczos(T, m, free, max_columns, zero_nu);
   const Eigen::MatrixXd ritz_vectors = lanczos.run(R, count);
 
   // One step of inverse iteration on the Ritz vectors, then Rayleigh–Ritz on the block: a Ritz
@@ -318,16 +345,19 @@ void require_accurate(const VibrationModes& modes, int first, int last) {
 
 VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int count, Progress* progress) {
   validate_stiffness_and_mass(K, mass);
-  VibrationModes modes = deflated_modes(K, mass, count, Eigen::MatrixXd(K.rows(), 0), progress, nullptr);
+  VibrationModes modes = deflated_modes(K, mass, count, Eigen::MatrixXd(K.rows(), 0), progress, nullptr, 0);
   require_accurate(modes, 0, count);
   return modes;
 }
 
 VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int count,
                                const Eigen::Ref<const Eigen::MatrixXd>& Z, Progress* progress, CholmodLLT* factor,
-                               ResidualCheck check) {
-  VibrationModes modes = deflated_modes(K, mass, count, checked_kernel_basis(K, mass, Z), progress, factor);
-  if (check == ResidualCheck::kThrow) require_accurate(modes, 0, count);
+                               double zero_modes_below) {
+  if (!(zero_modes_below >= 0 && std::isfinite(zero_modes_below)))
+    throw InputError(message("zero_modes_below: expected a finite bound >= 0, got ", zero_modes_below));
+  VibrationModes modes =
+      deflated_modes(K, mass, count, checked_kernel_basis(K, mass, Z), progress, factor, zero_modes_below);
+  if (zero_modes_below == 0) require_accurate(modes, 0, count);
   return modes;
 }
 

@@ -37,13 +37,13 @@ VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int
 // deform with, and lets the shift sit closer to the flexible modes.
 // `factor`, when given, is the CholmodLLT (3 DOFs per node) that K − σM is factored in, and holds
 // that factor afterwards (σ = VibrationModes::shift): the bake's derivative solves reuse it
-// (solve_in_range_shifted). With ResidualCheck::kReport a mode above its tolerance is returned
-// rather than thrown, for a caller that can do better (the bake deflates the zero modes found
-// and solves again).
-enum class ResidualCheck { kThrow, kReport };
+// (solve_in_range_shifted). zero_modes_below > 0 is for a caller that deflates the zero modes
+// returned (λ below it) and solves again (the bake): a mode above its tolerance is then returned
+// rather than thrown, and Lanczos returns as soon as the zero modes have converged when they keep
+// the others from converging (undeflated, they swamp them by up to 1e6; see BlockLanczos).
 VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int count,
                                const Eigen::Ref<const Eigen::MatrixXd>& Z, Progress* progress = nullptr,
-                               CholmodLLT* factor = nullptr, ResidualCheck check = ResidualCheck::kThrow);
+                               CholmodLLT* factor = nullptr, double zero_modes_below = 0);
 
 // Throws NumericalError, naming the mode, when a mode in [first, last) has a residual above its
 // tolerance.

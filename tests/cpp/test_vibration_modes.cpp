@@ -111,7 +111,7 @@ TEST(VibrationModes, ReportedResidualsAreCheckedOnRequest) {
   const std::vector<int> labels = build_topology(mesh.V, mesh.F).vertex_component;
   const Eigen::MatrixXd Z = rigid_motions(
       mesh.V, Eigen::Map<const Eigen::VectorXi>(labels.data(), static_cast<Eigen::Index>(labels.size())), mass);
-  VibrationModes modes = vibration_modes(K, mass, 8, Z, nullptr, nullptr, ResidualCheck::kReport);
+  VibrationModes modes = vibration_modes(K, mass, 8, Z, nullptr, nullptr, 1e-12 * K.diagonal().sum() / dof_masses(mass).sum());
   ASSERT_EQ(modes.tolerances.size(), 8);
   EXPECT_TRUE((modes.residuals.array() <= modes.tolerances.array()).all());
   EXPECT_TRUE((modes.tolerances.array() > 0).all());
