@@ -189,6 +189,8 @@ def section_accuracy(result):
     out += [f"- {other}: {len(w)} of {len(used) // len(bases)} cases" + (f" ({', '.join(w)})." if w else ".")
             for other, w in wins.items()]
 
+    out += section_accuracy_scans(parameters["scans"], result["figures"])
+
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     for name, colour in zip(parameters["shapes"], ("C0", "C1", "C2")):
         for kind, style in zip(bases, ("-o", ":^", "--s")):
@@ -205,6 +207,25 @@ def section_accuracy(result):
             "Plot: `bench/report.py` from bench/results/accuracy.json (solid: paper pairs, dotted: flexible pairs, "
             "dashed: linear modes; means over the poses).", "", provenance(result)]
     return "\n".join(out)
+
+
+def section_accuracy_scans(scans, figures):
+    """The accuracy suite's real scans: each pose against Refine's minimum, per basis."""
+    out = ["", f"A real scan, at the paper's size {tuple(scans['size'])}: " + "; ".join(
+        f"{name} ({scans['vertices'][name]} vertices): " + ", ".join(d for _, d in scans["poses"][name])
+        for name in scans["poses"]) + ". Its reference is Refine's: `solve_full` started at the paper basis's "
+        "reduced pose.", ""]
+    missed = [f"{r['shape']} {r['pose']}" for r in figures["scan_references"] if not r["converged"]]
+    body = []
+    for ref in figures["scan_references"]:
+        rs = {r["basis"]: r for r in figures["scan_rows"] if (r["shape"], r["pose"]) == (ref["shape"], ref["pose"])}
+        cells = [f"{rs[k]['dimension']}: {100 * rs[k]['rms_error']:.2f}%, {rs[k]['objective_gap']:.3f}"
+                 if ref["converged"] else "reference did not converge" for k in scans["bases"]]
+        body.append([ref["shape"], ref["pose"], f"{ref['iterations']} it, {ref['seconds']:.0f} s"] + cells)
+    out += [table(["scan", "pose", "reference (Newton)"] + [f"{k}: dims, RMS, gap" for k in scans["bases"]], body)]
+    if missed:
+        out += ["", "References that did not converge, left out: " + ", ".join(missed) + "."]
+    return out
 
 
 #: What the accuracy figures say, written from the committed run (bench/results/accuracy.json).
