@@ -12,15 +12,14 @@
 #include "bake/bake_memory.h"
 #include "energy/arap.h"
 #include "energy/discrete_shells.h"
-#include "linalg/cholmod_llt.h"
 #include "linalg/row_blocks.h"
 #include "mesh/mass.h"
 #include "mesh/mesh_check.h"
 #include "mesh/normalization.h"
 #include "modes/modal_derivatives.h"
 #include "modes/rigid_motions.h"
+#include "modes/shifted_pencil.h"
 #include "modes/stiffness_and_mass.h"
-#include "modes/vibration_modes.h"
 #include "reduction/attachment.h"
 #include "reduction/ghost.h"
 #include "reduction/orthonormalize.h"
@@ -41,16 +40,12 @@ constexpr int kPairsPerPass = 64;
 constexpr int kZeroModeAllowance = 6;
 
 // Vibration modes past the rigid motions: the zero modes of a floppy mesh (λ below
-// kZeroEigenvalue · tr K / tr M), then `flexible` modes with λ above it, ascending.
+// kZeroEigenvalue · tr K / tr M; their vectors are the pencil's kernel past the rigid motions),
+// then `flexible` modes with λ above it, ascending.
 struct Modes {
-  Eigen::VectorXd eigenvalues;
-  Eigen::MatrixXd vectors;  // 3n by num_zero + flexible, M-orthonormal
+  Eigen::VectorXd eigenvalues;  // num_zero + flexible
+  Eigen::MatrixXd flexible;     // 3n by flexible, M-orthonormal
   int num_zero = 0;
-  // The shift σ of the factor of K − σM left in the CholmodLLT, and all the non-zero eigenpairs
-  // found with it (the flexible ones and those past them): solve_in_range_shifted corrects them.
-  double shift = 0;
-  Eigen::VectorXd known_eigenvalues;
-  Eigen::MatrixXd known_vectors;
 };
 
 // Asks Lanczos for kZeroModeAllowance modes more than `flexible`, which covers the zero modes of
@@ -60,11 +55,10 @@ struct Modes {
 // apex: with the zero modes in K, their transformed eigenvalue 1/|σ| is about 1e10 times the
 // others', which are left to rounding), or whose Lanczos run returned as soon as its zero modes
 // converged because the others could not beside them (the 5k dragon's 9 at 60 modes).
-Modes flexible_modes(const SparseMatrix& K, const Eigen::VectorXd& mass, const Eigen::MatrixXd& rigid, int flexible,
-                     Progress& progress, CholmodLLT& factor) {
+Modes flexible_modes(ShiftedPencil& pencil, const SparseMatrix& K, const Eigen::VectorXd& mass, int flexible,
+                     Progress& progress) {
   const double zero = kZeroEigenvalue * K.diagonal().sum() / (3 * mass.sum());
-  const auto free = static_cast<int>(K.rows() - rigid.cols());
-  Eigen::MatrixXd kernel = rigid;  // the rigid motions, then the zero modes found so far
+  const auto free = static_cast<int>(K.rows() - pencil.kernel().cols());
   std::vector<double> zero_values;
   for (;;) {
     const int known = static_cast<int>(zero_values.size());
@@ -73,8 +67,7 @@ Modes flexible_modes(const SparseMatrix& K, const Eigen::VectorXd& mass, const E
       throw InputError(message("modes: the simulated mesh has only ", free - known,
                                " degrees of freedom besides its rigid motions and ", known,
                                " zero modes; ask for fewer modes"));
-    const VibrationModes modes =
-        vibration_modes(K, mass, count, kernel, &progress, &factor, zero);
+    const VibrationModes modes = pencil.lowest_modes(count, &progress, zero);
     int found = 0;
     while (found < count && modes.eigenvalues[found] < zero) ++found;
     // The zero modes are deflated next, and the flexible ones go into the basis: both must be
@@ -83,8 +76,7 @@ Modes flexible_modes(const SparseMatrix& K, const Eigen::VectorXd& mass, const E
     const auto within = (modes.residuals.array() <= modes.tolerances.array()).eval();
     require_accurate(modes, 0, found);
     if (found == 0) require_accurate(modes, 0, wanted);  // nothing to deflate: no second try
-    kernel.conservativeResize(Eigen::NoChange, kernel.cols() + found);
-    kernel.rightCols(found) = modes.modes.leftCols(found);
+    pencil.deflate(found);
     zero_values.insert(zero_values.end(), modes.eigenvalues.data(), modes.eigenvalues.data() + found);
     if (within.segment(found, wanted - found).all() && count - found >= flexible) {
       Modes result;
@@ -93,15 +85,7 @@ Modes flexible_modes(const SparseMatrix& K, const Eigen::VectorXd& mass, const E
       result.eigenvalues.head(result.num_zero) =
           Eigen::Map<const Eigen::VectorXd>(zero_values.data(), result.num_zero);
       result.eigenvalues.tail(flexible) = modes.eigenvalues.segment(found, flexible);
-      result.vectors.resize(K.rows(), result.num_zero + flexible);
-      result.vectors.leftCols(result.num_zero) = kernel.rightCols(result.num_zero);
-      result.vectors.rightCols(flexible) = modes.modes.middleCols(found, flexible);
-      result.shift = modes.shift;
-      std::vector<Eigen::Index> known_pairs;
-      for (int i = found; i < count; ++i)
-        if (within[i]) known_pairs.push_back(i);
-      result.known_eigenvalues = modes.eigenvalues(known_pairs);
-      result.known_vectors = modes.modes(Eigen::all, known_pairs);
+      result.flexible = modes.modes.middleCols(found, flexible);
       return result;
     }
   }
@@ -317,65 +301,60 @@ class MovingPart {
   const VectorRef mass;
 };
 
-// 4. CHOLMOD orders K while the ghost of what moves (MovingPart) is simplified beside it (stage
-// 8 uses it). Analysed here rather than inside the eigensolver's first factorisation, so the bar moves
-// between the two (CHOLMOD reports nothing during either), and so that the factor's size is known
-// before the numeric factorisation: what cannot fit is refused at once, not half a minute later.
-Ghost order_beside_the_ghost(const VerticesRef& V, const MovingPart& source, const Simulated& sim,
-                             const SparseMatrix& K, const BakeOptions& options, CholmodLLT& factor, Basis& basis,
-                             Progress& progress) {
+// 4. The pencil (K, M) with the rigid motions as its kernel, and CHOLMOD's ordering of K while the
+// ghost of what moves (MovingPart) is simplified beside it (step 8 uses it). Ordered here
+// rather than at the pencil's first factorisation, so the bar moves between the two (CHOLMOD
+// reports nothing during either), and so that the factor's size is known before the numeric
+// factorisation: what cannot fit is refused at once, not half a minute later.
+Ghost order_beside_the_ghost(const MovingPart& source, const SparseMatrix& K, const BakeOptions& options,
+                             ShiftedPencil& pencil, Basis& basis, Progress& progress) {
   GhostInBackground ghost(source.V, source.F, source.mass, options.ghost);
   progress.report(stages::kFactorisation, 0.0);
   try {
-    factor.analyze(K);
+    pencil.analyze();
   } catch (const OutOfMemory& e) {
     throw OutOfMemory(message("bake: not enough memory to order the stiffness matrix (", K.rows(), " rows, ",
                               K.nonZeros(), " entries): ", e.what()));
   }
-  require_memory(estimate_bake_memory(V.rows(), sim.size(), static_cast<double>(K.nonZeros()), factor.factor_bytes(),
-                                      options.modes, options.derivatives),
+  require_memory(estimate_bake_memory(basis.num_vertices(), K.rows() / 3, static_cast<double>(K.nonZeros()),
+                                      pencil.factor_bytes(), options.modes, options.derivatives),
                  available_memory());
   progress.report(stages::kFactorisation, 1.0);
   const Stopwatch stopwatch(basis.timings[stages::kGhost]);  // the wait beyond the ordering
   return ghost.get(progress);
 }
 
-// 5. The vibration modes (eigenvalue problem K φ = λ M φ), timed without the factorisations
-// (they are the "factorisation" stage). A breakdown names the fine vertex of the failing row.
-Modes vibration_stage(const VerticesRef& V, const Simulated& sim, const SparseMatrix& K, const Eigen::MatrixXd& rigid,
-                      CholmodLLT& factor, Basis& basis, Progress& progress) {
-  const double factoring = factor.seconds();
-  Modes modes;
-  {
-    const Stopwatch stopwatch(basis.timings[stages::kModes]);
-    try {
-      modes = flexible_modes(K, sim.mass, rigid, sim.flexible, progress, factor);
-    } catch (const NumericalError& e) {
-      if (factor.failed_row() < 0) throw;
-      const int vertex = sim.attachment.simulated[static_cast<size_t>(factor.failed_row() / 3)];
-      throw NumericalError(message(e.what(), "; that row is ", "xyz"[factor.failed_row() % 3], " of vertex ", vertex,
-                                   " at (", V(vertex, 0), ", ", V(vertex, 1), ", ", V(vertex, 2), ")"));
-    }
+// 5. The vibration modes (eigenvalue problem K φ = λ M φ), the zero modes of a floppy mesh
+// deflated into the pencil's kernel. A breakdown of the factorisation names the fine vertex of the
+// failing row.
+Modes vibration_stage(const VerticesRef& V, const Simulated& sim, const SparseMatrix& K, ShiftedPencil& pencil,
+                      Progress& progress) {
+  try {
+    return flexible_modes(pencil, K, sim.mass, sim.flexible, progress);
+  } catch (const NumericalError& e) {
+    const int row = pencil.failed_row();
+    if (row < 0) throw;
+    const int vertex = sim.attachment.simulated[static_cast<size_t>(row / 3)];
+    throw NumericalError(message(e.what(), "; that row is ", "xyz"[row % 3], " of vertex ", vertex, " at (",
+                                 V(vertex, 0), ", ", V(vertex, 1), ", ", V(vertex, 2), ")"));
   }
-  basis.timings[stages::kModes] -= factor.seconds() - factoring;
-  return modes;
 }
 
 // 6. Modal derivatives (paper eq. 9, ∇²E ψ_ij = −∇³E(φ_i, φ_j)) of the pairs of modes other than
 // the translations and zero modes: the linearised rotations of each component (λ = 0, so first),
-// then the flexible modes. The shells energy and the paired modes are freed before the solves,
-// where the bake's memory peaks (on dragon_vrip_res2 with 20 + 110, with the even blocks of
-// solve_in_range_shifted, the peak falls from 2137 to 1933 MiB).
-Eigen::MatrixXd derivative_stage(const Simulated& sim, Stiffness& stiffness, const Eigen::MatrixXd& rigid,
-                                 const Modes& modes, const BakeOptions& options, CholmodLLT& factor, Basis& basis,
-                                 Progress& progress) {
+// then the flexible modes, solved in the pencil. The shells energy and the paired modes are freed
+// before the solves, where the bake's memory peaks (on dragon_vrip_res2 with 20 + 110, with the
+// even blocks of solve_in_range, the peak falls from 2137 to 1933 MiB).
+Eigen::MatrixXd derivative_stage(const Simulated& sim, Stiffness& stiffness, const Modes& modes,
+                                 const BakeOptions& options, ShiftedPencil& pencil, Basis& basis, Progress& progress) {
   const Eigen::Index S = sim.size();
   Eigen::MatrixXd derivatives(3 * S, options.derivatives);
   if (options.derivatives == 0) return derivatives;
   const int paired_rotations = options.rotation_pairs ? 3 * sim.attachment.num_components : 0;
   Eigen::MatrixXd phi(3 * S, paired_rotations + sim.flexible);
+  const Eigen::MatrixXd& rigid = pencil.kernel();  // the rigid motions first, 6 per component
   for (int r = 0; r < paired_rotations; ++r) phi.col(r) = rigid.col(6 * (r / 3) + 3 + r % 3);
-  phi.rightCols(sim.flexible) = modes.vectors.rightCols(sim.flexible);
+  phi.rightCols(sim.flexible) = modes.flexible;
   const std::vector<std::array<int, 2>> pairs =
       derivative_pairs(components_moved(phi, sim.attachment.component), options.derivatives);
   // Modes are zero at a region's clamped vertices, which the energy has after the simulated ones.
@@ -393,26 +372,18 @@ Eigen::MatrixXd derivative_stage(const Simulated& sim, Stiffness& stiffness, con
   });
   stiffness.shells.reset();
   phi.resize(0, 0);
-  const int num_zero = modes.num_zero;
-  Eigen::MatrixXd kernel(3 * S, sim.num_rigid + num_zero);
-  kernel.leftCols(sim.num_rigid) = rigid;
-  kernel.rightCols(num_zero) = modes.vectors.leftCols(num_zero);
-  const Stopwatch stopwatch(basis.timings[stages::kDerivativeSolves]);
-  return solve_in_range_shifted(stiffness.K, sim.mass, kernel, std::move(derivatives), factor, modes.shift,
-                                modes.known_eigenvalues, modes.known_vectors, &progress);
+  return pencil.solve_in_range(std::move(derivatives), &progress);
 }
 
 // 7. [rigid motions, zero modes, modes, derivatives], M-orthonormal; derivatives that came out
 // dependent are dropped (basis.num_dropped).
-Eigen::MatrixXd orthonormal_basis(const Simulated& sim, const Eigen::MatrixXd& rigid, const Modes& modes,
-                                  Eigen::MatrixXd derivatives, const BakeOptions& options, Basis& basis,
-                                  Progress& progress) {
-  const int num_zero = modes.num_zero;
-  const int leading = options.modes + num_zero;
-  Eigen::MatrixXd U(3 * sim.size(), leading + options.derivatives);
-  U.leftCols(sim.num_rigid) = rigid;
-  U.middleCols(sim.num_rigid, num_zero + sim.flexible) = modes.vectors;
-  U.rightCols(options.derivatives) = derivatives;
+Eigen::MatrixXd orthonormal_basis(const Simulated& sim, const ShiftedPencil& pencil, const Modes& modes,
+                                  Eigen::MatrixXd derivatives, Basis& basis, Progress& progress) {
+  const Eigen::MatrixXd& kernel = pencil.kernel();  // the rigid motions, then the zero modes
+  const auto leading = static_cast<int>(kernel.cols() + modes.flexible.cols());
+  const Eigen::Index num_derivatives = derivatives.cols();
+  Eigen::MatrixXd U(kernel.rows(), leading + num_derivatives);
+  U << kernel, modes.flexible, derivatives;
   derivatives.resize(0, 0);
   {
     const Stopwatch stopwatch(basis.timings[stages::kOrthonormalisation]);
@@ -422,12 +393,12 @@ Eigen::MatrixXd orthonormal_basis(const Simulated& sim, const Eigen::MatrixXd& r
         throw NumericalError(message("bake: column ", j, " of the rigid motions and modes came out dependent; ",
                                      "they are not M-orthonormal"));
   }
-  basis.num_dropped = static_cast<int>(leading + options.derivatives - U.cols());
+  basis.num_dropped = static_cast<int>(leading + num_derivatives - U.cols());
   basis.num_rigid = sim.num_rigid;
-  basis.num_floppy = num_zero;
+  basis.num_floppy = modes.num_zero;
   basis.num_modes = leading;
   basis.eigenvalues = Eigen::VectorXd::Zero(leading);
-  basis.eigenvalues.tail(num_zero + sim.flexible) = modes.eigenvalues;
+  basis.eigenvalues.tail(modes.eigenvalues.size()) = modes.eigenvalues;
   return U;
 }
 
@@ -469,15 +440,18 @@ Basis bake_stages(const VerticesRef& V, const FacesRef& F, const BakeOptions& op
                   Progress& progress) {
   const Simulated sim = simulated_submesh(V, F, options, basis, progress);
   Stiffness stiffness = stiffness_at_rest(sim, options, basis, progress);
-  const Eigen::MatrixXd rigid = sim.num_rigid > 0 ? rigid_motions(sim.V, sim.attachment.component, sim.mass)
-                                                  : Eigen::MatrixXd(3 * sim.size(), 0);
-  CholmodLLT factor(3);  // one factorisation for the modes and the derivative solves
   const MovingPart source(V, F, basis.mass, sim.region_vertices, sim.attachment.faces);
-  Ghost coarse = order_beside_the_ghost(V, source, sim, stiffness.K, options, factor, basis, progress);
-  const Modes modes = vibration_stage(V, sim, stiffness.K, rigid, factor, basis, progress);
-  Eigen::MatrixXd derivatives = derivative_stage(sim, stiffness, rigid, modes, options, factor, basis, progress);
-  basis.timings[stages::kFactorisation] = factor.seconds();
-  Eigen::MatrixXd U = orthonormal_basis(sim, rigid, modes, std::move(derivatives), options, basis, progress);
+  ShiftedPencil pencil(stiffness.K, sim.mass,
+                       sim.num_rigid > 0 ? rigid_motions(sim.V, sim.attachment.component, sim.mass)
+                                         : Eigen::MatrixXd(3 * sim.size(), 0));
+  Ghost coarse = order_beside_the_ghost(source, stiffness.K, options, pencil, basis, progress);
+  const Modes modes = vibration_stage(V, sim, stiffness.K, pencil, progress);
+  Eigen::MatrixXd derivatives = derivative_stage(sim, stiffness, modes, options, pencil, basis, progress);
+  const ShiftedPencil::Timings pencil_timings = pencil.timings();
+  basis.timings[stages::kFactorisation] = pencil_timings.factorisation;
+  basis.timings[stages::kModes] = pencil_timings.modes;
+  if (options.derivatives > 0) basis.timings[stages::kDerivativeSolves] = pencil_timings.solves;
+  Eigen::MatrixXd U = orthonormal_basis(sim, pencil, modes, std::move(derivatives), basis, progress);
   fine_and_ghost_vectors(std::move(U), sim, source, std::move(coarse), options.paint, basis, progress);
   return basis;
 }
