@@ -45,11 +45,16 @@ constexpr double kRoundingFloor = 1e-12;
 // springs after the final inverse iteration, 1e-10 5e-13 (tests/cpp/test_vibration_modes.cpp
 // asks for 2.5e-11). On dragon_vrip_res2 each block of 8 takes the estimate down 30 to 60 times.
 constexpr double kEigenTolerance = 1e-10;
-// A Ritz estimate stops falling at the rounding of the largest ν: on the 5k dragon with its 9
-// zero modes undeflated (ν = 1.4e5), the estimates of the 60th mode (ν = 0.19) hovered at 2e-11 to
-// 6e-11, 1 to 2 ε ν_max, against a tolerance of 1.9e-11 over 700 Lanczos vectors. A pair whose
-// tolerance kEigenTolerance |ν| is below kRoundingReach ε ν_max is out of reach.
-constexpr double kRoundingReach = 10;
+// A Ritz estimate stops falling near the rounding of the largest ν, ε ν_max: on the 5k dragon with
+// its 9 zero modes undeflated (ν = 1.4e5), the estimates of the modes with tolerances of 0.6 to
+// 0.9 ε ν_max hovered at 1 to 2 ε ν_max over 700 Lanczos vectors. A pair whose tolerance
+// kEigenTolerance |ν| is below ε ν_max is out of reach once its Ritz value has settled (its
+// estimate below kSettledEstimate |ν|: early Ritz values are low, so the 23k dragon's 136th mode
+// looked out of reach but converged); pairs all within kRoundingLevels ε ν_max have stalled when
+// kStalledBlocks blocks do not halve the worst estimate relative to its tolerance.
+constexpr double kSettledEstimate = 1e-6;
+constexpr double kRoundingLevels = 10;
+constexpr size_t kStalledBlocks = 4;
 // A new Lanczos direction whose M-norm is below this fraction of the largest one in its block is
 // dropped (the Krylov space has closed, up to rounding).
 constexpr double kDependentNorm = 1e-8;
@@ -150,7 +155,7 @@ class BlockLanczos {
         // With `dimension` vectors the space is the whole problem and its Ritz pairs are exact
         // (small meshes).
         if (converged.all() || next.rows() == 0 || last == dimension_ ||
-            zero_modes_stand_in_the_way(nu, converged))
+            zero_modes_stand_in_the_way(nu, estimate, converged))
           return Q_.leftCols(last) * S;
       }
       if (added == 0)
@@ -163,14 +168,24 @@ class BlockLanczos {
 
  private:
   // Zero modes left in T (a floppy mesh's) have ν about 1/|σ|, up to 1e6 times the wanted
-  // flexible modes', whose estimates then stop at the rounding of the largest ν, below their
-  // tolerance: true, once the zero modes have converged, when some unconverged pair is out of
-  // reach, so that the caller deflates them and solves again.
-  bool zero_modes_stand_in_the_way(const Eigen::VectorXd& nu, const Eigen::Array<bool, Eigen::Dynamic, 1>& converged) const {
+  // flexible modes', whose estimates then stop near the rounding of the largest ν, above their
+  // tolerance: true, once the zero modes have converged, when an unconverged pair is out of reach
+  // or all have stalled at that rounding, so that the caller deflates them and solves again.
+  bool zero_modes_stand_in_the_way(const Eigen::VectorXd& nu, const Eigen::VectorXd& estimate,
+                                   const Eigen::Array<bool, Eigen::Dynamic, 1>& converged) {
     const auto zero = (nu.array() >= zero_nu_).eval();
     if (!zero.any() || (zero && !converged).any()) return false;
-    const double reach = kRoundingReach * std::numeric_limits<double>::epsilon() * nu.maxCoeff() / kEigenTolerance;
-    return (!converged && nu.array().abs() < reach).any();
+    const double rounding = std::numeric_limits<double>::epsilon() * nu.maxCoeff();
+    const auto tolerance = (kEigenTolerance * nu.array().abs()).eval();
+    const auto settled = (estimate.array() <= kSettledEstimate * nu.array().abs()).eval();
+    if ((!converged && settled && tolerance < rounding).any()) return true;
+    if ((!converged && estimate.array() > kRoundingLevels * rounding).any()) {
+      worst_.clear();
+      return false;
+    }
+    worst_.push_back((estimate.array() / tolerance).maxCoeff());
+    const size_t blocks = worst_.size();
+    return blocks > kStalledBlocks && worst_[blocks - 1] > 0.5 * worst_[blocks - 1 - kStalledBlocks];
   }
 
   // W −= Q Qᵀ M W over the first `columns` of Q; returns the coefficients removed. W = T Q_j lies
@@ -223,6 +238,9 @@ class BlockLanczos {
   const Eigen::VectorXd& m_;
   Eigen::Index dimension_;
   double zero_nu_;
+  // Per check since every unconverged estimate came within kRoundingLevels ε ν_max: the largest
+  // estimate relative to its tolerance.
+  std::vector<double> worst_;
   Eigen::MatrixXd Q_;  // the Lanczos vectors, columns_ of them so far
   Eigen::MatrixXd H_;  // Qᵀ M T Q
   Eigen::Index columns_ = 0;
