@@ -40,6 +40,9 @@ Eigen::VectorXd checked_input(const VerticesRef& V, const FacesRef& F, const Han
   if (options.max_iterations < 0)
     throw InputError(message("max_iterations: expected at least 0, got ", options.max_iterations));
   if (initial) require_positions(flatten(*initial), 3 * n, "initial");
+  for (size_t i = 0; i < options.held.size(); ++i)
+    if (options.held[i] < 0 || options.held[i] >= n)
+      throw InputError(message("held[", i, "] = ", options.held[i], " is not a vertex (0 to ", n - 1, ")"));
   return handle_weights;
 }
 
@@ -75,7 +78,7 @@ FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handle
   progress.report("solve", 0);
 
   PoseObjective objective(V, F, handles, handle_weights, stiffness, options.energy, options.bending,
-                          options.membrane, options.paint);
+                          options.membrane, options.paint, options.held);
   const LoadPath path(V, handles, transforms);
   ShiftedNewton newton(objective);
 
@@ -130,6 +133,9 @@ FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handle
   result.gradient_norm = point.gradient.norm();
   result.converged = result.gradient_norm <= options.tolerance * result.gradient_scale;
   result.positions = Eigen::Map<const RowMatrixX3d>(point.y.data(), V.rows(), 3) / objective.scale();
+  // Held vertices are where they started to the last bit, not through the frame's scaling.
+  const VerticesRef started_at = initial ? VerticesRef(*initial) : V;
+  for (int v : options.held) result.positions.row(v) = started_at.row(v);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

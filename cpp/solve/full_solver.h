@@ -20,6 +20,8 @@
 // stops and reports that it did not converge.
 #pragma once
 
+#include <vector>
+
 #include "energy/make_energy.h"
 #include "solve/handle_term.h"
 #include "util/progress.h"
@@ -38,6 +40,9 @@ struct FullSolveOptions {
   // Called as ("solve", fraction done) at most every 0.1 s; returning false cancels (Cancelled).
   ProgressCallback progress = nullptr;
   StiffnessPaint paint = {};  // the shells weights painted per vertex (stiffness_paint.h; not with ARAP)
+  // Vertices held exactly where the solve starts (at rest, or at `initial`): a region bake's
+  // outside, which Refine keeps still. Their coordinates leave the unknowns.
+  std::vector<int> held = {};
 };
 
 struct FullSolveResult {

@@ -1,5 +1,6 @@
 #include "solve/pose_objective.h"
 
+#include <algorithm>
 #include <limits>
 
 #include "mesh/mass.h"
@@ -10,7 +11,7 @@ namespace modal_deform {
 
 PoseObjective::PoseObjective(const VerticesRef& V, const FacesRef& F, const Handles& handles,
                              const Eigen::VectorXd& weights, double stiffness, EnergyKind energy, double bending,
-                             double membrane, const StiffnessPaint& paint)
+                             double membrane, const StiffnessPaint& paint, const std::vector<int>& held)
     : scale_(normalizing_scale(V)),
       rest_(scale_ * V),
       energy_(make_energy(energy, rest_, F, bending, membrane, paint)),
@@ -31,6 +32,20 @@ PoseObjective::PoseObjective(const VerticesRef& V, const FacesRef& F, const Hand
     if (mass[v] == 0 && hessian_diagonal.segment<3>(3 * v).isZero(0) && handle_diagonal.segment<3>(3 * v).isZero(0))
       constant_diagonal_.segment<3>(3 * v).setConstant(mean_mass);
   smallest_shift_ = 1e-8 * (hessian_diagonal + handle_diagonal).cwiseAbs().mean() / mean_mass;
+  // Held coordinates decouple (without_held) with a diagonal of their own, so their step is 0.
+  if (!held.empty()) held_.assign(3 * static_cast<size_t>(n), 0);
+  for (int v : held) {
+    std::fill_n(held_.begin() + 3 * static_cast<std::ptrdiff_t>(v), 3, 1);
+    constant_diagonal_.segment<3>(3 * v).setConstant(mean_mass);
+  }
+}
+
+SparseMatrix PoseObjective::without_held(SparseMatrix hessian) const {
+  if (held_.empty()) return hessian;
+  for (int col = 0; col < hessian.outerSize(); ++col)
+    for (SparseMatrix::InnerIterator entry(hessian, col); entry; ++entry)
+      if (held_[static_cast<size_t>(entry.row())] || held_[static_cast<size_t>(col)]) entry.valueRef() = 0;
+  return hessian;
 }
 
 bool PoseObjective::turns_a_triangle_over(const Eigen::VectorXd& y, const Eigen::VectorXd& y_new) const {
@@ -52,8 +67,10 @@ void PoseObjective::set_transforms(Transforms transforms) {
 
 double PoseObjective::operator()(const Eigen::VectorXd& y, Eigen::VectorXd& gradient) const {
   if (!positions_in_range(y)) return std::numeric_limits<double>::infinity();
-  const double value = energy_->value_and_gradient(y, gradient);
-  return value + handle_term_.add_value_and_gradient(y, gradient);
+  const double value = energy_->value_and_gradient(y, gradient) + handle_term_.add_value_and_gradient(y, gradient);
+  for (size_t i = 0; i < held_.size(); ++i)
+    if (held_[i]) gradient[static_cast<Eigen::Index>(i)] = 0;
+  return value;
 }
 
 }  // namespace modal_deform

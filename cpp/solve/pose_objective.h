@@ -19,12 +19,20 @@ class PoseObjective {
   // V: #V by 3 rest positions and F: #F by 3 triangles (validated); handles and weights as
   // checked_handle_weights returns them; stiffness μ > 0; energy, bending, membrane and paint as
   // make_energy takes them.
+  // `held` (vertex indices in range) stay where y puts them: their gradient and their Hessian rows
+  // are zero.
   PoseObjective(const VerticesRef& V, const FacesRef& F, const Handles& handles, const Eigen::VectorXd& weights,
-                double stiffness, EnergyKind energy, double bending, double membrane, const StiffnessPaint& paint);
+                double stiffness, EnergyKind energy, double bending, double membrane, const StiffnessPaint& paint,
+                const std::vector<int>& held = {});
 
   double scale() const { return scale_; }
   Eigen::VectorXd rest_positions() const { return flatten(rest_); }
-  const Energy& energy() const { return *energy_; }
+  // The energy's Hessian at y, exact or projected (each element's made semidefinite), with the held
+  // coordinates' rows and columns zero.
+  SparseMatrix hessian(const Eigen::VectorXd& y) const { return without_held(energy_->hessian(y)); }
+  SparseMatrix projected_hessian(const Eigen::VectorXd& y) const {
+    return without_held(energy_->projected_hessian(y));
+  }
   // D (3#V): the normalised lumped mass per coordinate, the shape of the Hessian's shift, floored
   // at 1e-6 of its mean.
   const Eigen::VectorXd& mass_diagonal() const { return mass_diagonal_; }
@@ -46,6 +54,8 @@ class PoseObjective {
   double operator()(const Eigen::VectorXd& y, Eigen::VectorXd& gradient) const;
 
  private:
+  SparseMatrix without_held(SparseMatrix hessian) const;
+
   double scale_;
   RowMatrixX3d rest_;
   std::unique_ptr<Energy> energy_;
@@ -53,6 +63,7 @@ class PoseObjective {
   Eigen::VectorXd mass_diagonal_, constant_diagonal_;
   double smallest_shift_ = 0;
   RowMatrixX3i faces_;
+  std::vector<char> held_;  // per coordinate, empty when nothing is held
 };
 
 }  // namespace modal_deform

@@ -30,11 +30,10 @@ int ShiftedNewton::minimize(NewtonPoint& point, double target, int budget, doubl
 }
 
 bool ShiftedNewton::iterate(NewtonPoint& point, bool near_minimum) {
-  const Energy& energy = objective_.energy();
   const bool try_exact = near_minimum && ++since_exact_failed_ > kRetryExactAfter;
-  const bool exact = try_exact && try_factorize(energy.hessian(point.y));
+  const bool exact = try_exact && try_factorize(objective_.hessian(point.y));
   if (try_exact && !exact) since_exact_failed_ = 0;
-  if (!exact) factorize_shifted(energy.projected_hessian(point.y));
+  if (!exact) factorize_shifted(objective_.projected_hessian(point.y));
   llt_.solve(point.gradient, step_);
   step_ = -step_;
   const double slope = point.gradient.dot(step_);

@@ -86,6 +86,29 @@ def test_a_dense_region_is_baked_on_a_proxy_of_its_own_faces():
         mdc.Basis.from_arrays({**arrays, "prolongation_weights": weights})
 
 
+def test_refine_keeps_the_outside_exactly_where_it_was(tube):
+    """Refine of a region bake holds every vertex outside the region where the reduced pose left it
+    (at rest), and reaches the full solve's minimum with the outside held."""
+    V, F, region = tube
+    basis = mdc.bake(V, F, modes=12, derivatives=30, ghost=100, region=region)
+    outside = np.setdiff1d(np.arange(len(V)), region)
+    top = np.flatnonzero(V[:, 2] > 6 - 1e-9)
+    T = np.eye(4)
+    T[:3, 3] = [0.6, 0.0, -0.3]
+    solver = mdc.ReducedSolver(basis, [top], stiffness=1e3)
+    solver.set_transforms([T])
+    solver.solve(max_iterations=200, tolerance=1e-8)
+    start = solver.positions().astype(np.float64)
+    X, stats = solver.refine(F)
+    assert stats["converged"], stats
+    assert X[outside].tobytes() == start[outside].tobytes()
+    held, held_stats = mdc.solve_full(V, F, [top], [T], stiffness=1e3, held=outside, return_stats=True)
+    assert held_stats["converged"] and np.array_equal(held[outside], V[outside])
+    assert np.abs(X - held).max() < 1e-4 * np.linalg.norm(np.ptp(V, axis=0))
+    with pytest.raises(ValueError, match=rf"held\[1\] = {len(V)} is not a vertex"):
+        mdc.solve_full(V, F, [top], [T], held=[0, len(V)])
+
+
 def test_handles_outside_the_region_are_refused(tube):
     V, F, region = tube
     basis = mdc.bake(V, F, modes=8, derivatives=0, ghost=100, region=region)
