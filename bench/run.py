@@ -22,8 +22,9 @@ Experiments (each writes bench/results/<name>.json: machine, commit, command, pa
                own bake and solve_full (bench/strong_poses.py)
   refine       the full solve from rest and Refine from the reduced pose on the 23k and 100k dragons and
                a raw-scan-like 23k dragon, turned by 30, 90, 170 degrees and bent (bench/refine.py)
-  region       the 100k dragon's head baked as a region against the whole dragon's bake: time, stages,
-               dimensions, and that nothing outside the region moves (bench/region.py)
+  region       the head of the 100k dragon, and of it subdivided to 1.6M (on proxies), baked as a region
+               against the whole mesh: time, stages, dimensions, and that nothing outside the region moves
+               (bench/region.py)
   blender      the add-on's pose update in headless Blender and Blender's Laplacian Deform
                (bench/blender_pose.py), in Debian's 3.4.1 app from the source tree
   bpy_pose     the pose update alone at 100k, 400k and 1.6M vertices in bpy 4.5 and 5.3 (.venv/bpy-<version>,

@@ -195,6 +195,15 @@ def end_turns(V, turns=(30, 90, 170), bend=90):
     return handles, poses
 
 
+def turned_scan(name, turns):
+    """A shared scan in the normalised frame (scaled so that its longest bounding-box edge is 10)
+    with Refine's handles and turns (end_turns, no bend)."""
+    V, F = mdc.read_mesh(SHARED_MESHES / _SCAN_FILES[name])
+    V = (V - V.min(axis=0)) * (10.0 / np.ptp(V, axis=0).max())
+    handles, poses = end_turns(V, turns, bend=None)
+    return Shape(name, V, F, handles, poses, (0.3, -1.0, -0.3))
+
+
 def scan(name):
     """A shared scan (read in place, in its own units) with the end_pull handles and pose."""
     V, F = mdc.read_mesh(SHARED_MESHES / _SCAN_FILES[name])

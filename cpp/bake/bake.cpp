@@ -12,15 +12,14 @@
 #include "bake/bake_memory.h"
 #include "energy/arap.h"
 #include "energy/discrete_shells.h"
-#include "linalg/cholmod_llt.h"
 #include "linalg/row_blocks.h"
 #include "mesh/mass.h"
 #include "mesh/mesh_check.h"
 #include "mesh/normalization.h"
 #include "modes/modal_derivatives.h"
 #include "modes/rigid_motions.h"
+#include "modes/shifted_pencil.h"
 #include "modes/stiffness_and_mass.h"
-#include "modes/vibration_modes.h"
 #include "reduction/attachment.h"
 #include "reduction/ghost.h"
 #include "reduction/orthonormalize.h"
@@ -41,16 +40,12 @@ constexpr int kPairsPerPass = 64;
 constexpr int kZeroModeAllowance = 6;
 
 // Vibration modes past the rigid motions: the zero modes of a floppy mesh (λ below
-// kZeroEigenvalue · tr K / tr M), then `flexible` modes with λ above it, ascending.
+// kZeroEigenvalue · tr K / tr M; their vectors are the pencil's kernel past the rigid motions),
+// then `flexible` modes with λ above it, ascending.
 struct Modes {
-  Eigen::VectorXd eigenvalues;
-  Eigen::MatrixXd vectors;  // 3n by num_zero + flexible, M-orthonormal
+  Eigen::VectorXd eigenvalues;  // num_zero + flexible
+  Eigen::MatrixXd flexible;     // 3n by flexible, M-orthonormal
   int num_zero = 0;
-  // The shift σ of the factor of K − σM left in the CholmodLLT, and all the non-zero eigenpairs
-  // found with it (the flexible ones and those past them): solve_in_range_shifted corrects them.
-  double shift = 0;
-  Eigen::VectorXd known_eigenvalues;
-  Eigen::MatrixXd known_vectors;
 };
 
 // Asks Lanczos for kZeroModeAllowance modes more than `flexible`, which covers the zero modes of
@@ -58,12 +53,12 @@ struct Modes {
 // the zero modes found deflated, until the flexible modes are complete. So is a mesh whose
 // flexible modes miss their residual tolerance next to zero modes (two cones joined at their
 // apex: with the zero modes in K, their transformed eigenvalue 1/|σ| is about 1e10 times the
-// others', which are left to rounding).
-Modes flexible_modes(const SparseMatrix& K, const Eigen::VectorXd& mass, const Eigen::MatrixXd& rigid, int flexible,
-                     Progress& progress, CholmodLLT& factor) {
+// others', which are left to rounding), or whose Lanczos run returned as soon as its zero modes
+// converged because the others could not beside them (the 5k dragon's 9 at 60 modes).
+Modes flexible_modes(ShiftedPencil& pencil, const SparseMatrix& K, const Eigen::VectorXd& mass, int flexible,
+                     Progress& progress) {
   const double zero = kZeroEigenvalue * K.diagonal().sum() / (3 * mass.sum());
-  const auto free = static_cast<int>(K.rows() - rigid.cols());
-  Eigen::MatrixXd kernel = rigid;  // the rigid motions, then the zero modes found so far
+  const auto free = static_cast<int>(K.rows() - pencil.kernel().cols());
   std::vector<double> zero_values;
   for (;;) {
     const int known = static_cast<int>(zero_values.size());
@@ -72,8 +67,7 @@ Modes flexible_modes(const SparseMatrix& K, const Eigen::VectorXd& mass, const E
       throw InputError(message("modes: the simulated mesh has only ", free - known,
                                " degrees of freedom besides its rigid motions and ", known,
                                " zero modes; ask for fewer modes"));
-    const VibrationModes modes =
-        vibration_modes(K, mass, count, kernel, &progress, &factor, ResidualCheck::kReport);
+    const VibrationModes modes = pencil.lowest_modes(count, &progress, zero);
     int found = 0;
     while (found < count && modes.eigenvalues[found] < zero) ++found;
     // The zero modes are deflated next, and the flexible ones go into the basis: both must be
@@ -82,8 +76,7 @@ Modes flexible_modes(const SparseMatrix& K, const Eigen::VectorXd& mass, const E
     const auto within = (modes.residuals.array() <= modes.tolerances.array()).eval();
     require_accurate(modes, 0, found);
     if (found == 0) require_accurate(modes, 0, wanted);  // nothing to deflate: no second try
-    kernel.conservativeResize(Eigen::NoChange, kernel.cols() + found);
-    kernel.rightCols(found) = modes.modes.leftCols(found);
+    pencil.deflate(found);
     zero_values.insert(zero_values.end(), modes.eigenvalues.data(), modes.eigenvalues.data() + found);
     if (within.segment(found, wanted - found).all() && count - found >= flexible) {
       Modes result;
@@ -92,15 +85,7 @@ Modes flexible_modes(const SparseMatrix& K, const Eigen::VectorXd& mass, const E
       result.eigenvalues.head(result.num_zero) =
           Eigen::Map<const Eigen::VectorXd>(zero_values.data(), result.num_zero);
       result.eigenvalues.tail(flexible) = modes.eigenvalues.segment(found, flexible);
-      result.vectors.resize(K.rows(), result.num_zero + flexible);
-      result.vectors.leftCols(result.num_zero) = kernel.rightCols(result.num_zero);
-      result.vectors.rightCols(flexible) = modes.modes.middleCols(found, flexible);
-      result.shift = modes.shift;
-      std::vector<Eigen::Index> known_pairs;
-      for (int i = found; i < count; ++i)
-        if (within[i]) known_pairs.push_back(i);
-      result.known_eigenvalues = modes.eigenvalues(known_pairs);
-      result.known_vectors = modes.modes(Eigen::all, known_pairs);
+      result.flexible = modes.modes.middleCols(found, flexible);
       return result;
     }
   }
@@ -291,74 +276,85 @@ Stiffness stiffness_at_rest(const Simulated& sim, const BakeOptions& options, Ba
   });
 }
 
-// What the ghost simplifies (mesh units): the whole mesh, or a region bake's submesh (its
-// simulated vertices, then the clamped ones, Simulated::region_vertices), so that all of the
-// ghost's vertices are spent where the mesh moves.
-struct GhostSource {
-  VerticesRef V;
-  FacesRef F;
-  VectorRef mass;
+// The part of the mesh that moves (mesh units), with its masses: the whole mesh, or a region bake's
+// submesh (its free vertices, then the clamped ones: RegionMesh::vertices, and its faces). The
+// ghost and a proxy simplify it, so that all their vertices are spent where the mesh moves.
+class MovingPart {
+ public:
+  MovingPart(const VerticesRef& mesh_V, const FacesRef& mesh_F, const VectorRef& mesh_mass,
+             const std::vector<int>& submesh, const FacesRef& submesh_F)
+      : submesh_V_(mesh_V(submesh, Eigen::all)),
+        submesh_mass_(mesh_mass(submesh)),
+        V(submesh.empty() ? mesh_V : VerticesRef(submesh_V_)),
+        F(submesh.empty() ? mesh_F : submesh_F),
+        mass(submesh.empty() ? mesh_mass : VectorRef(submesh_mass_)) {}
+  MovingPart(const MovingPart&) = delete;
+  MovingPart& operator=(const MovingPart&) = delete;
+
+ private:
+  const RowMatrixX3d submesh_V_;
+  const Eigen::VectorXd submesh_mass_;
+
+ public:
+  const VerticesRef V;
+  const FacesRef F;
+  const VectorRef mass;
 };
 
-// 4. CHOLMOD orders K while the ghost of what moves (GhostSource) is simplified beside it (stage
-// 8 uses it). Analysed here rather than inside the eigensolver's first factorisation, so the bar moves
-// between the two (CHOLMOD reports nothing during either), and so that the factor's size is known
-// before the numeric factorisation: what cannot fit is refused at once, not half a minute later.
-Ghost order_beside_the_ghost(const VerticesRef& V, const GhostSource& source, const Simulated& sim,
-                             const SparseMatrix& K, const BakeOptions& options, CholmodLLT& factor, Basis& basis,
-                             Progress& progress) {
+// 4. The pencil (K, M) with the rigid motions as its kernel, and CHOLMOD's ordering of K while the
+// ghost of what moves (MovingPart) is simplified beside it (step 8 uses it). Ordered here
+// rather than at the pencil's first factorisation, so the bar moves between the two (CHOLMOD
+// reports nothing during either), and so that the factor's size is known before the numeric
+// factorisation: what cannot fit is refused at once, not half a minute later.
+Ghost order_beside_the_ghost(const MovingPart& source, const SparseMatrix& K, const BakeOptions& options,
+                             ShiftedPencil& pencil, Basis& basis, Progress& progress) {
   GhostInBackground ghost(source.V, source.F, source.mass, options.ghost);
   progress.report(stages::kFactorisation, 0.0);
   try {
-    factor.analyze(K);
+    pencil.analyze();
   } catch (const OutOfMemory& e) {
     throw OutOfMemory(message("bake: not enough memory to order the stiffness matrix (", K.rows(), " rows, ",
                               K.nonZeros(), " entries): ", e.what()));
   }
-  require_memory(estimate_bake_memory(V.rows(), sim.size(), static_cast<double>(K.nonZeros()), factor.factor_bytes(),
-                                      options.modes, options.derivatives),
+  require_memory(estimate_bake_memory(basis.num_vertices(), K.rows() / 3, static_cast<double>(K.nonZeros()),
+                                      pencil.factor_bytes(), options.modes, options.derivatives),
                  available_memory());
   progress.report(stages::kFactorisation, 1.0);
   const Stopwatch stopwatch(basis.timings[stages::kGhost]);  // the wait beyond the ordering
   return ghost.get(progress);
 }
 
-// 5. The vibration modes (eigenvalue problem K φ = λ M φ), timed without the factorisations
-// (they are the "factorisation" stage). A breakdown names the fine vertex of the failing row.
-Modes vibration_stage(const VerticesRef& V, const Simulated& sim, const SparseMatrix& K, const Eigen::MatrixXd& rigid,
-                      CholmodLLT& factor, Basis& basis, Progress& progress) {
-  const double factoring = factor.seconds();
-  Modes modes;
-  {
-    const Stopwatch stopwatch(basis.timings[stages::kModes]);
-    try {
-      modes = flexible_modes(K, sim.mass, rigid, sim.flexible, progress, factor);
-    } catch (const NumericalError& e) {
-      if (factor.failed_row() < 0) throw;
-      const int vertex = sim.attachment.simulated[static_cast<size_t>(factor.failed_row() / 3)];
-      throw NumericalError(message(e.what(), "; that row is ", "xyz"[factor.failed_row() % 3], " of vertex ", vertex,
-                                   " at (", V(vertex, 0), ", ", V(vertex, 1), ", ", V(vertex, 2), ")"));
-    }
+// 5. The vibration modes (eigenvalue problem K φ = λ M φ), the zero modes of a floppy mesh
+// deflated into the pencil's kernel. A breakdown of the factorisation names the fine vertex of the
+// failing row.
+Modes vibration_stage(const VerticesRef& V, const Simulated& sim, const SparseMatrix& K, ShiftedPencil& pencil,
+                      Progress& progress) {
+  try {
+    return flexible_modes(pencil, K, sim.mass, sim.flexible, progress);
+  } catch (const NumericalError& e) {
+    const int row = pencil.failed_row();
+    if (row < 0) throw;
+    const int vertex = sim.attachment.simulated[static_cast<size_t>(row / 3)];
+    throw NumericalError(message(e.what(), "; that row is ", "xyz"[row % 3], " of vertex ", vertex, " at (",
+                                 V(vertex, 0), ", ", V(vertex, 1), ", ", V(vertex, 2), ")"));
   }
-  basis.timings[stages::kModes] -= factor.seconds() - factoring;
-  return modes;
 }
 
 // 6. Modal derivatives (paper eq. 9, ∇²E ψ_ij = −∇³E(φ_i, φ_j)) of the pairs of modes other than
 // the translations and zero modes: the linearised rotations of each component (λ = 0, so first),
-// then the flexible modes. The shells energy and the paired modes are freed before the solves,
-// where the bake's memory peaks (on dragon_vrip_res2 with 20 + 110, with the even blocks of
-// solve_in_range_shifted, the peak falls from 2137 to 1933 MiB).
-Eigen::MatrixXd derivative_stage(const Simulated& sim, Stiffness& stiffness, const Eigen::MatrixXd& rigid,
-                                 const Modes& modes, const BakeOptions& options, CholmodLLT& factor, Basis& basis,
-                                 Progress& progress) {
+// then the flexible modes, solved in the pencil. The shells energy and the paired modes are freed
+// before the solves, where the bake's memory peaks (on dragon_vrip_res2 with 20 + 110, with the
+// even blocks of solve_in_range, the peak falls from 2137 to 1933 MiB).
+Eigen::MatrixXd derivative_stage(const Simulated& sim, Stiffness& stiffness, const Modes& modes,
+                                 const BakeOptions& options, ShiftedPencil& pencil, Basis& basis, Progress& progress) {
   const Eigen::Index S = sim.size();
   Eigen::MatrixXd derivatives(3 * S, options.derivatives);
   if (options.derivatives == 0) return derivatives;
   const int paired_rotations = options.rotation_pairs ? 3 * sim.attachment.num_components : 0;
   Eigen::MatrixXd phi(3 * S, paired_rotations + sim.flexible);
+  const Eigen::MatrixXd& rigid = pencil.kernel();  // the rigid motions first, 6 per component
   for (int r = 0; r < paired_rotations; ++r) phi.col(r) = rigid.col(6 * (r / 3) + 3 + r % 3);
-  phi.rightCols(sim.flexible) = modes.vectors.rightCols(sim.flexible);
+  phi.rightCols(sim.flexible) = modes.flexible;
   const std::vector<std::array<int, 2>> pairs =
       derivative_pairs(components_moved(phi, sim.attachment.component), options.derivatives);
   // Modes are zero at a region's clamped vertices, which the energy has after the simulated ones.
@@ -376,26 +372,18 @@ Eigen::MatrixXd derivative_stage(const Simulated& sim, Stiffness& stiffness, con
   });
   stiffness.shells.reset();
   phi.resize(0, 0);
-  const int num_zero = modes.num_zero;
-  Eigen::MatrixXd kernel(3 * S, sim.num_rigid + num_zero);
-  kernel.leftCols(sim.num_rigid) = rigid;
-  kernel.rightCols(num_zero) = modes.vectors.leftCols(num_zero);
-  const Stopwatch stopwatch(basis.timings[stages::kDerivativeSolves]);
-  return solve_in_range_shifted(stiffness.K, sim.mass, kernel, std::move(derivatives), factor, modes.shift,
-                                modes.known_eigenvalues, modes.known_vectors, &progress);
+  return pencil.solve_in_range(std::move(derivatives), &progress);
 }
 
 // 7. [rigid motions, zero modes, modes, derivatives], M-orthonormal; derivatives that came out
 // dependent are dropped (basis.num_dropped).
-Eigen::MatrixXd orthonormal_basis(const Simulated& sim, const Eigen::MatrixXd& rigid, const Modes& modes,
-                                  Eigen::MatrixXd derivatives, const BakeOptions& options, Basis& basis,
-                                  Progress& progress) {
-  const int num_zero = modes.num_zero;
-  const int leading = options.modes + num_zero;
-  Eigen::MatrixXd U(3 * sim.size(), leading + options.derivatives);
-  U.leftCols(sim.num_rigid) = rigid;
-  U.middleCols(sim.num_rigid, num_zero + sim.flexible) = modes.vectors;
-  U.rightCols(options.derivatives) = derivatives;
+Eigen::MatrixXd orthonormal_basis(const Simulated& sim, const ShiftedPencil& pencil, const Modes& modes,
+                                  Eigen::MatrixXd derivatives, Basis& basis, Progress& progress) {
+  const Eigen::MatrixXd& kernel = pencil.kernel();  // the rigid motions, then the zero modes
+  const auto leading = static_cast<int>(kernel.cols() + modes.flexible.cols());
+  const Eigen::Index num_derivatives = derivatives.cols();
+  Eigen::MatrixXd U(kernel.rows(), leading + num_derivatives);
+  U << kernel, modes.flexible, derivatives;
   derivatives.resize(0, 0);
   {
     const Stopwatch stopwatch(basis.timings[stages::kOrthonormalisation]);
@@ -405,12 +393,12 @@ Eigen::MatrixXd orthonormal_basis(const Simulated& sim, const Eigen::MatrixXd& r
         throw NumericalError(message("bake: column ", j, " of the rigid motions and modes came out dependent; ",
                                      "they are not M-orthonormal"));
   }
-  basis.num_dropped = static_cast<int>(leading + options.derivatives - U.cols());
+  basis.num_dropped = static_cast<int>(leading + num_derivatives - U.cols());
   basis.num_rigid = sim.num_rigid;
-  basis.num_floppy = num_zero;
+  basis.num_floppy = modes.num_zero;
   basis.num_modes = leading;
   basis.eigenvalues = Eigen::VectorXd::Zero(leading);
-  basis.eigenvalues.tail(num_zero + sim.flexible) = modes.eigenvalues;
+  basis.eigenvalues.tail(modes.eigenvalues.size()) = modes.eigenvalues;
   return U;
 }
 
@@ -419,7 +407,7 @@ Eigen::MatrixXd orthonormal_basis(const Simulated& sim, const Eigen::MatrixXd& r
 // stiffness. A region's ghost is its submesh's: restricted from the submesh's rows, and the
 // vertices outside the submesh, which never move, map to ghost vertex 0 (the solver reads only
 // the ghost's own arrays).
-void fine_and_ghost_vectors(Eigen::MatrixXd U, const Simulated& sim, const GhostSource& source, Ghost coarse,
+void fine_and_ghost_vectors(Eigen::MatrixXd U, const Simulated& sim, const MovingPart& source, Ghost coarse,
                             const StiffnessPaint& paint, Basis& basis, Progress& progress) {
   stage(stages::kAssembly, basis, progress, [&] {
     if (U.rows() < basis.rest.size()) U = extend_to_attached(sim.attachment, U);
@@ -452,48 +440,87 @@ Basis bake_stages(const VerticesRef& V, const FacesRef& F, const BakeOptions& op
                   Progress& progress) {
   const Simulated sim = simulated_submesh(V, F, options, basis, progress);
   Stiffness stiffness = stiffness_at_rest(sim, options, basis, progress);
-  const Eigen::MatrixXd rigid = sim.num_rigid > 0 ? rigid_motions(sim.V, sim.attachment.component, sim.mass)
-                                                  : Eigen::MatrixXd(3 * sim.size(), 0);
-  CholmodLLT factor(3);  // one factorisation for the modes and the derivative solves
-  const RowMatrixX3d region_V = V(sim.region_vertices, Eigen::all);
-  const RowMatrixX3i region_F = sim.attachment.faces;
-  const Eigen::VectorXd region_mass = basis.mass(sim.region_vertices);
-  const bool in_region = !sim.region_vertices.empty();
-  const GhostSource source{in_region ? VerticesRef(region_V) : V, in_region ? FacesRef(region_F) : F,
-                           in_region ? VectorRef(region_mass) : VectorRef(basis.mass)};
-  Ghost coarse = order_beside_the_ghost(V, source, sim, stiffness.K, options, factor, basis, progress);
-  const Modes modes = vibration_stage(V, sim, stiffness.K, rigid, factor, basis, progress);
-  Eigen::MatrixXd derivatives = derivative_stage(sim, stiffness, rigid, modes, options, factor, basis, progress);
-  basis.timings[stages::kFactorisation] = factor.seconds();
-  Eigen::MatrixXd U = orthonormal_basis(sim, rigid, modes, std::move(derivatives), options, basis, progress);
+  const MovingPart source(V, F, basis.mass, sim.region_vertices, sim.attachment.faces);
+  ShiftedPencil pencil(stiffness.K, sim.mass,
+                       sim.num_rigid > 0 ? rigid_motions(sim.V, sim.attachment.component, sim.mass)
+                                         : Eigen::MatrixXd(3 * sim.size(), 0));
+  Ghost coarse = order_beside_the_ghost(source, stiffness.K, options, pencil, basis, progress);
+  const Modes modes = vibration_stage(V, sim, stiffness.K, pencil, progress);
+  Eigen::MatrixXd derivatives = derivative_stage(sim, stiffness, modes, options, pencil, basis, progress);
+  const ShiftedPencil::Timings pencil_timings = pencil.timings();
+  basis.timings[stages::kFactorisation] = pencil_timings.factorisation;
+  basis.timings[stages::kModes] = pencil_timings.modes;
+  if (options.derivatives > 0) basis.timings[stages::kDerivativeSolves] = pencil_timings.solves;
+  Eigen::MatrixXd U = orthonormal_basis(sim, pencil, modes, std::move(derivatives), basis, progress);
   fine_and_ghost_vectors(std::move(U), sim, source, std::move(coarse), options.paint, basis, progress);
   return basis;
 }
 
-// A dense mesh: the stages above on a proxy made by edge collapse of the fine mesh to about
-// options.proxy vertices, then the prolongation of the proxy's basis to the fine vertices
+// The proxy's region: the proxy vertices that only free vertices collapsed onto.
+Eigen::VectorXi proxy_region(const Ghost& proxy, const RegionMesh& region) {
+  std::vector<char> free(static_cast<size_t>(proxy.V.rows()), 0);
+  for (Eigen::Index s = 0; s < region.num_free; ++s) free[proxy.map[s]] = 1;
+  for (Eigen::Index s = region.num_free; s < proxy.map.size(); ++s) free[proxy.map[s]] = 0;
+  std::vector<int> vertices;
+  for (size_t p = 0; p < free.size(); ++p)
+    if (free[p]) vertices.push_back(static_cast<int>(p));
+  return Eigen::Map<const Eigen::VectorXi>(vertices.data(), static_cast<Eigen::Index>(vertices.size()));
+}
+
+// A dense mesh: the stages above on a proxy made by edge collapse to about options.proxy vertices
+// of the part that moves (MovingPart; a region's free and clamped vertices stay apart, so the line
+// between them stays in place), then the prolongation of the proxy's basis to the fine vertices
 // (prolongation.h); the ghost is the proxy's, reached from a fine vertex through its proxy vertex.
-Basis bake_on_proxy(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Progress& progress) {
-  const Basis fine = rest_state(V, F, options, normalizing_scale(V));
+// A region's proxy is baked as a region (its clamped vertices still), and every fine vertex but the
+// region's free ones is held at rest by a prolongation of zero weights.
+Basis bake_on_proxy(const VerticesRef& V, const FacesRef& F, const RegionMesh* region, const BakeOptions& options,
+                    Basis fine, Progress& progress) {
   Basis timed;  // the proxy stage's time, until the proxy's basis exists
   Progress as_proxy([&progress](const std::string&, double fraction) {
     progress.report(stages::kProxy, fraction);
     return true;
   });
-  const Ghost proxy =
-      stage(stages::kProxy, timed, progress, [&] { return ghost_mesh(V, F, fine.mass, options.proxy, &as_proxy); });
+  const MovingPart source(V, F, fine.mass, region ? region->vertices : std::vector<int>(),
+                          region ? FacesRef(region->faces) : F);
+  std::vector<char> sides;  // a region's: 1 for its free vertices, 0 for the clamped ones
+  if (region) {
+    sides.assign(region->vertices.size(), 0);
+    std::fill_n(sides.begin(), region->num_free, 1);
+  }
+  const Ghost proxy = stage(stages::kProxy, timed, progress, [&] {
+    return ghost_mesh(source.V, source.F, source.mass, options.proxy, &as_proxy, sides);
+  });
   // The proxy's elements carry the fine paint's means (restrict_to_ghost).
   BakeOptions on_proxy = options;
-  on_proxy.paint = restrict_to_ghost(proxy.map, static_cast<int>(proxy.V.rows()), fine.mass, options.paint);
+  const int num_proxy = static_cast<int>(proxy.V.rows());
+  StiffnessPaint paint = options.paint;
+  if (region && paint.weights.size() > 0) paint.weights = options.paint.weights(region->vertices).eval();
+  on_proxy.paint = restrict_to_ghost(proxy.map, num_proxy, source.mass, paint);
+  // A region with nothing clamped around it (a free component) is its whole proxy.
+  const bool clamped = region && region->num_free < static_cast<int>(region->vertices.size());
+  on_proxy.region = clamped ? proxy_region(proxy, *region) : Eigen::VectorXi();
   Basis basis = rest_state(proxy.V, proxy.F, on_proxy, fine.scale);
   basis.timings = timed.timings;
   basis = bake_stages(proxy.V, proxy.F, on_proxy, std::move(basis), progress);
   stage(stages::kProlongation, basis, progress, [&] {
-    basis.prolongation = prolongation_to_proxy(V, proxy.V, proxy.F, proxy.map);
-    basis.ghost_map = basis.ghost_map(proxy.map).eval();
-    basis.rest = fine.rest;
-    basis.mass = fine.mass;
-    basis.stiffness_weights = fine.stiffness_weights;
+    Prolongation onto_proxy = prolongation_to_proxy(source.V, proxy.V, proxy.F, proxy.map);
+    Eigen::VectorXi ghost_map = basis.ghost_map(proxy.map);
+    if (!region) {
+      basis.prolongation = std::move(onto_proxy);
+      basis.ghost_map = std::move(ghost_map);
+    } else {
+      basis.prolongation = held_at_rest(V.rows());
+      basis.ghost_map = Eigen::VectorXi::Zero(V.rows());
+      for (int s = 0; s < region->num_free; ++s) {
+        basis.prolongation.vertices.row(region->vertices[static_cast<size_t>(s)]) = onto_proxy.vertices.row(s);
+        basis.prolongation.weights.row(region->vertices[static_cast<size_t>(s)]) = onto_proxy.weights.row(s);
+      }
+      basis.ghost_map(region->vertices) = ghost_map;
+    }
+    basis.rest = std::move(fine.rest);
+    basis.mass = std::move(fine.mass);
+    basis.stiffness_weights = std::move(fine.stiffness_weights);
+    basis.region = std::move(fine.region);
   });
   return basis;
 }
@@ -504,9 +531,18 @@ Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, 
   try {
     check_options(options, V.rows());
     validate_mesh(V, F);
-    Basis basis = options.proxy_above > 0 && V.rows() > options.proxy_above && options.region.size() == 0
-                      ? bake_on_proxy(V, F, options, progress)
-                      : bake_stages(V, F, options, rest_state(V, F, options, normalizing_scale(V)), progress);
+    Basis fine = rest_state(V, F, options, normalizing_scale(V));
+    const bool proxies = options.proxy_above > 0;
+    Basis basis;
+    if (options.region.size() == 0) {
+      basis = proxies && V.rows() > options.proxy_above ? bake_on_proxy(V, F, nullptr, options, std::move(fine), progress)
+                                                        : bake_stages(V, F, options, std::move(fine), progress);
+    } else {
+      const RegionMesh region = region_mesh(F, fine.mass, options.region);
+      basis = proxies && region.num_free > options.proxy_above
+                  ? bake_on_proxy(V, F, &region, options, std::move(fine), progress)
+                  : bake_stages(V, F, options, std::move(fine), progress);
+    }
     validate_basis(basis);
     return basis;
   } catch (const std::bad_alloc&) {

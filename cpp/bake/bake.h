@@ -2,46 +2,51 @@
 // solver poses in. One forward pipeline:
 //
 //   1. validate_mesh; scale = normalizing_scale(V): the energy lives in the paper's normalised
-//      frame (longest bounding-box edge 10).
+//      frame (longest bounding-box edge 10). The basis keeps the rest mesh and its masses.
 //   2. Simulated vertices (attachment.h): components with less than 10% of the largest one's
 //      area, unreferenced vertices and vertices without mass are attached, not simulated; they
 //      follow the affine motion fitted to the simulated surface around them.
-//   3. K = ∇²E(x̄) of the simulated submesh, M lumped. The rigid motions of its components come
-//      first (analytic, M-orthonormal, 6 per component); the vibration modes are the lowest
-//      eigenpairs M-orthogonal to them (deflation). A floppy mesh (flaps at non-manifold
-//      vertices, duplicate faces; all three shared dragons) has further zero modes, with
-//      λ < kZeroEigenvalue tr K/tr M: they come on top of `modes` (a scan's count of mechanisms is
-//      not known before the bake, and each would take the place of a deformation mode), stay in
-//      the basis after the rigid motions (Basis::num_floppy) and join the kernel for step 4.
-//   4. Modal derivatives (eq. 13) for the pairs of the modes other than translations and zero
+//   3. K = ∇²E(x̄) of the simulated submesh, M lumped.
+//   4. The shifted pencil (shifted_pencil.h): K − σM, factored once for steps 5 and 6, with the
+//      rigid motions of the components as its kernel (analytic, M-orthonormal, 6 per component).
+//      CHOLMOD orders K while the ghost is simplified beside it (edge collapse of the whole mesh
+//      to about `ghost` vertices).
+//   5. Vibration modes: the lowest eigenpairs M-orthogonal to the kernel (deflation). A floppy
+//      mesh (flaps at non-manifold vertices, duplicate faces; all three shared dragons) has
+//      further zero modes, with λ < kZeroEigenvalue tr K/tr M: they come on top of `modes` (a
+//      scan's count of mechanisms is not known before the bake, and each would take the place
+//      of a deformation mode), stay in the basis after the rigid motions (Basis::num_floppy) and
+//      join the pencil's kernel.
+//   6. Modal derivatives (eq. 13) for the pairs of the modes other than translations and zero
 //      modes (the linearised rotations and the flexible modes), in the paper's order:
-//      right-hand sides ∇³E(x̄)(φᵢ, φⱼ) (third_batch), solved in the range of K against the
-//      kernel [rigid motions, zero modes] with the eigensolver's factor of K − σM, corrected on
-//      the eigenpairs found and refined (solve_in_range_shifted): one CHOLMOD factorisation in
-//      all, the most expensive step at 100k vertices.
-//   5. [rigid motions, modes, derivatives] M-orthonormalised (orthonormalize.h), numerically
-//      dependent derivatives dropped (Basis::num_dropped).
-//   6. Attached rows, conversion to mesh units (x = x̄ + U q), float32 vectors.
-//   7. Ghost: edge collapse of the whole mesh to about `ghost` vertices, the basis restricted.
+//      right-hand sides ∇³E(x̄)(φᵢ, φⱼ) (third_batch), solved in the range of K in the pencil,
+//      corrected on the eigenpairs found and refined: one CHOLMOD factorisation in all, the most
+//      expensive step at 100k vertices.
+//   7. [rigid motions, zero modes, modes, derivatives] M-orthonormalised (orthonormalize.h),
+//      numerically dependent derivatives dropped (Basis::num_dropped).
+//   8. Attached rows, conversion to mesh units (x = x̄ + U q), float32 vectors; the ghost's
+//      vectors restricted from them.
 //
-// A region (options.region) changes steps 2 and 3: the simulated vertices are the region's, the
+// A region (options.region) changes steps 2 to 4: the simulated vertices are the region's, the
 // energy is that of the faces touching it with the vertices outside clamped, K and M are the
 // blocks of the simulated vertices, there are no rigid motions (a free part of the region has
 // them as zero modes), and the rows of the vertices outside are zero (region.h).
 //
-// A mesh of more than options.proxy_above vertices goes through steps 2 to 7 as a proxy: the fine
+// A mesh of more than options.proxy_above vertices goes through steps 2 to 8 as a proxy: the fine
 // mesh simplified by the same edge collapse to about options.proxy vertices ("proxy"), baked in the
 // fine mesh's normalised frame; then each fine vertex gets its barycentric weights on the nearest
 // proxy triangle ("prolongation"). The Basis keeps the fine rest positions and masses, the
 // proxy's vectors and the prolongation: memory and storage grow with the fine mesh only by
-// those weights.
+// those weights. A region of more than options.proxy_above free vertices is baked so too: the proxy
+// is its submesh's, simplified with the free and clamped vertices kept apart (so the line between
+// them stays), baked as a region, and every fine vertex outside the region gets zero weights.
 //
 // Stages (kBakeStages in util/progress.h, in the order they run) are timed into Basis::timings and
 // reported through Progress with the same names: for a proxy bake "proxy" first; "attachment",
 // "hessian", "factorisation" (CHOLMOD's analysis, reported before the ghost, and the numeric
-// factorisation inside the modes), "ghost" (the wait for the ghost beyond the analysis: it is
+// factorisation of the pencil; the pencil times its own parts), "ghost" (the wait for the ghost beyond the analysis: it is
 // simplified on a thread of its own beside it), "modes" (the rest of them), "third derivatives",
-// "derivative solves", "orthonormalisation", "assembly" (steps 6 and 7: the fine and the ghost's
+// "derivative solves", "orthonormalisation", "assembly" (step 8: the fine and the ghost's
 // vectors); for a proxy bake "prolongation" last; seconds.
 // A cancel throws Cancelled at the next report and leaves nothing behind. CHOLMOD cannot report
 // during its analysis and factorisation (about 1 s and 2.5 s at 100k vertices), nor a blocked
@@ -82,7 +87,7 @@ struct BakeOptions {
   // with its fine vertices' means; the basis keeps the weights for the solver's ghost.
   StiffnessPaint paint = {};
   // Fine vertex indices that may move (any order; empty: the whole mesh). Every other vertex
-  // stays at rest, clamped (region.h); a region bake is never on a proxy.
+  // stays at rest, clamped (region.h); the region's free vertices decide on a proxy.
   Eigen::VectorXi region = {};
 };
 

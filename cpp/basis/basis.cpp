@@ -33,7 +33,7 @@ void require_shared(Check&& check) {
 }
 
 // A stored prolongation: one row per fine vertex, proxy vertices in range (vectors has 3 rows
-// per proxy vertex), barycentric weights.
+// per proxy vertex), barycentric weights or zero ones (a vertex held at rest, outside a region).
 void require_prolongation(const Prolongation& P, Eigen::Index n, Eigen::Index vector_rows) {
   require(vector_rows > 0 && vector_rows % 3 == 0,
           message("vectors has ", vector_rows, " rows, expected 3 per proxy vertex"));
@@ -47,17 +47,17 @@ void require_prolongation(const Prolongation& P, Eigen::Index n, Eigen::Index ve
     if ((P.vertices.row(i).array() < 0).any() || (P.vertices.row(i).array() >= p).any())
       require(false, message("prolongation vertices[", i, "] = (", P.vertices.row(i), ") leaves [0, ", p,
                              "), the proxy vertices of vectors"));
-    if ((P.weights.row(i).array() < -kSlack).any() || std::abs(P.weights.row(i).sum() - 1.0f) > kSlack)
+    if (!P.weights.row(i).isZero(0) &&
+        ((P.weights.row(i).array() < -kSlack).any() || std::abs(P.weights.row(i).sum() - 1.0f) > kSlack))
       require(false, message("prolongation weights[", i, "] = (", P.weights.row(i),
-                             ") are not barycentric (each in [0, 1], summing to 1)"));
+                             ") are not barycentric (each in [0, 1], summing to 1) nor all 0"));
   }
 }
 
-// A region bake's region: vertices ascending and in range, a basis of the mesh itself (not on a
-// proxy) whose rows outside the region are zero.
+// A region bake's region: vertices ascending and in range, and every vertex outside held at rest:
+// its rows of the basis zero, or on a proxy its prolongation weights.
 void require_region(const Basis& b) {
   const Eigen::Index n = b.rest.rows();
-  require(!b.on_proxy(), "region: a region bake is never on a proxy, but this basis has a prolongation");
   std::vector<char> inside(static_cast<size_t>(n), 0);
   for (Eigen::Index i = 0; i < b.region.size(); ++i) {
     if (b.region[i] < 0 || b.region[i] >= n || (i > 0 && b.region[i] <= b.region[i - 1]))
@@ -65,9 +65,13 @@ void require_region(const Basis& b) {
                              "] (the region is ascending, in [0, ", n, "))"));
     inside[b.region[i]] = 1;
   }
-  for (Eigen::Index v = 0; v < n; ++v)
-    if (!inside[v] && !b.vectors.middleRows<3>(3 * v).isZero(0))
+  for (Eigen::Index v = 0; v < n; ++v) {
+    if (inside[v]) continue;
+    if (b.on_proxy() && !b.prolongation.weights.row(v).isZero(0))
+      require(false, message("prolongation weights[", v, "]: vertex ", v, " lies outside the region but has weights"));
+    if (!b.on_proxy() && !b.vectors.middleRows<3>(3 * v).isZero(0))
       require(false, message("vectors: vertex ", v, " lies outside the region but has non-zero rows"));
+  }
 }
 
 }  // namespace

@@ -81,7 +81,7 @@ void bind_solve(py::module_& m) {
          const Transforms& transforms, const VectorRef& weights, double stiffness, const std::string& energy,
          double bending, double membrane, const Eigen::VectorXd& stiffness_weights, double max_stiffness,
          double tolerance, int max_iterations, const std::optional<RowMatrixX3d>& initial,
-         const py::object& progress) {
+         const py::object& progress, const std::vector<int>& held) {
         FullSolveOptions options;
         options.energy = energy_kind(energy);
         options.bending = bending;
@@ -90,6 +90,7 @@ void bind_solve(py::module_& m) {
         options.tolerance = tolerance;
         options.max_iterations = max_iterations;
         options.progress = python_progress(progress);
+        options.held = held;
         FullSolveResult result;
         {
           py::gil_scoped_release release;
@@ -107,7 +108,7 @@ void bind_solve(py::module_& m) {
       py::arg("V"), py::arg("F"), py::arg("handles"), py::arg("transforms"), py::arg("weights"), py::arg("stiffness"),
       py::arg("energy"), py::arg("bending"), py::arg("membrane"), py::arg("stiffness_weights"),
       py::arg("max_stiffness"), py::arg("tolerance"), py::arg("max_iterations"),
-      py::arg("initial"), py::arg("progress"));
+      py::arg("initial"), py::arg("progress"), py::arg("held"));
 }
 
 }  // namespace modal_deform

@@ -295,14 +295,20 @@ void project_block(double* block) {
 template <int K>
 void term_hessian(const Response& q, const double* gradient, const double* hessian, bool projected, double* full) {
   constexpr int N = 3 * (K - 1), M = 3 * K;
+  // An edge's length ℓ has ∇²ℓ = (I − êêᵀ)/ℓ, semidefinite with ∇ℓ = ê in its kernel: f''∇ℓ∇ℓᵀ and
+  // f'∇²ℓ are the block's eigenspaces, and projecting it clamps f'' and f' at 0, with no
+  // eigendecomposition.
+  constexpr bool kClosedForm = K == 2;
+  const bool clamp = projected && kClosedForm;
+  const double d2f = clamp ? std::max(q.d2f, 0.0) : q.d2f, df = clamp ? std::max(q.df, 0.0) : q.df;
   // Written so that the result is exactly symmetric (the assembled Hessian then is too).
   for (int i = 0; i < N; ++i)
-    for (int j = 0; j < N; ++j) full[(3 + i) * M + 3 + j] = q.d2f * (gradient[i] * gradient[j]);
-  if (q.df != 0)
+    for (int j = 0; j < N; ++j) full[(3 + i) * M + 3 + j] = d2f * (gradient[i] * gradient[j]);
+  if (df != 0)
     for (int i = 0; i < N; ++i)
-      for (int j = 0; j < N; ++j) full[(3 + i) * M + 3 + j] += q.df * hessian[i * N + j];
+      for (int j = 0; j < N; ++j) full[(3 + i) * M + 3 + j] += df * hessian[i * N + j];
   // Without the f' term the block is f'' ∇s∇sᵀ: semidefinite unless f'' < 0.
-  if (projected && (q.df != 0 || q.d2f < 0)) project_block<N, M>(full + 3 * M + 3);
+  if (projected && !kClosedForm && (q.df != 0 || q.d2f < 0)) project_block<N, M>(full + 3 * M + 3);
   // The first vertex's columns, then its rows: minus the sums over the other vertices.
   for (int i = 3; i < M; ++i)
     for (int c = 0; c < 3; ++c) {

@@ -103,12 +103,14 @@ struct Candidate {
 
 class Simplifier {
  public:
-  Simplifier(const VerticesRef& V, const FacesRef& F, const VectorRef& mass);
+  Simplifier(const VerticesRef& V, const FacesRef& F, const VectorRef& mass, std::vector<char> sides);
   void simplify(int target, Progress* progress);
   EdgeCollapse result();
 
  private:
   bool has_vertex(int f, int x) const { return faces_(f, 0) == x || faces_(f, 1) == x || faces_(f, 2) == x; }
+  bool same_side(int x, int y) const { return sides_.empty() || sides_[x] == sides_[y]; }
+  bool keeps_the_sides(int u, int v) const;
   const std::vector<int>& live_faces(int x);
   void tally_neighbours(int x, std::vector<Neighbour>& out);
   void add_boundary_quadrics();
@@ -131,6 +133,7 @@ class Simplifier {
   std::vector<int> version_;                     // bumped whenever a vertex's cluster grows
   std::vector<int> merged_into_;                 // -1 for a live vertex or one no face uses
   std::vector<char> alive_;
+  std::vector<char> sides_;  // empty: one side
   int num_alive_ = 0;
   std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> heap_;
   // Scratch space of try_collapse and push_edges, kept to avoid allocations per collapse.
@@ -139,7 +142,8 @@ class Simplifier {
   std::vector<Candidate> candidates_;
 };
 
-Simplifier::Simplifier(const VerticesRef& V, const FacesRef& F, const VectorRef& mass) {
+Simplifier::Simplifier(const VerticesRef& V, const FacesRef& F, const VectorRef& mass, std::vector<char> sides)
+    : sides_(std::move(sides)) {
   const int n = static_cast<int>(V.rows());
   // Faces on the same three vertices: oppositely oriented copies cancel in pairs (together they
   // are a sheet of no thickness, which decimated scans are full of); one copy of the orientation
@@ -266,7 +270,7 @@ void Simplifier::add_candidates(int x, bool higher_only, std::vector<Candidate>&
     if (triangle_shape(position_[faces_(f, 0)], position_[faces_(f, 1)], position_[faces_(f, 2)]).degenerate)
       degenerate_faces_.push_back(f);
   for (const Neighbour& s : around_u_) {
-    if (higher_only && s.vertex < x) continue;
+    if ((higher_only && s.vertex < x) || !same_side(x, s.vertex)) continue;
     const bool on_degenerate_face = std::any_of(degenerate_faces_.begin(), degenerate_faces_.end(),
                                                 [&](int f) { return has_vertex(f, s.vertex); });
     out.push_back({on_degenerate_face ? -1.0 : cost(x, s.vertex), x, s.vertex, version_[x], version_[s.vertex]});
@@ -340,6 +344,7 @@ int Simplifier::try_collapse(int u, int v) {
   };
   const bool u_boundary = on_boundary(around_u_);
   if (u_boundary != on_boundary(around_v_) || (u_boundary && shared_.size() != 1)) return -1;
+  if (!keeps_the_sides(u, v)) return -1;
 
   // Link condition: every common neighbour spans a face with u and v.
   for (const Neighbour& s : around_u_) {
@@ -378,6 +383,21 @@ int Simplifier::try_collapse(int u, int v) {
   if (star_quality(u, v, p, true) < std::min(kMinFaceQuality, star_quality(u, v, p, false))) return -1;
   collapse(u, v, p);
   return u;
+}
+
+// Sides, like the boundary: u and v on one side, both next to the other side or neither, and then
+// merged along an edge of a face that reaches the other side (around_u_, around_v_, shared_ set).
+bool Simplifier::keeps_the_sides(int u, int v) const {
+  if (sides_.empty()) return true;
+  if (!same_side(u, v)) return false;
+  const auto next_to_other_side = [this](int x, const std::vector<Neighbour>& around) {
+    return std::any_of(around.begin(), around.end(), [&](const Neighbour& s) { return !same_side(x, s.vertex); });
+  };
+  const bool u_next = next_to_other_side(u, around_u_);
+  if (u_next != next_to_other_side(v, around_v_)) return false;
+  return !u_next || std::any_of(shared_.begin(), shared_.end(), [&](int f) {
+    return !same_side(u, faces_(f, 0)) || !same_side(u, faces_(f, 1)) || !same_side(u, faces_(f, 2));
+  });
 }
 
 void Simplifier::collapse(int u, int v, const Eigen::Vector3d& p) {
@@ -496,7 +516,7 @@ EdgeCollapse Simplifier::result() {
 }  // namespace
 
 EdgeCollapse collapse_edges(const VerticesRef& V, const FacesRef& F, const VectorRef& mass, int target,
-                            Progress* progress) {
+                            Progress* progress, const std::vector<char>& sides) {
   validate_mesh(V, F);
   if (target < 4) throw InputError(message("target: a ghost needs at least 4 vertices, got ", target));
   if (mass.size() != V.rows())
@@ -504,13 +524,15 @@ EdgeCollapse collapse_edges(const VerticesRef& V, const FacesRef& F, const Vecto
   for (Eigen::Index i = 0; i < mass.size(); ++i)
     if (!std::isfinite(mass[i]) || mass[i] < 0)
       throw InputError(message("mass[", i, "]: expected a finite value >= 0, got ", mass[i]));
+  if (!sides.empty() && static_cast<Eigen::Index>(sides.size()) != V.rows())
+    throw InputError(message("sides: expected ", V.rows(), " values (one per vertex), got ", sides.size()));
 
   if (target >= V.rows()) {
     if (progress) progress->report(stages::kGhost, 1.0);
     EdgeCollapse identity{V, F, Eigen::VectorXi::LinSpaced(V.rows(), 0, static_cast<int>(V.rows()) - 1)};
     return identity;
   }
-  Simplifier simplifier(V, F, mass);
+  Simplifier simplifier(V, F, mass, sides);
   simplifier.simplify(target, progress);
   return simplifier.result();
 }

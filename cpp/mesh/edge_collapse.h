@@ -22,8 +22,13 @@
 //     left islands of uncollapsed fine vertices among large clusters on subdivided scans (every
 //     collapse there thins some needle a little or turns its normal): tiny ghost triangles that a
 //     pose crushes first (issue 22).
+//   - sides: vertices of different sides (a region bake's free and clamped vertices) never merge,
+//     and a vertex next to the other side merges only with another such vertex along an edge of a
+//     face that reaches the other side, so the line between the sides stays where it is.
 // Edges of degenerate input faces are collapsed first, which removes those faces.
 #pragma once
+
+#include <vector>
 
 #include "util/progress.h"
 #include "util/types.h"
@@ -50,10 +55,11 @@ struct EdgeCollapse {
 // lumped_mass) weights the centroids. Faces with repeated indices are dropped first, and faces
 // on the same three vertices cancel by orientation (one copy of a surplus orientation stays);
 // vertices left without a face belong to no cluster. A target of at least #V gives (V, F) unchanged, each vertex
-// its own cluster. Reports progress as stage "ghost"; throws Cancelled when told to stop and
-// InputError for bad input (see validate_mesh; target < 4; mass of the wrong size, negative or
-// not finite; no triangle left once faces cancel).
+// its own cluster. `sides` (#V, or empty for one side) splits the vertices into sides that stay
+// apart (see above). Reports progress as stage "ghost"; throws Cancelled when told to stop and
+// InputError for bad input (see validate_mesh; target < 4; mass or sides of the wrong size, mass
+// negative or not finite; no triangle left once faces cancel).
 EdgeCollapse collapse_edges(const VerticesRef& V, const FacesRef& F, const VectorRef& mass, int target,
-                            Progress* progress = nullptr);
+                            Progress* progress = nullptr, const std::vector<char>& sides = {});
 
 }  // namespace modal_deform

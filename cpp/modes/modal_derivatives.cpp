@@ -8,6 +8,7 @@
 
 #include "linalg/cholmod_llt.h"
 #include "linalg/row_blocks.h"
+#include "linalg/sparse_operations.h"
 #include "mesh/union_find.h"
 #include "modes/stiffness_and_mass.h"
 #include "util/errors.h"
@@ -21,12 +22,6 @@ constexpr double kRankThreshold = 1e-8;
 constexpr double kResidualTolerance = 1e-6;
 // Right-hand sides per solve: blocked solves run at BLAS-3 speed, and the bar moves between them.
 constexpr Eigen::Index kBlockColumns = 64;
-// solve_in_range_shifted refines until the error left on each eigenvector it does not know is
-// below this fraction of that component, in at most this many steps. Those components are the
-// small, high-frequency part of a modal derivative: on dragon_vrip_res2 two steps leave it within
-// 1e-5 of the converged solution, closer than the pinned solve gets there (4e-4).
-constexpr double kRefinementTolerance = 1e-3;
-constexpr int kMaxRefinementSteps = 6;
 
 // A checked kernel basis, zero on the DOFs that take no part in the problem.
 struct Kernel {
@@ -70,55 +65,6 @@ std::vector<int> pins_for(const SparseMatrix& K, const Kernel& kernel) {
   return pins;
 }
 
-// Ψ (3n by p) with K Ψ = P B and Zᵀ M Ψ = 0, block by block, written over B (each block is copied
-// out before its solution goes in, so Ψ needs no memory of its own): solve(P B, X, report) writes
-// the solution of a block of P B into X (any kernel part is removed here), whose residuals are then
-// checked; report(part) tells the bar what part of the block is done. The blocks reuse their
-// buffers: at 100k vertices each is 113 MB, and fresh memory costs page faults.
-template <typename Solve>
-Eigen::MatrixXd solve_by_blocks(const SparseMatrix& K, const VectorRef& mass, const Kernel& kernel, Eigen::MatrixXd B,
-                                Solve&& solve, Progress* progress) {
-  const Eigen::Index n = K.rows();
-  const Eigen::VectorXd m = dof_masses(mass);
-  const Eigen::MatrixXd& Z = kernel.Z;
-  const std::vector<bool>& decoupled = kernel.decoupled;
-  // P = I − Z (ZᵀZ)⁻¹ Zᵀ, also zero on the decoupled DOFs (part of the kernel, zero rows in Z).
-  const Eigen::LLT<Eigen::MatrixXd> gram(Z.transpose() * Z);
-  const double norm_K = norm_1(K);
-  Eigen::MatrixXd& Psi = B;
-  Eigen::MatrixXd PB;
-  // Blocks of equal width, at most kBlockColumns: 110 columns go as 55 + 55 rather than 64 + 46,
-  // so the buffers are the narrower (at 100k vertices 88 MB less for the four of them).
-  const Eigen::Index blocks = (B.cols() + kBlockColumns - 1) / kBlockColumns;
-  const Eigen::Index block_columns = blocks > 0 ? (B.cols() + blocks - 1) / blocks : 1;
-  for (Eigen::Index first = 0; first < B.cols(); first += block_columns) {
-    const Eigen::Index width = std::min(block_columns, B.cols() - first);
-    PB.resize(n, width);
-    for_row_blocks(n, [&](Eigen::Index first_row, Eigen::Index rows) {
-      PB.middleRows(first_row, rows) = B.block(first_row, first, rows, width);
-      for (Eigen::Index d = first_row; d < first_row + rows; ++d)
-        if (decoupled[static_cast<size_t>(d)]) PB.row(d).setZero();
-    });
-    if (Z.cols()) add_dense_product(PB, Z, -gram.solve(inner_product(Z, PB)));
-    const auto report = [&](double part) {
-      if (progress) progress->report(stages::kDerivativeSolves, (static_cast<double>(first) + part * width) / B.cols());
-    };
-    auto X = Psi.middleCols(first, width);
-    solve(PB, X, report);
-    report(1.0);  // the check below takes a product with K, as long as a step
-    if (Z.cols()) add_dense_product(X, Z, -inner_product(Z, m, X));
-    const Eigen::VectorXd rhs_norms = PB.colwise().norm();
-    add_product(K, X, -1.0, PB);  // PB becomes the residual P B − K X
-    for (Eigen::Index j = 0; j < width; ++j) {
-      const double bound = kResidualTolerance * (norm_K * X.col(j).norm() + rhs_norms[j]);
-      if (!(PB.col(j).norm() <= bound))
-        throw NumericalError(message("solve_in_range: column ", first + j, " has residual ", PB.col(j).norm(),
-                                     ", above ", bound, "; does Z span the kernel of K?"));
-    }
-  }
-  return std::move(Psi);
-}
-
 void check_right_hand_sides(const SparseMatrix& K, const Eigen::Ref<const Eigen::MatrixXd>& B) {
   if (B.rows() != K.rows()) throw InputError(message("B: expected ", K.rows(), " rows, got ", B.rows()));
   if (!B.allFinite()) throw InputError("B: has an entry that is not finite");
@@ -127,7 +73,6 @@ void check_right_hand_sides(const SparseMatrix& K, const Eigen::Ref<const Eigen:
 Eigen::MatrixXd solve_with_pins(const SparseMatrix& K, const VectorRef& mass, const Kernel& kernel,
                                 const Eigen::Ref<const Eigen::MatrixXd>& B, const std::vector<int>& pins,
                                 Progress* progress) {
-  check_right_hand_sides(K, B);
   const Eigen::Index n = K.rows();
   if (progress) progress->report(stages::kDerivativeSolves, 0.0);
 
@@ -148,12 +93,59 @@ Eigen::MatrixXd solve_with_pins(const SparseMatrix& K, const VectorRef& mass, co
     throw NumericalError(message("solve_in_range: K with its kernel pinned cannot be factored; does Z span the whole ",
                                  "kernel of K? ", e.what()));
   }
-  return solve_by_blocks(
-      K, mass, kernel, Eigen::MatrixXd(B),
-      [&](const Eigen::MatrixXd& PB, Eigen::Ref<Eigen::MatrixXd> X, const auto&) { llt.solve(PB, X); }, progress);
+  return solve_in_range_by_blocks(
+      K, dof_masses(mass), kernel.Z, kernel.decoupled, Eigen::MatrixXd(B),
+      [&](const Eigen::MatrixXd& PB, Eigen::Ref<Eigen::MatrixXd> X, const std::function<void(double)>&) {
+        llt.solve(PB, X);
+      },
+      progress);
 }
 
 }  // namespace
+
+// Each block is copied out of B before its solution goes in, so Ψ needs no memory of its own. The
+// blocks reuse their buffers: at 100k vertices each is 113 MB, and fresh memory costs page faults.
+Eigen::MatrixXd solve_in_range_by_blocks(const SparseMatrix& K, const Eigen::VectorXd& m, const Eigen::MatrixXd& Z,
+                                         const std::vector<bool>& decoupled, Eigen::MatrixXd B,
+                                         const BlockSolve& solve, Progress* progress) {
+  check_right_hand_sides(K, B);
+  const Eigen::Index n = K.rows();
+  // P = I − Z (ZᵀZ)⁻¹ Zᵀ, also zero on the decoupled DOFs (part of the kernel, zero rows in Z).
+  const Eigen::LLT<Eigen::MatrixXd> gram(Z.transpose() * Z);
+  const double norm_K = norm_1(K);
+  Eigen::MatrixXd& Psi = B;
+  Eigen::MatrixXd PB;
+  // Blocks of equal width, at most kBlockColumns: 110 columns go as 55 + 55 rather than 64 + 46,
+  // so the buffers are the narrower (at 100k vertices 88 MB less for the four of them).
+  const Eigen::Index blocks = (B.cols() + kBlockColumns - 1) / kBlockColumns;
+  const Eigen::Index block_columns = blocks > 0 ? (B.cols() + blocks - 1) / blocks : 1;
+  for (Eigen::Index first = 0; first < B.cols(); first += block_columns) {
+    const Eigen::Index width = std::min(block_columns, B.cols() - first);
+    PB.resize(n, width);
+    for_row_blocks(n, [&](Eigen::Index first_row, Eigen::Index rows) {
+      PB.middleRows(first_row, rows) = B.block(first_row, first, rows, width);
+      for (Eigen::Index d = first_row; d < first_row + rows; ++d)
+        if (decoupled[static_cast<size_t>(d)]) PB.row(d).setZero();
+    });
+    if (Z.cols()) add_dense_product(PB, Z, -gram.solve(inner_product(Z, PB)));
+    const std::function<void(double)> report = [&](double part) {
+      if (progress) progress->report(stages::kDerivativeSolves, (static_cast<double>(first) + part * width) / B.cols());
+    };
+    auto X = Psi.middleCols(first, width);
+    solve(PB, X, report);
+    report(1.0);  // the check below takes a product with K, as long as a step
+    if (Z.cols()) add_dense_product(X, Z, -inner_product(Z, m, X));
+    const Eigen::VectorXd rhs_norms = PB.colwise().norm();
+    add_product(K, X, -1.0, PB);  // PB becomes the residual P B − K X
+    for (Eigen::Index j = 0; j < width; ++j) {
+      const double bound = kResidualTolerance * (norm_K * X.col(j).norm() + rhs_norms[j]);
+      if (!(PB.col(j).norm() <= bound))
+        throw NumericalError(message("solve_in_range: column ", first + j, " has residual ", PB.col(j).norm(),
+                                     ", above ", bound, "; does Z span the kernel of K?"));
+    }
+  }
+  return std::move(Psi);
+}
 
 std::vector<std::array<int, 2>> derivative_pairs(const std::vector<std::vector<int>>& components, int count) {
   const auto share_a_component = [](const std::vector<int>& a, const std::vector<int>& b) {
@@ -226,76 +218,6 @@ Eigen::MatrixXd solve_in_range(const SparseMatrix& K, const VectorRef& mass, con
     throw InputError(message("pins: Z restricted to the pinned DOFs has rank ", qr.rank(), " of ", Z.cols(),
                              "; they do not pin the kernel"));
   return solve_with_pins(K, mass, kernel, B, pins, progress);
-}
-
-Eigen::MatrixXd solve_in_range_shifted(const SparseMatrix& K, const VectorRef& mass,
-                                       const Eigen::Ref<const Eigen::MatrixXd>& Z,
-                                       Eigen::MatrixXd B, CholmodLLT& shifted, double sigma,
-                                       const VectorRef& eigenvalues, const Eigen::Ref<const Eigen::MatrixXd>& modes,
-                                       Progress* progress) {
-  const Kernel kernel = checked_kernel(K, mass, Z);
-  check_right_hand_sides(K, B);
-  const Eigen::Index n = K.rows();
-  if (!(sigma < 0 && std::isfinite(sigma)))
-    throw InputError(message("sigma: expected a finite shift < 0, got ", sigma));
-  if (shifted.rows() != n)
-    throw InputError(message("shifted: a factor of ", shifted.rows(), " rows, expected ", n, " (K - sigma M)"));
-  if (modes.rows() != n || modes.cols() != eigenvalues.size())
-    throw InputError(message("modes: expected ", n, " by ", eigenvalues.size(), " (one per eigenvalue), got ",
-                             modes.rows(), " by ", modes.cols()));
-  if (eigenvalues.size() == 0 || !(eigenvalues.array() > 0).all() || !eigenvalues.allFinite() || !modes.allFinite())
-    throw InputError("eigenvalues: expected at least one eigenpair, with finite positive eigenvalues");
-  if (progress) progress->report(stages::kDerivativeSolves, 0.0);
-
-  // (K − σM)⁻¹ = Σ φφᵀ/(λ − σ) over the M-orthonormal eigenpairs, K⁺ = Σ φφᵀ/λ on the range.
-  // The known pairs get the difference −σ/(λ(λ − σ)) added; on the others the error of each step
-  // is the fraction −σ/(λ − σ), at most `contraction`.
-  const Eigen::VectorXd correction = (-sigma) * (eigenvalues.array() * (eigenvalues.array() - sigma)).inverse();
-  const double contraction = -sigma / (eigenvalues.maxCoeff() - sigma);
-  const int steps = static_cast<int>(std::ceil(std::log(kRefinementTolerance) / std::log(contraction)));
-  if (steps > kMaxRefinementSteps)
-    throw InputError(message("sigma: ", sigma, " is too far below the largest eigenvalue given, ",
-                             eigenvalues.maxCoeff(), ": ", steps, " refinement steps would be needed"));
-  const Eigen::VectorXd m = dof_masses(mass);
-  // One step: X += (K − σM)⁻¹ R less its kernel part, corrected on the known pairs by w. What it
-  // leaves of R needs no product with K: K (K − σM)⁻¹ R = R + σM (K − σM)⁻¹ R, K Z = 0 and
-  // K Φ = M Φ Λ, so R − K X = −σ M (K − σM)⁻¹ R − M Φ Λ w, which overwrites R unless `last`.
-  // The updates of X and R go through the rows once, block by block in parallel (rather than a
-  // pass over 3n rows per statement on one thread). Each product is a statement of its own: nested
-  // in one expression, Eigen evaluated M (σY − ΦΛw) coefficient by coefficient, which took as long
-  // as the solve. Y stays in the factor's solution buffer, which is kept from step to step.
-  Eigen::MatrixXd R;
-  const auto step = [&](Eigen::Ref<Eigen::MatrixXd> X, bool last) {
-    const CholmodLLT::Solution Y = shifted.solve_in_workspace(R);
-    const Eigen::MatrixXd w = correction.asDiagonal() * inner_product(modes, R);
-    const Eigen::MatrixXd lambda_w = eigenvalues.asDiagonal() * w;
-    const Eigen::MatrixXd kernel_part = inner_product(kernel.Z, m, Y);
-    for_row_blocks(n, [&](Eigen::Index first, Eigen::Index rows) {
-      auto x = X.middleRows(first, rows);
-      const auto y = Y.middleRows(first, rows);
-      const auto phi = modes.middleRows(first, rows);
-      x += y;
-      x.noalias() -= kernel.Z.middleRows(first, rows) * kernel_part;
-      x.noalias() += phi * w;
-      if (last) return;
-      auto r = R.middleRows(first, rows);
-      r = (-sigma) * y;
-      r.noalias() -= phi * lambda_w;
-      r.array().colwise() *= m.segment(first, rows).array();
-    });
-  };
-  return solve_by_blocks(
-      K, mass, kernel, std::move(B),
-      [&](const Eigen::MatrixXd& PB, Eigen::Ref<Eigen::MatrixXd> X, const auto& report) {
-        X.setZero();
-        R = PB;
-        for (int k = 0; k < steps; ++k) {
-          if (k > 0) report(static_cast<double>(k) / steps);
-          step(X, k + 1 == steps);
-        }
-        R.resize(0, 0);  // not kept through the residual check, where the bake's memory peaks
-      },
-      progress);
 }
 
 }  // namespace modal_deform

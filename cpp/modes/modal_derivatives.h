@@ -8,14 +8,13 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <vector>
 
 #include "util/progress.h"
 #include "util/types.h"
 
 namespace modal_deform {
-
-class CholmodLLT;
 
 // The first `count` pairs (i, j), i ≤ j, of modes ordered by eigenvalue (lowest first), in the
 // paper's order (two loops, so that pairs of low eigenvalues come first): (0,0), (0,1), (1,1),
@@ -54,21 +53,17 @@ Eigen::MatrixXd solve_in_range(const SparseMatrix& K, const VectorRef& mass, con
                                const Eigen::Ref<const Eigen::MatrixXd>& B, const std::vector<int>& pins,
                                Progress* progress = nullptr);
 
-// The same Ψ without a factorisation of its own, in `shifted`, the factor of K − σM (σ < 0) the
-// eigensolver used (vibration_modes leaves it there), with the eigenpairs it found: eigenvalues
-// (k, > 0) and modes (3n by k, M-orthonormal, M-orthogonal to Z). A solve with K − σM is off by
-// the factor λ/(λ − σ) along each eigenvector: exact correction on the known ones, and steps of
-// iterative refinement (ψ += (K − σM)⁻¹ (P b − K ψ), corrected again) on the others, each
-// leaving at most −σ/(λmax − σ) of the error, until below 1e-3 of each such component (two steps
-// on the shared dragons; they are the small, high-frequency part of a derivative).
-// Saves a factorisation (2.5 s at 100k vertices) for a solve and a product with K per step.
-// B is taken by value and Ψ is written over it: a caller that moves B in needs no second p columns.
-// Throws InputError for inconsistent input, or a σ so far below the eigenvalues given that more
-// than 6 steps would be needed; NumericalError when a column fails the residual check.
-Eigen::MatrixXd solve_in_range_shifted(const SparseMatrix& K, const VectorRef& mass,
-                                       const Eigen::Ref<const Eigen::MatrixXd>& Z, Eigen::MatrixXd B,
-                                       CholmodLLT& shifted, double sigma,
-                                       const VectorRef& eigenvalues, const Eigen::Ref<const Eigen::MatrixXd>& modes,
-                                       Progress* progress = nullptr);
+// What the solves in the range above share, for a caller with a solver of its own (ShiftedPencil):
+// Ψ written over B, block by block of at most 64 columns, each block's P B handed to
+// solve(P B, X, report), which writes a solution of K X = P B into X (its kernel part is removed
+// here) and may tell the bar what part of the block is done; then the residuals are checked.
+// m: the diagonal of M (3n); Z: a checked kernel basis (checked_kernel_basis); decoupled:
+// decoupled_dofs. Throws InputError for a B of the wrong size or not finite, NumericalError when
+// a column fails the residual check.
+using BlockSolve = std::function<void(const Eigen::MatrixXd& PB, Eigen::Ref<Eigen::MatrixXd> X,
+                                      const std::function<void(double part)>& report)>;
+Eigen::MatrixXd solve_in_range_by_blocks(const SparseMatrix& K, const Eigen::VectorXd& m, const Eigen::MatrixXd& Z,
+                                         const std::vector<bool>& decoupled, Eigen::MatrixXd B,
+                                         const BlockSolve& solve, Progress* progress);
 
 }  // namespace modal_deform

@@ -5,8 +5,7 @@
 #include <utility>
 #include <vector>
 
-#include <omp.h>
-
+#include "linalg/sparse_operations.h"
 #include "util/errors.h"
 
 namespace modal_deform {
@@ -19,11 +18,6 @@ constexpr double kSymmetryTolerance = 1e-10;
 constexpr double kOrthonormalTolerance = 1e-8;
 // ‖K z‖ ≤ kKernelTolerance ‖K‖₁ ‖z‖ for each column z of a kernel basis.
 constexpr double kKernelTolerance = 1e-8;
-// Columns of X per task of add_product, copied to row-major storage: Eigen then streams K once per
-// task and adds each entry's multiple of a contiguous row, where column-major columns make it
-// stream K once per column. On dragon_vrip_res2 (300k rows, 52 columns) 0.34-0.37 s against
-// 0.56-0.57 s (4 columns: 0.43 s, 13: 0.37 s), for two 8-column buffers per thread (38 MB).
-constexpr Eigen::Index kProductColumns = 8;
 
 // Entries [begin, end) of column `col` in K's index and value arrays; rows come sorted.
 std::pair<int, int> column_range(const SparseMatrix& K, int col) {
@@ -32,29 +26,6 @@ std::pair<int, int> column_range(const SparseMatrix& K, int col) {
 }
 
 }  // namespace
-
-void add_product(const SparseMatrix& K, const Eigen::Ref<const Eigen::MatrixXd>& X, double scale,
-                 Eigen::Ref<Eigen::MatrixXd> out) {
-  using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  const Eigen::Index tasks = (X.cols() + kProductColumns - 1) / kProductColumns;
-#pragma omp parallel if (tasks > 1)
-  {
-    RowMajorMatrix rows, product;  // reused from task to task
-#pragma omp for schedule(dynamic)
-    for (Eigen::Index task = 0; task < tasks; ++task) {
-      const Eigen::Index first = task * kProductColumns, width = std::min(kProductColumns, X.cols() - first);
-      rows = X.middleCols(first, width);
-      product.noalias() = K * rows;
-      out.middleCols(first, width) += scale * product;
-    }
-  }
-}
-
-Eigen::MatrixXd multiply(const SparseMatrix& K, const Eigen::Ref<const Eigen::MatrixXd>& X) {
-  Eigen::MatrixXd KX = Eigen::MatrixXd::Zero(K.rows(), X.cols());
-  add_product(K, X, 1.0, KX);
-  return KX;
-}
 
 void validate_stiffness_and_mass(const SparseMatrix& K, const VectorRef& mass) {
   const Eigen::Index n = mass.size();
@@ -120,16 +91,6 @@ std::vector<bool> decoupled_dofs(const SparseMatrix& K, const VectorRef& mass) {
     decoupled[static_cast<size_t>(j)] = empty;
   }
   return decoupled;
-}
-
-double norm_1(const SparseMatrix& K) {
-  double largest = 0;
-  for (int j = 0; j < K.outerSize(); ++j) {
-    double sum = 0;
-    for (SparseMatrix::InnerIterator it(K, j); it; ++it) sum += std::abs(it.value());
-    largest = std::max(largest, sum);
-  }
-  return largest;
 }
 
 Eigen::MatrixXd checked_kernel_basis(const SparseMatrix& K, const VectorRef& mass,

@@ -21,15 +21,6 @@ Eigen::VectorXd dof_masses(const VectorRef& mass);
 // column of K, such as those of unreferenced vertices. Modes and derivatives are zero there.
 std::vector<bool> decoupled_dofs(const SparseMatrix& K, const VectorRef& mass);
 
-// out += scale K X, and K X, in blocks of a few columns on the OpenMP threads (Eigen's sparse
-// products run on one thread).
-void add_product(const SparseMatrix& K, const Eigen::Ref<const Eigen::MatrixXd>& X, double scale,
-                 Eigen::Ref<Eigen::MatrixXd> out);
-Eigen::MatrixXd multiply(const SparseMatrix& K, const Eigen::Ref<const Eigen::MatrixXd>& X);
-
-// ‖K‖₁, the largest column sum of |K|.
-double norm_1(const SparseMatrix& K);
-
 // Z (3n by z) as a basis of (part of) the kernel of K, with zero rows on the decoupled DOFs, after
 // validate_stiffness_and_mass. Throws InputError unless Z is finite, M-orthonormal and, column by
 // column, in the kernel of K up to rounding (‖K z‖ ≤ 1e-8 ‖K‖₁ ‖z‖).

@@ -8,8 +8,9 @@
 
 namespace modal_deform {
 
-Ghost ghost_mesh(const VerticesRef& V, const FacesRef& F, const VectorRef& mass, int target, Progress* progress) {
-  EdgeCollapse collapse = collapse_edges(V, F, mass, target, progress);
+Ghost ghost_mesh(const VerticesRef& V, const FacesRef& F, const VectorRef& mass, int target, Progress* progress,
+                 const std::vector<char>& sides) {
+  EdgeCollapse collapse = collapse_edges(V, F, mass, target, progress, sides);
   Ghost ghost;
   ghost.F = std::move(collapse.F);
   ghost.map = std::move(collapse.cluster);

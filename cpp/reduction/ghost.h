@@ -6,6 +6,8 @@
 // of a rigid motion of the fine mesh is the same rigid motion of the ghost.
 #pragma once
 
+#include <vector>
+
 #include "energy/stiffness_paint.h"
 #include "util/progress.h"
 #include "util/types.h"
@@ -21,10 +23,11 @@ struct Ghost {
 // Simplifies (V #V by 3, F #F by 3) by edge collapse (see collapse_edges) to about `target`
 // vertices (fewer are not reached when no valid collapse is left; the result says how many).
 // `mass` (#V, length², lumped_mass) weights the means. Vertices left without a face (unreferenced,
-// or only on faces that cancelled) join the nearest ghost vertex. A target of at least #V gives the mesh itself with the identity map. Reports
+// or only on faces that cancelled) join the nearest ghost vertex. A target of at least #V gives the mesh itself with the identity map.
+// `sides` (#V or empty) keeps vertices of different sides apart (collapse_edges). Reports
 // stage "ghost"; throws Cancelled when told to stop, InputError for bad input.
 Ghost ghost_mesh(const VerticesRef& V, const FacesRef& F, const VectorRef& mass, int target,
-                 Progress* progress = nullptr);
+                 Progress* progress = nullptr, const std::vector<char>& sides = {});
 
 // Restricts fine vectors to the ghost: U (3#V by r, interleaved x0 y0 z0 x1 ...) to 3#G by r,
 // each ghost vertex getting the `fine_mass`-weighted mean of its fine vertices, per coordinate.

@@ -52,6 +52,10 @@ Prolongation prolongation_to_proxy(const VerticesRef& V, const VerticesRef& prox
   return prolongation;
 }
 
+Prolongation held_at_rest(Eigen::Index num_vertices) {
+  return {RowMatrixX3i::Zero(num_vertices, 3), RowMatrixX3f::Zero(num_vertices, 3)};
+}
+
 void prolongate_positions(const Prolongation& prolongation, const double* rest, const float* proxy_displacement,
                           float* out) {
   const int* vertices = prolongation.vertices.data();

@@ -28,7 +28,9 @@ using RowMatrixX3f = Eigen::Matrix<float, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
 struct Prolongation {
   RowMatrixX3i vertices;  // #V by 3 proxy vertices of each fine vertex's triangle
-  RowMatrixX3f weights;   // #V by 3 barycentric weights, each in [0, 1], summing to 1
+  // #V by 3 barycentric weights, each in [0, 1], summing to 1; all 0 for a vertex held at rest
+  // (outside a region bake's region).
+  RowMatrixX3f weights;
 
   bool empty() const { return vertices.rows() == 0; }
   Eigen::Index size() const { return vertices.rows(); }
@@ -40,6 +42,9 @@ struct Prolongation {
 // Runs in parallel over the fine vertices; throws InputError for a cluster index out of range.
 Prolongation prolongation_to_proxy(const VerticesRef& V, const VerticesRef& proxy_V, const FacesRef& proxy_F,
                                    const Eigen::Ref<const Eigen::VectorXi>& cluster);
+
+// #V rows that hold every fine vertex at rest (zero weights on proxy vertex 0).
+Prolongation held_at_rest(Eigen::Index num_vertices);
 
 // out_i = x̄_i + Σ_k w_ik d_{v_ik} for every fine vertex: `rest` (3#V, x̄), `proxy_displacement`
 // (3#P, d) and `out` (3#V), interleaved. In parallel over blocks of fine vertices.

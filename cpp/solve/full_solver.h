@@ -9,33 +9,18 @@
 // with E the discrete shells energy (bending, membrane, painted stiffness) or ARAP of the rest mesh s V, and m_i the
 // lumped masses of (V, F): the reduced solver's objective with U = I and no ghost.
 //
-// Globalisation (what makes it converge on scans with floppy flaps and fins): each iteration
-// factors ∇²F + τD once (D the normalised lumped mass per coordinate, floored at 1e-6 of its mean;
-// CHOLMOD's analysis of the pattern is kept for the whole solve), the shift τ adapted to how
-// well the quadratic model predicted the decrease (Levenberg–Marquardt with Nielsen's update:
-// shrunk after a good step, grown after a poor one — at least by the factor the line search cut the
-// step by — and tenfold when the factorisation finds the matrix not positive definite, never below
-// 1e-8 of the Hessian's scale so that a free component's rigid motions stay regularised). A large
-// τ shortens the step where curvature is low (flaps) and leaves it Newton's where curvature is
-// high, unlike a line search, which would shorten it everywhere. The step is then backtracked
-// (Armijo) when F does not decrease enough. The Hessian is the projected one (each element's made
-// semidefinite) far from the minimum, and the exact one near it wherever it factors at the current
-// τ (quadratic convergence).
-//
-// Load steps: from rest, the handles' transforms are followed from the identity (each handle
-// turning about its centre, the mean of its rest vertices, its centre moving in a straight
-// line). The suggested increment turns a handle by at most 30° and moves its centre by at most a
-// tenth of the bounding-box diagonal (at least a hundredth of the whole motion); the first
-// increment is a sixth of it (a longer first step, nearly the linear elastic answer, tangles
-// fins and flaps), and each next one doubles after a load step that took few iterations (up to
-// the suggested one) and halves after one that took many. Intermediate loads are solved to a
-// loose tolerance (1e-3), and each load step starts from the previous answer moved on along the
-// path the last step took (a secant predictor), when F is lower there.
+// The pieces: the objective (pose_objective.h); Newton on the shifted Hessian, keeping CHOLMOD's
+// analysis for the whole solve and backtracking along its step (shifted_newton.h: what makes it
+// converge on scans with floppy flaps and fins); the load steps from rest (load_steps.h). Each
+// load step starts from the previous answer moved on along the path the last step took (a secant
+// predictor) when F is lower there; intermediate loads are solved to a loose tolerance (1e-3).
 //
 // Where F has a kink rather than a minimum (a sliver triangle collapsed: its bending terms'
 // angle flips as its normal does), F stops decreasing while ‖∇F‖ stays large; the solve then
 // stops and reports that it did not converge.
 #pragma once
+
+#include <vector>
 
 #include "energy/make_energy.h"
 #include "solve/handle_term.h"
@@ -55,6 +40,9 @@ struct FullSolveOptions {
   // Called as ("solve", fraction done) at most every 0.1 s; returning false cancels (Cancelled).
   ProgressCallback progress = nullptr;
   StiffnessPaint paint = {};  // the shells weights painted per vertex (stiffness_paint.h; not with ARAP)
+  // Vertices held exactly where the solve starts (at rest, or at `initial`): a region bake's
+  // outside, which Refine keeps still. Their coordinates leave the unknowns.
+  std::vector<int> held = {};
 };
 
 struct FullSolveResult {

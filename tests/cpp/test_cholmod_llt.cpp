@@ -5,6 +5,7 @@
 
 #include "linalg/cholmod_llt.h"
 #include "mesh/mass.h"
+#include "linalg/sparse_operations.h"
 #include "modes/stiffness_and_mass.h"
 #include "stand_in_stiffness.h"
 #include "test_support.h"

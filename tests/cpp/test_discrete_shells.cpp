@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <functional>
 #include <random>
 #include <string>
 
@@ -17,13 +16,17 @@
 #include "mesh/mesh_topology.h"
 #include "mesh/normalization.h"
 #include "mesh/primitives.h"
+#include "finite_differences.h"
 #include "test_support.h"
 #include "util/errors.h"
 
 namespace modal_deform {
 namespace {
 
+using testing::expect_gradient_matches;
+using testing::expect_hessian_matches;
 using testing::expect_input_error;
+using testing::expect_third_matches;
 using testing::normalized;
 using testing::random_vector;
 using testing::shared_mesh;
@@ -87,30 +90,6 @@ std::vector<State> states(const RowMatrixX3d& V) {
           {"bent 90 deg", flat(bent(V))}};
 }
 
-// Relative errors of `exact` against centred differences at steps 1e-3 .. 1e-7, relative to the
-// larger of the exact value and the difference at the largest step (the exact value is 0 at rest).
-std::vector<double> difference_errors(const Eigen::VectorXd& exact,
-                                      const std::function<Eigen::VectorXd(double)>& centred_difference) {
-  const std::vector<double> steps{1e-3, 1e-4, 1e-5, 1e-6, 1e-7};
-  std::vector<Eigen::VectorXd> differences;
-  for (double h : steps) differences.push_back(centred_difference(h));
-  const double scale = std::max(exact.norm(), differences.front().norm());
-  std::vector<double> errors;
-  for (const auto& difference : differences) errors.push_back((difference - exact).norm() / scale);
-  return errors;
-}
-
-// The error of a centred difference falls like h² until round-off takes over: by about 100 per
-// decade of h from the largest step, and to `tolerance` at best.
-void expect_second_order(const std::vector<double>& errors, double tolerance, const std::string& what) {
-  std::printf("  %-44s h = 1e-3 .. 1e-7:", what.c_str());
-  for (double e : errors) std::printf(" %8.1e", e);
-  std::printf("\n");
-  EXPECT_LT(errors[1], errors[0] / 30) << what << ": not second order";
-  EXPECT_LT(errors[2], errors[1] / 30) << what << ": not second order";
-  EXPECT_LT(*std::min_element(errors.begin(), errors.end()), tolerance) << what;
-}
-
 // Gradient from value, Hessian from gradient, third contraction from Hessian, batched third
 // against single third, at every state.
 void check_derivatives(const TriangleMesh& mesh, const std::string& mesh_name) {
@@ -120,36 +99,10 @@ void check_derivatives(const TriangleMesh& mesh, const std::string& mesh_name) {
   for (const State& state : states(mesh.V)) {
     const Eigen::VectorXd& x = state.x;
     const std::string where = mesh_name + ", " + state.name;
-    Eigen::VectorXd gradient(size), plus(size), minus(size);
-    energy.value_and_gradient(x, gradient);
-
-    Eigen::VectorXd slope(1);
-    slope[0] = gradient.dot(d);
-    expect_second_order(difference_errors(slope,
-                                          [&](double h) {
-                                            Eigen::VectorXd s(1);
-                                            s[0] = (energy.value(x + h * d) - energy.value(x - h * d)) / (2 * h);
-                                            return s;
-                                          }),
-                        1e-6, "gradient, " + where);
-
-    const SparseMatrix H = energy.hessian(x);
-    expect_second_order(difference_errors(H * d,
-                                          [&](double h) {
-                                            energy.value_and_gradient(x + h * d, plus);
-                                            energy.value_and_gradient(x - h * d, minus);
-                                            return Eigen::VectorXd((plus - minus) / (2 * h));
-                                          }),
-                        1e-6, "Hessian, " + where);
-
+    expect_gradient_matches(energy, x, d, where);
+    expect_hessian_matches(energy, x, d, where);
+    expect_third_matches(energy, x, u, w, where);
     const Eigen::VectorXd third = energy.third(x, u, w);
-    expect_second_order(difference_errors(third,
-                                          [&](double h) {
-                                            return Eigen::VectorXd((energy.hessian(x + h * u) * w -
-                                                                    energy.hessian(x - h * u) * w) /
-                                                                   (2 * h));
-                                          }),
-                        1e-6, "third, " + where);
 
     Eigen::MatrixXd Phi(size, 3);
     Phi << u, w, d;
@@ -182,26 +135,10 @@ TEST(DiscreteShells, DerivativesAreSmoothWhereTheAngleWraps) {
   const double angle = kPi - 1e-3;
   X.row(3) << 0.6, -std::cos(angle), -std::sin(angle);
   const Eigen::VectorXd x = flat(X), d = random_vector(12, 5);
-  Eigen::VectorXd gradient(12), plus(12), minus(12);
-  energy.value_and_gradient(x, gradient);
-  Eigen::VectorXd slope(1);
-  slope[0] = gradient.dot(d);
   // Steps of 1e-3 cross θ = ±π. The slope is small (sin δ ≈ 1e-3) next to E ≈ 2w, so round-off
   // in E sets in early.
-  expect_second_order(difference_errors(slope,
-                                        [&](double h) {
-                                          Eigen::VectorXd s(1);
-                                          s[0] = (energy.value(x + h * d) - energy.value(x - h * d)) / (2 * h);
-                                          return s;
-                                        }),
-                      2e-6, "gradient across the fold");
-  expect_second_order(difference_errors(energy.hessian(x) * d,
-                                        [&](double h) {
-                                          energy.value_and_gradient(x + h * d, plus);
-                                          energy.value_and_gradient(x - h * d, minus);
-                                          return Eigen::VectorXd((plus - minus) / (2 * h));
-                                        }),
-                      1e-7, "Hessian across the fold");
+  expect_gradient_matches(energy, x, d, "across the fold", 2e-6);
+  expect_hessian_matches(energy, x, d, "across the fold", 1e-7);
 }
 
 // A hinge with its opposite vertex 2 at (0.4, t, lift): with no lift the first triangle turns
@@ -239,31 +176,9 @@ TEST(DiscreteShells, BendingFadesOutContinuouslyAsATriangleTurnsOver) {
   for (double t : {0.03, 0.015, -0.015, -0.03}) {  // area ratios 0.032, 0.018: faded
     const Eigen::VectorXd x = crushed_hinge(t, 0.01);
     const std::string where = "crushed hinge at t = " + std::to_string(t);
-    Eigen::VectorXd gradient(12), plus(12), minus(12);
-    energy.value_and_gradient(x, gradient);
-    Eigen::VectorXd slope(1);
-    slope[0] = gradient.dot(d);
-    expect_second_order(difference_errors(slope,
-                                          [&](double h) {
-                                            Eigen::VectorXd s(1);
-                                            s[0] = (energy.value(x + h * d) - energy.value(x - h * d)) / (2 * h);
-                                            return s;
-                                          }),
-                        1e-6, "gradient, " + where);
-    expect_second_order(difference_errors(energy.hessian(x) * d,
-                                          [&](double h) {
-                                            energy.value_and_gradient(x + h * d, plus);
-                                            energy.value_and_gradient(x - h * d, minus);
-                                            return Eigen::VectorXd((plus - minus) / (2 * h));
-                                          }),
-                        1e-6, "Hessian, " + where);
-    expect_second_order(difference_errors(energy.third(x, u, d),
-                                          [&](double h) {
-                                            return Eigen::VectorXd(
-                                                (energy.hessian(x + h * u) * d - energy.hessian(x - h * u) * d) /
-                                                (2 * h));
-                                          }),
-                        1e-6, "third, " + where);
+    expect_gradient_matches(energy, x, d, where);
+    expect_hessian_matches(energy, x, d, where);
+    expect_third_matches(energy, x, u, d, where);
   }
 }
 
@@ -462,16 +377,7 @@ TEST(DiscreteShells, DegenerateAndNonManifoldInputFollowTheRules) {
   const Eigen::VectorXd x = flat(stretched(mesh.V)), d = random_vector(x.size(), 41);
   expect_finite_everywhere(energy, x, "awkward mesh stretched");
   // The terms that exist are differentiated consistently.
-  energy.value_and_gradient(x, gradient);
-  Eigen::VectorXd slope(1);
-  slope[0] = gradient.dot(d);
-  expect_second_order(difference_errors(slope,
-                                        [&](double h) {
-                                          Eigen::VectorXd s(1);
-                                          s[0] = (energy.value(x + h * d) - energy.value(x - h * d)) / (2 * h);
-                                          return s;
-                                        }),
-                      1e-7, "gradient, awkward mesh");
+  expect_gradient_matches(energy, x, d, "awkward mesh", 1e-7);
 }
 
 TEST(DiscreteShells, CollapsedElementsKeepEverythingFinite) {

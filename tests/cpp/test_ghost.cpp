@@ -219,6 +219,39 @@ TEST(Ghost, FacesAgreeWithTheNormalsOfTheRegionTheyCover) {
     expect_agrees_with_region_normals(mesh, ghost_mesh(mesh.V, mesh.F, lumped_mass(mesh.V, mesh.F), target));
 }
 
+// A region bake's proxy: a bumpy plane split by the line x = 0 into sides that never merge, and
+// the vertices on either side of the line merge only along it, so every cluster that holds one of
+// them has its centroid one column off the line, as the fine vertices there have. (Without the
+// rule along the line, at this target clusters reach across the line and away from it.)
+TEST(Ghost, SidesStayApartAndTheLineBetweenThemStays) {
+  const TriangleMesh plane = bumpy_plane(40, 10.0, 12, 1.0);
+  const Eigen::VectorXd mass = lumped_mass(plane.V, plane.F);
+  const double column = 10.0 / 40;
+  std::vector<char> sides(static_cast<size_t>(plane.V.rows()));
+  for (Eigen::Index i = 0; i < plane.V.rows(); ++i) sides[static_cast<size_t>(i)] = plane.V(i, 0) > 1e-9;
+  const Ghost ghost = ghost_mesh(plane.V, plane.F, mass, 150, nullptr, sides);
+  expect_valid_ghost(plane, mass, ghost);
+  EXPECT_LE(ghost.V.rows(), 160);
+  const auto g = static_cast<size_t>(ghost.V.rows());
+  std::vector<std::set<char>> cluster_sides(g);
+  std::vector<char> on_line(g, 0);
+  for (Eigen::Index i = 0; i < plane.V.rows(); ++i) {
+    cluster_sides[static_cast<size_t>(ghost.map[i])].insert(sides[static_cast<size_t>(i)]);
+    if (std::abs(plane.V(i, 0)) < 1e-9 || std::abs(plane.V(i, 0) - column) < 1e-9)
+      on_line[static_cast<size_t>(ghost.map[i])] = 1;
+  }
+  int line_clusters = 0;
+  for (size_t c = 0; c < g; ++c) {
+    EXPECT_EQ(cluster_sides[c].size(), 1u) << "ghost vertex " << c << " holds both sides";
+    if (!on_line[c]) continue;
+    ++line_clusters;
+    const double x = ghost.V(static_cast<Eigen::Index>(c), 0);
+    EXPECT_TRUE(std::abs(x) < 1e-9 || std::abs(x - column) < 1e-9) << "ghost vertex " << c << " at x " << x;
+  }
+  EXPECT_GT(line_clusters, 4);
+  EXPECT_THROW(ghost_mesh(plane.V, plane.F, mass, 150, nullptr, std::vector<char>(3, 0)), InputError);
+}
+
 class GhostOfDragon : public ::testing::TestWithParam<std::pair<std::string, int>> {};
 
 TEST_P(GhostOfDragon, IsValidAndReachesTheTarget) {

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "solve/handle_term.h"
+#include "finite_differences.h"
 #include "test_posing.h"
 #include "test_support.h"
 #include "util/errors.h"
@@ -12,6 +13,7 @@ namespace modal_deform {
 namespace {
 
 using testing::expect_input_error;
+using testing::expect_slope_matches;
 using testing::rigid_transform;
 
 // μs⁴ Σ_h w_h Σ_{i∈h} m_i ‖x̄_i + U_i q − R_h x̄_i − t_h‖², summed over the handle vertices.
@@ -70,19 +72,13 @@ TEST(ReducedHandleTerm, EqualsTheSumOverHandleVertices) {
                                                setup.transforms, setup.coefficient, q);
     Eigen::VectorXd gradient(5);
     EXPECT_NEAR(term.value_and_gradient(q, gradient), expected, 1e-10 * expected);
-    // The term is quadratic: central differences are exact up to rounding.
-    for (int j = 0; j < 5; ++j) {
-      const double h = 1e-3;
-      Eigen::VectorXd plus = q, minus = q;
-      plus[j] += h;
-      minus[j] -= h;
-      const double fd = (direct_handle_term(setup.rest, setup.mass, setup.U, setup.handles, setup.weights,
-                                            setup.transforms, setup.coefficient, plus) -
-                         direct_handle_term(setup.rest, setup.mass, setup.U, setup.handles, setup.weights,
-                                            setup.transforms, setup.coefficient, minus)) /
-                        (2 * h);
-      EXPECT_NEAR(gradient[j], fd, 1e-6 * gradient.norm()) << "q[" << j << "]";
-    }
+    const Eigen::VectorXd d = Eigen::VectorXd::Random(5);
+    expect_slope_matches(
+        [&](const Eigen::VectorXd& p) {
+          return direct_handle_term(setup.rest, setup.mass, setup.U, setup.handles, setup.weights, setup.transforms,
+                                    setup.coefficient, p);
+        },
+        q, d, gradient.dot(d), "reduced handle term");
     // ∇E_C(q) − ∇E_C(0) = 2A q.
     Eigen::VectorXd gradient0(5);
     term.value_and_gradient(Eigen::VectorXd::Zero(5), gradient0);
@@ -104,14 +100,13 @@ TEST(HandleTerm, OnTheFineMeshEqualsTheSumAndItsDerivatives) {
   Eigen::VectorXd gradient = offset;
   EXPECT_NEAR(term.add_value_and_gradient(x, gradient), expected, 1e-10 * expected);
   gradient -= offset;
-  for (int j = 0; j < 36; ++j) {
-    const double h = 1e-2;
-    Eigen::VectorXd plus = x, minus = x, unused(36);
-    plus[j] += h;
-    minus[j] -= h;
-    const double fd = (term.add_value_and_gradient(plus, unused) - term.add_value_and_gradient(minus, unused)) / (2 * h);
-    EXPECT_NEAR(gradient[j], fd, 1e-6 * gradient.norm()) << "x[" << j << "]";
-  }
+  const Eigen::VectorXd d = Eigen::VectorXd::Random(36);
+  expect_slope_matches(
+      [&](const Eigen::VectorXd& y) {
+        Eigen::VectorXd unused(36);
+        return term.add_value_and_gradient(y, unused);
+      },
+      x, d, gradient.dot(d), "handle term");
   // Vertex 7 is in handles 0 and 1 (weights 1 and 0.5); vertex 1 in none.
   const Eigen::VectorXd diagonal = term.hessian_diagonal(12);
   EXPECT_NEAR(diagonal[21], 2 * setup.coefficient * 1.5 * setup.mass[7], 1e-12);

@@ -7,6 +7,7 @@
 #include "mesh/mesh_topology.h"
 #include "mesh/primitives.h"
 #include "modes/rigid_motions.h"
+#include "modes/shifted_pencil.h"
 #include "modes/stiffness_and_mass.h"
 #include "modes/vibration_modes.h"
 #include "stand_in_stiffness.h"
@@ -16,6 +17,7 @@
 namespace modal_deform {
 namespace {
 
+using testing::expect_input_error;
 using testing::jittered_bar;
 using testing::laplacian_stiffness;
 using testing::shared_mesh;
@@ -111,7 +113,8 @@ TEST(VibrationModes, ReportedResidualsAreCheckedOnRequest) {
   const std::vector<int> labels = build_topology(mesh.V, mesh.F).vertex_component;
   const Eigen::MatrixXd Z = rigid_motions(
       mesh.V, Eigen::Map<const Eigen::VectorXi>(labels.data(), static_cast<Eigen::Index>(labels.size())), mass);
-  VibrationModes modes = vibration_modes(K, mass, 8, Z, nullptr, nullptr, ResidualCheck::kReport);
+  ShiftedPencil pencil(K, mass, Z);
+  VibrationModes modes = pencil.lowest_modes(8);
   ASSERT_EQ(modes.tolerances.size(), 8);
   EXPECT_TRUE((modes.residuals.array() <= modes.tolerances.array()).all());
   EXPECT_TRUE((modes.tolerances.array() > 0).all());
@@ -123,6 +126,27 @@ TEST(VibrationModes, ReportedResidualsAreCheckedOnRequest) {
   } catch (const NumericalError& e) {
     EXPECT_NE(std::string(e.what()).find("mode 2 ("), std::string::npos) << e.what();
   }
+}
+
+// The shifted pencil deflates modes it found: the 12 zero modes of two spring networks, without
+// their rigid motions given, then the flexible modes above them, as with the rigid motions given.
+TEST(VibrationModes, DeflatedZeroModesLeaveTheFlexibleModes) {
+  const TriangleMesh mesh = two_boxes();
+  const Eigen::VectorXd mass = lumped_mass(mesh.V, mesh.F);
+  const Eigen::VectorXd m = dof_masses(mass);
+  const SparseMatrix K = spring_network_hessian(mesh.V, mesh.F);
+  ShiftedPencil pencil(K, mass, Eigen::MatrixXd(K.rows(), 0));
+  const VibrationModes all = pencil.lowest_modes(20);
+  const double undeflated_shift = pencil.shift();
+  pencil.deflate(12);
+  ASSERT_EQ(pencil.kernel().cols(), 12);
+  const VibrationModes flexible = pencil.lowest_modes(8);
+  EXPECT_GT(pencil.shift(), undeflated_shift);  // closer to 0 with the kernel deflated
+  const double top = all.eigenvalues[19];
+  for (int i = 0; i < 8; ++i) EXPECT_NEAR(flexible.eigenvalues[i], all.eigenvalues[12 + i], 1e-9 * top) << "mode " << i;
+  EXPECT_LT((pencil.kernel().transpose() * m.asDiagonal() * flexible.modes).cwiseAbs().maxCoeff(), 1e-10);
+  expect_m_orthonormal(flexible.modes, m);
+  expect_input_error([&] { pencil.deflate(9); }, "deflate:");
 }
 
 TEST(VibrationModes, UnreferencedVertexStaysStill) {

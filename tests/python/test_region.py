@@ -50,6 +50,65 @@ def test_a_region_bake_matches_the_full_solve_with_the_outside_held(tube):
     assert error < 0.05 * 0.5, error
 
 
+def test_a_dense_region_is_baked_on_a_proxy_of_its_own_faces():
+    """A region of more free vertices than proxy_above is baked on a proxy of the region and the
+    faces around it: the outside is held exactly by zero prolongation weights, and the pose agrees
+    with the region's dense bake."""
+    V, F = mdc.cylinder(40, 120, radius=0.5, length=6.0)
+    region = np.flatnonzero(V[:, 2] > 3.0 - 1e-9)
+    outside = np.setdiff1d(np.arange(len(V)), region)
+    top = np.flatnonzero(V[:, 2] > 6 - 1e-9)
+    T = np.eye(4)
+    T[:3, 3] = [0.6, 0.0, -0.3]
+    sizes = dict(modes=12, derivatives=30, ghost=300, region=region)
+    dense = mdc.bake(V, F, proxy=None, **sizes)
+    basis = mdc.bake(V, F, proxy=600, proxy_above=1000, **sizes)
+    assert basis.on_proxy and basis.num_basis_vertices <= 650 and basis.num_rigid == 0
+    np.testing.assert_array_equal(basis.region, region)
+    assert not basis.prolongation_weights[outside].any()
+    np.testing.assert_allclose(basis.prolongation_weights[region].sum(axis=1), 1.0, atol=1e-6)
+    poses = []
+    for b in (dense, basis, mdc.Basis.from_arrays(basis.to_arrays())):
+        solver = mdc.ReducedSolver(b, [top], stiffness=1e3)
+        solver.set_transforms([T])
+        assert solver.solve(max_iterations=300, tolerance=1e-8)["converged"]
+        poses.append(solver.positions())
+    X = poses[1]
+    assert X[outside].tobytes() == V[outside].astype(np.float32).tobytes()
+    assert np.abs(X[top] - (V[top] + T[:3, 3])).max() < 0.05 * 0.6
+    diagonal = np.linalg.norm(np.ptp(V, axis=0))
+    assert np.sqrt(np.mean(np.sum((X - poses[0]) ** 2, axis=1))) < 0.005 * diagonal
+    assert poses[2].tobytes() == X.tobytes()
+    arrays = basis.to_arrays()
+    weights = arrays["prolongation_weights"].copy()
+    weights[outside[0]] = [1.0, 0.0, 0.0]
+    with pytest.raises(ValueError, match=rf"prolongation weights\[{outside[0]}\]: vertex {outside[0]} lies outside"):
+        mdc.Basis.from_arrays({**arrays, "prolongation_weights": weights})
+
+
+def test_refine_keeps_the_outside_exactly_where_it_was(tube):
+    """Refine of a region bake holds every vertex outside the region where the reduced pose left it
+    (at rest), and reaches the full solve's minimum with the outside held."""
+    V, F, region = tube
+    basis = mdc.bake(V, F, modes=12, derivatives=30, ghost=100, region=region)
+    outside = np.setdiff1d(np.arange(len(V)), region)
+    top = np.flatnonzero(V[:, 2] > 6 - 1e-9)
+    T = np.eye(4)
+    T[:3, 3] = [0.6, 0.0, -0.3]
+    solver = mdc.ReducedSolver(basis, [top], stiffness=1e3)
+    solver.set_transforms([T])
+    solver.solve(max_iterations=200, tolerance=1e-8)
+    start = solver.positions().astype(np.float64)
+    X, stats = solver.refine(F)
+    assert stats["converged"], stats
+    assert X[outside].tobytes() == start[outside].tobytes()
+    held, held_stats = mdc.solve_full(V, F, [top], [T], stiffness=1e3, held=outside, return_stats=True)
+    assert held_stats["converged"] and np.array_equal(held[outside], V[outside])
+    assert np.abs(X - held).max() < 1e-4 * np.linalg.norm(np.ptp(V, axis=0))
+    with pytest.raises(ValueError, match=rf"held\[1\] = {len(V)} is not a vertex"):
+        mdc.solve_full(V, F, [top], [T], held=[0, len(V)])
+
+
 def test_handles_outside_the_region_are_refused(tube):
     V, F, region = tube
     basis = mdc.bake(V, F, modes=8, derivatives=0, ghost=100, region=region)

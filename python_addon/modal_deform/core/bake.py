@@ -71,8 +71,8 @@ class Basis:
 
     A dense mesh baked on a proxy (``on_proxy``) keeps the proxy's basis: ``vectors`` is then
     (3p, r) over its ``num_basis_vertices`` = p vertices, and each fine vertex i moves with
-    ``prolongation_weights[i]`` (3,) float32 (barycentric) of the proxy vertices
-    ``prolongation_vertices[i]`` (3,) int32: x_i = x̄_i + Σ_k w_ik (U q)_{v_ik}. Both are (0, 3)
+    ``prolongation_weights[i]`` (3,) float32 (barycentric, or all 0 for a vertex outside a region)
+    of the proxy vertices ``prolongation_vertices[i]`` (3,) int32: x_i = x̄_i + Σ_k w_ik (U q)_{v_ik}. Both are (0, 3)
     for a basis of the mesh itself. ``fine_vectors(columns)`` gives the fine (3n, c) basis in either case.
     """
 
@@ -207,10 +207,13 @@ def bake(V, F, modes=20, derivatives=52, ghost=1000, energy="shells", bending=1.
     [1, 1e4]); the modes, derivatives, proxy and ghost all see it, and so does the solver (shells
     only; all-zero weights give the plain bake).
     region: None (the whole mesh moves) or the indices of the vertices that may move: every other
-    vertex stays exactly at rest (its rows of the basis are zero), the faces around the region
-    hold it as a fixed boundary, and all the modes and derivatives are spent inside it (no rigid
-    motions, but for a part of the region that touches nothing outside: its come as zero modes).
-    Handles must lie in it. Never on a proxy (``Basis.region`` keeps it, ascending).
+    vertex stays exactly at rest (its rows of the basis, or on a proxy its prolongation weights, are
+    zero), the faces around the region hold it as a fixed boundary, and all the modes and
+    derivatives are spent inside it (no rigid motions, but for a part of the region that touches
+    nothing outside: its come as zero modes). Handles must lie in it. A region of more than
+    ``proxy_above`` vertices is baked on a proxy of its own faces of about ``proxy`` vertices,
+    whatever the size of the rest (a region that touches nothing outside it is then that proxy's
+    whole mesh, with rigid motions); ``Basis.region`` keeps the region, ascending.
     ``progress(stage, fraction)`` is called
     at least every second or so (not during a CHOLMOD factorisation, about 2 s at 100k vertices);
     returning False raises ``Cancelled``, and an exception it raises propagates.

@@ -162,7 +162,8 @@ class ReducedSolver:
         ``initial`` (n, 3): where to start, by default the reduced pose ``positions()``; an
         animation passes the previous frame's refined answer. Same objective as ``solve``: the
         handles, weights, stiffness, energy (with the basis's material weights, painted ones too) and the current
-        transforms. ``progress(stage, fraction) -> bool`` is called from time to time (False
+        transforms; a region bake's outside stays exactly at rest (``solve_full``'s ``held``).
+        ``progress(stage, fraction) -> bool`` is called from time to time (False
         cancels: ``Cancelled``). Returns (positions (n, 3) float64, stats) with the stats of
         ``solve_full`` ("initial_energy" is the objective at the start). When the solve from the
         start does not converge (it stalled at a kink, or spent ``max_iterations``), the solve from
@@ -186,6 +187,8 @@ class ReducedSolver:
             raise ValueError(f"initial: expected shape ({n}, 3), got {start.shape}")
         basis, problem = self._basis, self._problem
         F = _arrays.faces(F)
+        # A region bake's outside stays exactly at rest (where the reduced pose left it).
+        held = np.setdiff1d(np.arange(n), basis.region) if len(basis.region) else None
         if progress is not None and not callable(progress):
             raise ValueError(f"progress: expected a callable or None, got {type(progress).__name__}")
 
@@ -195,7 +198,7 @@ class ReducedSolver:
                               weights=problem["weights"], energy=problem["energy"], bending=basis.bending,
                               membrane=basis.membrane, stiffness_weights=basis.stiffness_weights,
                               max_stiffness=basis.max_stiffness, tolerance=tolerance, max_iterations=iterations,
-                              initial=initial, progress=report, return_stats=True)
+                              initial=initial, progress=report, return_stats=True, held=held)
 
         X, stats = solve(start, max_iterations, (0.0, 0.5))
         stats["from_rest"] = False
@@ -241,12 +244,13 @@ class ReducedSolver:
 
 def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, energy="shells", bending=1.0,
                membrane=1.0, tolerance=1e-8, max_iterations=300, initial=None, progress=None, return_stats=False,
-               stiffness_weights=None, max_stiffness=1.0):
+               stiffness_weights=None, max_stiffness=1.0, held=None):
     """The reference: Newton's method on the full mesh for the reduced solver's objective.
 
     V (n, 3), F (m, 3): the rest mesh; handles, transforms, weights, stiffness, energy as for
     ReducedSolver, with ``bending`` and ``membrane`` the shells weights, ``stiffness_weights`` and
-    ``max_stiffness`` their painting per vertex as for ``bake``. From rest, large motions
+    ``max_stiffness`` their painting per vertex as for ``bake``. ``held``: vertex indices that stay
+    exactly where the solve starts (at rest, or at ``initial``), as a region bake's outside does. From rest, large motions
     are taken in load steps (the first turning each handle by at most 30° and moving its centre by
     at most a tenth of the bounding-box diagonal, later ones longer or shorter as the previous
     converged fast or slowly); with ``initial`` (n, 3) the solve starts there in one step
@@ -272,5 +276,6 @@ def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, ene
                                   _arrays.stiffness_weights(stiffness_weights, len(V)),
                                   _arrays.number(max_stiffness, "max_stiffness"), _arrays.number(tolerance, "tolerance"),
                                   max_iterations,
-                                  None if initial is None else _arrays.vertices(initial, "initial"), progress)
+                                  None if initial is None else _arrays.vertices(initial, "initial"), progress,
+                                  [] if held is None else _arrays.indices(held, "held"))
     return (X, stats) if return_stats else X

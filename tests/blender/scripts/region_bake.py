@@ -1,5 +1,6 @@
 """A region bake through the Basis panel (issue 24): Suzanne's left ear as the Region Group, its tip
-pulled up; every vertex outside the ear stays exactly where it was. Stale when the region is
+pulled up; every vertex outside the ear stays exactly where it was. The ear alone has more vertices
+than Proxy Above, so it is baked on a proxy of its own faces. Stale when the region is
 painted anew; a handle outside the region is refused. Saves TEST_TMP/region.blend for
 region_reload.py."""
 import os
@@ -21,10 +22,11 @@ ear = V[:, 0] > 0.75
 group = obj.vertex_groups.new(name="Ear")
 group.add([int(i) for i in np.flatnonzero(ear)], 1.0, "REPLACE")
 settings.region_group = "Ear"
+settings.proxy_above, settings.proxy = int(ear.sum()) // 2, int(ear.sum()) // 3
 assert bpy.ops.modal_deform.bake() == {"FINISHED"}
 basis = storage.load(obj)
 np.testing.assert_array_equal(basis.region, np.flatnonzero(ear))
-assert basis.num_rigid == 0
+assert basis.num_rigid == 0 and basis.on_proxy and settings.status.proxy_vertices == basis.num_basis_vertices
 
 # A handle outside the ear: refused, naming the region.
 outside = support.add_handle(obj, V[:, 2] < -0.7)

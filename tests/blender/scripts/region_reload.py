@@ -1,5 +1,5 @@
 """Open the file region_bake.py wrote: the region bake is fresh, poses as before, and the ear's
-tip pulled further still leaves every vertex outside the ear exactly where it was."""
+tip pulled further still leaves every vertex outside the ear exactly where it was, refined too."""
 import os
 import sys
 
@@ -27,4 +27,8 @@ assert bpy.ops.modal_deform.solve() == {"FINISHED"}
 pose = support.key_positions(obj, posing.POSE_KEY)
 assert pose[~ear].tobytes() == V[~ear].tobytes(), "a vertex outside the region moved"
 assert np.abs(pose - saved).max() > 0.1
+assert bpy.ops.modal_deform.refine() == {"FINISHED"}
+refined = support.key_positions(obj, posing.POSE_KEY)
+assert refined[~ear].tobytes() == V[~ear].tobytes(), "Refine moved a vertex outside the region"
+assert np.abs(refined - pose).max() > 1e-4, "Refine left the reduced pose as it was"
 print("REGION_RELOADED")

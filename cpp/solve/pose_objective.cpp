@@ -1,0 +1,76 @@
+#include "solve/pose_objective.h"
+
+#include <algorithm>
+#include <limits>
+
+#include "mesh/mass.h"
+#include "mesh/normalization.h"
+#include "util/require_positions.h"
+
+namespace modal_deform {
+
+PoseObjective::PoseObjective(const VerticesRef& V, const FacesRef& F, const Handles& handles,
+                             const Eigen::VectorXd& weights, double stiffness, EnergyKind energy, double bending,
+                             double membrane, const StiffnessPaint& paint, const std::vector<int>& held)
+    : scale_(normalizing_scale(V)),
+      rest_(scale_ * V),
+      energy_(make_energy(energy, rest_, F, bending, membrane, paint)),
+      handle_term_(rest_, scale_ * scale_ * lumped_mass(V, F), handles, weights, stiffness),
+      faces_(F) {
+  const int n = static_cast<int>(V.rows());
+  const Eigen::VectorXd mass = lumped_mass(V, F);
+  const Eigen::VectorXd handle_diagonal = handle_term_.hessian_diagonal(n);
+  const Eigen::VectorXd hessian_diagonal = energy_->hessian(rest_positions()).diagonal();
+  mass_diagonal_.resize(3 * n);
+  for (int v = 0; v < n; ++v) mass_diagonal_.segment<3>(3 * v).setConstant(scale_ * scale_ * mass[v]);
+  const double mean_mass = mass_diagonal_.mean();
+  mass_diagonal_ = mass_diagonal_.cwiseMax(1e-6 * mean_mass);
+  // Coordinates of vertices in no energy term and no handle (no mass, a zero Hessian block) get a
+  // fixed diagonal: nothing moves them.
+  constant_diagonal_ = handle_diagonal;
+  for (int v = 0; v < n; ++v)
+    if (mass[v] == 0 && hessian_diagonal.segment<3>(3 * v).isZero(0) && handle_diagonal.segment<3>(3 * v).isZero(0))
+      constant_diagonal_.segment<3>(3 * v).setConstant(mean_mass);
+  smallest_shift_ = 1e-8 * (hessian_diagonal + handle_diagonal).cwiseAbs().mean() / mean_mass;
+  // Held coordinates decouple (without_held) with a diagonal of their own, so their step is 0.
+  if (!held.empty()) held_.assign(3 * static_cast<size_t>(n), 0);
+  for (int v : held) {
+    std::fill_n(held_.begin() + 3 * static_cast<std::ptrdiff_t>(v), 3, 1);
+    constant_diagonal_.segment<3>(3 * v).setConstant(mean_mass);
+  }
+}
+
+SparseMatrix PoseObjective::without_held(SparseMatrix hessian) const {
+  if (held_.empty()) return hessian;
+  for (int col = 0; col < hessian.outerSize(); ++col)
+    for (SparseMatrix::InnerIterator entry(hessian, col); entry; ++entry)
+      if (held_[static_cast<size_t>(entry.row())] || held_[static_cast<size_t>(col)]) entry.valueRef() = 0;
+  return hessian;
+}
+
+bool PoseObjective::turns_a_triangle_over(const Eigen::VectorXd& y, const Eigen::VectorXd& y_new) const {
+  for (Eigen::Index f = 0; f < faces_.rows(); ++f) {
+    const int a = faces_(f, 0), b = faces_(f, 1), c = faces_(f, 2);
+    const Eigen::Vector3d n =
+        (y.segment<3>(3 * b) - y.segment<3>(3 * a)).cross(y.segment<3>(3 * c) - y.segment<3>(3 * a));
+    const Eigen::Vector3d n_new =
+        (y_new.segment<3>(3 * b) - y_new.segment<3>(3 * a)).cross(y_new.segment<3>(3 * c) - y_new.segment<3>(3 * a));
+    if (n.dot(n_new) < 0) return true;
+  }
+  return false;
+}
+
+void PoseObjective::set_transforms(Transforms transforms) {
+  for (Eigen::Matrix4d& T : transforms) T.topRightCorner<3, 1>() *= scale_;
+  handle_term_.set_transforms(transforms);
+}
+
+double PoseObjective::operator()(const Eigen::VectorXd& y, Eigen::VectorXd& gradient) const {
+  if (!positions_in_range(y)) return std::numeric_limits<double>::infinity();
+  const double value = energy_->value_and_gradient(y, gradient) + handle_term_.add_value_and_gradient(y, gradient);
+  for (size_t i = 0; i < held_.size(); ++i)
+    if (held_[i]) gradient[static_cast<Eigen::Index>(i)] = 0;
+  return value;
+}
+
+}  // namespace modal_deform

@@ -1,0 +1,69 @@
+// The full solve's objective (full_solver.h) in the normalised frame y = s x:
+//
+//   F(y) = E(y) + μ Σ_h w_h Σ_{i∈h} s²m_i ‖y_i − s (R_h x̄_i + t_h)‖²,
+//
+// with the parts of its Hessian that do not change (the handle term's diagonal) and the shape of
+// the Newton shift (the lumped mass per coordinate).
+#pragma once
+
+#include <memory>
+
+#include "energy/make_energy.h"
+#include "solve/handle_term.h"
+#include "util/types.h"
+
+namespace modal_deform {
+
+class PoseObjective {
+ public:
+  // V: #V by 3 rest positions and F: #F by 3 triangles (validated); handles and weights as
+  // checked_handle_weights returns them; stiffness μ > 0; energy, bending, membrane and paint as
+  // make_energy takes them.
+  // `held` (vertex indices in range) stay where y puts them: their gradient and their Hessian rows
+  // are zero.
+  PoseObjective(const VerticesRef& V, const FacesRef& F, const Handles& handles, const Eigen::VectorXd& weights,
+                double stiffness, EnergyKind energy, double bending, double membrane, const StiffnessPaint& paint,
+                const std::vector<int>& held = {});
+
+  double scale() const { return scale_; }
+  Eigen::VectorXd rest_positions() const { return flatten(rest_); }
+  // The energy's Hessian at y, exact or projected (each element's made semidefinite), with the held
+  // coordinates' rows and columns zero.
+  SparseMatrix hessian(const Eigen::VectorXd& y) const { return without_held(energy_->hessian(y)); }
+  SparseMatrix projected_hessian(const Eigen::VectorXd& y) const {
+    return without_held(energy_->projected_hessian(y));
+  }
+  // D (3#V): the normalised lumped mass per coordinate, the shape of the Hessian's shift, floored
+  // at 1e-6 of its mean.
+  const Eigen::VectorXd& mass_diagonal() const { return mass_diagonal_; }
+  // The handle term's Hessian (diagonal, constant) and the fixed unreferenced coordinates.
+  const Eigen::VectorXd& constant_diagonal() const { return constant_diagonal_; }
+  // The smallest shift τ used: 1e-8 of the mean curvature per unit mass at rest.
+  double smallest_shift() const { return smallest_shift_; }
+
+  // Whether a triangle turns over between y and y_new: its normal reverses (a triangle with no
+  // normal at y, collapsed already, is not counted). F has a kink where a triangle collapses (its
+  // hinges' angles flip by π as its normal does), and a step through it lands beyond the smooth
+  // part of F that Newton's method can converge in, often lower: iterates are kept out of it.
+  bool turns_a_triangle_over(const Eigen::VectorXd& y, const Eigen::VectorXd& y_new) const;
+
+  // Transforms (one per handle) in mesh units, applied to the handle term in the normalised frame.
+  void set_transforms(Transforms transforms);
+
+  // F(y), ∇F(y) written into `gradient`; +inf where y is beyond what the energy takes.
+  double operator()(const Eigen::VectorXd& y, Eigen::VectorXd& gradient) const;
+
+ private:
+  SparseMatrix without_held(SparseMatrix hessian) const;
+
+  double scale_;
+  RowMatrixX3d rest_;
+  std::unique_ptr<Energy> energy_;
+  HandleTerm handle_term_;
+  Eigen::VectorXd mass_diagonal_, constant_diagonal_;
+  double smallest_shift_ = 0;
+  RowMatrixX3i faces_;
+  std::vector<char> held_;  // per coordinate, empty when nothing is held
+};
+
+}  // namespace modal_deform

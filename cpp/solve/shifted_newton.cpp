@@ -1,0 +1,92 @@
+#include "solve/shifted_newton.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "solve/line_search.h"
+#include "util/errors.h"
+
+namespace modal_deform {
+
+ShiftedNewton::ShiftedNewton(const PoseObjective& objective)
+    : objective_(objective), llt_(3), shift_(objective.smallest_shift()) {
+  const Eigen::Index size = objective.mass_diagonal().size();
+  step_.resize(size);
+  trial_.y.resize(size);
+  trial_.gradient.resize(size);
+}
+
+int ShiftedNewton::minimize(NewtonPoint& point, double target, int budget, double exact_below,
+                            const std::function<void(const NewtonPoint&)>& after_iteration) {
+  int iterations = 0, stalled = 0;
+  while (iterations < budget && stalled < kMaxStalledIterations && point.gradient.norm() > target) {
+    const bool near_minimum = point.gradient.norm() <= exact_below;
+    stalled = iterate(point, near_minimum) ? 0 : stalled + 1;
+    ++iterations;
+    after_iteration(point);
+  }
+  return iterations;
+}
+
+bool ShiftedNewton::iterate(NewtonPoint& point, bool near_minimum) {
+  const bool try_exact = near_minimum && ++since_exact_failed_ > kRetryExactAfter;
+  const bool exact = try_exact && try_factorize(objective_.hessian(point.y));
+  if (try_exact && !exact) since_exact_failed_ = 0;
+  if (!exact) factorize_shifted(objective_.projected_hessian(point.y));
+  llt_.solve(point.gradient, step_);
+  step_ = -step_;
+  const double slope = point.gradient.dot(step_);
+  // The decrease the model F + ∇Fᵀp + ½pᵀ∇²F p promises: pᵀ(∇²F + τD)p = −∇Fᵀp gives it.
+  const double predicted = -0.5 * slope + 0.5 * shift_ * step_.dot(objective_.mass_diagonal().cwiseProduct(step_));
+  const double noise = 1e-12 * (1 + std::abs(point.value));
+  // A trial point that turns a triangle over counts as too far.
+  const Objective within_smooth_part = [&](const Eigen::VectorXd& trial, Eigen::VectorXd& trial_gradient) {
+    if (objective_.turns_a_triangle_over(point.y, trial)) return std::numeric_limits<double>::infinity();
+    return objective_(trial, trial_gradient);
+  };
+  const BacktrackingResult search = backtracking_line_search(within_smooth_part, point.y, point.value, point.gradient,
+                                                             step_, trial_.y, trial_.value, trial_.gradient, noise);
+  update_shift(search.step, (point.value - trial_.value) / predicted);
+  if (search.step == 0) return false;
+  const bool progress =
+      point.value - trial_.value > noise || trial_.gradient.norm() < 0.5 * point.gradient.norm();
+  std::swap(point, trial_);
+  return progress;
+}
+
+void ShiftedNewton::update_shift(double step, double ratio) {
+  failed_shift_ /= 3;  // the Hessian changes: a shift too small a while ago may do now
+  if (step == 1) {
+    shift_ = std::max({objective_.smallest_shift(), failed_shift_,
+                       shift_ * std::max(0.1, 1 - std::pow(2 * ratio - 1, 3))});
+    growth_ = 2;
+  } else {
+    // Too long a step: lean towards steepest descent. Where τD dominates the Hessian (the floppy
+    // parts that made the step too long) the step shrinks as 1/τ, so τ grows at least by the
+    // factor the line search cut the step by (from a poor start, τ must rise by ten orders of
+    // magnitude, which doubling alone took ten iterations to reach).
+    shift_ *= std::max(growth_, std::min(1 / step, kMaxCutGrowth));
+    growth_ = std::min(2 * growth_, kMaxGrowth);
+  }
+}
+
+bool ShiftedNewton::try_factorize(const SparseMatrix& hessian) {
+  ++factorizations_;
+  try {
+    llt_.factorize(hessian, objective_.constant_diagonal() + shift_ * objective_.mass_diagonal());
+    return true;
+  } catch (const NumericalError&) {
+    return false;
+  }
+}
+
+void ShiftedNewton::factorize_shifted(const SparseMatrix& hessian) {
+  for (int attempt = 0; !try_factorize(hessian); ++attempt) {
+    if (attempt == 60) throw NumericalError("solve_full: no shift of the Hessian could be factored");
+    failed_shift_ = std::max(failed_shift_, shift_);
+    shift_ *= 10;
+  }
+}
+
+}  // namespace modal_deform

@@ -1,0 +1,86 @@
+// Newton's method on the full solve's objective F (pose_objective.h) with the Hessian shifted,
+// ∇²F + τD (D the normalised lumped mass per coordinate), factored once an iteration. CHOLMOD's
+// analysis of the Hessian's pattern is kept for the whole solve, and τ from one iteration (and
+// load step) to the next.
+//
+// τ follows how well the quadratic model predicted the decrease (Levenberg–Marquardt with
+// Nielsen's update: shrunk after a good step, grown after a poor one — at least by the factor the
+// line search cut the step by — and tenfold when the factorisation finds the matrix not positive
+// definite, never below 1e-8 of the Hessian's scale so that a free component's rigid motions stay
+// regularised). A large τ shortens the step where curvature is low (flaps) and leaves it Newton's
+// where curvature is high, unlike a line search, which would shorten it everywhere. The step is
+// then backtracked (Armijo, line_search.h) when F does not decrease enough or a triangle turns
+// over. The Hessian is the projected one (each element's made semidefinite) far from the minimum,
+// and the exact one near it wherever it factors at the current τ (quadratic convergence).
+#pragma once
+
+#include <functional>
+
+#include "linalg/cholmod_llt.h"
+#include "solve/pose_objective.h"
+
+namespace modal_deform {
+
+// A point of the solve: y (3#V, normalised frame), F(y) and ∇F(y).
+struct NewtonPoint {
+  Eigen::VectorXd y;
+  double value = 0;
+  Eigen::VectorXd gradient;
+};
+
+class ShiftedNewton {
+ public:
+  // Keeps a reference to `objective`, which must outlive it.
+  explicit ShiftedNewton(const PoseObjective& objective);
+
+  int factorizations() const { return factorizations_; }
+
+  // Iterates from `point` (updated) until ‖∇F‖ ≤ target, `budget` iterations are spent, or F
+  // stops decreasing (kMaxStalledIterations iterations without progress: at a kink of F, a triangle
+  // collapsed, its bending terms' angles undefined, F stops decreasing while ‖∇F‖ does not fall).
+  // The exact Hessian is tried once ‖∇F‖ ≤ exact_below. after_iteration(point) is called after
+  // each iteration. Returns the iterations made.
+  int minimize(NewtonPoint& point, double target, int budget, double exact_below,
+               const std::function<void(const NewtonPoint&)>& after_iteration);
+
+  // One iteration from `point` (updated). Near the minimum (`near_minimum`) the exact Hessian is
+  // tried first, at the current τ only: where it is not definite there (a flap still bent far from
+  // rest), the projected one (Energy::projected_hessian) serves instead for the next
+  // kRetryExactAfter iterations. Growing τ until the exact Hessian factors would damp the whole
+  // mesh (on the 23k dragon τ rose to 3e6 and the next ten iterations crept). Returns whether it
+  // made progress: F fell by more than its rounding, or ‖∇F‖ by half (near the minimum, where F's
+  // decrease is below rounding).
+  bool iterate(NewtonPoint& point, bool near_minimum);
+
+ private:
+  static constexpr int kMaxStalledIterations = 3;
+  static constexpr double kMaxGrowth = 16;
+  static constexpr double kMaxCutGrowth = 1e4;
+  // Iterations on the projected Hessian after the exact one failed to factor before it is tried
+  // again: the projected one converges only linearly (clamping the negative curvature of a bent
+  // flap overestimates it), so the exact one is retried soon, at one factorisation's cost.
+  static constexpr int kRetryExactAfter = 3;
+
+  // Factors ∇²F + τD at the current τ; false (the matrix not definite) leaves τ as it is.
+  bool try_factorize(const SparseMatrix& hessian);
+  // Factors ∇²F + τD, τ grown tenfold until it factors.
+  void factorize_shifted(const SparseMatrix& hessian);
+  // τ after a step the line search cut to `step` (0: none taken), its decrease `ratio` times the
+  // model's.
+  void update_shift(double step, double ratio);
+
+  const PoseObjective& objective_;
+  CholmodLLT llt_;
+  double shift_;       // τ
+  double growth_ = 2;  // τ's factor after the next poor step (Nielsen's ν)
+  // The largest τ that failed to factor lately (decaying): τ is not lowered below it, which would
+  // only cost another failed factorisation.
+  double failed_shift_ = 0;
+  int factorizations_ = 0;
+  // Iterations since the exact Hessian was last found not definite at τ.
+  int since_exact_failed_ = kRetryExactAfter;
+  Eigen::VectorXd step_;
+  NewtonPoint trial_;
+};
+
+}  // namespace modal_deform
