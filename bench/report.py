@@ -599,7 +599,7 @@ def section_bake_busy(result):
     p, summary = result["parameters"], result["figures"]["summary"]
     out = ["## The bake beside a busy core (issue 25)", "",
            f"{p['mesh']} baked at {p['modes']} + {p['derivatives']} with a {p['ghost']}-vertex ghost, each bake in a "
-           f"fresh process, quiet and beside {p['busy']}, as shipped (OpenMP's passive wait, OpenBLAS under CHOLMOD "
+           f"fresh process, quiet and with {p['busy']}, as shipped (OpenMP's passive wait, OpenBLAS under CHOLMOD "
            "on the usable cores less one) and with GCC OpenMP's default spinning wait; the four in turn in each of "
            f"{p['rounds']} round(s); ratios round by round, medians. Issue 25's target: busy / quiet at most 1.3.", ""]
     rows = [[variant.replace("_", " "), f"{summary['seconds']['quiet'][variant]:.1f}",
