@@ -13,6 +13,8 @@ Experiments (each writes bench/results/<name>.json: machine, commit, command, pa
   bake_limit   the 100k-vertex dragon's bake at 67 and 130 dimensions, three fresh processes, against
                CHOLMOD's analysis and factorisation of the same matrix and issue 14's targets
                (bench/bake_limit.py)
+  bake_busy    the 23k dragon's bake quiet and beside one busy core (`yes`), as shipped and with
+               OpenMP's default spinning wait, fresh processes in turn (bench/bake_busy.py)
   raw_scan     a damaged, subdivided dragon of about 405k vertices baked in a fresh process: time
                and peak memory against issue 15's targets (bench/raw_scan.py)
   multires     the dragon subdivided twice (1.6M vertices) baked on a proxy: time, memory, stored
@@ -51,7 +53,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import common  # noqa: E402
 import report  # noqa: E402
 
-PYTHON_EXPERIMENTS = ("table1", "accuracy", "convergence", "taylor", "bake_limit", "raw_scan", "multires",
+PYTHON_EXPERIMENTS = ("table1", "accuracy", "convergence", "taylor", "bake_limit", "bake_busy", "raw_scan", "multires",
                       "strong_poses", "refine", "region")
 EXPERIMENTS = ("native",) + PYTHON_EXPERIMENTS + ("blender", "bpy_pose", "viewport_frames", "renders")
 NATIVE_IN_TABLE1 = "BM_Bake|BM_BfgsIteration|BM_Positions"

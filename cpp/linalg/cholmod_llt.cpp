@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "linalg/blas_threads.h"
 #include "util/errors.h"
 #include "util/stopwatch.h"
 
@@ -220,6 +221,7 @@ void CholmodLLT::factorize_lower(SparseMatrix lower, double min_rcond) {
   if (new_pattern) analyze_lower();
   cholmod_sparse view = Cholmod::view(lower_);
   cholmod_factor* L = cholmod_->factor;
+  const BlasThreadLimit blas_threads;
   const int ok = cholmod_factorize(&view, L, &cholmod_->common);
   if (cholmod_->common.status == CHOLMOD_NOT_POSDEF) {
     const int pivot = static_cast<int>(L->minor);
@@ -262,6 +264,7 @@ CholmodLLT::Solution CholmodLLT::solve_in_workspace(const Eigen::Ref<const Eigen
   rhs.xtype = CHOLMOD_REAL;
   rhs.dtype = CHOLMOD_DOUBLE;
   Cholmod& c = *cholmod_;
+  const BlasThreadLimit blas_threads;
   const int ok =
       cholmod_solve2(CHOLMOD_A, c.factor, &rhs, nullptr, &c.solution, nullptr, &c.work_y, &c.work_e, &c.common);
   c.check(ok != 0, "solve");
