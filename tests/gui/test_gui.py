@@ -41,4 +41,4 @@ def test_viewport_frame_time_while_posing_100k(tmp_path):
     result = json.loads(output.read_text())
     assert result["ok"], "\n".join(result["log"])
     print("\n".join(result["log"]))
-    assert result["vertices"] == 100250 and set(result["displays"]) == {"positions", "shape_key"}
+    assert result["vertices"] == 100250 and set(result["displays"]) == {"positions", "stand_in", "shape_key"}
