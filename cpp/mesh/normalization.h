@@ -16,6 +16,12 @@ inline double bounding_box_extent(const VerticesRef& V) {
   return (V.colwise().maxCoeff() - V.colwise().minCoeff()).maxCoeff();
 }
 
+// The length of the bounding box's diagonal of V (#V by 3), in V's units; 0 when V has no rows.
+inline double bounding_box_diagonal(const VerticesRef& V) {
+  if (V.rows() == 0) return 0;
+  return (V.colwise().maxCoeff() - V.colwise().minCoeff()).norm();
+}
+
 // The factor that scales V (#V by 3) to a longest bounding-box edge of 10.
 inline double normalizing_scale(const VerticesRef& V) {
   const double extent = bounding_box_extent(V);

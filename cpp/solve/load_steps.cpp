@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "mesh/normalization.h"
+
 namespace modal_deform {
 namespace {
 
@@ -15,7 +17,7 @@ constexpr double kFirstStepDivisor = 6;
 
 LoadPath::LoadPath(const VerticesRef& V, const Handles& handles, const Transforms& transforms)
     : transforms_(transforms) {
-  const double diagonal = (V.colwise().maxCoeff() - V.colwise().minCoeff()).norm();
+  const double diagonal = bounding_box_diagonal(V);
   for (size_t h = 0; h < handles.size(); ++h) {
     Eigen::Vector3d c = Eigen::Vector3d::Zero();
     for (int v : handles[h]) c += V.row(v).transpose();

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "mesh/normalization.h"
 #include "reduction/region.h"
 #include "util/errors.h"
 #include "util/require_positions.h"
@@ -22,11 +23,6 @@ double checked_stiffness(double stiffness) {
 const Basis& checked(const Basis& basis) {
   validate_basis(basis);
   return basis;
-}
-
-double bounding_box_diagonal(const RowMatrixX3d& V) {
-  if (V.rows() == 0) return 0;
-  return (V.colwise().maxCoeff() - V.colwise().minCoeff()).norm();
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "bake/bake.h"
+#include "mesh/normalization.h"
 #include "mesh/primitives.h"
 #include "reduction/prolongation.h"
 #include "solve/reduced_solver.h"
@@ -179,8 +180,7 @@ TEST(BakeOnProxy, SolverAgreesWithTheDenseProlongatedBasis) {
   on_proxy.positions(x);
   made_dense.positions(y);
   // Each map is within its 16-bit tolerance of the float32 one (reduced_solver.h), which agree.
-  const double diagonal = (b.mesh.V.colwise().maxCoeff() - b.mesh.V.colwise().minCoeff()).norm();
-  const double map_tolerance = ReducedSolver::kMapTolerance * diagonal;
+  const double map_tolerance = ReducedSolver::kMapTolerance * bounding_box_diagonal(b.mesh.V);
   EXPECT_LT((x - y).cwiseAbs().maxCoeff(), 2 * map_tolerance + 1e-5);
   EXPECT_GT((x.cast<double>() - flatten(b.mesh.V)).cwiseAbs().maxCoeff(), 0.1);  // it did move
 }

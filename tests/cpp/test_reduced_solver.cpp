@@ -4,6 +4,7 @@
 #include <limits>
 #include <map>
 
+#include "mesh/normalization.h"
 #include "mesh/primitives.h"
 #include "solve/line_search.h"
 #include "solve/reduced_solver.h"
@@ -179,7 +180,7 @@ TEST(ReducedSolver, PositionsAreRestPlusUqInTheCallersBuffer) {
   const double magnitude =
       flatten(basis.rest).cwiseAbs().maxCoeff() + (expected - flatten(basis.rest)).cwiseAbs().maxCoeff();
   // Read from 16 bits (QuantizedVectors): within the map's tolerance, beside float32's own rounding.
-  const double diagonal = (basis.rest.colwise().maxCoeff() - basis.rest.colwise().minCoeff()).norm();
+  const double diagonal = bounding_box_diagonal(basis.rest);
   EXPECT_LE((out.cast<double>() - expected).cwiseAbs().maxCoeff(),
             ReducedSolver::kMapTolerance * diagonal + 1e-6 * magnitude);
   solver.reset();
