@@ -561,7 +561,7 @@ def section_strong_poses(result):
             + ", ".join(f"{100 * v:.0f}% at {k}" for k, v in p["targets"].items()) + "). Objectives: the reduced "
             "solver's (ghost energy plus handle term). Gap: the full objective of the 100k dragon at the pose (the 1.6M "
             "pose on the vertices the meshes share) above its minimum, relative to the minimum; the minimum is "
-            "solve_full's, converged from the 100k bake's pose (Refine), with its iterations and seconds.", ""]
+            "solve_full's, converged from the lower of the two poses (Refine), with its iterations and seconds.", ""]
     rows = []
     for degrees, r in f["turns"].items():
         full = r.get("full")
@@ -574,7 +574,8 @@ def section_strong_poses(result):
         minimum = ""
         if full and "gap" in full:
             minimum = (f"{full['energy']:.3f}" if full["converged"] else
-                       f"NOT converged (from {full['gap']['own'] + full['energy']:.4g} to {full['energy']:.4g})")
+                       f"NOT converged (from {full['gap'][full.get('start', 'own')] + full['energy']:.4g} to "
+                       f"{full['energy']:.4g})")
             minimum += f", {full['iterations']} it, {full['seconds']:.0f} s"
         rows.append([degrees, "yes" if r["fine"]["converged"] else "NO", r["fine"]["stalled_calls"],
                      r["fine"]["calls_without_progress"], f"{r['fine']['energy']:.3f}", f"{r['own']['energy']:.3f}",
