@@ -68,22 +68,26 @@ def thread_check(python, folder):
 
 
 def bake_pair(bake, mesh, busy_first, folder):
-    """{condition: seconds} of the bake quiet and beside one `yes`, back to back."""
+    """{condition: seconds, "stages": {condition: {stage: seconds}}} of the bake quiet and beside one
+    `yes`, back to back."""
     python, _, variant = bake
-    seconds = {}
+    pair = {"stages": {}}
     for condition in (CONDITIONS[::-1] if busy_first else CONDITIONS):
         busy = subprocess.Popen(["yes"], stdout=subprocess.DEVNULL) if condition == "busy" else None
         try:
-            seconds[condition] = in_fresh_process(python, [mesh], VARIANTS[variant], folder)[0]["seconds"]
+            result = in_fresh_process(python, [mesh], VARIANTS[variant], folder)[0]
         finally:
             if busy is not None:
                 busy.kill()
                 busy.wait()
-    return seconds
+        pair[condition] = result["seconds"]
+        pair["stages"][condition] = result["stages"]
+    return pair
 
 
 def summary(bakes, rounds):
-    """Medians over the rounds per bake: seconds, busy / quiet pair by pair; shipped / spinning."""
+    """Medians over the rounds per bake: seconds, busy / quiet pair by pair, also per stage; shipped /
+    spinning."""
     def median(values):
         return statistics.median(list(values))
     out = {}
@@ -91,6 +95,9 @@ def summary(bakes, rounds):
         pairs = [r[name(bake)] for r in rounds]
         out[name(bake)] = {"quiet": median(p["quiet"] for p in pairs), "busy": median(p["busy"] for p in pairs),
                            "busy_over_quiet": median(p["busy"] / p["quiet"] for p in pairs),
+                           "stages_busy_over_quiet": {
+                               stage: median(p["stages"]["busy"][stage] / p["stages"]["quiet"][stage] for p in pairs)
+                               for stage in pairs[0]["stages"]["quiet"] if pairs[0]["stages"]["quiet"][stage] > 0},
                            "load_before": [min(p["load_before"] for p in pairs), max(p["load_before"] for p in pairs)]}
     shipped, spinning = (name(b) for b in bakes if b[0] == "python" and b[1] == bakes[0][1])
     out["shipped_over_spinning"] = {c: median(r[shipped][c] / r[spinning][c] for r in rounds) for c in CONDITIONS}

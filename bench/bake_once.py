@@ -1,7 +1,7 @@
 """One bake of a shared mesh at 15 modes + 52 derivatives with a 1k ghost, for bench/bake_busy.py: in
 plain Python on the source tree's core, or in bpy on the core of the extension that
 tests/blender/bpy_session.py installed (Blender's own NumPy and its OpenBLAS beside it). Prints
-{"seconds": the bake's wall time} as JSON on its last line.
+{"seconds": the bake's wall time, "stages": {stage: seconds}} as JSON on its last line.
 
     python bench/bake_once.py MESH [--threads]
     python tests/blender/bpy_session.py --extension ZIP bench/bake_once.py -- MESH [--threads]
@@ -90,8 +90,8 @@ def main():
     sampler = ThreadSampler() if arguments.threads else contextlib.nullcontext()
     start = time.perf_counter()
     with sampler:
-        mdc.bake(V, F, modes=15, derivatives=52, ghost=1000)
-    result = {"seconds": time.perf_counter() - start}
+        basis = mdc.bake(V, F, modes=15, derivatives=52, ghost=1000)
+    result = {"seconds": time.perf_counter() - start, "stages": basis.timings}
     if arguments.threads:
         result["openblas_threads_seen"] = {library: sorted(seen) for library, seen in sampler.seen.items()}
     print(json.dumps(result), flush=True)

@@ -631,6 +631,11 @@ def section_bake_busy(result):
              "{:.1f}–{:.1f}".format(*s["load_before"])]
             for bake, s in summary.items() if bake != "shipped_over_spinning"]
     out.append(table(["bake", "quiet s", "busy s", "busy / quiet", "load before"], rows))
+    out += ["", "Busy / quiet by stage (the bake's own timings, medians):", ""]
+    stages = [k for k in bake_limit.STAGE_KEYS if k in next(iter(summary.values()))["stages_busy_over_quiet"]]
+    out.append(table(["bake"] + stages, [[bake.replace("_", " ")] + [f"{s['stages_busy_over_quiet'].get(k, 0):.2f}"
+                                                                      for k in stages]
+                                         for bake, s in summary.items() if bake != "shipped_over_spinning"]))
     out += ["", "Shipped / spinning (plain Python): " +
             ", ".join(f"{c} {x:.2f}" for c, x in summary["shipped_over_spinning"].items()) + ".", "",
             f"The threads, in each Python, during a bake of {p['check_mesh']}: what the core's OpenMP runtime "
