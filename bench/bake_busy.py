@@ -4,7 +4,11 @@ bench/bake_once.py, each bake in a fresh process, quiet and with one `yes` proce
 Python as the add-on ships (OpenMP's passive wait, OpenBLAS under CHOLMOD on the usable cores less
 one) and, at 23k, with GCC OpenMP's default spinning wait (GOMP_SPINCOUNT=300000, which the core's
 import then leaves alone); and inside bpy 4.5 and 5.3 on the installed extension, beside Blender's
-own NumPy and its OpenBLAS. The machine is shared, so "quiet" means nothing of ours beside the bake:
+own NumPy and its OpenBLAS. `yes` runs in a session of its own, as another application does: Linux
+shares the cores between sessions first (autogroups), so a `yes` in the bake's session would take half
+of what the session gets, which on a machine loaded by other sessions is far less than the core it
+leaves free on an idle one (the 23k bake then took 1.9 to 2.7 times as long at load 10 to 11, against
+1.09 on an idle machine). The machine is shared, so "quiet" means nothing of ours beside the bake:
 each bake runs quiet and busy back to back (which comes first alternates by round), the ratio is
 taken pair by pair and the load average before each pair is kept; medians over the rounds.
 
@@ -73,7 +77,8 @@ def bake_pair(bake, mesh, busy_first, folder):
     python, _, variant = bake
     pair = {"stages": {}}
     for condition in (CONDITIONS[::-1] if busy_first else CONDITIONS):
-        busy = subprocess.Popen(["yes"], stdout=subprocess.DEVNULL) if condition == "busy" else None
+        busy = subprocess.Popen(["yes"], stdout=subprocess.DEVNULL, start_new_session=True) \
+            if condition == "busy" else None
         try:
             result = in_fresh_process(python, [mesh], VARIANTS[variant], folder)[0]
         finally:
