@@ -1,4 +1,4 @@
-"""The bake at the limit (issue 14): dragon_vrip_res2 (100k vertices) baked at the paper's 67
+"""The bake at the limit (issues 14 and 25): dragon_vrip_res2 (100k vertices) baked at the paper's 67
 dimensions (15 modes + 52 derivatives) and 130 (20 + 110) with a 1k ghost by the native benchmark
 BM_Bake (bench/bench_bake.cpp), each run in a fresh process: wall time, the stages, peak resident
 memory, and CHOLMOD alone analysing and factoring the same stiffness matrix in the same process
@@ -17,9 +17,10 @@ from common import ROOT
 
 BINARY = ROOT / "build" / "bench" / "modal_deform_bench"
 RUNS = 3
-#: Issue 14's targets: seconds for each dimension, the 67-dimensional bake's ratio to CHOLMOD's
-#: analysis and factorisation, and peak memory (GB of 2^30 bytes) at 100k vertices.
-TARGETS = {"seconds_67": 8.0, "seconds_130": 12.0, "ratio_67": 2.5, "peak_gb": 2.0}
+#: At 100k vertices, issue 25's for the 67-dimensional bake: seconds, ratio to CHOLMOD's analysis and
+#: factorisation, peak memory (GB of 2^30 bytes); issue 14's for the 130-dimensional one (issue 25
+#: sets none): seconds and peak.
+TARGETS = {"seconds_67": 10.0, "ratio_67": 2.7, "peak_gb_67": 1.8, "seconds_130": 12.0, "peak_gb_130": 2.0}
 #: Block widths at which bench_bake.cpp times CHOLMOD's solves with the factor it made alone.
 SOLVE_WIDTHS = ("1", "8", "52")
 #: The stages of a bake without a proxy.
@@ -62,15 +63,20 @@ def summary(runs):
 
 
 def checks(result):
-    """(what, measured, target, unit) for each of issue 14's targets that this run measured."""
+    """(what, measured, target, unit) for each target that this run measured."""
     rows = []
     if "67" in result:
-        rows += [("bake at 67 dimensions ≤ 8 s", result["67"]["seconds"], TARGETS["seconds_67"], "s"),
-                 ("bake / CHOLMOD analyse + factor at 67 ≤ 2.5", result["67"]["ratio"], TARGETS["ratio_67"], "x")]
+        rows += [(f"bake at 67 dimensions ≤ {TARGETS['seconds_67']:g} s (issue 25)", result["67"]["seconds"],
+                  TARGETS["seconds_67"], "s"),
+                 (f"bake / CHOLMOD analyse + factor at 67 ≤ {TARGETS['ratio_67']:g} (issue 25)", result["67"]["ratio"],
+                  TARGETS["ratio_67"], "x"),
+                 (f"peak memory at 67 ≤ {TARGETS['peak_gb_67']:g} GB (issue 25)", result["67"]["peak_gb"],
+                  TARGETS["peak_gb_67"], "GB")]
     if "130" in result:
-        rows.append(("bake at 130 dimensions ≤ 12 s", result["130"]["seconds"], TARGETS["seconds_130"], "s"))
-    peak = max(r["peak_gb"] for r in result.values())
-    rows.append(("peak memory ≤ 2 GB", peak, TARGETS["peak_gb"], "GB"))
+        rows += [(f"bake at 130 dimensions ≤ {TARGETS['seconds_130']:g} s (issue 14)", result["130"]["seconds"],
+                  TARGETS["seconds_130"], "s"),
+                 (f"peak memory at 130 ≤ {TARGETS['peak_gb_130']:g} GB (issue 14)", result["130"]["peak_gb"],
+                  TARGETS["peak_gb_130"], "GB")]
     return rows
 
 

@@ -4,6 +4,7 @@ import json
 import os
 import pathlib
 import platform
+import shutil
 import subprocess
 import sys
 import time
@@ -11,9 +12,13 @@ import time
 import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "python_addon"))
+import package  # noqa: E402 (which extension zip serves which Python)
 RESULTS = ROOT / "bench" / "results"
 #: Posed meshes passed from one experiment to the next (accuracy -> blender -> renders); not committed.
 MESHES = ROOT / "bench" / "results" / "tmp" / "meshes"
+#: The Blenders the bpy experiments run in, as Python modules (.venv/bpy-<version>, made by `make bench`).
+BPY_VERSIONS = ("4.5", "5.3")
 
 
 def machine():
@@ -81,3 +86,24 @@ def json_from_fresh_process(code):
     if result.returncode != 0:
         return {"ok": False, "error": result.stderr.strip().splitlines()[-1:]}
     return {"ok": True} | json.loads(result.stdout.strip().splitlines()[-1])
+
+
+def in_bpy(version, script, arguments, folder, **run):
+    """Run `script` in bpy `version` (.venv/bpy-<version>) as tests/blender/bpy_session.py runs the
+    tests: the extension zip of its Python installed by Blender's installer into a fresh user
+    folder under `folder`, neither the source tree's add-on nor the machine's libraries in sight.
+    `run`: subprocess.run's further arguments (environment variables in `env`, added to this
+    process's); returns what it returns."""
+    python = ROOT / ".venv" / f"bpy-{version}" / "bin" / "python"
+    tag = subprocess.run([str(python), "-c", "import sys; print('%d.%d' % sys.version_info[:2])"],
+                         capture_output=True, text=True, check=True).stdout.strip()
+    extension = next(e for e in package.EXTENSIONS if e.python == tag)
+    user = pathlib.Path(folder) / f"user-{version}"
+    environment = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
+    environment.update(run.pop("env", {}), LD_LIBRARY_PATH="", BLENDER_USER_RESOURCES=str(user))
+    try:
+        return subprocess.run([str(python), str(ROOT / "tests" / "blender" / "bpy_session.py"), "--extension",
+                               str(ROOT / "dist" / package.extension_zip_name(extension)), str(script), "--",
+                               *arguments], check=True, cwd=ROOT, env=environment, **run)
+    finally:
+        shutil.rmtree(user, ignore_errors=True)

@@ -11,10 +11,12 @@ Experiments (each writes bench/results/<name>.json: machine, commit, command, pa
   convergence  Fig. 7 analogue (bench/convergence.py)
   taylor       Fig. 9 analogue (bench/taylor.py)
   bake_limit   the 100k-vertex dragon's bake at 67 and 130 dimensions, three fresh processes, against
-               CHOLMOD's analysis and factorisation of the same matrix and issue 14's targets
-               (bench/bake_limit.py)
-  bake_busy    the 23k dragon's bake quiet and beside one busy core (`yes`), as shipped and with
-               OpenMP's default spinning wait, fresh processes in turn (bench/bake_busy.py)
+               CHOLMOD's analysis and factorisation of the same matrix and issue 25's targets (issue 14's
+               at 130) (bench/bake_limit.py)
+  bake_busy    the 23k and 100k dragons' bakes quiet and beside one busy core (`yes`), in plain Python
+               (as shipped, and with OpenMP's default spinning wait) and in bpy 4.5 and 5.3 on the
+               extension zip (`make addon`), fresh processes, quiet and busy back to back
+               (bench/bake_busy.py)
   raw_scan     a damaged, subdivided dragon of about 405k vertices baked in a fresh process: time
                and peak memory against issue 15's targets (bench/raw_scan.py)
   multires     the dragon subdivided twice (1.6M vertices) baked on a proxy: time, memory, stored
@@ -41,9 +43,7 @@ written. The report alone is regenerated from the JSON with --report-only (or be
 import argparse
 import importlib
 import json
-import os
 import pathlib
-import shutil
 import subprocess
 import sys
 import tempfile
@@ -58,9 +58,6 @@ PYTHON_EXPERIMENTS = ("table1", "accuracy", "convergence", "taylor", "bake_limit
 EXPERIMENTS = ("native",) + PYTHON_EXPERIMENTS + ("blender", "bpy_pose", "viewport_frames", "renders")
 NATIVE_IN_TABLE1 = "BM_Bake|BM_BfgsIteration|BM_Positions"
 BLENDER = ["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python"]
-BPY_VERSIONS = ("4.5", "5.3")
-sys.path.insert(0, str(common.ROOT / "python_addon"))
-import package  # noqa: E402 (which extension zip serves which Python)
 
 
 def command(name):
@@ -78,23 +75,6 @@ def native(quick):
         raw = json.loads(out.read_text())
     return {"binary": str(binary.relative_to(common.ROOT)), "filter": arguments[3:],
             "context": raw["context"]}, {"benchmarks": raw["benchmarks"]}
-
-
-def in_bpy(version, script, arguments, folder):
-    """Run `script` in bpy `version` (.venv/bpy-<version>) as tests/blender/bpy_session.py runs the
-    tests: the extension zip of its Python installed by Blender's installer into a fresh user
-    folder, neither the source tree's add-on nor the machine's libraries in sight."""
-    python = common.ROOT / ".venv" / f"bpy-{version}" / "bin" / "python"
-    tag = subprocess.run([str(python), "-c", "import sys; print('%d.%d' % sys.version_info[:2])"],
-                         capture_output=True, text=True, check=True).stdout.strip()
-    extension = next(e for e in package.EXTENSIONS if e.python == tag)
-    user = pathlib.Path(folder) / f"user-{version}"
-    environment = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
-    environment.update(LD_LIBRARY_PATH="", BLENDER_USER_RESOURCES=str(user))
-    subprocess.run([str(python), str(common.ROOT / "tests" / "blender" / "bpy_session.py"), "--extension",
-                    str(common.ROOT / "dist" / package.extension_zip_name(extension)), str(script), "--", *arguments],
-                   check=True, cwd=common.ROOT, env=environment)
-    shutil.rmtree(user)
 
 
 def blender(quick):
@@ -127,14 +107,14 @@ def bpy_pose(quick):
     runs = []
     sizes = DENSE_DRAGONS[:1] if quick else DENSE_DRAGONS
     with tempfile.TemporaryDirectory() as folder:
-        for version in BPY_VERSIONS:
+        for version in common.BPY_VERSIONS:
             for i, size in enumerate(sizes):
                 out = pathlib.Path(folder) / f"bpy-{version}-{i}.json"
-                in_bpy(version, common.ROOT / "bench" / "blender_pose.py",
+                common.in_bpy(version, common.ROOT / "bench" / "blender_pose.py",
                        ["--output", str(out), "--pose-only", *size,
                         "--updates", "3" if quick else "15", *(["--quick"] if quick else [])], folder)
                 runs.append(json.loads(out.read_text()))
-    return {"blenders": BPY_VERSIONS, "sizes": sizes}, {"runs": runs}
+    return {"blenders": common.BPY_VERSIONS, "sizes": sizes}, {"runs": runs}
 
 
 def viewport_frames(quick):

@@ -144,21 +144,29 @@ void check_options(const BakeOptions& o, Eigen::Index num_vertices) {
   require_paintable(o.energy, o.paint);
 }
 
-// One stage of the bake: reported to the bar at its start and end, and its wall time added to
-// basis.timings[name] (a stage may run in parts). Returns what `work` returns.
-template <typename Work>
-auto stage(const char* name, Basis& basis, Progress& progress, Work&& work) {
-  const Stopwatch stopwatch(basis.timings[name]);
-  progress.report(name, 0.0);
-  if constexpr (std::is_void_v<std::invoke_result_t<Work>>) {
-    work();
-    progress.report(name, 1.0);
-  } else {
-    auto result = work();
-    progress.report(name, 1.0);
-    return result;
+// What every step of one bake shares: the options, the basis it fills (its rest state first, its
+// timings as it goes) and the bar.
+struct BakeRun {
+  const BakeOptions& options;
+  Basis& basis;
+  Progress& progress;
+
+  // One stage of the bake: reported to the bar at its start and end, and its wall time added to
+  // basis.timings[name] (a stage may run in parts). Returns what `work` returns.
+  template <typename Work>
+  auto stage(const char* name, Work&& work) {
+    const Stopwatch stopwatch(basis.timings[name]);
+    progress.report(name, 0.0);
+    if constexpr (std::is_void_v<std::invoke_result_t<Work>>) {
+      work();
+      progress.report(name, 1.0);
+    } else {
+      auto result = work();
+      progress.report(name, 1.0);
+      return result;
+    }
   }
-}
+};
 
 // 1. What the basis keeps of the input: the rest mesh, its masses and the normalising scale
 // (the fine mesh's, also for a proxy: the energy is the fine mesh's, in its frame).
@@ -213,11 +221,12 @@ Attachment region_attachment(const RegionMesh& region, Eigen::Index num_vertices
 
 // 2. Which vertices are simulated and which follow them (attachment.h); refuses mode counts the
 // submesh cannot give.
-Simulated simulated_submesh(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Basis& basis,
-                            Progress& progress) {
+Simulated simulated_submesh(const VerticesRef& V, const FacesRef& F, BakeRun& run) {
+  const BakeOptions& options = run.options;
+  const Basis& basis = run.basis;
   Simulated sim;
   RegionMesh region;
-  sim.attachment = stage(stages::kAttachment, basis, progress, [&] {
+  sim.attachment = run.stage(stages::kAttachment, [&] {
     if (options.region.size() == 0) return attach(V, F);
     region = region_mesh(F, basis.mass, options.region);
     return region_attachment(region, V.rows());
@@ -258,8 +267,9 @@ struct Stiffness {
   SparseMatrix K;
 };
 
-Stiffness stiffness_at_rest(const Simulated& sim, const BakeOptions& options, Basis& basis, Progress& progress) {
-  return stage(stages::kHessian, basis, progress, [&] {
+Stiffness stiffness_at_rest(const Simulated& sim, BakeRun& run) {
+  const BakeOptions& options = run.options;
+  return run.stage(stages::kHessian, [&] {
     Stiffness stiffness;
     const RowMatrixX3d V = sim.energy_vertices();
     if (options.energy == EnergyKind::kShells) {
@@ -306,31 +316,31 @@ class MovingPart {
 // rather than at the pencil's first factorisation, so the bar moves between the two (CHOLMOD
 // reports nothing during either), and so that the factor's size is known before the numeric
 // factorisation: what cannot fit is refused at once, not half a minute later.
-Ghost order_beside_the_ghost(const MovingPart& source, const SparseMatrix& K, const BakeOptions& options,
-                             ShiftedPencil& pencil, Basis& basis, Progress& progress) {
+Ghost order_beside_the_ghost(const MovingPart& source, const SparseMatrix& K, ShiftedPencil& pencil, BakeRun& run) {
+  const BakeOptions& options = run.options;
   GhostInBackground ghost(source.V, source.F, source.mass, options.ghost);
-  progress.report(stages::kFactorisation, 0.0);
+  run.progress.report(stages::kFactorisation, 0.0);
   try {
     pencil.analyze();
   } catch (const OutOfMemory& e) {
     throw OutOfMemory(message("bake: not enough memory to order the stiffness matrix (", K.rows(), " rows, ",
                               K.nonZeros(), " entries): ", e.what()));
   }
-  require_memory(estimate_bake_memory(basis.num_vertices(), K.rows() / 3, static_cast<double>(K.nonZeros()),
+  require_memory(estimate_bake_memory(run.basis.num_vertices(), K.rows() / 3, static_cast<double>(K.nonZeros()),
                                       pencil.factor_bytes(), options.modes, options.derivatives),
                  available_memory());
-  progress.report(stages::kFactorisation, 1.0);
-  const Stopwatch stopwatch(basis.timings[stages::kGhost]);  // the wait beyond the ordering
-  return ghost.get(progress);
+  run.progress.report(stages::kFactorisation, 1.0);
+  const Stopwatch stopwatch(run.basis.timings[stages::kGhost]);  // the wait beyond the ordering
+  return ghost.get(run.progress);
 }
 
 // 5. The vibration modes (eigenvalue problem K φ = λ M φ), the zero modes of a floppy mesh
 // deflated into the pencil's kernel. A breakdown of the factorisation names the fine vertex of the
 // failing row.
 Modes vibration_stage(const VerticesRef& V, const Simulated& sim, const SparseMatrix& K, ShiftedPencil& pencil,
-                      Progress& progress) {
+                      BakeRun& run) {
   try {
-    return flexible_modes(pencil, K, sim.mass, sim.flexible, progress);
+    return flexible_modes(pencil, K, sim.mass, sim.flexible, run.progress);
   } catch (const NumericalError& e) {
     const int row = pencil.failed_row();
     if (row < 0) throw;
@@ -342,43 +352,64 @@ Modes vibration_stage(const VerticesRef& V, const Simulated& sim, const SparseMa
 
 // 6. Modal derivatives (paper eq. 9, ∇²E ψ_ij = −∇³E(φ_i, φ_j)) of the pairs of modes other than
 // the translations and zero modes: the linearised rotations of each component (λ = 0, so first),
-// then the flexible modes, solved in the pencil. The shells energy and the paired modes are freed
-// before the solves, where the bake's memory peaks (on dragon_vrip_res2 with 20 + 110, with the
-// even blocks of solve_in_range, the peak falls from 2137 to 1933 MiB).
-Eigen::MatrixXd derivative_stage(const Simulated& sim, Stiffness& stiffness, const Modes& modes,
-                                 const BakeOptions& options, ShiftedPencil& pencil, Basis& basis, Progress& progress) {
+// then the flexible modes.
+struct PairedModes {
+  Eigen::MatrixXd phi;  // energy DOFs by paired modes: zero at a region's clamped vertices
+  std::vector<std::array<int, 2>> pairs;  // options.derivatives of them, in the paper's order
+};
+
+PairedModes paired_modes(const Simulated& sim, const Eigen::MatrixXd& rigid, const Modes& modes,
+                         const BakeOptions& options) {
   const Eigen::Index S = sim.size();
-  Eigen::MatrixXd derivatives(3 * S, options.derivatives);
-  if (options.derivatives == 0) return derivatives;
   const int paired_rotations = options.rotation_pairs ? 3 * sim.attachment.num_components : 0;
-  Eigen::MatrixXd phi(3 * S, paired_rotations + sim.flexible);
-  const Eigen::MatrixXd& rigid = pencil.kernel();  // the rigid motions first, 6 per component
+  PairedModes paired;
+  Eigen::MatrixXd& phi = paired.phi;
+  phi.resize(3 * S, paired_rotations + sim.flexible);
+  // The rigid motions come 6 per component, the rotations after the translations.
   for (int r = 0; r < paired_rotations; ++r) phi.col(r) = rigid.col(6 * (r / 3) + 3 + r % 3);
   phi.rightCols(sim.flexible) = modes.flexible;
-  const std::vector<std::array<int, 2>> pairs =
-      derivative_pairs(components_moved(phi, sim.attachment.component), options.derivatives);
+  paired.pairs = derivative_pairs(components_moved(phi, sim.attachment.component), options.derivatives);
   // Modes are zero at a region's clamped vertices, which the energy has after the simulated ones.
   phi.conservativeResizeLike(Eigen::MatrixXd::Zero(3 * (S + sim.clamped.rows()), phi.cols()));
-  const DiscreteShells& shells = *stiffness.shells;
-  stage(stages::kThirdDerivatives, basis, progress, [&] {
+  return paired;
+}
+
+// The right-hand sides ∇³E(x̄)(φᵢ, φⱼ) of the pairs, kPairsPerPass per pass over the elements, in
+// the rows of the simulated vertices (3S by pairs).
+Eigen::MatrixXd third_derivatives(const DiscreteShells& shells, const PairedModes& paired, Eigen::Index S,
+                                  BakeRun& run) {
+  const std::vector<std::array<int, 2>>& pairs = paired.pairs;
+  Eigen::MatrixXd B(3 * S, static_cast<Eigen::Index>(pairs.size()));
+  run.stage(stages::kThirdDerivatives, [&] {
     for (size_t first = 0; first < pairs.size(); first += kPairsPerPass) {
-      progress.report(stages::kThirdDerivatives, static_cast<double>(first) / pairs.size());
+      run.progress.report(stages::kThirdDerivatives, static_cast<double>(first) / pairs.size());
       const size_t last = std::min(pairs.size(), first + kPairsPerPass);
-      const RowMatrixXd batch = shells.third_batch(shells.rest(), phi, {pairs.begin() + first, pairs.begin() + last});
-      for_row_blocks(derivatives.rows(), [&](Eigen::Index row, Eigen::Index rows) {
-        derivatives.block(row, static_cast<Eigen::Index>(first), rows, batch.cols()) = batch.middleRows(row, rows);
+      const RowMatrixXd batch = shells.third_batch(shells.rest(), paired.phi, {pairs.begin() + first, pairs.begin() + last});
+      for_row_blocks(B.rows(), [&](Eigen::Index row, Eigen::Index rows) {
+        B.block(row, static_cast<Eigen::Index>(first), rows, batch.cols()) = batch.middleRows(row, rows);
       });
     }
   });
+  return B;
+}
+
+// The derivatives, solved in the pencil. The shells energy and the paired modes are freed before
+// the solves, where the bake's memory peaks (on dragon_vrip_res2 with 20 + 110, with the even
+// blocks of solve_in_range, the peak falls from 2137 to 1933 MiB).
+Eigen::MatrixXd derivative_stage(const Simulated& sim, Stiffness& stiffness, const Modes& modes, ShiftedPencil& pencil,
+                                 BakeRun& run) {
+  if (run.options.derivatives == 0) return Eigen::MatrixXd(3 * sim.size(), 0);
+  Eigen::MatrixXd B =
+      third_derivatives(*stiffness.shells, paired_modes(sim, pencil.kernel(), modes, run.options), sim.size(), run);
   stiffness.shells.reset();
-  phi.resize(0, 0);
-  return pencil.solve_in_range(std::move(derivatives), &progress);
+  return pencil.solve_in_range(std::move(B), &run.progress);
 }
 
 // 7. [rigid motions, zero modes, modes, derivatives], M-orthonormal; derivatives that came out
 // dependent are dropped (basis.num_dropped).
 Eigen::MatrixXd orthonormal_basis(const Simulated& sim, const ShiftedPencil& pencil, const Modes& modes,
-                                  Eigen::MatrixXd derivatives, Basis& basis, Progress& progress) {
+                                  Eigen::MatrixXd derivatives, BakeRun& run) {
+  Basis& basis = run.basis;
   const Eigen::MatrixXd& kernel = pencil.kernel();  // the rigid motions, then the zero modes
   const auto leading = static_cast<int>(kernel.cols() + modes.flexible.cols());
   const Eigen::Index num_derivatives = derivatives.cols();
@@ -387,7 +418,7 @@ Eigen::MatrixXd orthonormal_basis(const Simulated& sim, const ShiftedPencil& pen
   derivatives.resize(0, 0);
   {
     const Stopwatch stopwatch(basis.timings[stages::kOrthonormalisation]);
-    const std::vector<int> kept = orthonormalize(U, dof_masses(sim.mass), kDependentTolerance, &progress);
+    const std::vector<int> kept = orthonormalize(U, dof_masses(sim.mass), kDependentTolerance, &run.progress);
     for (int j = 0; j < leading; ++j)
       if (j >= static_cast<int>(kept.size()) || kept[static_cast<size_t>(j)] != j)
         throw NumericalError(message("bake: column ", j, " of the rigid motions and modes came out dependent; ",
@@ -408,8 +439,10 @@ Eigen::MatrixXd orthonormal_basis(const Simulated& sim, const ShiftedPencil& pen
 // vertices outside the submesh, which never move, map to ghost vertex 0 (the solver reads only
 // the ghost's own arrays).
 void fine_and_ghost_vectors(Eigen::MatrixXd U, const Simulated& sim, const MovingPart& source, Ghost coarse,
-                            const StiffnessPaint& paint, Basis& basis, Progress& progress) {
-  stage(stages::kAssembly, basis, progress, [&] {
+                            BakeRun& run) {
+  Basis& basis = run.basis;
+  const StiffnessPaint& paint = run.options.paint;
+  run.stage(stages::kAssembly, [&] {
     if (U.rows() < basis.rest.size()) U = extend_to_attached(sim.attachment, U);
     U /= basis.scale;
     basis.vectors = U.cast<float>();
@@ -438,21 +471,22 @@ void fine_and_ghost_vectors(Eigen::MatrixXd U, const Simulated& sim, const Movin
 // The bake of (V, F) itself, stages 2 to 8 on the rest state `basis`.
 Basis bake_stages(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Basis basis,
                   Progress& progress) {
-  const Simulated sim = simulated_submesh(V, F, options, basis, progress);
-  Stiffness stiffness = stiffness_at_rest(sim, options, basis, progress);
+  BakeRun run{options, basis, progress};
+  const Simulated sim = simulated_submesh(V, F, run);
+  Stiffness stiffness = stiffness_at_rest(sim, run);
   const MovingPart source(V, F, basis.mass, sim.region_vertices, sim.attachment.faces);
   ShiftedPencil pencil(stiffness.K, sim.mass,
                        sim.num_rigid > 0 ? rigid_motions(sim.V, sim.attachment.component, sim.mass)
                                          : Eigen::MatrixXd(3 * sim.size(), 0));
-  Ghost coarse = order_beside_the_ghost(source, stiffness.K, options, pencil, basis, progress);
-  const Modes modes = vibration_stage(V, sim, stiffness.K, pencil, progress);
-  Eigen::MatrixXd derivatives = derivative_stage(sim, stiffness, modes, options, pencil, basis, progress);
+  Ghost coarse = order_beside_the_ghost(source, stiffness.K, pencil, run);
+  const Modes modes = vibration_stage(V, sim, stiffness.K, pencil, run);
+  Eigen::MatrixXd derivatives = derivative_stage(sim, stiffness, modes, pencil, run);
   const ShiftedPencil::Timings pencil_timings = pencil.timings();
   basis.timings[stages::kFactorisation] = pencil_timings.factorisation;
   basis.timings[stages::kModes] = pencil_timings.modes;
   if (options.derivatives > 0) basis.timings[stages::kDerivativeSolves] = pencil_timings.solves;
-  Eigen::MatrixXd U = orthonormal_basis(sim, pencil, modes, std::move(derivatives), basis, progress);
-  fine_and_ghost_vectors(std::move(U), sim, source, std::move(coarse), options.paint, basis, progress);
+  Eigen::MatrixXd U = orthonormal_basis(sim, pencil, modes, std::move(derivatives), run);
+  fine_and_ghost_vectors(std::move(U), sim, source, std::move(coarse), run);
   return basis;
 }
 
@@ -487,7 +521,8 @@ Basis bake_on_proxy(const VerticesRef& V, const FacesRef& F, const RegionMesh* r
     sides.assign(region->vertices.size(), 0);
     std::fill_n(sides.begin(), region->num_free, 1);
   }
-  const Ghost proxy = stage(stages::kProxy, timed, progress, [&] {
+  BakeRun proxy_run{options, timed, progress};
+  const Ghost proxy = proxy_run.stage(stages::kProxy, [&] {
     return ghost_mesh(source.V, source.F, source.mass, options.proxy, &as_proxy, sides);
   });
   // The proxy's elements carry the fine paint's means (restrict_to_ghost).
@@ -502,7 +537,7 @@ Basis bake_on_proxy(const VerticesRef& V, const FacesRef& F, const RegionMesh* r
   Basis basis = rest_state(proxy.V, proxy.F, on_proxy, fine.scale);
   basis.timings = timed.timings;
   basis = bake_stages(proxy.V, proxy.F, on_proxy, std::move(basis), progress);
-  stage(stages::kProlongation, basis, progress, [&] {
+  BakeRun{options, basis, progress}.stage(stages::kProlongation, [&] {
     Prolongation onto_proxy = prolongation_to_proxy(source.V, proxy.V, proxy.F, proxy.map);
     Eigen::VectorXi ghost_map = basis.ghost_map(proxy.map);
     if (!region) {

@@ -95,8 +95,9 @@ Eigen::MatrixXd solve_with_pins(const SparseMatrix& K, const VectorRef& mass, co
   }
   return solve_in_range_by_blocks(
       K, dof_masses(mass), kernel.Z, kernel.decoupled, Eigen::MatrixXd(B),
-      [&](const Eigen::MatrixXd& PB, Eigen::Ref<Eigen::MatrixXd> X, const std::function<void(double)>&) {
+      [&](Eigen::MatrixXd& PB, Eigen::Ref<Eigen::MatrixXd> X, const std::function<void(double)>&) {
         llt.solve(PB, X);
+        return false;  // a pinned factor knows no residual
       },
       progress);
 }
@@ -132,11 +133,12 @@ Eigen::MatrixXd solve_in_range_by_blocks(const SparseMatrix& K, const Eigen::Vec
       if (progress) progress->report(stages::kDerivativeSolves, (static_cast<double>(first) + part * width) / B.cols());
     };
     auto X = Psi.middleCols(first, width);
-    solve(PB, X, report);
-    report(1.0);  // the check below takes a product with K, as long as a step
-    if (Z.cols()) add_dense_product(X, Z, -inner_product(Z, m, X));
     const Eigen::VectorXd rhs_norms = PB.colwise().norm();
-    add_product(K, X, -1.0, PB);  // PB becomes the residual P B − K X
+    const bool residual_known = solve(PB, X, report);
+    if (!residual_known) report(1.0);  // the product with K below takes as long as a step
+    // K Z = 0: removing the kernel part leaves the residual as it is.
+    if (Z.cols()) add_dense_product(X, Z, -inner_product(Z, m, X));
+    if (!residual_known) add_product(K, X, -1.0, PB);  // PB becomes the residual P B − K X
     for (Eigen::Index j = 0; j < width; ++j) {
       const double bound = kResidualTolerance * (norm_K * X.col(j).norm() + rhs_norms[j]);
       if (!(PB.col(j).norm() <= bound))

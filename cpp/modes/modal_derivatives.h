@@ -56,11 +56,14 @@ Eigen::MatrixXd solve_in_range(const SparseMatrix& K, const VectorRef& mass, con
 // What the solves in the range above share, for a caller with a solver of its own (ShiftedPencil):
 // Ψ written over B, block by block of at most 64 columns, each block's P B handed to
 // solve(P B, X, report), which writes a solution of K X = P B into X (its kernel part is removed
-// here) and may tell the bar what part of the block is done; then the residuals are checked.
+// here) and may tell the bar what part of the block is done; then the residuals P B − K X are
+// checked. A solve that knows that residual from its own recurrence leaves it in PB and returns
+// true, sparing the product with K (as long as a solve step at 100k vertices); one that returns
+// false leaves PB as it was, and the residual is computed here.
 // m: the diagonal of M (3n); Z: a checked kernel basis (checked_kernel_basis); decoupled:
 // decoupled_dofs. Throws InputError for a B of the wrong size or not finite, NumericalError when
 // a column fails the residual check.
-using BlockSolve = std::function<void(const Eigen::MatrixXd& PB, Eigen::Ref<Eigen::MatrixXd> X,
+using BlockSolve = std::function<bool(Eigen::MatrixXd& PB, Eigen::Ref<Eigen::MatrixXd> X,
                                       const std::function<void(double part)>& report)>;
 Eigen::MatrixXd solve_in_range_by_blocks(const SparseMatrix& K, const Eigen::VectorXd& m, const Eigen::MatrixXd& Z,
                                          const std::vector<bool>& decoupled, Eigen::MatrixXd B,

@@ -423,13 +423,14 @@ Eigen::MatrixXd ShiftedPencil::solve_in_range(Eigen::MatrixXd B, Progress* progr
                                  eigenvalues.maxCoeff(), ": ", steps, " refinement steps would be needed"));
   // One step: X += (K − σM)⁻¹ R less its kernel part, corrected on the known pairs by w. What it
   // leaves of R needs no product with K: K (K − σM)⁻¹ R = R + σM (K − σM)⁻¹ R, K Z = 0 and
-  // K Φ = M Φ Λ, so R − K X = −σ M (K − σM)⁻¹ R − M Φ Λ w, which overwrites R unless `last`.
+  // K Φ = M Φ Λ, so R − K X = −σ M (K − σM)⁻¹ R − M Φ Λ w, which overwrites R: after the last
+  // step it is the residual that solve_in_range_by_blocks checks, up to the rounding of the solve,
+  // whose factor the modes' residuals (computed with K) have checked already.
   // The updates of X and R go through the rows once, block by block in parallel (rather than a
   // pass over 3n rows per statement on one thread). Each product is a statement of its own: nested
   // in one expression, Eigen evaluated M (σY − ΦΛw) coefficient by coefficient, which took as long
   // as the solve. Y stays in the factor's solution buffer, which is kept from step to step.
-  Eigen::MatrixXd R;
-  const auto step = [&](Eigen::Ref<Eigen::MatrixXd> X, bool last) {
+  const auto step = [&](Eigen::MatrixXd& R, Eigen::Ref<Eigen::MatrixXd> X) {
     const CholmodLLT::Solution Y = factor_.solve_in_workspace(R);
     const Eigen::MatrixXd w = correction.asDiagonal() * inner_product(modes, R);
     const Eigen::MatrixXd lambda_w = eigenvalues.asDiagonal() * w;
@@ -441,7 +442,6 @@ Eigen::MatrixXd ShiftedPencil::solve_in_range(Eigen::MatrixXd B, Progress* progr
       x += y;
       x.noalias() -= kernel_.middleRows(first, rows) * kernel_part;
       x.noalias() += phi * w;
-      if (last) return;
       auto r = R.middleRows(first, rows);
       r = (-sigma) * y;
       r.noalias() -= phi * lambda_w;
@@ -450,14 +450,13 @@ Eigen::MatrixXd ShiftedPencil::solve_in_range(Eigen::MatrixXd B, Progress* progr
   };
   return solve_in_range_by_blocks(
       K_, m, kernel_, decoupled_, std::move(B),
-      [&](const Eigen::MatrixXd& PB, Eigen::Ref<Eigen::MatrixXd> X, const std::function<void(double)>& report) {
+      [&](Eigen::MatrixXd& PB, Eigen::Ref<Eigen::MatrixXd> X, const std::function<void(double)>& report) {
         X.setZero();
-        R = PB;
         for (int k = 0; k < steps; ++k) {
           if (k > 0) report(static_cast<double>(k) / steps);
-          step(X, k + 1 == steps);
+          step(PB, X);  // PB becomes the residual
         }
-        R.resize(0, 0);  // not kept through the residual check, where the bake's memory peaks
+        return true;
       },
       progress);
 }
