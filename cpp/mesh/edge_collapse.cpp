@@ -22,6 +22,11 @@ constexpr double kBoundaryWeight = 10.0;
 // added to the quadric error. Both are area times length squared; where the quadric is flat
 // this keeps clusters compact and alike in size instead of growing one cluster at random.
 constexpr double kCompactnessWeight = 0.1;
+// Two faces that a collapse lays on each other cancel when their input faces are this close to
+// one plane, relative to their longest edge, and their normals this close to opposite
+// (is_double_sheet; cos 2.6°).
+constexpr double kSheetThickness = 1e-3;
+constexpr double kSheetCosine = 0.999;
 // Collapses go in rounds (collapse_in_rounds) down to this many times the target.
 constexpr int kRoundsAbove = 2;
 // Heap pops between progress reports (a pop takes microseconds).
@@ -111,6 +116,9 @@ class Simplifier {
   bool has_vertex(int f, int x) const { return faces_(f, 0) == x || faces_(f, 1) == x || faces_(f, 2) == x; }
   bool same_side(int x, int y) const { return sides_.empty() || sides_[x] == sides_[y]; }
   bool keeps_the_sides(int u, int v) const;
+  bool find_cancelled_faces(int u, int v);
+  bool is_double_sheet(int f, int g) const;
+  bool is_cancelled(int f) const { return std::find(cancelled_.begin(), cancelled_.end(), f) != cancelled_.end(); }
   const std::vector<int>& live_faces(int x);
   void tally_neighbours(int x, std::vector<Neighbour>& out);
   void add_boundary_quadrics();
@@ -127,6 +135,7 @@ class Simplifier {
   RowMatrixX3i faces_;  // the kept input faces; a collapse of v into u renames v to u
   std::vector<char> face_alive_;
   std::vector<Eigen::Vector3d> input_normals_;   // unit normal of each kept input face, 0 if degenerate
+  std::vector<double> input_offsets_;             // its plane: n·x = offset
   std::vector<std::vector<int>> vertex_faces_;   // faces around each vertex; dead ones dropped lazily
   std::vector<Cluster> clusters_;
   std::vector<Eigen::Vector3d> position_;        // centroid of each live cluster
@@ -137,7 +146,7 @@ class Simplifier {
   int num_alive_ = 0;
   std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> heap_;
   // Scratch space of try_collapse and push_edges, kept to avoid allocations per collapse.
-  std::vector<int> shared_, u_only_, v_only_, degenerate_faces_;
+  std::vector<int> shared_, u_only_, v_only_, cancelled_, degenerate_faces_;
   std::vector<Neighbour> around_u_, around_v_;
   std::vector<Candidate> candidates_;
 };
@@ -201,10 +210,12 @@ Simplifier::Simplifier(const VerticesRef& V, const FacesRef& F, const VectorRef&
     clusters_[x].count = 1;
   }
   input_normals_.resize(num_faces);
+  input_offsets_.resize(num_faces);
   for (int f = 0; f < num_faces; ++f) {
     const Eigen::Vector3d& a = position_[faces_(f, 0)];
     const TriangleShape shape = triangle_shape(a, position_[faces_(f, 1)], position_[faces_(f, 2)]);
     input_normals_[f] = shape.degenerate ? Eigen::Vector3d::Zero() : shape.normal.normalized();
+    input_offsets_[f] = input_normals_[f].dot(a);
     if (shape.degenerate) continue;
     const Quadric plane = Quadric::plane(input_normals_[f], -input_normals_[f].dot(a), 0.5 * shape.normal.norm());
     for (int k = 0; k < 3; ++k) clusters_[faces_(f, k)].quadric += plane;
@@ -319,7 +330,8 @@ double Simplifier::star_quality(int u, int v, const Eigen::Vector3d& p, bool mer
   double least = 1.0;
   for (const std::vector<int>* faces : {&u_only_, &v_only_, &shared_}) {
     if (merged && faces == &shared_) continue;
-    for (int f : *faces) least = std::min(least, quality(f));
+    for (int f : *faces)
+      if (!merged || !is_cancelled(f)) least = std::min(least, quality(f));
   }
   return least;
 }
@@ -346,6 +358,7 @@ int Simplifier::try_collapse(int u, int v) {
   if (u_boundary != on_boundary(around_v_) || (u_boundary && shared_.size() != 1)) return -1;
   if (!keeps_the_sides(u, v)) return -1;
 
+  if (!find_cancelled_faces(u, v)) return -1;
   // Link condition: every common neighbour spans a face with u and v.
   for (const Neighbour& s : around_u_) {
     if (s.vertex == v) continue;
@@ -356,26 +369,10 @@ int Simplifier::try_collapse(int u, int v) {
     if (common && !opposite) return -1;
   }
 
-  // No face of v may land on a face of u.
-  auto other_two = [this](int f, int x) {
-    std::array<int, 2> pair{};
-    int i = 0;
-    for (int k = 0; k < 3; ++k)
-      if (faces_(f, k) != x) pair[i++] = faces_(f, k);
-    if (pair[0] > pair[1]) std::swap(pair[0], pair[1]);
-    return pair;
-  };
-  for (int f : v_only_) {
-    const auto pair = other_two(f, v);
-    for (int g : u_only_)
-      if (other_two(g, u) == pair) return -1;
-  }
-
   const Eigen::Vector3d p = merged_centroid(clusters_[u], clusters_[v]);
-  for (int f : u_only_)
-    if (!face_stays_sound(f, u, v, p)) return -1;
-  for (int f : v_only_)
-    if (!face_stays_sound(f, u, v, p)) return -1;
+  for (const std::vector<int>* faces : {&u_only_, &v_only_})
+    for (int f : *faces)
+      if (!is_cancelled(f) && !face_stays_sound(f, u, v, p)) return -1;
   // Needles: the worst face around the merged vertex may be below kMinFaceQuality only if it is no
   // worse than the worst face around u and v before, the faces the collapse removes included. A
   // rule per face locked islands of small clusters among large ones for good: merging one into a
@@ -383,6 +380,48 @@ int Simplifier::try_collapse(int u, int v) {
   if (star_quality(u, v, p, true) < std::min(kMinFaceQuality, star_quality(u, v, p, false))) return -1;
   collapse(u, v, p);
   return u;
+}
+
+// Whether faces f and g descend from input faces that are a sheet of no thickness: in one plane
+// (within kSheetThickness of the longest edge of f and g now) with opposite normals. The two
+// sides of a thin part are not; the two sides of a sheet are, however far their vertices have
+// moved since (the centroids of their clusters).
+bool Simplifier::is_double_sheet(int f, int g) const {
+  const Eigen::Vector3d &n = input_normals_[f], &m = input_normals_[g];
+  if (n.squaredNorm() == 0 || m.squaredNorm() == 0 || n.dot(m) > -kSheetCosine) return false;
+  double longest = 0;
+  for (int h : {f, g})
+    for (int k = 0; k < 3; ++k)
+      longest = std::max(longest, (position_[faces_(h, (k + 1) % 3)] - position_[faces_(h, k)]).norm());
+  return std::abs(input_offsets_[f] + input_offsets_[g]) <= kSheetThickness * longest;
+}
+
+// A face of v that the collapse lays on a face of u (the same three vertices once v is u): when
+// the two are a sheet of no thickness already (is_double_sheet), they cancel, as copies in the
+// input do; otherwise (a duplicate face, or the two sides of a thin part pressed together) the
+// collapse is refused. So is one that leaves the merged vertex without a face. Fills cancelled_
+// (with shared_, u_only_ and v_only_ set); false when the collapse is refused.
+bool Simplifier::find_cancelled_faces(int u, int v) {
+  cancelled_.clear();
+  // The two vertices that follow x in face f, in f's cyclic order.
+  const auto after = [this](int f, int x) {
+    const int k = faces_(f, 0) == x ? 0 : faces_(f, 1) == x ? 1 : 2;
+    return std::array<int, 2>{faces_(f, (k + 1) % 3), faces_(f, (k + 2) % 3)};
+  };
+  for (int f : v_only_) {
+    const std::array<int, 2> after_v = after(f, v);
+    for (int g : u_only_) {
+      const std::array<int, 2> after_u = after(g, u);
+      if (after_u == after_v) return false;
+      if (after_u[0] == after_v[1] && after_u[1] == after_v[0] && !is_cancelled(g)) {
+        if (!is_double_sheet(f, g)) return false;
+        cancelled_.push_back(f);
+        cancelled_.push_back(g);
+        break;
+      }
+    }
+  }
+  return u_only_.size() + v_only_.size() > cancelled_.size();
 }
 
 // Sides, like the boundary: u and v on one side, both next to the other side or neither, and then
@@ -401,8 +440,10 @@ bool Simplifier::keeps_the_sides(int u, int v) const {
 }
 
 void Simplifier::collapse(int u, int v, const Eigen::Vector3d& p) {
-  for (int f : shared_) face_alive_[f] = 0;
+  for (const std::vector<int>* faces : {&shared_, &cancelled_})
+    for (int f : *faces) face_alive_[f] = 0;
   for (int f : v_only_) {
+    if (!face_alive_[f]) continue;
     for (int k = 0; k < 3; ++k)
       if (faces_(f, k) == v) faces_(f, k) = u;
     vertex_faces_[u].push_back(f);
@@ -420,6 +461,15 @@ void Simplifier::collapse(int u, int v, const Eigen::Vector3d& p) {
   merged_into_[v] = u;
   --num_alive_;
   ++version_[u];
+  // A vertex whose faces all cancelled leaves the mesh; its fine vertices belong to no cluster.
+  for (int f : cancelled_)
+    for (int k = 0; k < 3; ++k) {
+      const int w = faces_(f, k);
+      if (alive_[w] && live_faces(w).empty()) {
+        alive_[w] = 0;
+        --num_alive_;
+      }
+    }
 }
 
 // Far above the target, collapses go in rounds: every live edge's candidate, sorted by cost; the
