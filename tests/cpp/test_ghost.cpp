@@ -345,6 +345,22 @@ TEST(Ghost, UnreferencedVerticesJoinTheNearestGhostVertex) {
   }
 }
 
+// A bake error on a proxy names the fine vertex nearest to the proxy vertex (bake.cpp): one that
+// collapsed onto it, and none of those nearer.
+TEST(Ghost, NearestFineVertexIsTheClosestOfThoseCollapsedOntoIt) {
+  const TriangleMesh plane = bumpy_plane(30, 10.0, 6, 1.0);
+  const Ghost ghost = ghost_mesh(plane.V, plane.F, lumped_mass(plane.V, plane.F), 50);
+  for (int g = 0; g < ghost.V.rows(); ++g) {
+    const int nearest = nearest_fine_vertex(ghost, plane.V, g);
+    ASSERT_EQ(ghost.map[nearest], g);
+    const double distance = (plane.V.row(nearest) - ghost.V.row(g)).norm();
+    for (Eigen::Index i = 0; i < plane.V.rows(); ++i)
+      if (ghost.map[i] == g) ASSERT_LE(distance, (plane.V.row(i) - ghost.V.row(g)).norm()) << "ghost vertex " << g;
+  }
+  expect_input_error([&] { nearest_fine_vertex(ghost, plane.V, static_cast<int>(ghost.V.rows())); }, "g");
+  expect_input_error([&] { nearest_fine_vertex(ghost, plane.V.topRows(10), 0); }, "fine_V");
+}
+
 TEST(Ghost, ClustersWithoutMassUseThePlainMean) {
   const TriangleMesh plane = bumpy_plane(20, 10.0, 4, 1.0);
   Eigen::VectorXd mass = lumped_mass(plane.V, plane.F);
