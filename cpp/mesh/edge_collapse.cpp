@@ -22,11 +22,9 @@ constexpr double kBoundaryWeight = 10.0;
 // added to the quadric error. Both are area times length squared; where the quadric is flat
 // this keeps clusters compact and alike in size instead of growing one cluster at random.
 constexpr double kCompactnessWeight = 0.1;
-// Two faces that a collapse lays on each other cancel when their input faces are this close to
-// one plane, relative to their longest edge, and their normals this close to opposite
-// (is_double_sheet; cos 2.6°).
-constexpr double kSheetThickness = 1e-3;
-constexpr double kSheetCosine = 0.999;
+// Two faces that a collapse lays on each other cancel when their four vertices are this close to
+// one plane (is_double_sheet: the volume they span over the cube of their longest distance).
+constexpr double kSheetThickness = 1e-2;
 // Collapses go in rounds (collapse_in_rounds) down to this many times the target.
 constexpr int kRoundsAbove = 2;
 // Heap pops between progress reports (a pop takes microseconds).
@@ -117,7 +115,7 @@ class Simplifier {
   bool same_side(int x, int y) const { return sides_.empty() || sides_[x] == sides_[y]; }
   bool keeps_the_sides(int u, int v) const;
   bool find_cancelled_faces(int u, int v);
-  bool is_double_sheet(int f, int g) const;
+  bool is_double_sheet(int u, int v, int p, int q) const;
   bool is_cancelled(int f) const { return std::find(cancelled_.begin(), cancelled_.end(), f) != cancelled_.end(); }
   const std::vector<int>& live_faces(int x);
   void tally_neighbours(int x, std::vector<Neighbour>& out);
@@ -135,7 +133,6 @@ class Simplifier {
   RowMatrixX3i faces_;  // the kept input faces; a collapse of v into u renames v to u
   std::vector<char> face_alive_;
   std::vector<Eigen::Vector3d> input_normals_;   // unit normal of each kept input face, 0 if degenerate
-  std::vector<double> input_offsets_;             // its plane: n·x = offset
   std::vector<std::vector<int>> vertex_faces_;   // faces around each vertex; dead ones dropped lazily
   std::vector<Cluster> clusters_;
   std::vector<Eigen::Vector3d> position_;        // centroid of each live cluster
@@ -210,12 +207,10 @@ Simplifier::Simplifier(const VerticesRef& V, const FacesRef& F, const VectorRef&
     clusters_[x].count = 1;
   }
   input_normals_.resize(num_faces);
-  input_offsets_.resize(num_faces);
   for (int f = 0; f < num_faces; ++f) {
     const Eigen::Vector3d& a = position_[faces_(f, 0)];
     const TriangleShape shape = triangle_shape(a, position_[faces_(f, 1)], position_[faces_(f, 2)]);
     input_normals_[f] = shape.degenerate ? Eigen::Vector3d::Zero() : shape.normal.normalized();
-    input_offsets_[f] = input_normals_[f].dot(a);
     if (shape.degenerate) continue;
     const Quadric plane = Quadric::plane(input_normals_[f], -input_normals_[f].dot(a), 0.5 * shape.normal.norm());
     for (int k = 0; k < 3; ++k) clusters_[faces_(f, k)].quadric += plane;
@@ -382,18 +377,18 @@ int Simplifier::try_collapse(int u, int v) {
   return u;
 }
 
-// Whether faces f and g descend from input faces that are a sheet of no thickness: in one plane
-// (within kSheetThickness of the longest edge of f and g now) with opposite normals. The two
-// sides of a thin part are not; the two sides of a sheet are, however far their vertices have
-// moved since (the centroids of their clusters).
-bool Simplifier::is_double_sheet(int f, int g) const {
-  const Eigen::Vector3d &n = input_normals_[f], &m = input_normals_[g];
-  if (n.squaredNorm() == 0 || m.squaredNorm() == 0 || n.dot(m) > -kSheetCosine) return false;
-  double longest = 0;
-  for (int h : {f, g})
-    for (int k = 0; k < 3; ++k)
-      longest = std::max(longest, (position_[faces_(h, (k + 1) % 3)] - position_[faces_(h, k)]).norm());
-  return std::abs(input_offsets_[f] + input_offsets_[g]) <= kSheetThickness * longest;
+// Whether face f = (v, p, q) and face g = (u, q, p), which the collapse of v into u lays on each
+// other, are a sheet of no thickness: u and v on the same side of pq, and the four points in one
+// plane (the volume they span within kSheetThickness of the cube of their longest distance;
+// measured on the clusters' positions, not the faces' normals, which are noise on slivers). The
+// two sides of a thin part are not, nor two faces of a flat surface on both sides of pq.
+bool Simplifier::is_double_sheet(int u, int v, int p, int q) const {
+  const Eigen::Vector3d &x = position_[u], &y = position_[v], &a = position_[p], &b = position_[q];
+  const Eigen::Vector3d edge = b - a;
+  if (edge.cross(x - a).dot(edge.cross(y - a)) <= 0) return false;
+  const double longest = std::max({(x - y).norm(), (x - a).norm(), (x - b).norm(), (y - a).norm(), (y - b).norm(),
+                                   edge.norm()});
+  return std::abs((y - x).dot((a - x).cross(b - x))) <= kSheetThickness * longest * longest * longest;
 }
 
 // A face of v that the collapse lays on a face of u (the same three vertices once v is u): when
@@ -414,7 +409,7 @@ bool Simplifier::find_cancelled_faces(int u, int v) {
       const std::array<int, 2> after_u = after(g, u);
       if (after_u == after_v) return false;
       if (after_u[0] == after_v[1] && after_u[1] == after_v[0] && !is_cancelled(g)) {
-        if (!is_double_sheet(f, g)) return false;
+        if (!is_double_sheet(u, v, after_v[0], after_v[1])) return false;
         cancelled_.push_back(f);
         cancelled_.push_back(g);
         break;

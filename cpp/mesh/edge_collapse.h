@@ -8,8 +8,8 @@
 // a collapse makes them: a double sheet whose two sides are triangulated differently (refined
 // scans: bench/subdivision.split_edges cuts the two copies of a face along different diagonals)
 // is not a copy of a face until its vertices merge. Two faces a collapse lays on each other cancel
-// when they are such a sheet already (in one plane, opposite normals); the two sides of a thin
-// part are not, and are never merged. A vertex whose faces all cancel leaves the mesh. Refusing
+// when they are such a sheet already (their four vertices in one plane, folded onto each other);
+// the two sides of a thin part are not, and are never merged. A vertex whose faces all cancel leaves the mesh. Refusing
 // every such collapse instead left each vertex of such a sheet a cluster of its own: 2,310 single
 // fine vertices in the 50k proxy of the dragon refined to 3.2M, whose stiffness per mass, up to
 // 1e9 times the median, made K − σM numerically indefinite (issue 23). Every collapse merges

@@ -355,7 +355,9 @@ TEST(Ghost, NearestFineVertexIsTheClosestOfThoseCollapsedOntoIt) {
     ASSERT_EQ(ghost.map[nearest], g);
     const double distance = (plane.V.row(nearest) - ghost.V.row(g)).norm();
     for (Eigen::Index i = 0; i < plane.V.rows(); ++i)
-      if (ghost.map[i] == g) ASSERT_LE(distance, (plane.V.row(i) - ghost.V.row(g)).norm()) << "ghost vertex " << g;
+      if (ghost.map[i] == g) {
+        ASSERT_LE(distance, (plane.V.row(i) - ghost.V.row(g)).norm()) << "ghost vertex " << g;
+      }
   }
   expect_input_error([&] { nearest_fine_vertex(ghost, plane.V, static_cast<int>(ghost.V.rows())); }, "g");
   expect_input_error([&] { nearest_fine_vertex(ghost, plane.V.topRows(10), 0); }, "fine_V");
