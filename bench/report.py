@@ -462,6 +462,11 @@ def plot_update_time(runs):
             ax.plot(n, ours, "o--", color=colour, label=f"{label}: ours")
             ax.plot(n, update, "s-", color=colour, label=f"{label}: ours + Blender's evaluation")
             ax.fill_between(n, ours, update, color=colour, alpha=0.15)
+        for run in mine:  # a run merged from a separate measurement says under what load it was taken
+            if "measured" in run:
+                ax.annotate(f"measured apart,\nload {run['measured']['load_average'][0]:.1f}",
+                            (run["vertices"], next(iter(run["bases"].values()))["positions"]["update"]),
+                            xytext=(-70, 10), textcoords="offset points", fontsize=7)
         ax.plot(list(UPDATE_TARGETS), list(UPDATE_TARGETS.values()), "r*", markersize=12, label="target (issue 23)")
         ax.set_xscale("log")
         ax.set_yscale("log")
