@@ -25,6 +25,7 @@ import json
 import math
 import os
 import pathlib
+import resource
 import sys
 import tempfile
 import time
@@ -353,6 +354,7 @@ def main():
               + "; ".join(f"{display}: ours {figures[display]['tick']:.1f} ms + Blender's evaluation "
                           f"{figures[display]['evaluate']:.1f} ms" for display in DISPLAYS), flush=True)
     results["blender"] = bpy.app.version_string
+    results["peak_gb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20  # the bake's, on dense meshes
     if not args.pose_only:
         with tempfile.TemporaryDirectory() as folder:
             results["storage"] = storage_figures(obj, folder)

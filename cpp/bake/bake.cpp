@@ -4,9 +4,11 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <future>
 #include <memory>
 #include <new>
+#include <string>
 #include <type_traits>
 
 #include "bake/bake_memory.h"
@@ -89,6 +91,14 @@ Modes flexible_modes(ShiftedPencil& pencil, const SparseMatrix& K, const Eigen::
       return result;
     }
   }
+}
+
+// How a bake error names a vertex of the mesh being baked: as the vertex of the artist's mesh it
+// stands for, with its position (vertex_at).
+using VertexName = std::function<std::string(int vertex)>;
+
+std::string vertex_at(const VerticesRef& V, int vertex) {
+  return message("vertex ", vertex, " at (", V(vertex, 0), ", ", V(vertex, 1), ", ", V(vertex, 2), ")");
 }
 
 // The ghost mesh, simplified on its own thread while CHOLMOD orders the stiffness matrix: both are
@@ -335,9 +345,9 @@ Ghost order_beside_the_ghost(const MovingPart& source, const SparseMatrix& K, Sh
 }
 
 // 5. The vibration modes (eigenvalue problem K φ = λ M φ), the zero modes of a floppy mesh
-// deflated into the pencil's kernel. A breakdown of the factorisation names the fine vertex of the
-// failing row.
-Modes vibration_stage(const VerticesRef& V, const Simulated& sim, const SparseMatrix& K, ShiftedPencil& pencil,
+// deflated into the pencil's kernel. A breakdown of the factorisation names the artist's vertex of
+// the failing row (`name`).
+Modes vibration_stage(const VertexName& name, const Simulated& sim, const SparseMatrix& K, ShiftedPencil& pencil,
                       BakeRun& run) {
   try {
     return flexible_modes(pencil, K, sim.mass, sim.flexible, run.progress);
@@ -345,8 +355,7 @@ Modes vibration_stage(const VerticesRef& V, const Simulated& sim, const SparseMa
     const int row = pencil.failed_row();
     if (row < 0) throw;
     const int vertex = sim.attachment.simulated[static_cast<size_t>(row / 3)];
-    throw NumericalError(message(e.what(), "; that row is ", "xyz"[row % 3], " of vertex ", vertex, " at (",
-                                 V(vertex, 0), ", ", V(vertex, 1), ", ", V(vertex, 2), ")"));
+    throw NumericalError(message(e.what(), "; that row is ", "xyz"[row % 3], " of ", name(vertex)));
   }
 }
 
@@ -468,9 +477,10 @@ void fine_and_ghost_vectors(Eigen::MatrixXd U, const Simulated& sim, const Movin
   });
 }
 
-// The bake of (V, F) itself, stages 2 to 8 on the rest state `basis`.
+// The bake of (V, F) itself, stages 2 to 8 on the rest state `basis`; errors name V's vertices by
+// `name`.
 Basis bake_stages(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Basis basis,
-                  Progress& progress) {
+                  const VertexName& name, Progress& progress) {
   BakeRun run{options, basis, progress};
   const Simulated sim = simulated_submesh(V, F, run);
   Stiffness stiffness = stiffness_at_rest(sim, run);
@@ -479,7 +489,7 @@ Basis bake_stages(const VerticesRef& V, const FacesRef& F, const BakeOptions& op
                        sim.num_rigid > 0 ? rigid_motions(sim.V, sim.attachment.component, sim.mass)
                                          : Eigen::MatrixXd(3 * sim.size(), 0));
   Ghost coarse = order_beside_the_ghost(source, stiffness.K, pencil, run);
-  const Modes modes = vibration_stage(V, sim, stiffness.K, pencil, run);
+  const Modes modes = vibration_stage(name, sim, stiffness.K, pencil, run);
   Eigen::MatrixXd derivatives = derivative_stage(sim, stiffness, modes, pencil, run);
   const ShiftedPencil::Timings pencil_timings = pencil.timings();
   basis.timings[stages::kFactorisation] = pencil_timings.factorisation;
@@ -536,7 +546,13 @@ Basis bake_on_proxy(const VerticesRef& V, const FacesRef& F, const RegionMesh* r
   on_proxy.region = clamped ? proxy_region(proxy, *region) : Eigen::VectorXi();
   Basis basis = rest_state(proxy.V, proxy.F, on_proxy, fine.scale);
   basis.timings = timed.timings;
-  basis = bake_stages(proxy.V, proxy.F, on_proxy, std::move(basis), progress);
+  // A proxy vertex's index means nothing to the artist: errors name the nearest of its fine vertices.
+  const VertexName fine_vertex = [&](int p) {
+    const int s = nearest_fine_vertex(proxy, source.V, p);
+    return message(vertex_at(V, region ? region->vertices[static_cast<size_t>(s)] : s),
+                   ", the nearest of the mesh's vertices to the proxy's vertex ", p);
+  };
+  basis = bake_stages(proxy.V, proxy.F, on_proxy, std::move(basis), fine_vertex, progress);
   BakeRun{options, basis, progress}.stage(stages::kProlongation, [&] {
     Prolongation onto_proxy = prolongation_to_proxy(source.V, proxy.V, proxy.F, proxy.map);
     Eigen::VectorXi ghost_map = basis.ghost_map(proxy.map);
@@ -568,15 +584,16 @@ Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, 
     validate_mesh(V, F);
     Basis fine = rest_state(V, F, options, normalizing_scale(V));
     const bool proxies = options.proxy_above > 0;
+    const VertexName own_vertex = [&V](int vertex) { return vertex_at(V, vertex); };
     Basis basis;
     if (options.region.size() == 0) {
       basis = proxies && V.rows() > options.proxy_above ? bake_on_proxy(V, F, nullptr, options, std::move(fine), progress)
-                                                        : bake_stages(V, F, options, std::move(fine), progress);
+                                                        : bake_stages(V, F, options, std::move(fine), own_vertex, progress);
     } else {
       const RegionMesh region = region_mesh(F, fine.mass, options.region);
       basis = proxies && region.num_free > options.proxy_above
                   ? bake_on_proxy(V, F, &region, options, std::move(fine), progress)
-                  : bake_stages(V, F, options, std::move(fine), progress);
+                  : bake_stages(V, F, options, std::move(fine), own_vertex, progress);
     }
     validate_basis(basis);
     return basis;

@@ -22,6 +22,9 @@ constexpr double kBoundaryWeight = 10.0;
 // added to the quadric error. Both are area times length squared; where the quadric is flat
 // this keeps clusters compact and alike in size instead of growing one cluster at random.
 constexpr double kCompactnessWeight = 0.1;
+// Two faces that a collapse lays on each other cancel when their four vertices are this close to
+// one plane (is_double_sheet: the volume they span over the cube of their longest distance).
+constexpr double kSheetThickness = 1e-2;
 // Collapses go in rounds (collapse_in_rounds) down to this many times the target.
 constexpr int kRoundsAbove = 2;
 // Heap pops between progress reports (a pop takes microseconds).
@@ -111,6 +114,9 @@ class Simplifier {
   bool has_vertex(int f, int x) const { return faces_(f, 0) == x || faces_(f, 1) == x || faces_(f, 2) == x; }
   bool same_side(int x, int y) const { return sides_.empty() || sides_[x] == sides_[y]; }
   bool keeps_the_sides(int u, int v) const;
+  bool find_cancelled_faces(int u, int v);
+  bool is_double_sheet(int u, int v, int p, int q) const;
+  bool is_cancelled(int f) const { return std::find(cancelled_.begin(), cancelled_.end(), f) != cancelled_.end(); }
   const std::vector<int>& live_faces(int x);
   void tally_neighbours(int x, std::vector<Neighbour>& out);
   void add_boundary_quadrics();
@@ -137,7 +143,7 @@ class Simplifier {
   int num_alive_ = 0;
   std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> heap_;
   // Scratch space of try_collapse and push_edges, kept to avoid allocations per collapse.
-  std::vector<int> shared_, u_only_, v_only_, degenerate_faces_;
+  std::vector<int> shared_, u_only_, v_only_, cancelled_, degenerate_faces_;
   std::vector<Neighbour> around_u_, around_v_;
   std::vector<Candidate> candidates_;
 };
@@ -319,7 +325,8 @@ double Simplifier::star_quality(int u, int v, const Eigen::Vector3d& p, bool mer
   double least = 1.0;
   for (const std::vector<int>* faces : {&u_only_, &v_only_, &shared_}) {
     if (merged && faces == &shared_) continue;
-    for (int f : *faces) least = std::min(least, quality(f));
+    for (int f : *faces)
+      if (!merged || !is_cancelled(f)) least = std::min(least, quality(f));
   }
   return least;
 }
@@ -346,6 +353,7 @@ int Simplifier::try_collapse(int u, int v) {
   if (u_boundary != on_boundary(around_v_) || (u_boundary && shared_.size() != 1)) return -1;
   if (!keeps_the_sides(u, v)) return -1;
 
+  if (!find_cancelled_faces(u, v)) return -1;
   // Link condition: every common neighbour spans a face with u and v.
   for (const Neighbour& s : around_u_) {
     if (s.vertex == v) continue;
@@ -356,26 +364,10 @@ int Simplifier::try_collapse(int u, int v) {
     if (common && !opposite) return -1;
   }
 
-  // No face of v may land on a face of u.
-  auto other_two = [this](int f, int x) {
-    std::array<int, 2> pair{};
-    int i = 0;
-    for (int k = 0; k < 3; ++k)
-      if (faces_(f, k) != x) pair[i++] = faces_(f, k);
-    if (pair[0] > pair[1]) std::swap(pair[0], pair[1]);
-    return pair;
-  };
-  for (int f : v_only_) {
-    const auto pair = other_two(f, v);
-    for (int g : u_only_)
-      if (other_two(g, u) == pair) return -1;
-  }
-
   const Eigen::Vector3d p = merged_centroid(clusters_[u], clusters_[v]);
-  for (int f : u_only_)
-    if (!face_stays_sound(f, u, v, p)) return -1;
-  for (int f : v_only_)
-    if (!face_stays_sound(f, u, v, p)) return -1;
+  for (const std::vector<int>* faces : {&u_only_, &v_only_})
+    for (int f : *faces)
+      if (!is_cancelled(f) && !face_stays_sound(f, u, v, p)) return -1;
   // Needles: the worst face around the merged vertex may be below kMinFaceQuality only if it is no
   // worse than the worst face around u and v before, the faces the collapse removes included. A
   // rule per face locked islands of small clusters among large ones for good: merging one into a
@@ -383,6 +375,48 @@ int Simplifier::try_collapse(int u, int v) {
   if (star_quality(u, v, p, true) < std::min(kMinFaceQuality, star_quality(u, v, p, false))) return -1;
   collapse(u, v, p);
   return u;
+}
+
+// Whether face f = (v, p, q) and face g = (u, q, p), which the collapse of v into u lays on each
+// other, are a sheet of no thickness: u and v on the same side of pq, and the four points in one
+// plane (the volume they span within kSheetThickness of the cube of their longest distance;
+// measured on the clusters' positions, not the faces' normals, which are noise on slivers). The
+// two sides of a thin part are not, nor two faces of a flat surface on both sides of pq.
+bool Simplifier::is_double_sheet(int u, int v, int p, int q) const {
+  const Eigen::Vector3d &x = position_[u], &y = position_[v], &a = position_[p], &b = position_[q];
+  const Eigen::Vector3d edge = b - a;
+  if (edge.cross(x - a).dot(edge.cross(y - a)) <= 0) return false;
+  const double longest = std::max({(x - y).norm(), (x - a).norm(), (x - b).norm(), (y - a).norm(), (y - b).norm(),
+                                   edge.norm()});
+  return std::abs((y - x).dot((a - x).cross(b - x))) <= kSheetThickness * longest * longest * longest;
+}
+
+// A face of v that the collapse lays on a face of u (the same three vertices once v is u): when
+// the two are a sheet of no thickness already (is_double_sheet), they cancel, as copies in the
+// input do; otherwise (a duplicate face, or the two sides of a thin part pressed together) the
+// collapse is refused. So is one that leaves the merged vertex without a face. Fills cancelled_
+// (with shared_, u_only_ and v_only_ set); false when the collapse is refused.
+bool Simplifier::find_cancelled_faces(int u, int v) {
+  cancelled_.clear();
+  // The two vertices that follow x in face f, in f's cyclic order.
+  const auto after = [this](int f, int x) {
+    const int k = faces_(f, 0) == x ? 0 : faces_(f, 1) == x ? 1 : 2;
+    return std::array<int, 2>{faces_(f, (k + 1) % 3), faces_(f, (k + 2) % 3)};
+  };
+  for (int f : v_only_) {
+    const std::array<int, 2> after_v = after(f, v);
+    for (int g : u_only_) {
+      const std::array<int, 2> after_u = after(g, u);
+      if (after_u == after_v) return false;
+      if (after_u[0] == after_v[1] && after_u[1] == after_v[0] && !is_cancelled(g)) {
+        if (!is_double_sheet(u, v, after_v[0], after_v[1])) return false;
+        cancelled_.push_back(f);
+        cancelled_.push_back(g);
+        break;
+      }
+    }
+  }
+  return u_only_.size() + v_only_.size() > cancelled_.size();
 }
 
 // Sides, like the boundary: u and v on one side, both next to the other side or neither, and then
@@ -401,8 +435,10 @@ bool Simplifier::keeps_the_sides(int u, int v) const {
 }
 
 void Simplifier::collapse(int u, int v, const Eigen::Vector3d& p) {
-  for (int f : shared_) face_alive_[f] = 0;
+  for (const std::vector<int>* faces : {&shared_, &cancelled_})
+    for (int f : *faces) face_alive_[f] = 0;
   for (int f : v_only_) {
+    if (!face_alive_[f]) continue;
     for (int k = 0; k < 3; ++k)
       if (faces_(f, k) == v) faces_(f, k) = u;
     vertex_faces_[u].push_back(f);
@@ -420,6 +456,15 @@ void Simplifier::collapse(int u, int v, const Eigen::Vector3d& p) {
   merged_into_[v] = u;
   --num_alive_;
   ++version_[u];
+  // A vertex whose faces all cancelled leaves the mesh; its fine vertices belong to no cluster.
+  for (int f : cancelled_)
+    for (int k = 0; k < 3; ++k) {
+      const int w = faces_(f, k);
+      if (alive_[w] && live_faces(w).empty()) {
+        alive_[w] = 0;
+        --num_alive_;
+      }
+    }
 }
 
 // Far above the target, collapses go in rounds: every live edge's candidate, sorted by cost; the

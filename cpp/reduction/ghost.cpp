@@ -25,6 +25,24 @@ Ghost ghost_mesh(const VerticesRef& V, const FacesRef& F, const VectorRef& mass,
   return ghost;
 }
 
+int nearest_fine_vertex(const Ghost& ghost, const VerticesRef& fine_V, int g) {
+  if (g < 0 || g >= ghost.V.rows()) throw InputError(message("g: ghost vertex ", g, " is outside [0, ", ghost.V.rows(), ")"));
+  if (fine_V.rows() != ghost.map.size())
+    throw InputError(message("fine_V: expected ", ghost.map.size(), " vertices (one per entry of the map), got ", fine_V.rows()));
+  int nearest = -1;
+  double least = 0;
+  for (Eigen::Index i = 0; i < ghost.map.size(); ++i) {
+    if (ghost.map[i] != g) continue;
+    const double distance = (fine_V.row(i) - ghost.V.row(g)).squaredNorm();
+    if (nearest < 0 || distance < least) {
+      nearest = static_cast<int>(i);
+      least = distance;
+    }
+  }
+  if (nearest < 0) throw InputError(message("map: no fine vertex maps to ghost vertex ", g));
+  return nearest;
+}
+
 namespace {
 
 // The weight of each fine vertex in the mean over its ghost vertex's preimage: its share of the

@@ -29,6 +29,11 @@ struct Ghost {
 Ghost ghost_mesh(const VerticesRef& V, const FacesRef& F, const VectorRef& mass, int target,
                  Progress* progress = nullptr, const std::vector<char>& sides = {});
 
+// The fine vertex (row of fine_V, #V by 3) nearest to ghost vertex g among those that collapse onto
+// it: how a message names a vertex of a ghost or proxy to the artist, whose mesh it is not. Throws
+// InputError when g is not a ghost vertex or no fine vertex collapses onto it.
+int nearest_fine_vertex(const Ghost& ghost, const VerticesRef& fine_V, int g);
+
 // Restricts fine vectors to the ghost: U (3#V by r, interleaved x0 y0 z0 x1 ...) to 3#G by r,
 // each ghost vertex getting the `fine_mass`-weighted mean of its fine vertices, per coordinate.
 // `map` (#V) sends fine vertices to ghost vertices in [0, num_ghost); every ghost vertex needs at

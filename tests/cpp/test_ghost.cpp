@@ -286,6 +286,54 @@ TEST(Ghost, MessyInputGivesACleanGhost) {
   }
 }
 
+// A 30 by 30 grid of side 1 with a fin of no thickness standing on its middle row: 3 rows of
+// quads, 0.003 high each (a tenth of the grid's spacing), on the same vertices on both sides, cut
+// along one diagonal on the front and the other on the back. So bench/subdivision.split_edges cuts
+// the two copies of a scan's double-sheet face, and so the dragon refined to 3.2M vertices is full
+// of them. (#V = 961 grid vertices, then the fin's, row after row.)
+TriangleMesh grid_with_a_fin(int* first_fin_vertex) {
+  const TriangleMesh plane = grid(30, 30, 1.0, 1.0);
+  constexpr int kColumns = 31, kRows = 3;
+  constexpr double kHeight = 0.003;
+  const auto base = [](int i) { return 15 * kColumns + i; };  // the middle row of the grid
+  const int n = static_cast<int>(plane.V.rows());
+  const auto fin = [&](int i, int r) { return r == 0 ? base(i) : n + (r - 1) * kColumns + i; };
+  TriangleMesh mesh;
+  mesh.V.resize(n + kRows * kColumns, 3);
+  mesh.V.topRows(n) = plane.V;
+  for (int r = 1; r <= kRows; ++r)
+    for (int i = 0; i < kColumns; ++i) mesh.V.row(fin(i, r)) = plane.V.row(base(i)) + Eigen::RowVector3d(0, 0, r * kHeight);
+  std::vector<int> faces(plane.F.data(), plane.F.data() + plane.F.size());
+  for (int r = 0; r < kRows; ++r)
+    for (int i = 0; i + 1 < kColumns; ++i) {
+      const int a = fin(i, r), b = fin(i + 1, r), c = fin(i + 1, r + 1), d = fin(i, r + 1);
+      faces.insert(faces.end(), {a, b, c, a, c, d});  // the front, cut along ac
+      faces.insert(faces.end(), {a, d, b, b, d, c});  // the back, reversed, cut along bd
+    }
+  mesh.F = Eigen::Map<const RowMatrixX3i>(faces.data(), static_cast<Eigen::Index>(faces.size() / 3), 3);
+  *first_fin_vertex = n;
+  return mesh;
+}
+
+// The fin's two sides become copies of each other's faces only as its vertices merge: they must
+// cancel then, as copies in the input do. Refused as duplicates, they left every fin vertex a
+// cluster of its own (93 of 93 here), and the 3.2M dragon's 50k proxy 2,310 single fine vertices
+// whose tiny elements made K − σM impossible to factor (issue 23).
+TEST(Ghost, ASheetOfNoThicknessCutTwoWaysCollapsesAndCancels) {
+  int first_fin_vertex = 0;
+  const TriangleMesh mesh = grid_with_a_fin(&first_fin_vertex);
+  ASSERT_GT(build_topology(mesh.V, mesh.F).nonmanifold_edges.size(), 0u);
+  const Eigen::VectorXd mass = lumped_mass(mesh.V, mesh.F);
+  const Ghost ghost = ghost_mesh(mesh.V, mesh.F, mass, 150);
+  expect_valid_ghost(mesh, mass, ghost);
+  EXPECT_EQ(ghost.V.rows(), 150);
+  std::vector<int> size(ghost.V.rows(), 0);
+  for (Eigen::Index i = 0; i < ghost.map.size(); ++i) ++size[ghost.map[i]];
+  int alone = 0;
+  for (Eigen::Index i = first_fin_vertex; i < mesh.V.rows(); ++i) alone += size[ghost.map[i]] == 1;
+  EXPECT_EQ(alone, 0) << "of " << mesh.V.rows() - first_fin_vertex << " fin vertices are clusters of their own";
+}
+
 TEST(Ghost, UnreferencedVerticesJoinTheNearestGhostVertex) {
   const TriangleMesh mesh = messy_plane();
   const Eigen::VectorXd mass = lumped_mass(mesh.V, mesh.F);
@@ -295,6 +343,24 @@ TEST(Ghost, UnreferencedVerticesJoinTheNearestGhostVertex) {
     (ghost.V.rowwise() - mesh.V.row(i)).rowwise().squaredNorm().minCoeff(&nearest);
     EXPECT_EQ(ghost.map[i], nearest) << "fine vertex " << i;
   }
+}
+
+// A bake error on a proxy names the fine vertex nearest to the proxy vertex (bake.cpp): one that
+// collapsed onto it, and none of those nearer.
+TEST(Ghost, NearestFineVertexIsTheClosestOfThoseCollapsedOntoIt) {
+  const TriangleMesh plane = bumpy_plane(30, 10.0, 6, 1.0);
+  const Ghost ghost = ghost_mesh(plane.V, plane.F, lumped_mass(plane.V, plane.F), 50);
+  for (int g = 0; g < ghost.V.rows(); ++g) {
+    const int nearest = nearest_fine_vertex(ghost, plane.V, g);
+    ASSERT_EQ(ghost.map[nearest], g);
+    const double distance = (plane.V.row(nearest) - ghost.V.row(g)).norm();
+    for (Eigen::Index i = 0; i < plane.V.rows(); ++i)
+      if (ghost.map[i] == g) {
+        ASSERT_LE(distance, (plane.V.row(i) - ghost.V.row(g)).norm()) << "ghost vertex " << g;
+      }
+  }
+  expect_input_error([&] { nearest_fine_vertex(ghost, plane.V, static_cast<int>(ghost.V.rows())); }, "g");
+  expect_input_error([&] { nearest_fine_vertex(ghost, plane.V.topRows(10), 0); }, "fine_V");
 }
 
 TEST(Ghost, ClustersWithoutMassUseThePlainMean) {

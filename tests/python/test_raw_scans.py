@@ -158,12 +158,13 @@ def test_a_factorisation_out_of_memory_is_not_called_indefinite():
 
 def test_raw_scan_with_many_mechanisms_bakes_on_its_proxy():
     """The 400k-vertex raw scan of seed 0 baked on its 50k proxy, whose flaps at non-manifold edges
-    make some 25 zero modes: their residuals stop at the rounding of K phi on the flaps' stiff small
+    make zero modes: their residuals stop at the rounding of K phi on the flaps' stiff small
     elements, above the even-mesh rounding floor, which failed the bake ("mode 1 (eigenvalue
-    -5.6e-06) has residual 3.2e-05, above the tolerance 1.16e-05")."""
+    -5.6e-06) has residual 3.2e-05, above the tolerance 1.16e-05"). 26 zero modes then, 9 since the
+    proxy's double sheets cancel as their vertices merge (issue 23)."""
     V, F = raw_scans.raw_scan("dragon_res2", levels=1, seed=0)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # floppy
         basis = mdc.bake(V, F, modes=20, derivatives=10, ghost=300)
-    assert basis.on_proxy and basis.num_floppy > 20
+    assert basis.on_proxy and basis.num_floppy > 5
     assert np.isfinite(basis.vectors).all() and basis.eigenvalues[basis.num_rigid + basis.num_floppy] > 0
