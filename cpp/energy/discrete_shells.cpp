@@ -303,7 +303,7 @@ struct BlockCoefficients {
 //   the Gauss–Newton block f''∇θ∇θᵀ. Its exact block is always indefinite away from rest (θ does
 //   not change as the hinge is scaled, so ∇²θ couples the scaling to ∇θ), and the projection of
 //   f'∇²θ kept positive curvature that held the mesh back: from the reduced pose of the 23k dragon
-//   turned by 30° Newton took 38 iterations with it and 11 without (90°: 89 and 27), to the same
+//   turned by 30° Newton took 38 iterations with it and 11 without (90°: 89 and 30), to the same
 //   or a lower minimum, and the 9 by 9 eigendecompositions were most of the assembly;
 // - every other block is projected: its negative eigenvalues set to 0.
 template <int K>
