@@ -14,7 +14,7 @@
 // was right wherever F was evaluated, and the triangles are a few crushed ones (area 0.1–10% of
 // rest) that a full step passes through zero area. On the 23k dragon turned by 170° growing τ by
 // the cut kept it at 1e4–1e8 times its floor and the whole mesh crept (300 iterations, not
-// converged); without, 62 iterations. The Hessian is the projected one (each element's made
+// converged); without, 55. The Hessian is the projected one (each element's made
 // semidefinite) far from the minimum, and the exact one near it wherever it factors at the
 // current τ (quadratic convergence).
 #pragma once
