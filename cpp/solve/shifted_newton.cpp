@@ -88,7 +88,11 @@ void ShiftedNewton::update_shift(double cut, double ratio) {
 bool ShiftedNewton::try_factorize(const SparseMatrix& hessian) {
   ++factorizations_;
   try {
-    llt_.factorize(hessian, objective_.constant_diagonal() + shift_ * objective_.mass_diagonal());
+    // Not refused for CHOLMOD's cheap condition estimate: ∇²F + τD with τ > 0 is definite when it
+    // factors, and on the 100k dragon the estimate fell below 1e-13 for every τ below 4 times its
+    // floor. Refusing it held τ there, and the steps crept: Refine at turn 30 took 120 iterations
+    // and 268 factorisations; without, 24 and 27 (79 s).
+    llt_.factorize(hessian, objective_.constant_diagonal() + shift_ * objective_.mass_diagonal(), 0);
     return true;
   } catch (const NumericalError&) {
     return false;
