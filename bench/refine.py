@@ -18,6 +18,7 @@ dragon converges at 30 and 90 degrees; Refine converges at 23k within 15 s and a
 """
 import argparse
 import json
+import os
 import sys
 import time
 
@@ -75,9 +76,14 @@ def refine(basis, F, handles, transforms):
 
 def row(stats):
     keys = ("steps", "iterations", "factorizations", "seconds", "wall_seconds", "energy", "initial_energy",
-            "converged", "gradient_norm", "gradient_scale", "gap", "rms", "reduced_seconds", "reduced_iterations",
-            "reduced_converged")
-    return {k: stats[k] for k in keys if k in stats}
+            "converged", "stalled", "gradient_norm", "gradient_scale", "gap", "rms", "reduced_seconds",
+            "reduced_iterations", "reduced_converged")
+    history = stats["history"]
+    return {k: stats[k] for k in keys if k in stats} | {
+        "exact_iterations": sum(it["model"] == "exact" for it in history),
+        "guarded_steps": sum(it["guarded"] for it in history),
+        "line_search_failures": sum(it["step"] == 0 for it in history),
+        "load_average": os.getloadavg()[0]}
 
 
 def run(quick=False, meshes=MESHES):

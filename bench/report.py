@@ -702,17 +702,23 @@ def section_refine(result):
            "axis and moved by 9% of the length sideways and 4.5% up (turn), or bent about the up axis (bend). "
            f"Refine: the reduced pose ({p['basis']}, BFGS to convergence), then `ReducedSolver.refine` from it; gap "
            "and RMS (of the bounding-box diagonal) are the reduced pose's against the refined minimum. Time: the "
-           "native solve's wall time. Non-converged solves are marked and are no reference.", ""]
+           "native solve's wall time, with the load average when it ended (2 cores shared). Exact / guarded / "
+           "failed: iterations on the exact Hessian (the rest on the projected one), steps cut only because "
+           "longer ones turned a triangle over, line searches that found no decrease. Non-converged solves are "
+           "marked and are no reference.", ""]
     rows = []
     for mesh, entry in result["figures"].items():
         for kind in ("from_rest", "refine"):
             for pose, r in entry[kind].items():
                 rows.append([mesh, entry["vertices"], pose, "from rest" if kind == "from_rest" else "Refine",
                              r["steps"], r["iterations"], r["factorizations"], f"{r['seconds']:.1f}",
+                             f"{r['load_average']:.1f}" if "load_average" in r else "",
+                             "/".join(str(r.get(k, "")) for k in ("exact_iterations", "guarded_steps",
+                                                                 "line_search_failures")),
                              f"{r['energy']:.5g}", "yes" if r["converged"] else "**no**",
                              f"{r['gap']:.3g}" if "gap" in r else "", f"{100 * r['rms']:.3f}%" if "rms" in r else ""])
     out.append(table(["mesh", "vertices", "pose", "solve", "load steps", "iterations", "factorisations", "s",
-                      "objective", "converged", "reduced gap", "reduced RMS"], rows))
+                      "load", "exact/guarded/failed", "objective", "converged", "reduced gap", "reduced RMS"], rows))
     out += ["", "Targets:", ""]
     for mesh, degrees in p["targets"]["from_rest_converges"].items():
         entry = result["figures"].get(mesh)

@@ -102,7 +102,16 @@ void bind_solve(py::module_& m) {
                        py::arg("gradient_norm") = result.gradient_norm,
                        py::arg("gradient_scale") = result.gradient_scale,
                        py::arg("factorizations") = result.factorizations,
-                       py::arg("initial_energy") = result.initial_energy, py::arg("seconds") = result.seconds);
+                       py::arg("initial_energy") = result.initial_energy, py::arg("seconds") = result.seconds,
+                       py::arg("stalled") = result.stalled);
+        // Per iteration: the Hessian model, τ, the step and why it was cut, the model's accuracy.
+        py::list history;
+        for (const NewtonIteration& it : result.history)
+          history.append(py::dict(py::arg("model") = it.exact ? "exact" : "projected", py::arg("shift") = it.shift,
+                                  py::arg("step") = it.step, py::arg("guarded") = it.guarded,
+                                  py::arg("ratio") = it.ratio, py::arg("progress") = it.progress,
+                                  py::arg("energy") = it.value, py::arg("gradient_norm") = it.gradient_norm));
+        stats["history"] = history;
         return py::make_tuple(std::move(result.positions), stats);
       },
       py::arg("V"), py::arg("F"), py::arg("handles"), py::arg("transforms"), py::arg("weights"), py::arg("stiffness"),

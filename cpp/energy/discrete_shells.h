@@ -146,7 +146,9 @@ class DiscreteShells final : public Energy {
   // diagonal blocks) is the same at every x.
   SparseMatrix hessian(const VectorRef& x) const override;
   // Each term's Hessian projected onto the positive semidefinite cone (an eigendecomposition of
-  // its 3(K−1) by 3(K−1) block over the relative coordinates of its K vertices).
+  // its 3(K−1) by 3(K−1) block over the relative coordinates of its K vertices; an edge's in
+  // closed form), but for hinges bent less than 90° from rest, which take the Gauss–Newton block
+  // f''(θ)∇θ∇θᵀ (discrete_shells.cpp, block_coefficients, says why).
   SparseMatrix projected_hessian(const VectorRef& x) const override;
   Eigen::VectorXd third(const VectorRef& x, const VectorRef& u, const VectorRef& w) const override;
 

@@ -23,11 +23,11 @@ class Energy {
   virtual double value_and_gradient(const VectorRef& x, Eigen::Ref<Eigen::VectorXd> gradient) const = 0;
   // ∇²E(x): symmetric 3n by 3n, both triangles stored.
   virtual SparseMatrix hessian(const VectorRef& x) const = 0;
-  // ∇²E(x) with each element's Hessian projected onto the positive semidefinite matrices (its
-  // negative eigenvalues set to zero): positive semidefinite, the same pattern as hessian(x), and
-  // equal to it where no element's Hessian is indefinite. Far from a minimum, Newton's method
-  // descends with it where the exact Hessian would need a large shift. An energy that is not a
-  // sum over elements returns hessian(x).
+  // A positive semidefinite stand-in for ∇²E(x), element by element: each element's Hessian
+  // projected onto the positive semidefinite matrices (its negative eigenvalues set to zero) or,
+  // where the energy says so, a Gauss–Newton block; the same pattern as hessian(x), and equal to
+  // it at rest. Far from a minimum, Newton's method descends with it where the exact Hessian would
+  // need a large shift. An energy that is not a sum over elements returns hessian(x).
   virtual SparseMatrix projected_hessian(const VectorRef& x) const { return hessian(x); }
   // ∇³E(x)(u, w) (3n): the Hessian's derivative along u, applied to w.
   virtual Eigen::VectorXd third(const VectorRef& x, const VectorRef& u, const VectorRef& w) const = 0;

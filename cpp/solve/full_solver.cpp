@@ -132,6 +132,8 @@ FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handle
   result.energy = point.value;
   result.gradient_norm = point.gradient.norm();
   result.converged = result.gradient_norm <= options.tolerance * result.gradient_scale;
+  result.stalled = !result.converged && newton.stalled();
+  result.history = newton.history();
   result.positions = Eigen::Map<const RowMatrixX3d>(point.y.data(), V.rows(), 3) / objective.scale();
   // Held vertices are where they started to the last bit, not through the frame's scaling.
   const VerticesRef started_at = initial ? VerticesRef(*initial) : V;

@@ -24,6 +24,7 @@
 
 #include "energy/make_energy.h"
 #include "solve/handle_term.h"
+#include "solve/shifted_newton.h"
 #include "util/progress.h"
 #include "util/types.h"
 
@@ -56,6 +57,8 @@ struct FullSolveResult {
   double initial_energy = 0;  // F at the start (rest, or `initial`) under the full transforms
   double seconds = 0;         // wall time of the solve
   bool converged = false;     // gradient_norm ≤ tolerance · gradient_scale at the full load
+  bool stalled = false;       // stopped because F no longer decreased (not converged)
+  std::vector<NewtonIteration> history;  // every Newton iteration, all load steps together
 };
 
 // V: #V by 3 rest positions, F: #F by 3 triangles (validate_mesh); handles and weights as in

@@ -133,7 +133,10 @@ BacktrackingResult backtracking_line_search(const Objective& objective, const Ei
       x_new = x + step * p;
       value_new = objective(x_new, gradient_new);
       ++result.evaluations;
-      if (!std::isfinite(value_new)) continue;
+      if (!std::isfinite(value_new)) {
+        ++result.undefined;
+        continue;
+      }
       const bool decreased = value_new <= value + sufficient_decrease * step * slope;
       const bool within_rounding =
           -step * slope < noise && value_new <= value + noise && gradient_new.norm() < gradient_norm;
@@ -141,6 +144,7 @@ BacktrackingResult backtracking_line_search(const Objective& objective, const Ei
         result.step = step;
         return result;
       }
+      ++result.insufficient;
     }
   }
   x_new = x;

@@ -43,6 +43,8 @@ LineSearchResult wolfe_line_search(const Objective& objective, const Eigen::Vect
 struct BacktrackingResult {
   double step = 0;      // α, 0 when no halving gave a decrease
   int evaluations = 0;  // calls of the objective
+  int undefined = 0;    // trials rejected because f was +inf or NaN there (beyond its domain)
+  int insufficient = 0;  // trials rejected because f did not decrease enough
 };
 
 // Halves α from 1 until f(x + αp) ≤ f(x) + c1 α ∇f(x)ᵀp (a point where f returns +inf or NaN

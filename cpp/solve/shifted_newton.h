@@ -10,11 +10,17 @@
 // regularised). A large τ shortens the step where curvature is low (flaps) and leaves it Newton's
 // where curvature is high, unlike a line search, which would shorten it everywhere. The step is
 // then backtracked (Armijo, line_search.h) when F does not decrease enough or a triangle turns
-// over. The Hessian is the projected one (each element's made semidefinite) far from the minimum,
-// and the exact one near it wherever it factors at the current τ (quadratic convergence).
+// over. A step cut only because longer ones turned a triangle over does not grow τ: the model
+// was right wherever F was evaluated, and the triangles are a few crushed ones (area 0.1–10% of
+// rest) that a full step passes through zero area. On the 23k dragon turned by 170° growing τ by
+// the cut kept it at 1e4–1e8 times its floor and the whole mesh crept (300 iterations, not
+// converged); without, 55. The Hessian is the projected one (each element's made
+// semidefinite) far from the minimum, and the exact one near it wherever it factors at the
+// current τ (quadratic convergence).
 #pragma once
 
 #include <functional>
+#include <vector>
 
 #include "linalg/cholmod_llt.h"
 #include "solve/pose_objective.h"
@@ -28,12 +34,28 @@ struct NewtonPoint {
   Eigen::VectorXd gradient;
 };
 
+// What one iteration did, for the solve's statistics.
+struct NewtonIteration {
+  bool exact = false;     // the exact Hessian (else the projected one)
+  double shift = 0;       // τ it was factored with
+  double step = 0;        // α the line search took; 0: it found no decrease (the iterate stays)
+  bool guarded = false;   // α < 1 only because longer steps turned a triangle over
+  double ratio = 0;       // F's decrease over the model's at α
+  bool progress = false;  // as iterate() returns
+  double value = 0;       // F and ‖∇F‖ after the iteration
+  double gradient_norm = 0;
+};
+
 class ShiftedNewton {
  public:
   // Keeps a reference to `objective`, which must outlive it.
   explicit ShiftedNewton(const PoseObjective& objective);
 
   int factorizations() const { return factorizations_; }
+  // Every iteration made so far, in order.
+  const std::vector<NewtonIteration>& history() const { return history_; }
+  // Whether the last minimize() stopped because F stopped decreasing.
+  bool stalled() const { return stalled_; }
 
   // Iterates from `point` (updated) until ‖∇F‖ ≤ target, `budget` iterations are spent, or F
   // stops decreasing (kMaxStalledIterations iterations without progress: at a kink of F, a triangle
@@ -65,9 +87,11 @@ class ShiftedNewton {
   bool try_factorize(const SparseMatrix& hessian);
   // Factors ∇²F + τD, τ grown tenfold until it factors.
   void factorize_shifted(const SparseMatrix& hessian);
-  // τ after a step the line search cut to `step` (0: none taken), its decrease `ratio` times the
-  // model's.
-  void update_shift(double step, double ratio);
+  // τ after a step the line search cut to `cut` for want of decrease (1: not cut; 0: no step
+  // taken), its decrease `ratio` times the model's.
+  void update_shift(double cut, double ratio);
+  // The decrease the model F + ∇Fᵀp + ½pᵀ∇²F p promises at αp, with p = step_ and slope = ∇Fᵀp.
+  double predicted_decrease(double alpha, double slope) const;
 
   const PoseObjective& objective_;
   CholmodLLT llt_;
@@ -77,10 +101,12 @@ class ShiftedNewton {
   // only cost another failed factorisation.
   double failed_shift_ = 0;
   int factorizations_ = 0;
+  bool stalled_ = false;
   // Iterations since the exact Hessian was last found not definite at τ.
   int since_exact_failed_ = kRetryExactAfter;
   Eigen::VectorXd step_;
   NewtonPoint trial_;
+  std::vector<NewtonIteration> history_;
 };
 
 }  // namespace modal_deform

@@ -133,6 +133,8 @@ TEST(BacktrackingLineSearch, HalvesUntilSufficientDecreaseSkippingWhatCannotBeEv
   BacktrackingResult result = backtracking_line_search(quadratic, x, value, g, 8 * newton, x_new, value_new, g_new);
   EXPECT_EQ(result.step, 0.125);
   EXPECT_EQ(result.evaluations, 4);
+  EXPECT_EQ(result.insufficient, 3);
+  EXPECT_EQ(result.undefined, 0);
   EXPECT_LE((x_new - (x + newton)).norm(), 1e-12);
   // Undefined beyond a radius: those trials count as too far.
   const Objective bounded = [&](const Eigen::VectorXd& y, Eigen::VectorXd& gradient) {
@@ -140,6 +142,8 @@ TEST(BacktrackingLineSearch, HalvesUntilSufficientDecreaseSkippingWhatCannotBeEv
   };
   result = backtracking_line_search(bounded, x, value, g, newton, x_new, value_new, g_new);
   EXPECT_EQ(result.step, 0.25);
+  EXPECT_EQ(result.undefined, 2);  // why the step was cut: the domain, not the decrease (full_solver)
+  EXPECT_EQ(result.insufficient, 0);
   Eigen::VectorXd check(6);
   EXPECT_EQ(quadratic(x_new, check), value_new);
   EXPECT_EQ(check, g_new);

@@ -262,8 +262,12 @@ def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, ene
     about every 0.1 s (False cancels: ``Cancelled``). Returns the positions (n, 3) float64, or with
     ``return_stats=True`` the pair (positions, stats) with stats = {"steps", "iterations",
     "energy", "converged", "gradient_norm", "gradient_scale", "factorizations", "seconds",
-    "initial_energy"}. A solve that did not converge says so in "converged"; only a converged
-    one is a reference.
+    "initial_energy", "stalled", "history"}. A solve that did not converge says so in "converged";
+    only a converged one is a reference. "stalled": it stopped because the objective no longer
+    decreased. "history": one dict per Newton iteration with "model" ("projected" or "exact": the
+    Hessian factored), "shift" (τ), "step" (the line search's α; 0 when it found no decrease),
+    "guarded" (α < 1 only because longer steps turned a triangle over), "ratio" (the decrease over
+    the model's), "progress", "energy" and "gradient_norm" after it.
     """
     V, F = _arrays.vertices(V), _arrays.faces(F)
     handles = _handles(handles)
