@@ -315,6 +315,20 @@ def test_refine_lowers_the_reduced_pose_to_a_converged_minimum(tube, tube_basis)
     assert np.abs(solver.positions() - reduced).max() == 0  # the reduced state is left alone
 
 
+def test_refine_that_does_not_converge_counts_both_solves(tube, tube_basis):
+    """Cut short, Refine runs the solve from rest as well: whichever answer it returns, the stats
+    count what both solves spent, one history entry per iteration."""
+    V, F, handles, transforms = tube
+    solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0)
+    solver.set_transforms(transforms)
+    converge(solver)
+    _, alone = solver.refine(F, max_iterations=1)
+    _, from_rest = mdc.solve_full(V, F, handles, transforms, stiffness=100.0, max_iterations=1, return_stats=True)
+    assert not alone["converged"] and not from_rest["converged"]
+    assert alone["iterations"] == len(alone["history"]) == 2, alone
+    assert alone["factorizations"] >= 2 and alone["seconds"] >= from_rest["seconds"] / 10
+
+
 def test_refine_reports_progress_and_cancels(tube, tube_basis):
     V, F, handles, transforms = tube
     solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0)

@@ -167,8 +167,9 @@ class ReducedSolver:
         cancels: ``Cancelled``). Returns (positions (n, 3) float64, stats) with the stats of
         ``solve_full`` ("initial_energy" is the objective at the start). When the solve from the
         start does not converge (it stalled at a kink, or spent ``max_iterations``), the solve from
-        rest (in load steps) is run as well and its answer returned if it converged or is lower:
-        stats["from_rest"] says so (iterations, factorisations and seconds then count both solves).
+        rest (in load steps) is run as well and its answer returned if it converged or is lower
+        (stats["from_rest"] says so); iterations, factorisations, seconds and the history then
+        count both solves, whichever answer is returned.
 
         The solve runs on the fine mesh, not on the proxy of a basis baked on one: the proxy's rest
         mesh is not kept, and a refined proxy pose carried back by the prolongation would lose the
@@ -208,12 +209,11 @@ class ReducedSolver:
             # A start far from the minimum (a small basis, a strong pose) can lead Newton's first
             # steps to collapse triangles; the solve from rest, in load steps, does not start there.
             X_rest, stats_rest = solve(None, max_iterations, (0.5, 0.5))
+            spent = {key: stats[key] + stats_rest[key] for key in ("iterations", "factorizations", "seconds", "history")}
             if stats_rest["converged"] or stats_rest["energy"] < stats["energy"]:
-                stats_rest.update(from_rest=True, initial_energy=stats["initial_energy"],
-                                  iterations=stats["iterations"] + stats_rest["iterations"],
-                                  factorizations=stats["factorizations"] + stats_rest["factorizations"],
-                                  seconds=stats["seconds"] + stats_rest["seconds"])
+                stats_rest.update(from_rest=True, initial_energy=stats["initial_energy"])
                 X, stats = X_rest, stats_rest
+            stats.update(spent)
         return X, stats
 
     def objective(self, q):
