@@ -578,7 +578,7 @@ def section_strong_poses(result):
             "pose on the vertices the meshes share) above its minimum, relative to the minimum; the minimum is "
             "solve_full's, converged from the lower of the two poses (Refine), with its iterations and seconds. The gaps "
             "are large because neither reduced pose sees the 100k mesh's own slivers: the ghost's energy leaves them "
-            "out, and the terms of triangles of about 1e-8 of the mean area take most of the full objective at a "
+            "out, and its tiniest triangles (areas near 1e-8) take most of the full objective at a "
             "reduced pose; the RMS, not the gap, says how close the poses are.", ""]
     rows = []
     for degrees, r in f["turns"].items():
