@@ -109,7 +109,8 @@ void bind_solve(py::module_& m) {
         for (const NewtonIteration& it : result.history)
           history.append(py::dict(py::arg("model") = it.exact ? "exact" : "projected", py::arg("shift") = it.shift,
                                   py::arg("step") = it.step, py::arg("guarded") = it.guarded,
-                                  py::arg("ratio") = it.ratio, py::arg("progress") = it.progress,
+                                  py::arg("ratio") = it.ratio, py::arg("cg_iterations") = it.cg_iterations,
+                                  py::arg("progress") = it.progress,
                                   py::arg("energy") = it.value, py::arg("gradient_norm") = it.gradient_norm));
         stats["history"] = history;
         return py::make_tuple(std::move(result.positions), stats);

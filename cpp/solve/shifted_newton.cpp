@@ -12,7 +12,8 @@ namespace modal_deform {
 ShiftedNewton::ShiftedNewton(const PoseObjective& objective)
     : objective_(objective), llt_(3), shift_(objective.smallest_shift()) {
   const Eigen::Index size = objective.mass_diagonal().size();
-  step_.resize(size);
+  for (Eigen::VectorXd* v : {&step_, &shifted_diagonal_, &residual_, &preconditioned_, &direction_, &product_})
+    v->resize(size);
   trial_.y.resize(size);
   trial_.gradient.resize(size);
 }
@@ -20,9 +21,11 @@ ShiftedNewton::ShiftedNewton(const PoseObjective& objective)
 int ShiftedNewton::minimize(NewtonPoint& point, double target, int budget, double exact_below,
                             const std::function<void(const NewtonPoint&)>& after_iteration) {
   int iterations = 0, stalled = 0;
+  previous_gradient_norm_ = 0;  // a new load: no forcing term from the last one's steps
   while (iterations < budget && stalled < kMaxStalledIterations && point.gradient.norm() > target) {
-    const bool near_minimum = point.gradient.norm() <= exact_below;
-    stalled = iterate(point, near_minimum) ? 0 : stalled + 1;
+    const double gradient_norm = point.gradient.norm();
+    stalled = iterate(point, gradient_norm <= exact_below, forcing(gradient_norm, target, exact_below)) ? 0
+                                                                                                    : stalled + 1;
     ++iterations;
     after_iteration(point);
   }
@@ -30,14 +33,43 @@ int ShiftedNewton::minimize(NewtonPoint& point, double target, int budget, doubl
   return iterations;
 }
 
-bool ShiftedNewton::iterate(NewtonPoint& point, bool near_minimum) {
+double ShiftedNewton::forcing(double gradient_norm, double target, double exact_below) const {
+  // Eisenstat & Walker's choice 2, η = γ (‖∇F‖ / ‖∇F‖ before)^α with γ = 0.9, α = 2, and near the
+  // minimum at most ‖∇F‖ / exact_below (η = O(‖∇F‖): Newton's quadratic convergence, Dembo,
+  // Eisenstat & Steihaug 1982); at most kMaxForcing, and no tighter than reaching the target needs.
+  const double ratio = previous_gradient_norm_ > 0 ? gradient_norm / previous_gradient_norm_ : 1;
+  const double eta = std::min(0.9 * ratio * ratio, gradient_norm / exact_below);
+  return std::min(kMaxForcing, std::max(eta, 0.5 * target / gradient_norm));
+}
+
+bool ShiftedNewton::iterate(NewtonPoint& point, bool near_minimum, double forcing) {
+  previous_gradient_norm_ = point.gradient.norm();
   const bool try_exact = near_minimum && ++since_exact_failed_ > kRetryExactAfter;
-  const bool exact = try_exact && try_factorize(objective_.hessian(point.y));
-  if (try_exact && !exact) since_exact_failed_ = 0;
-  if (!exact) factorize_shifted(objective_.projected_hessian(point.y));
-  llt_.solve(point.gradient, step_);
-  step_ = -step_;
+  shifted_diagonal_ = objective_.constant_diagonal() + shift_ * objective_.mass_diagonal();
+  // The exact Hessian by conjugate gradients, else factored; where it does not factor (not definite
+  // at τ), the projected one the same way.
+  SparseMatrix hessian;
+  bool exact = false;
+  int cg_iterations = 0;
+  if (try_exact) {
+    hessian = objective_.hessian(point.y);
+    cg_iterations = factored_ ? solve_by_cg(hessian, point.gradient, forcing) : 0;
+    exact = cg_iterations > 0 || try_factorize(hessian);
+    if (!exact) since_exact_failed_ = 0;
+  }
+  if (!exact) {
+    hessian = objective_.projected_hessian(point.y);
+    cg_iterations = factored_ ? solve_by_cg(hessian, point.gradient, forcing) : 0;
+    if (cg_iterations <= 0) factorize_shifted(hessian);
+  }
+  if (cg_iterations <= 0) {
+    cg_iterations = 0;
+    llt_.solve(point.gradient, step_);
+    step_ = -step_;
+  }
   const double slope = point.gradient.dot(step_);
+  product_.noalias() = hessian * step_;
+  const double curvature = step_.dot(product_) + step_.dot(objective_.constant_diagonal().cwiseProduct(step_));
   const double noise = 1e-12 * (1 + std::abs(point.value));
   // A trial point that turns a triangle over counts as too far.
   const Objective within_smooth_part = [&](const Eigen::VectorXd& trial, Eigen::VectorXd& trial_gradient) {
@@ -49,8 +81,9 @@ bool ShiftedNewton::iterate(NewtonPoint& point, bool near_minimum) {
   // Cut only by the guard: every longer trial turned a triangle over (or left F's domain), none
   // fell short of the decrease.
   const bool guarded = search.step > 0 && search.step < 1 && search.insufficient == 0;
-  const double ratio = search.step > 0 ? (point.value - trial_.value) / predicted_decrease(search.step, slope) : 0;
-  NewtonIteration record{exact, shift_, search.step, guarded, ratio};
+  const double ratio =
+      search.step > 0 ? (point.value - trial_.value) / predicted_decrease(search.step, slope, curvature) : 0;
+  NewtonIteration record{exact, shift_, search.step, guarded, ratio, cg_iterations};
   update_shift(guarded ? 1 : search.step, ratio);
   if (search.step > 0) {
     record.progress =
@@ -63,10 +96,38 @@ bool ShiftedNewton::iterate(NewtonPoint& point, bool near_minimum) {
   return record.progress;
 }
 
-double ShiftedNewton::predicted_decrease(double alpha, double slope) const {
-  // pᵀ∇²F p = −∇Fᵀp − τ pᵀDp, since (∇²F + τD)p = −∇F.
-  const double curvature = -slope - shift_ * step_.dot(objective_.mass_diagonal().cwiseProduct(step_));
+double ShiftedNewton::predicted_decrease(double alpha, double slope, double curvature) {
   return -alpha * slope - 0.5 * alpha * alpha * curvature;
+}
+
+int ShiftedNewton::solve_by_cg(const SparseMatrix& hessian, const Eigen::VectorXd& gradient, double forcing) {
+  // Preconditioned conjugate gradients (Nocedal & Wright, Numerical Optimization, algorithm 5.3)
+  // on (H + C + τD) p = −∇F, with the residual r = −∇F − (H + C + τD) p.
+  const double initial_norm = gradient.norm(), bound = forcing * initial_norm;
+  step_.setZero();
+  residual_ = -gradient;
+  llt_.solve(residual_, preconditioned_);
+  direction_ = preconditioned_;
+  double residual_dot = residual_.dot(preconditioned_);
+  for (int k = 1; k <= kMaxCgIterations; ++k) {
+    product_.noalias() = hessian * direction_;
+    product_ += shifted_diagonal_.cwiseProduct(direction_);
+    const double curvature = direction_.dot(product_);
+    if (!(curvature > 0)) return -1;
+    const double alpha = residual_dot / curvature;
+    step_ += alpha * direction_;
+    residual_ -= alpha * product_;
+    const double residual_norm = residual_.norm();
+    if (residual_norm <= bound) return k;
+    // Given up once the mean decrease so far would not reach the bound within the budget.
+    const double mean_log_decrease = std::log(residual_norm / initial_norm) / k;
+    if (k >= 2 && (kMaxCgIterations - k) * mean_log_decrease > std::log(bound / residual_norm)) return 0;
+    llt_.solve(residual_, preconditioned_);
+    const double next_dot = residual_.dot(preconditioned_);
+    direction_ = preconditioned_ + (next_dot / residual_dot) * direction_;
+    residual_dot = next_dot;
+  }
+  return 0;
 }
 
 void ShiftedNewton::update_shift(double cut, double ratio) {
@@ -87,12 +148,14 @@ void ShiftedNewton::update_shift(double cut, double ratio) {
 
 bool ShiftedNewton::try_factorize(const SparseMatrix& hessian) {
   ++factorizations_;
+  factored_ = false;
   try {
     // Not refused for CHOLMOD's cheap condition estimate: ∇²F + τD with τ > 0 is definite when it
     // factors, and on the 100k dragon the estimate fell below 1e-13 for every τ below 4 times its
     // floor. Refusing it held τ there, and the steps crept: Refine at turn 30 took 120 iterations
     // and 268 factorisations; without, 24 and 27 (79 s).
     llt_.factorize(hessian, objective_.constant_diagonal() + shift_ * objective_.mass_diagonal(), 0);
+    factored_ = true;
     return true;
   } catch (const NumericalError&) {
     return false;

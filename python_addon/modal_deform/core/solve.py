@@ -254,10 +254,11 @@ def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, ene
     are taken in load steps (the first turning each handle by at most 30° and moving its centre by
     at most a tenth of the bounding-box diagonal, later ones longer or shorter as the previous
     converged fast or slowly); with ``initial`` (n, 3) the solve starts there in one step
-    (Refine; an animation passes the previous frame's answer). Each Newton iteration factors the
+    (Refine; an animation passes the previous frame's answer). Each Newton iteration solves with the
     Hessian shifted by a multiple of the mass matrix, the shift adapted to how well the step
-    predicted the decrease (see cpp/solve/full_solver.h). Stops when the gradient norm is below
-    ``tolerance`` times its value at rest (or at ``initial``, if larger), or after
+    predicted the decrease: by conjugate gradients preconditioned by the last factorisation when
+    they converge fast, else by factoring it anew (see cpp/solve/shifted_newton.h). Stops when the
+    gradient norm is below ``tolerance`` times its value at rest (or at ``initial``, if larger), or after
     ``max_iterations`` Newton iterations in all. ``progress(stage, fraction) -> bool`` is called
     about every 0.1 s (False cancels: ``Cancelled``). Returns the positions (n, 3) float64, or with
     ``return_stats=True`` the pair (positions, stats) with stats = {"steps", "iterations",
@@ -265,9 +266,10 @@ def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, ene
     "initial_energy", "stalled", "history"}. A solve that did not converge says so in "converged";
     only a converged one is a reference. "stalled": it stopped because the objective no longer
     decreased. "history": one dict per Newton iteration with "model" ("projected" or "exact": the
-    Hessian factored), "shift" (τ), "step" (the line search's α; 0 when it found no decrease),
+    Hessian the step solved with), "shift" (τ), "step" (the line search's α; 0 when it found no decrease),
     "guarded" (α < 1 only because longer steps turned a triangle over), "ratio" (the decrease over
-    the model's), "progress", "energy" and "gradient_norm" after it.
+    the model's), "cg_iterations" (conjugate gradient iterations of the step; 0: a new
+    factorisation solved it), "progress", "energy" and "gradient_norm" after it.
     """
     V, F = _arrays.vertices(V), _arrays.faces(F)
     handles = _handles(handles)
