@@ -722,7 +722,9 @@ def section_refine(result):
                              f"{r['gap']:.3g}" if "gap" in r else "", f"{100 * r['rms']:.3f}%" if "rms" in r else ""])
     out.append(table(["mesh", "vertices", "pose", "solve", "load steps", "iterations", "factorisations", "s",
                       "load", "exact/guarded/failed", "objective", "converged", "reduced gap", "reduced RMS"], rows))
-    out += ["", "Targets:", ""]
+    older = [f"The {mesh} rows are from an earlier run: commit `{entry['commit'][:12]}`, {entry['date']}."
+             for mesh, entry in result["figures"].items() if entry.get("commit", result["commit"]) != result["commit"]]
+    out += ["", *older, "", "Targets:", ""] if older else ["", "Targets:", ""]
     for mesh, degrees in p["targets"]["from_rest_converges"].items():
         entry = result["figures"].get(mesh)
         for d in degrees:
