@@ -724,7 +724,7 @@ def section_refine(result):
                       "load", "exact/guarded/failed", "objective", "converged", "reduced gap", "reduced RMS"], rows))
     older = [f"The {mesh} rows are from an earlier run: commit `{entry['commit'][:12]}`, {entry['date']}."
              for mesh, entry in result["figures"].items() if entry.get("commit", result["commit"]) != result["commit"]]
-    out += ["", *older, "", "Targets:", ""] if older else ["", "Targets:", ""]
+    out += ["", *(older + [""] if older else []), "Targets:", ""]
     for mesh, degrees in p["targets"]["from_rest_converges"].items():
         entry = result["figures"].get(mesh)
         for d in degrees:

@@ -45,7 +45,7 @@ double ShiftedNewton::forcing(double gradient_norm, double target, double exact_
 bool ShiftedNewton::iterate(NewtonPoint& point, bool near_minimum, double forcing) {
   previous_gradient_norm_ = point.gradient.norm();
   const bool try_exact = near_minimum && ++since_exact_failed_ > kRetryExactAfter;
-  shifted_diagonal_ = objective_.constant_diagonal() + shift_ * objective_.mass_diagonal();
+  set_shifted_diagonal();
   // The exact Hessian by conjugate gradients, else factored; where it does not factor (not definite
   // at τ), the projected one the same way.
   SparseMatrix hessian;
@@ -60,10 +60,9 @@ bool ShiftedNewton::iterate(NewtonPoint& point, bool near_minimum, double forcin
   if (!exact) {
     hessian = objective_.projected_hessian(point.y);
     cg_iterations = factored_ ? solve_by_cg(hessian, point.gradient, forcing) : 0;
-    if (cg_iterations <= 0) factorize_shifted(hessian);
+    if (cg_iterations == 0) factorize_shifted(hessian);
   }
-  if (cg_iterations <= 0) {
-    cg_iterations = 0;
+  if (cg_iterations == 0) {
     llt_.solve(point.gradient, step_);
     step_ = -step_;
   }
@@ -96,6 +95,10 @@ bool ShiftedNewton::iterate(NewtonPoint& point, bool near_minimum, double forcin
   return record.progress;
 }
 
+void ShiftedNewton::set_shifted_diagonal() {
+  shifted_diagonal_ = objective_.constant_diagonal() + shift_ * objective_.mass_diagonal();
+}
+
 double ShiftedNewton::predicted_decrease(double alpha, double slope, double curvature) {
   return -alpha * slope - 0.5 * alpha * alpha * curvature;
 }
@@ -113,7 +116,7 @@ int ShiftedNewton::solve_by_cg(const SparseMatrix& hessian, const Eigen::VectorX
     product_.noalias() = hessian * direction_;
     product_ += shifted_diagonal_.cwiseProduct(direction_);
     const double curvature = direction_.dot(product_);
-    if (!(curvature > 0)) return -1;
+    if (!(curvature > 0)) return 0;
     const double alpha = residual_dot / curvature;
     step_ += alpha * direction_;
     residual_ -= alpha * product_;
@@ -154,7 +157,8 @@ bool ShiftedNewton::try_factorize(const SparseMatrix& hessian) {
     // factors, and on the 100k dragon the estimate fell below 1e-13 for every τ below 4 times its
     // floor. Refusing it held τ there, and the steps crept: Refine at turn 30 took 120 iterations
     // and 268 factorisations; without, 24 and 27 (79 s).
-    llt_.factorize(hessian, objective_.constant_diagonal() + shift_ * objective_.mass_diagonal(), 0);
+    set_shifted_diagonal();
+    llt_.factorize(hessian, shifted_diagonal_, 0);
     factored_ = true;
     return true;
   } catch (const NumericalError&) {

@@ -105,6 +105,8 @@ class ShiftedNewton {
   int solve_by_cg(const SparseMatrix& hessian, const Eigen::VectorXd& gradient, double forcing);
   // The relative residual the next Newton system is solved to by conjugate gradients.
   double forcing(double gradient_norm, double target, double exact_below) const;
+  // shifted_diagonal_ = C + τD at the current τ: the shift of both the factor and the system CG solves.
+  void set_shifted_diagonal();
   // Factors ∇²F + τD at the current τ; false (the matrix not definite) leaves τ as it is.
   bool try_factorize(const SparseMatrix& hessian);
   // Factors ∇²F + τD, τ grown tenfold until it factors.
