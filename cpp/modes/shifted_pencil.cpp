@@ -29,11 +29,13 @@ namespace {
 // motions, Spectra's single-vector Lanczos (used before the block solver) took on the 100k
 // dragon 111 solves for 14 modes at 1e-8, 50 at 1e-10 or 1e-12; on the 23k dragon 20 modes took
 // 93 solves for every fraction from 1e-12 to 1e-8 (106 at 1e-6).
-// 1e-12 would let the bake's derivative solves refine once instead of twice (their contraction
-// −σ/(λ − σ) below 1e-3 on the 100k dragon), but leaves small meshes' modes above their residual
-// tolerance (the ARAP bake of a 3 by 3 by 3 bar: 5.3e-7 against 3.0e-7).
+// The deflated fraction also sets how often the bake's derivative solves refine: their
+// contraction −σ/(λ − σ) on the 100k dragon's 15 + 52 is 4.3e-3 at 1e-10 (two steps to 1e-3),
+// 4.3e-4 at 1e-11 (one step, a 52-wide solve saved; its 88 Lanczos solves unchanged). 1e-12
+// leaves small meshes' modes above their residual tolerance (the ARAP bake of a 3 by 3 by 3
+// bar: 5.3e-7 against 3.0e-7); 1e-11 keeps them within.
 constexpr double kShiftFraction = 1e-8;
-constexpr double kDeflatedShiftFraction = 1e-10;
+constexpr double kDeflatedShiftFraction = 1e-11;
 // A mode fails when its residual exceeds kResidualTolerance · (|λ| + the largest λ computed) +
 // kRoundingFloor · tr K / tr M, the last term for rounding in modes with λ = 0, plus the rounding
 // of K φ itself (rounding_levels).
@@ -71,8 +73,8 @@ constexpr int kBlockWidth = 8;
 
 // solve_in_range refines until the error left on each eigenvector it does not know is below this
 // fraction of that component, in at most this many steps. Those components are the small,
-// high-frequency part of a modal derivative: on dragon_vrip_res2 two steps leave it within 1e-5 of
-// the converged solution, closer than the pinned solve gets there (4e-4).
+// high-frequency part of a modal derivative: on dragon_vrip_res2 one step leaves it within 4.3e-4
+// (the contraction at σ's kDeflatedShiftFraction), about where the pinned solve gets (4e-4).
 constexpr double kRefinementTolerance = 1e-3;
 constexpr int kMaxRefinementSteps = 6;
 
