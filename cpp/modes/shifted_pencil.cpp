@@ -158,7 +158,7 @@ class BlockLanczos {
         // (small meshes).
         if (converged.all() || next.rows() == 0 || last == dimension_ ||
             zero_modes_stand_in_the_way(nu, estimate, converged))
-          return Q_.leftCols(last) * S;
+          return dense_product(Q_.leftCols(last), S);
       }
       if (added == 0)
         throw NumericalError(message("vibration modes: the eigensolver did not converge within ", last,
@@ -224,7 +224,7 @@ class BlockLanczos {
     while (keep < gram.rows() && eig.eigenvalues()[gram.rows() - 1 - keep] > floor) ++keep;
     const Eigen::MatrixXd V = eig.eigenvectors().rightCols(keep);
     const Eigen::VectorXd d = eig.eigenvalues().tail(keep).cwiseSqrt();
-    W = W * (V * d.cwiseInverse().asDiagonal());
+    W = dense_product(W, V * d.cwiseInverse().asDiagonal());
     return d.asDiagonal() * V.transpose();
   }
 
@@ -359,17 +359,20 @@ VibrationModes ShiftedPencil::lowest_modes(int count, Progress* progress, double
   // more solve damps it by λ / λ_max.
   Eigen::MatrixXd Y = T.apply(ritz_vectors);
   const Eigen::MatrixXd KY = multiply(K_, Y);
-  const Eigen::MatrixXd reduced_K = Y.transpose() * KY;
-  const Eigen::MatrixXd reduced_M = Y.transpose() * (m.asDiagonal() * Y);
+  const Eigen::MatrixXd reduced_K = inner_product(Y, KY);
+  const Eigen::MatrixXd reduced_M = inner_product(Y, m, Y);
   Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> ritz(0.5 * (reduced_K + reduced_K.transpose()),
                                                                  0.5 * (reduced_M + reduced_M.transpose()));
   if (ritz.info() != Eigen::Success) throw NumericalError("vibration modes: the Rayleigh-Ritz step failed");
 
   VibrationModes result;
   result.eigenvalues = ritz.eigenvalues();  // ascending
-  result.modes = Y * ritz.eigenvectors();   // M-orthonormal
-  const Eigen::MatrixXd residual =
-      KY * ritz.eigenvectors() - m.asDiagonal() * (result.modes * result.eigenvalues.asDiagonal());
+  result.modes = dense_product(Y, ritz.eigenvectors());  // M-orthonormal
+  Eigen::MatrixXd residual = dense_product(KY, ritz.eigenvectors());
+  for_row_blocks(residual.rows(), [&](Eigen::Index first, Eigen::Index rows) {
+    residual.middleRows(first, rows) -= m.segment(first, rows).asDiagonal() *
+                                        (result.modes.middleRows(first, rows) * result.eigenvalues.asDiagonal());
+  });
   result.residuals = inverse_mass_norms(residual, m);
   const double largest = result.eigenvalues[count - 1];
   result.tolerances = kResidualTolerance * (result.eigenvalues.array().abs() + largest) + kRoundingFloor * scale_ +
