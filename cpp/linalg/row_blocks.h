@@ -56,6 +56,15 @@ inline Eigen::MatrixXd inner_product(const Eigen::Ref<const Eigen::MatrixXd>& A,
   });
 }
 
+// A C (n by c) for A (n by a) and C (a by c).
+inline Eigen::MatrixXd dense_product(const Eigen::Ref<const Eigen::MatrixXd>& A, const Eigen::MatrixXd& C) {
+  Eigen::MatrixXd X(A.rows(), C.cols());
+  for_row_blocks(A.rows(), [&](Eigen::Index first, Eigen::Index count) {
+    X.middleRows(first, count).noalias() = A.middleRows(first, count) * C;
+  });
+  return X;
+}
+
 // X += A C for X (n by c), A (n by a) and C (a by c).
 inline void add_dense_product(Eigen::Ref<Eigen::MatrixXd> X, const Eigen::Ref<const Eigen::MatrixXd>& A,
                               const Eigen::MatrixXd& C) {

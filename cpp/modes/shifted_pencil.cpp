@@ -29,11 +29,13 @@ namespace {
 // motions, Spectra's single-vector Lanczos (used before the block solver) took on the 100k
 // dragon 111 solves for 14 modes at 1e-8, 50 at 1e-10 or 1e-12; on the 23k dragon 20 modes took
 // 93 solves for every fraction from 1e-12 to 1e-8 (106 at 1e-6).
-// 1e-12 would let the bake's derivative solves refine once instead of twice (their contraction
-// −σ/(λ − σ) below 1e-3 on the 100k dragon), but leaves small meshes' modes above their residual
-// tolerance (the ARAP bake of a 3 by 3 by 3 bar: 5.3e-7 against 3.0e-7).
+// The deflated fraction also sets how often the bake's derivative solves refine: their
+// contraction −σ/(λ − σ) on the 100k dragon's 15 + 52 is 4.3e-3 at 1e-10 (two steps to 1e-3),
+// 4.3e-4 at 1e-11 (one step, a 52-wide solve saved; its 88 Lanczos solves unchanged). 1e-12
+// leaves small meshes' modes above their residual tolerance (the ARAP bake of a 3 by 3 by 3
+// bar: 5.3e-7 against 3.0e-7); 1e-11 keeps them within.
 constexpr double kShiftFraction = 1e-8;
-constexpr double kDeflatedShiftFraction = 1e-10;
+constexpr double kDeflatedShiftFraction = 1e-11;
 // A mode fails when its residual exceeds kResidualTolerance · (|λ| + the largest λ computed) +
 // kRoundingFloor · tr K / tr M, the last term for rounding in modes with λ = 0, plus the rounding
 // of K φ itself (rounding_levels).
@@ -71,8 +73,8 @@ constexpr int kBlockWidth = 8;
 
 // solve_in_range refines until the error left on each eigenvector it does not know is below this
 // fraction of that component, in at most this many steps. Those components are the small,
-// high-frequency part of a modal derivative: on dragon_vrip_res2 two steps leave it within 1e-5 of
-// the converged solution, closer than the pinned solve gets there (4e-4).
+// high-frequency part of a modal derivative: on dragon_vrip_res2 one step leaves it within 4.3e-4
+// (the contraction at σ's kDeflatedShiftFraction), about where the pinned solve gets (4e-4).
 constexpr double kRefinementTolerance = 1e-3;
 constexpr int kMaxRefinementSteps = 6;
 
@@ -156,7 +158,7 @@ class BlockLanczos {
         // (small meshes).
         if (converged.all() || next.rows() == 0 || last == dimension_ ||
             zero_modes_stand_in_the_way(nu, estimate, converged))
-          return Q_.leftCols(last) * S;
+          return dense_product(Q_.leftCols(last), S);
       }
       if (added == 0)
         throw NumericalError(message("vibration modes: the eigensolver did not converge within ", last,
@@ -222,7 +224,7 @@ class BlockLanczos {
     while (keep < gram.rows() && eig.eigenvalues()[gram.rows() - 1 - keep] > floor) ++keep;
     const Eigen::MatrixXd V = eig.eigenvectors().rightCols(keep);
     const Eigen::VectorXd d = eig.eigenvalues().tail(keep).cwiseSqrt();
-    W = W * (V * d.cwiseInverse().asDiagonal());
+    W = dense_product(W, V * d.cwiseInverse().asDiagonal());
     return d.asDiagonal() * V.transpose();
   }
 
@@ -357,17 +359,20 @@ VibrationModes ShiftedPencil::lowest_modes(int count, Progress* progress, double
   // more solve damps it by λ / λ_max.
   Eigen::MatrixXd Y = T.apply(ritz_vectors);
   const Eigen::MatrixXd KY = multiply(K_, Y);
-  const Eigen::MatrixXd reduced_K = Y.transpose() * KY;
-  const Eigen::MatrixXd reduced_M = Y.transpose() * (m.asDiagonal() * Y);
+  const Eigen::MatrixXd reduced_K = inner_product(Y, KY);
+  const Eigen::MatrixXd reduced_M = inner_product(Y, m, Y);
   Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> ritz(0.5 * (reduced_K + reduced_K.transpose()),
                                                                  0.5 * (reduced_M + reduced_M.transpose()));
   if (ritz.info() != Eigen::Success) throw NumericalError("vibration modes: the Rayleigh-Ritz step failed");
 
   VibrationModes result;
   result.eigenvalues = ritz.eigenvalues();  // ascending
-  result.modes = Y * ritz.eigenvectors();   // M-orthonormal
-  const Eigen::MatrixXd residual =
-      KY * ritz.eigenvectors() - m.asDiagonal() * (result.modes * result.eigenvalues.asDiagonal());
+  result.modes = dense_product(Y, ritz.eigenvectors());  // M-orthonormal
+  Eigen::MatrixXd residual = dense_product(KY, ritz.eigenvectors());
+  for_row_blocks(residual.rows(), [&](Eigen::Index first, Eigen::Index rows) {
+    residual.middleRows(first, rows) -= m.segment(first, rows).asDiagonal() *
+                                        (result.modes.middleRows(first, rows) * result.eigenvalues.asDiagonal());
+  });
   result.residuals = inverse_mass_norms(residual, m);
   const double largest = result.eigenvalues[count - 1];
   result.tolerances = kResidualTolerance * (result.eigenvalues.array().abs() + largest) + kRoundingFloor * scale_ +

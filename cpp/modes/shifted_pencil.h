@@ -71,7 +71,7 @@ class ShiftedPencil {
   // of K (as solve_in_range in modal_derivatives.h) through this factor of K − σM: exact on the
   // eigenpairs of the last lowest_modes within their tolerance and not deflated, each off by
   // λ/(λ − σ) on the others, so refined (ψ += (K − σM)⁻¹(P b − K ψ)) until each such component
-  // is within 1e-3 (two steps on the shared dragons). Saves a factorisation (2.5 s at 100k
+  // is within 1e-3 (one step on the 100k dragon). Saves a factorisation (2.5 s at 100k
   // vertices) for a solve and a product with K per step. B (3n by p) is taken by value and Ψ is
   // written over it. Reports ("derivative solves", fraction). Throws InputError for a bad B or
   // before any eigenpair is known; NumericalError when a column fails its residual check.

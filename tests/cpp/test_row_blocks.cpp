@@ -42,6 +42,10 @@ TEST(RowBlocks, ProductsMatchTheirDefinitionForAnyNumberOfThreads) {
     Eigen::MatrixXd X = B;
     add_dense_product(X, A, C);
     EXPECT_LT((X - (B + A * C)).cwiseAbs().maxCoeff(), 1e-12) << t << " threads";
+    const Eigen::MatrixXd AC = dense_product(A, C);
+    ASSERT_EQ(AC.rows(), n);
+    ASSERT_EQ(AC.cols(), C.cols());
+    EXPECT_LT((AC - A * C).cwiseAbs().maxCoeff(), 1e-12) << t << " threads";
   }
   omp_set_num_threads(threads);
   EXPECT_LT((inner_product(A, d, B) - A.transpose() * d.asDiagonal() * B).cwiseAbs().maxCoeff(), 1e-9);
