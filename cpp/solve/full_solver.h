@@ -37,7 +37,9 @@ struct FullSolveOptions {
   // In (0, 1): the factor by which ‖∇F‖ must drop below the larger of its values at rest and at
   // `initial` at the full load.
   double tolerance = 1e-8;
-  int max_iterations = 300;  // ≥ 0: Newton iterations at most, all load steps together
+  // ≥ 0: Newton iterations at most, all load steps together (the Python API's default, FULL_SOLVE_MAX_ITERATIONS,
+  // says why so many)
+  int max_iterations = 1000;
   // Called as ("solve", fraction done) at most every 0.1 s; returning false cancels (Cancelled).
   ProgressCallback progress = nullptr;
   StiffnessPaint paint = {};  // the shells weights painted per vertex (stiffness_paint.h; not with ARAP)

@@ -194,7 +194,7 @@ the "Modal Deform" shape key: the exact physically based shape, for a final fram
     bl_label = "Refine"
     bl_options = {"REGISTER", "UNDO"}
 
-    max_iterations: bpy.props.IntProperty(name="Max Iterations", default=300, min=1,
+    max_iterations: bpy.props.IntProperty(name="Max Iterations", default=mdc.FULL_SOLVE_MAX_ITERATIONS, min=1,
                                           description="Newton iterations at most; fewer may leave the pose unfinished")
     tolerance: bpy.props.FloatProperty(name="Tolerance", default=1e-8, min=1e-12, max=0.5,
                                        description="Factor by which the gradient must shrink: smaller solves more "

@@ -13,11 +13,11 @@ from .frame_budget import FrameBudget
 from .mesh import bar, bumpy_plane, check, cylinder, grid, mass, read_mesh
 from .modes import rigid_motions, solve_in_range, vibration_modes
 from .reduction import ghost_mesh, restrict_to_ghost
-from .solve import ReducedSolver, nearest_rigid, solve_full
+from .solve import FULL_SOLVE_MAX_ITERATIONS, ReducedSolver, nearest_rigid, solve_full
 
 __all__ = [
     "Arap", "BAKE_STAGES", "Basis", "FrameBudget", "PROXY", "PROXY_ABOVE", "Cancelled", "DiscreteShells", "OutOfMemoryError", "bake", "bake_fraction", "bar", "bumpy_plane", "check", "cylinder",
     "ghost_mesh", "grid", "mass", "read_mesh", "restrict_to_ghost", "rigid_motions", "solve_in_range",
     "vibration_modes",
 ]
-__all__ += ["ReducedSolver", "nearest_rigid", "solve_full"]
+__all__ += ["FULL_SOLVE_MAX_ITERATIONS", "ReducedSolver", "nearest_rigid", "solve_full"]
