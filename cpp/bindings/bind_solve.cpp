@@ -30,6 +30,7 @@ Handles to_handles(const std::vector<Eigen::VectorXi>& arrays) {
 }  // namespace
 
 void bind_solve(py::module_& m) {
+  m.attr("FULL_SOLVE_MAX_ITERATIONS") = FullSolveOptions{}.max_iterations;
   py::class_<ReducedSolver>(m, "ReducedSolver")
       .def(py::init([](const Basis& basis, const std::vector<Eigen::VectorXi>& handles, const VectorRef& weights,
                        double stiffness, const std::string& energy, bool warm_start) {

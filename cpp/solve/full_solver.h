@@ -37,8 +37,11 @@ struct FullSolveOptions {
   // In (0, 1): the factor by which ‖∇F‖ must drop below the larger of its values at rest and at
   // `initial` at the full load.
   double tolerance = 1e-8;
-  // ≥ 0: Newton iterations at most, all load steps together (the Python API's default, FULL_SOLVE_MAX_ITERATIONS,
-  // says why so many)
+  // ≥ 0: Newton iterations at most, all load steps together (also the Python API's default, exported
+  // as FULL_SOLVE_MAX_ITERATIONS). Strong poses of scans need hundreds while F falls steadily: the
+  // 23k dragon bent by 90° converges in 346 from its reduced pose and in 771 from rest (triangles
+  // on the inside of the bend are crushed one after another, each cutting a step); 300 left both
+  // unconverged.
   int max_iterations = 1000;
   // Called as ("solve", fraction done) at most every 0.1 s; returning false cancels (Cancelled).
   ProgressCallback progress = nullptr;

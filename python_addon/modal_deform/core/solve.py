@@ -19,11 +19,9 @@ from .bake import PROXY_ABOVE, Basis
 
 #: The most vertices ReducedSolver.refine takes: the size bake takes without a proxy.
 REFINE_MAX_VERTICES = PROXY_ABOVE
-# Newton iterations a full solve (and Refine) takes at most by default. Strong poses of scans need
-# hundreds while F falls steadily: the 23k dragon bent by 90° converges in 346 from its reduced
-# pose and in 771 from rest (triangles on the inside of the bend are crushed one after another,
-# each cutting a step); 300 left both unconverged.
-FULL_SOLVE_MAX_ITERATIONS = 1000
+#: Newton iterations a full solve (and Refine) takes at most by default: the native core's
+#: (cpp/solve/full_solver.h says why so many).
+FULL_SOLVE_MAX_ITERATIONS = _native.FULL_SOLVE_MAX_ITERATIONS
 
 
 #: The default handle stiffness μ: stiff enough that handles land within a small fraction of a
