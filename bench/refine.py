@@ -77,7 +77,7 @@ def refine(basis, F, handles, transforms):
 def row(stats):
     keys = ("steps", "iterations", "factorizations", "seconds", "wall_seconds", "energy", "initial_energy",
             "converged", "stalled", "gradient_norm", "gradient_scale", "gap", "rms", "reduced_seconds",
-            "reduced_iterations", "reduced_converged")
+            "reduced_iterations", "reduced_converged", "relaxed_vertices")
     history = stats["history"]
     return {k: stats[k] for k in keys if k in stats} | {
         "exact_iterations": sum(it["model"] == "exact" for it in history),

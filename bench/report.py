@@ -707,8 +707,9 @@ def section_refine(result):
            "and RMS (of the bounding-box diagonal) are the reduced pose's against the refined minimum. Time: the "
            "native solve's wall time, with the load average when it ended (2 cores shared). Exact / guarded / "
            "failed: iterations on the exact Hessian (the rest on the projected one), steps cut only because "
-           "longer ones turned a triangle over, line searches that found no decrease. Non-converged solves are "
-           "marked and are no reference.", ""]
+           "longer ones turned a triangle over, line searches that found no decrease. Relaxed: vertices of edges the "
+           "reduced pose stretched beyond 10 times, relaxed on their own before Newton (fins and needles of the "
+           "scan). Non-converged solves are marked and are no reference.", ""]
     rows = []
     for mesh, entry in result["figures"].items():
         for kind in ("from_rest", "refine"):
@@ -719,9 +720,11 @@ def section_refine(result):
                              "/".join(str(r.get(k, "")) for k in ("exact_iterations", "guarded_steps",
                                                                  "line_search_failures")),
                              f"{r['energy']:.5g}", "yes" if r["converged"] else "**no**",
-                             f"{r['gap']:.3g}" if "gap" in r else "", f"{100 * r['rms']:.3f}%" if "rms" in r else ""])
+                             f"{r['gap']:.3g}" if "gap" in r else "", f"{100 * r['rms']:.3f}%" if "rms" in r else "",
+                             r.get("relaxed_vertices", "")])
     out.append(table(["mesh", "vertices", "pose", "solve", "load steps", "iterations", "factorisations", "s",
-                      "load", "exact/guarded/failed", "objective", "converged", "reduced gap", "reduced RMS"], rows))
+                      "load", "exact/guarded/failed", "objective", "converged", "reduced gap", "reduced RMS",
+                      "relaxed"], rows))
     older = [f"The {mesh} rows are from an earlier run: commit `{entry['commit'][:12]}`, {entry['date']}."
              for mesh, entry in result["figures"].items() if entry.get("commit", result["commit"]) != result["commit"]]
     out += ["", *(older + [""] if older else []), "Targets:", ""]

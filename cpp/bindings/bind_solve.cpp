@@ -103,7 +103,8 @@ void bind_solve(py::module_& m) {
                        py::arg("gradient_norm") = result.gradient_norm,
                        py::arg("gradient_scale") = result.gradient_scale,
                        py::arg("factorizations") = result.factorizations,
-                       py::arg("initial_energy") = result.initial_energy, py::arg("seconds") = result.seconds,
+                       py::arg("initial_energy") = result.initial_energy,
+                       py::arg("relaxed_vertices") = result.relaxed_vertices, py::arg("seconds") = result.seconds,
                        py::arg("stalled") = result.stalled);
         // Per iteration: the Hessian model, τ, the step and why it was cut, the model's accuracy.
         py::list history;

@@ -7,6 +7,7 @@
 #include "mesh/mesh_check.h"
 #include "solve/load_steps.h"
 #include "solve/pose_objective.h"
+#include "solve/relax_stretched.h"
 #include "solve/shifted_newton.h"
 #include "util/errors.h"
 #include "util/require_positions.h"
@@ -94,6 +95,7 @@ FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handle
     result.gradient_scale = std::max(result.gradient_scale, point.gradient.norm());
   }
   result.initial_energy = point.value;
+  if (initial) result.relaxed_vertices = relax_stretched(objective, point);
 
   LoadSchedule schedule(!initial, path.suggested_steps());
   Eigen::VectorXd y_previous;  // the answer at the load before, for the predictor

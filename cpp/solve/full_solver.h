@@ -9,7 +9,8 @@
 // with E the discrete shells energy (bending, membrane, painted stiffness) or ARAP of the rest mesh s V, and m_i the
 // lumped masses of (V, F): the reduced solver's objective with U = I and no ghost.
 //
-// The pieces: the objective (pose_objective.h); Newton on the shifted Hessian, keeping CHOLMOD's
+// The pieces: the objective (pose_objective.h); a start's stretched vertices relaxed first
+// (relax_stretched.h: a reduced pose's fins and needles); Newton on the shifted Hessian, keeping CHOLMOD's
 // analysis for the whole solve and backtracking along its step (shifted_newton.h: what makes it
 // converge on scans with floppy flaps and fins); the load steps from rest (load_steps.h). Each
 // load step starts from the previous answer moved on along the path the last step took (a secant
@@ -60,6 +61,7 @@ struct FullSolveResult {
   double gradient_norm = 0;   // ‖∇F‖ at the result (normalised frame)
   double gradient_scale = 0;  // the larger ‖∇F‖ at rest and at `initial`: the tolerance's unit
   double initial_energy = 0;  // F at the start (rest, or `initial`) under the full transforms
+  int relaxed_vertices = 0;   // vertices of `initial` relaxed before Newton (relax_stretched.h)
   double seconds = 0;         // wall time of the solve
   bool converged = false;     // gradient_norm ≤ tolerance · gradient_scale at the full load
   bool stalled = false;       // stopped because F no longer decreased (not converged)

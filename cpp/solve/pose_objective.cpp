@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <utility>
 
 #include "mesh/mass.h"
 #include "mesh/normalization.h"
@@ -12,17 +13,24 @@ namespace modal_deform {
 PoseObjective::PoseObjective(const VerticesRef& V, const FacesRef& F, const Handles& handles,
                              const Eigen::VectorXd& weights, double stiffness, EnergyKind energy, double bending,
                              double membrane, const StiffnessPaint& paint, const std::vector<int>& held)
-    : scale_(normalizing_scale(V)),
-      rest_(scale_ * V),
-      energy_(make_energy(energy, rest_, F, bending, membrane, paint)),
-      handle_term_(rest_, scale_ * scale_ * lumped_mass(V, F), handles, weights, stiffness),
+    : PoseObjective(normalizing_scale(V) * V, normalizing_scale(V), F,
+                    Terms{handles, weights, stiffness, energy, bending, membrane, paint}, held) {}
+
+PoseObjective::PoseObjective(RowMatrixX3d rest, double scale, const FacesRef& F, Terms terms,
+                             const std::vector<int>& held)
+    : terms_(std::move(terms)),
+      transforms_(terms_.handles.size(), Eigen::Matrix4d::Identity()),
+      scale_(scale),
+      rest_(std::move(rest)),
+      energy_(make_energy(terms_.energy, rest_, F, terms_.bending, terms_.membrane, terms_.paint)),
+      handle_term_(rest_, lumped_mass(rest_, F), terms_.handles, terms_.weights, terms_.stiffness),
       faces_(F) {
-  const int n = static_cast<int>(V.rows());
-  const Eigen::VectorXd mass = lumped_mass(V, F);
+  const int n = static_cast<int>(rest_.rows());
+  const Eigen::VectorXd mass = lumped_mass(rest_, F);
   const Eigen::VectorXd handle_diagonal = handle_term_.hessian_diagonal(n);
   const Eigen::VectorXd hessian_diagonal = energy_->hessian(rest_positions()).diagonal();
   mass_diagonal_.resize(3 * n);
-  for (int v = 0; v < n; ++v) mass_diagonal_.segment<3>(3 * v).setConstant(scale_ * scale_ * mass[v]);
+  for (int v = 0; v < n; ++v) mass_diagonal_.segment<3>(3 * v).setConstant(mass[v]);
   const double mean_mass = mass_diagonal_.mean();
   mass_diagonal_ = mass_diagonal_.cwiseMax(1e-6 * mean_mass);
   // Coordinates of vertices in no energy term and no handle (no mass, a zero Hessian block) get a
@@ -38,6 +46,52 @@ PoseObjective::PoseObjective(const VerticesRef& V, const FacesRef& F, const Hand
     std::fill_n(held_.begin() + 3 * static_cast<std::ptrdiff_t>(v), 3, 1);
     constant_diagonal_.segment<3>(3 * v).setConstant(mean_mass);
   }
+}
+
+PoseObjective PoseObjective::around(const std::vector<int>& free, std::vector<int>& vertices) const {
+  const int n = static_cast<int>(rest_.rows());
+  std::vector<char> is_free(n, 0), near(n, 0);
+  for (int v : free) is_free[v] = 1;
+  auto touches = [&](const std::vector<char>& marked, Eigen::Index f) {
+    return marked[faces_(f, 0)] || marked[faces_(f, 1)] || marked[faces_(f, 2)];
+  };
+  for (Eigen::Index f = 0; f < faces_.rows(); ++f)
+    if (touches(is_free, f)) near[faces_(f, 0)] = near[faces_(f, 1)] = near[faces_(f, 2)] = 1;
+  std::vector<Eigen::Index> kept;
+  std::vector<int> index(n, -1);  // the parent's vertex → this one's
+  for (Eigen::Index f = 0; f < faces_.rows(); ++f)
+    if (touches(near, f)) {
+      kept.push_back(f);
+      for (int k = 0; k < 3; ++k) index[faces_(f, k)] = 0;
+    }
+  vertices.clear();
+  for (int v = 0; v < n; ++v)
+    if (index[v] == 0) {
+      index[v] = static_cast<int>(vertices.size());
+      vertices.push_back(v);
+    }
+  RowMatrixX3i F(static_cast<Eigen::Index>(kept.size()), 3);
+  for (size_t i = 0; i < kept.size(); ++i)
+    for (int k = 0; k < 3; ++k) F(static_cast<Eigen::Index>(i), k) = index[faces_(kept[i], k)];
+  RowMatrixX3d rest(static_cast<Eigen::Index>(vertices.size()), 3);
+  std::vector<int> held;
+  Terms terms = terms_;
+  if (!terms_.paint.uniform()) terms.paint.weights.resize(static_cast<Eigen::Index>(vertices.size()));
+  for (size_t i = 0; i < vertices.size(); ++i) {
+    const auto local = static_cast<Eigen::Index>(i);
+    rest.row(local) = rest_.row(vertices[i]);
+    if (!terms_.paint.uniform()) terms.paint.weights[local] = terms_.paint.weights[vertices[i]];
+    if (!is_free[vertices[i]]) held.push_back(static_cast<int>(i));
+  }
+  for (std::vector<int>& handle : terms.handles) {
+    std::vector<int> inside;
+    for (int v : handle)
+      if (index[v] >= 0) inside.push_back(index[v]);
+    handle = std::move(inside);
+  }
+  PoseObjective local(std::move(rest), 1.0, F, std::move(terms), held);
+  local.set_transforms(transforms_);  // already normalised, and the scale is 1
+  return local;
 }
 
 SparseMatrix PoseObjective::without_held(SparseMatrix hessian) const {
@@ -63,6 +117,7 @@ bool PoseObjective::turns_a_triangle_over(const Eigen::VectorXd& y, const Eigen:
 void PoseObjective::set_transforms(Transforms transforms) {
   for (Eigen::Matrix4d& T : transforms) T.topRightCorner<3, 1>() *= scale_;
   handle_term_.set_transforms(transforms);
+  transforms_ = std::move(transforms);
 }
 
 double PoseObjective::operator()(const Eigen::VectorXd& y, Eigen::VectorXd& gradient) const {

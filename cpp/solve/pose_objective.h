@@ -25,6 +25,13 @@ class PoseObjective {
                 double stiffness, EnergyKind energy, double bending, double membrane, const StiffnessPaint& paint,
                 const std::vector<int>& held = {});
 
+  // The same objective, up to a constant, as a function of the `free` vertices' coordinates (none
+  // held) with every other vertex held: only the faces that touch a free vertex or a neighbour of
+  // one, which hold every term a free vertex is in (its hinges' and its neighbours' rotations too).
+  // In this objective's normalised frame (its scale() is 1) and under its transforms. `vertices`
+  // receives the parent's index of each of its vertices, ascending.
+  PoseObjective around(const std::vector<int>& free, std::vector<int>& vertices) const;
+
   double scale() const { return scale_; }
   Eigen::VectorXd rest_positions() const { return flatten(rest_); }
   // The energy's Hessian at y, exact or projected (each element's made semidefinite), with the held
@@ -53,9 +60,26 @@ class PoseObjective {
   // F(y), ∇F(y) written into `gradient`; +inf where y is beyond what the energy takes.
   double operator()(const Eigen::VectorXd& y, Eigen::VectorXd& gradient) const;
 
+  const RowMatrixX3d& rest() const { return rest_; }  // #V by 3, normalised frame
+  const RowMatrixX3i& faces() const { return faces_; }
+  bool held(int vertex) const { return !held_.empty() && held_[3 * static_cast<size_t>(vertex)]; }
+
  private:
+  // What the objective is made of, kept for around().
+  struct Terms {
+    Handles handles;
+    Eigen::VectorXd weights;
+    double stiffness;
+    EnergyKind energy;
+    double bending, membrane;
+    StiffnessPaint paint;
+  };
+  // rest: #V by 3 in the normalised frame, scale the factor it was scaled by from mesh units.
+  PoseObjective(RowMatrixX3d rest, double scale, const FacesRef& F, Terms terms, const std::vector<int>& held);
   SparseMatrix without_held(SparseMatrix hessian) const;
 
+  Terms terms_;
+  Transforms transforms_;  // normalised frame, as the handle term has them
   double scale_;
   RowMatrixX3d rest_;
   std::unique_ptr<Energy> energy_;

@@ -315,6 +315,26 @@ def test_refine_lowers_the_reduced_pose_to_a_converged_minimum(tube, tube_basis)
     assert np.abs(solver.positions() - reduced).max() == 0  # the reduced state is left alone
 
 
+def test_refine_relaxes_a_vertex_its_start_pulled_off_before_newton(tube, tube_basis):
+    """A start with a vertex far off the surface (as a reduced pose leaves a scan's fins): Refine
+    relaxes it and its neighbours on their own first, then reaches the same minimum."""
+    V, F, handles, transforms = tube
+    solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0)
+    solver.set_transforms(transforms)
+    converge(solver)
+    start = solver.positions().astype(np.float64)
+    X, stats = solver.refine(F)
+    assert stats["relaxed_vertices"] == 0
+    pulled = start.copy()
+    middle = int(np.argmin(np.abs(V[:, 2] - 1.5)))
+    pulled[middle] += 5.0 * V[middle] * [1, 1, 0]  # 5 radii outwards: its edges stretched 10 times and more
+    Y, spiked = solver.refine(F, initial=pulled)
+    assert spiked["converged"] and spiked["relaxed_vertices"] >= 7, spiked
+    assert spiked["initial_energy"] > 10 * stats["initial_energy"]
+    assert spiked["energy"] == pytest.approx(stats["energy"], rel=1e-9)
+    assert np.abs(Y - X).max() < 1e-6 * np.ptp(V)
+
+
 def test_refine_that_does_not_converge_counts_both_solves(tube, tube_basis):
     """Cut short, Refine runs the solve from rest as well: whichever answer it returns, the stats
     count what both solves spent, one history entry per iteration."""

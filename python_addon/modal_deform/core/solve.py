@@ -266,7 +266,9 @@ def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, ene
     about every 0.1 s (False cancels: ``Cancelled``). Returns the positions (n, 3) float64, or with
     ``return_stats=True`` the pair (positions, stats) with stats = {"steps", "iterations",
     "energy", "converged", "gradient_norm", "gradient_scale", "factorizations", "seconds",
-    "initial_energy", "stalled", "history"}. A solve that did not converge says so in "converged";
+    "initial_energy", "relaxed_vertices", "stalled", "history"}. "relaxed_vertices": with ``initial``,
+    the vertices of edges it stretched beyond three times their rest length (a reduced pose's fins
+    and needles, which the ghost does not see) relaxed on their own before Newton's iterations. A solve that did not converge says so in "converged";
     only a converged one is a reference. "stalled": it stopped because the objective no longer
     decreased. "history": one dict per Newton iteration with "model" ("projected" or "exact": the
     Hessian the step solved with), "shift" (τ), "step" (the line search's α; 0 when it found no decrease),
