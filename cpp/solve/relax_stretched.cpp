@@ -11,7 +11,7 @@ constexpr double kRelaxTolerance = 1e-8;
 constexpr int kRelaxIterations = 100;
 
 // The vertices (not held) of the edges y stretches beyond kStretchedBeyond times their rest
-// length, ascending.
+// length (edges of length 0 at rest left out), ascending.
 std::vector<int> stretched_vertices(const PoseObjective& objective, const Eigen::VectorXd& y) {
   const RowMatrixX3d& rest = objective.rest();
   const RowMatrixX3i& F = objective.faces();
@@ -19,7 +19,9 @@ std::vector<int> stretched_vertices(const PoseObjective& objective, const Eigen:
   for (Eigen::Index f = 0; f < F.rows(); ++f)
     for (int k = 0; k < 3; ++k) {
       const int a = F(f, k), b = F(f, (k + 1) % 3);
-      if ((y.segment<3>(3 * a) - y.segment<3>(3 * b)).norm() > kStretchedBeyond * (rest.row(a) - rest.row(b)).norm())
+      const double rest_length = (rest.row(a) - rest.row(b)).norm();
+      // A zero-length rest edge (a raw scan's unwelded duplicate) has no term to stretch.
+      if (rest_length > 0 && (y.segment<3>(3 * a) - y.segment<3>(3 * b)).norm() > kStretchedBeyond * rest_length)
         stretched[a] = stretched[b] = 1;
     }
   std::vector<int> vertices;
