@@ -37,13 +37,16 @@ int relax_stretched(const PoseObjective& objective, NewtonPoint& point) {
   if (free.empty()) return 0;
   std::vector<int> vertices;
   const PoseObjective local = objective.around(free, vertices);
+  // Coordinates of the local objective's vertex i: the parent's vertex vertices[i].
+  auto at = [&](Eigen::VectorXd& y, size_t i) { return y.segment<3>(3 * static_cast<Eigen::Index>(i)); };
   const auto size = static_cast<Eigen::Index>(3 * vertices.size());
   NewtonPoint near{Eigen::VectorXd(size), 0, Eigen::VectorXd(size)};
-  for (size_t i = 0; i < vertices.size(); ++i) near.y.segment<3>(3 * static_cast<Eigen::Index>(i)) = point.y.segment<3>(3 * vertices[i]);
+  for (size_t i = 0; i < vertices.size(); ++i) at(near.y, i) = at(point.y, vertices[i]);
   near.value = local(near.y, near.gradient);
+  // exact_below = target: the projected Hessian throughout, the robust one far from the minimum.
   const double target = kRelaxTolerance * near.gradient.norm();
   ShiftedNewton(local).minimize(near, target, kRelaxIterations, target, [](const NewtonPoint&) {});
-  for (size_t i = 0; i < vertices.size(); ++i) point.y.segment<3>(3 * vertices[i]) = near.y.segment<3>(3 * static_cast<Eigen::Index>(i));
+  for (size_t i = 0; i < vertices.size(); ++i) at(point.y, vertices[i]) = at(near.y, i);
   point.value = objective(point.y, point.gradient);
   return static_cast<int>(free.size());
 }

@@ -180,7 +180,8 @@ TEST(PoseObjective, AroundFewVerticesIsTheObjectiveOfTheirCoordinates) {
     for (int v : free) moved.segment<3>(3 * v) += Eigen::Vector3d(0.03, -0.02, 0.04);
     auto restrict = [&](const Eigen::VectorXd& full) {
       Eigen::VectorXd part(3 * vertices.size());
-      for (size_t i = 0; i < vertices.size(); ++i) part.segment<3>(3 * static_cast<Eigen::Index>(i)) = full.segment<3>(3 * vertices[i]);
+      for (size_t i = 0; i < vertices.size(); ++i)
+        part.segment<3>(3 * static_cast<Eigen::Index>(i)) = full.segment<3>(3 * vertices[i]);
       return part;
     };
     Eigen::VectorXd g_whole(3 * n), g_moved(3 * n), g_local(3 * vertices.size()), g_local_moved(3 * vertices.size());
@@ -189,7 +190,8 @@ TEST(PoseObjective, AroundFewVerticesIsTheObjectiveOfTheirCoordinates) {
     EXPECT_NEAR(local_change, change, 1e-9 * std::abs(change));
     for (size_t i = 0; i < vertices.size(); ++i) {
       const bool is_free = std::find(free.begin(), free.end(), vertices[i]) != free.end();
-      const Eigen::Vector3d expected = is_free ? Eigen::Vector3d(g_whole.segment<3>(3 * vertices[i])) : Eigen::Vector3d::Zero();
+      const Eigen::Vector3d expected =
+          is_free ? Eigen::Vector3d(g_whole.segment<3>(3 * vertices[i])) : Eigen::Vector3d::Zero();
       EXPECT_LE((g_local.segment<3>(3 * static_cast<Eigen::Index>(i)) - expected).norm(), 1e-9 * g_whole.norm())
           << "vertex " << vertices[i];
     }

@@ -296,11 +296,18 @@ def test_solve_full_converges_from_rest_on_the_23k_dragon(shared_mesh):
     assert stats["factorizations"] < 1.5 * stats["iterations"], stats
 
 
-def test_refine_lowers_the_reduced_pose_to_a_converged_minimum(tube, tube_basis):
-    V, F, handles, transforms = tube
+def converged_solver(tube, tube_basis):
+    """The tube's reduced solver at its converged reduced pose, Refine's start."""
+    _, _, handles, transforms = tube
     solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0)
     solver.set_transforms(transforms)
     converge(solver)
+    return solver
+
+
+def test_refine_lowers_the_reduced_pose_to_a_converged_minimum(tube, tube_basis):
+    V, F, handles, transforms = tube
+    solver = converged_solver(tube, tube_basis)
     reduced = solver.positions().astype(np.float64)
     X, stats = solver.refine(F)
     assert stats["converged"] and stats["steps"] == 1, stats
@@ -318,10 +325,8 @@ def test_refine_lowers_the_reduced_pose_to_a_converged_minimum(tube, tube_basis)
 def test_refine_relaxes_a_vertex_its_start_pulled_off_before_newton(tube, tube_basis):
     """A start with a vertex far off the surface (as a reduced pose leaves a scan's fins): Refine
     relaxes it and its neighbours on their own first, then reaches the same minimum."""
-    V, F, handles, transforms = tube
-    solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0)
-    solver.set_transforms(transforms)
-    converge(solver)
+    V, F, _, _ = tube
+    solver = converged_solver(tube, tube_basis)
     start = solver.positions().astype(np.float64)
     X, stats = solver.refine(F)
     assert stats["relaxed_vertices"] == 0
@@ -339,9 +344,7 @@ def test_refine_that_does_not_converge_counts_both_solves(tube, tube_basis):
     """Cut short, Refine runs the solve from rest as well: whichever answer it returns, the stats
     count what both solves spent, one history entry per iteration."""
     V, F, handles, transforms = tube
-    solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0)
-    solver.set_transforms(transforms)
-    converge(solver)
+    solver = converged_solver(tube, tube_basis)
     _, alone = solver.refine(F, max_iterations=1)
     _, from_rest = mdc.solve_full(V, F, handles, transforms, stiffness=100.0, max_iterations=1, return_stats=True)
     assert not alone["converged"] and not from_rest["converged"]
