@@ -12,7 +12,7 @@
 //      CHOLMOD orders K while the ghost is simplified beside it (edge collapse of the whole mesh
 //      to about `ghost` vertices).
 //   5. Vibration modes: the lowest eigenpairs M-orthogonal to the kernel (deflation). A floppy
-//      mesh (flaps at non-manifold vertices, duplicate faces; all three shared dragons) has
+//      mesh (large parts joined at a single vertex; scan debris is attached in step 2) has
 //      further zero modes, with λ < kZeroEigenvalue tr K/tr M: they come on top of `modes` (a
 //      scan's count of mechanisms is not known before the bake, and each would take the place
 //      of a deformation mode), stay in the basis after the rigid motions (Basis::num_floppy) and
@@ -65,7 +65,8 @@ namespace modal_deform {
 // A mode with λ below this fraction of tr K / tr M (a mass-weighted mean of the spectrum, which
 // grows with the resolution as rounding in K does) is a zero mode. Measured on the shells
 // Hessians of the dragons, zero modes / lowest flexible mode relative to that mean: res4 (9 zero
-// modes) 2e-15 / 1.7e-7, res3 (3) 4e-14 / 9e-9, res2 (6) 3e-15 / 1.8e-10.
+// modes) 2e-15 / 1.7e-7, res3 (3) 4e-14 / 9e-9, res2 (6) 3e-15 / 1.8e-10 (their doubled faces and
+// pieces hanging by one vertex, attached since, made those zero modes).
 constexpr double kZeroEigenvalue = 1e-12;
 
 struct BakeOptions {

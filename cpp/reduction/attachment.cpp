@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "mesh/mass.h"
@@ -97,6 +98,40 @@ Attachment::Follower follow(const VerticesRef& V, const RowMatrixX3d& P, const E
   return follower;
 }
 
+// Faces that share their three vertices with another face, in either orientation (a scan's
+// doubled triangles). The copies fold onto each other, their common hinges at an angle of π whose
+// sign is undefined, and a vertex on them alone is held by nothing across them: on the shared
+// 100k dragon each such fin gave a zero mode, M-orthonormalised to 1e6 times the median entry at
+// its tiny mass, and the derivatives' largest entries sat there too (a reduced pose drew spikes).
+std::vector<char> doubled_faces(const FacesRef& F) {
+  const auto m = static_cast<int>(F.rows());
+  std::vector<std::array<int, 4>> keys(static_cast<size_t>(m));  // sorted vertices, then the face
+  for (int f = 0; f < m; ++f) {
+    keys[static_cast<size_t>(f)] = {F(f, 0), F(f, 1), F(f, 2), f};
+    std::sort(keys[static_cast<size_t>(f)].begin(), keys[static_cast<size_t>(f)].begin() + 3);
+  }
+  std::sort(keys.begin(), keys.end());
+  std::vector<char> doubled(static_cast<size_t>(m), 0);
+  for (size_t i = 1; i < keys.size(); ++i)
+    if (std::equal(keys[i].begin(), keys[i].begin() + 3, keys[i - 1].begin()))
+      doubled[static_cast<size_t>(keys[i][3])] = doubled[static_cast<size_t>(keys[i - 1][3])] = 1;
+  return doubled;
+}
+
+// Joins the `sound` faces that share an edge into pieces (face indices in `pieces`).
+void join_across_edges(const FacesRef& F, const std::vector<char>& sound, UnionFind& pieces) {
+  std::vector<std::array<int, 3>> edges;  // both ends ascending, then the face
+  for (int f = 0; f < static_cast<int>(F.rows()); ++f)
+    if (sound[static_cast<size_t>(f)])
+      for (int k = 0; k < 3; ++k) {
+        const int a = F(f, k), b = F(f, (k + 1) % 3);
+        edges.push_back({std::min(a, b), std::max(a, b), f});
+      }
+  std::sort(edges.begin(), edges.end());
+  for (size_t i = 1; i < edges.size(); ++i)
+    if (edges[i][0] == edges[i - 1][0] && edges[i][1] == edges[i - 1][1]) pieces.unite(edges[i][2], edges[i - 1][2]);
+}
+
 }  // namespace
 
 Attachment attach(const VerticesRef& V, const FacesRef& F) {
@@ -105,24 +140,47 @@ Attachment attach(const VerticesRef& V, const FacesRef& F) {
   const auto m = static_cast<int>(F.rows());
   const Eigen::VectorXd area = face_areas(V, F);
 
-  // Components over the non-degenerate faces, and the area of each (at its root).
-  UnionFind sets(n);
-  std::vector<bool> sound(static_cast<size_t>(m)), on_sound_face(static_cast<size_t>(n), false);
-  for (int f = 0; f < m; ++f) {
-    sound[static_cast<size_t>(f)] = face_shape_ratio(V, F, f) > kMinSimulatedShape;
-    if (!sound[static_cast<size_t>(f)]) continue;
-    sets.unite(F(f, 0), F(f, 1));
-    sets.unite(F(f, 0), F(f, 2));
-    for (int k = 0; k < 3; ++k) on_sound_face[static_cast<size_t>(F(f, k))] = true;
-  }
-  std::vector<double> root_area(static_cast<size_t>(n), 0.0);
+  // Pieces: the sound faces joined across edges, and the area of each (at its root face).
+  const std::vector<char> doubled = doubled_faces(F);
+  std::vector<char> sound(static_cast<size_t>(m));
   for (int f = 0; f < m; ++f)
-    if (sound[static_cast<size_t>(f)]) root_area[static_cast<size_t>(sets.find(F(f, 0)))] += area[f];
-  const double largest = *std::max_element(root_area.begin(), root_area.end());
+    sound[static_cast<size_t>(f)] = !doubled[static_cast<size_t>(f)] && face_shape_ratio(V, F, f) > kMinSimulatedShape;
+  UnionFind pieces(m);
+  join_across_edges(F, sound, pieces);
+  std::vector<double> piece_area(static_cast<size_t>(m), 0.0);
+  for (int f = 0; f < m; ++f)
+    if (sound[static_cast<size_t>(f)]) piece_area[static_cast<size_t>(pieces.find(f))] += area[f];
+  const double largest = *std::max_element(piece_area.begin(), piece_area.end());
   if (!(largest > 0))
     throw InputError(message("F: every face is degenerate or a sliver (twice its area below ", kMinSimulatedShape,
-                             " of its longest edge squared); the mesh has nothing to simulate"));
+                             " of its longest edge squared) or laid twice; the mesh has nothing to simulate"));
   const double threshold = kSimulatedAreaFraction * largest;
+  std::vector<char> large(static_cast<size_t>(m), 0);  // a sound face of a simulated piece
+  for (int f = 0; f < m; ++f)
+    large[static_cast<size_t>(f)] = sound[static_cast<size_t>(f)] && piece_area[static_cast<size_t>(pieces.find(f))] >= threshold;
+
+  // Vertices: simulated on a large piece's face, the large pieces that share a vertex one
+  // component (pinned there: they share rigid motions, and turning about the pin is a zero mode);
+  // the other vertices of a small piece's faces one attached group.
+  UnionFind sets(n);
+  std::vector<char> simulated(static_cast<size_t>(n), 0), on_small_piece(static_cast<size_t>(n), 0);
+  for (int f = 0; f < m; ++f)
+    if (large[static_cast<size_t>(f)]) {
+      sets.unite(F(f, 0), F(f, 1));
+      sets.unite(F(f, 0), F(f, 2));
+      for (int k = 0; k < 3; ++k) simulated[static_cast<size_t>(F(f, k))] = 1;
+    }
+  for (int f = 0; f < m; ++f) {
+    if (!sound[static_cast<size_t>(f)] || large[static_cast<size_t>(f)]) continue;
+    int first = -1;
+    for (int k = 0; k < 3; ++k) {
+      const int v = F(f, k);
+      on_small_piece[static_cast<size_t>(v)] = 1;
+      if (simulated[static_cast<size_t>(v)]) continue;
+      if (first < 0) first = v;
+      sets.unite(first, v);
+    }
+  }
 
   Attachment result;
   result.submesh_index = Eigen::VectorXi::Constant(n, -1);
@@ -131,12 +189,12 @@ Attachment attach(const VerticesRef& V, const FacesRef& F) {
   std::vector<Group> groups;
   std::vector<int> labels;
   for (int v = 0; v < n; ++v) {
-    if (!on_sound_face[static_cast<size_t>(v)]) {
+    if (!simulated[static_cast<size_t>(v)] && !on_small_piece[static_cast<size_t>(v)]) {
       groups.push_back({{v}});
       continue;
     }
     const auto root = static_cast<size_t>(sets.find(v));
-    if (root_area[root] >= threshold) {
+    if (simulated[static_cast<size_t>(v)]) {
       if (label_of_root[root] < 0) label_of_root[root] = result.num_components++;
       result.submesh_index[v] = static_cast<int>(result.simulated.size());
       result.simulated.push_back(v);
@@ -154,7 +212,7 @@ Attachment attach(const VerticesRef& V, const FacesRef& F) {
 
   std::vector<int> faces;
   for (int f = 0; f < m; ++f)
-    if (sound[static_cast<size_t>(f)] && result.submesh_index[F(f, 0)] >= 0)
+    if (large[static_cast<size_t>(f)])
       for (int k = 0; k < 3; ++k) faces.push_back(result.submesh_index[F(f, k)]);
   result.faces = Eigen::Map<const RowMatrixX3i>(faces.data(), static_cast<Eigen::Index>(faces.size() / 3), 3);
 

@@ -1,22 +1,26 @@
 // Which vertices the bake simulates, and how the others follow them.
 //
-// Every connected component adds 6 zero modes, and real scans come with debris: tiny components,
-// unreferenced vertices, vertices whose faces have no area. The bake spends its modes only on
+// Every connected component adds 6 zero modes, every mechanism more, and real scans come with
+// debris: tiny components, unreferenced vertices, vertices whose faces have no area, doubled
+// triangles, blobs hanging from the surface by one vertex. The bake spends its modes only on
 // the simulated vertices; the others are attached and ride along.
 //
-// The rule. Components are taken over the sound faces: neither degenerate nor slivers
-// (face_shape_ratio above kMinSimulatedShape). A vertex is simulated when it lies on a sound face
-// of a component whose area is at least kSimulatedAreaFraction (10%) of the largest component's
-// area. Every other vertex is attached: unreferenced vertices, vertices on degenerate faces or
-// slivers only, and all vertices of smaller components (scan debris; Suzanne's eyes, about 7% of
-// her vertices each). The energy, the mass and the eigenproblem use only the simulated submesh:
-// the sound faces of the simulated components.
+// The rule. Sound faces are neither degenerate nor slivers (face_shape_ratio above
+// kMinSimulatedShape) nor doubled (another face on the same three vertices: a scan's folded
+// copies). Sound faces sharing an edge form pieces; a piece is simulated when its area is at least
+// kSimulatedAreaFraction (10%) of the largest piece's, and so are its vertices. Every other vertex
+// is attached: unreferenced vertices, vertices on degenerate, sliver or doubled faces only, and the
+// vertices of smaller pieces (scan debris; Suzanne's eyes, about 7% of her vertices each; a small
+// closed blob or flap joined to the surface at one vertex, which would turn about it at no cost).
+// Simulated pieces that share a vertex are one component: they share rigid motions, and turning
+// about the shared vertex is a zero mode of the bake. The energy, the mass and the eigenproblem
+// use only the simulated submesh: the sound faces of the simulated pieces.
 //
-// How attached vertices follow. The vertices of one attached component (or a single attached
+// How attached vertices follow. The vertices of one attached piece (or a single attached
 // vertex) move as one affine body with the surface around them: their displacement is the affine
 // field t + A (p − m) fitted by mass-weighted least squares to the displacements of the simulated
 // vertices nearby, m their mean. The region: the simulated vertices within 1.5 times the
-// component's radius from its centre, grown until it holds at least 16 vertices and is not flat
+// group's radius from its centre, grown until it holds at least 16 vertices and is not flat
 // (thinner than a tenth of its extent). Every affine motion of that region, rigid motions
 // included, carries over exactly; a region that deforms is followed on average, so an eye stays
 // in its socket rather than following four far-apart vertices. A flat region could not tell how
@@ -64,7 +68,7 @@ struct Attachment {
     Eigen::Vector3d normal;     // the flat region's normal, zero when the region is not flat
   };
   std::vector<Follower> followers;  // one per group, in the order of their first vertex
-  int num_attached_components = 0;  // components attached as a whole
+  int num_attached_components = 0;  // small pieces attached (each one group, less any vertex it shares)
 };
 
 // The simulated submesh of (V #V by 3, F #F by 3) and how the other vertices follow it (rule

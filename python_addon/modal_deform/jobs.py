@@ -129,8 +129,8 @@ class BakeJob(_ThreadJob):
         message = (f"Baked '{obj.name}' in {self.seconds:.1f} s: {basis.dimension} dimensions, ghost "
                    f"{len(basis.ghost_vertices)} vertices")
         if basis.num_floppy:
-            message += (f"; {basis.num_floppy} zero modes besides the rigid motions (flaps at non-manifold edges "
-                        f"or vertices) came on top of the modes")
+            message += (f"; {basis.num_floppy} zero modes besides the rigid motions (large parts joined at a "
+                        f"single vertex) came on top of the modes")
         return "INFO", message
 
 

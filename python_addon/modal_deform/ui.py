@@ -97,7 +97,7 @@ class VIEW3D_PT_modal_deform_bake(_Panel, bpy.types.Panel):
             box.label(text=f"Ghost: {status.ghost_vertices} vertices ({status.energy.title()})")
             box.label(text=f"Baked {status.baked_at} in {status.seconds:.1f} s")
             if status.num_floppy:
-                box.label(text=f"{status.num_floppy} floppy zero modes (non-manifold flaps)", icon="INFO")
+                box.label(text=f"{status.num_floppy} floppy zero modes (parts joined at a vertex)", icon="INFO")
             reason = stale_reason(obj)
             if reason:
                 row = box.row()

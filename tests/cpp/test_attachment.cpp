@@ -94,6 +94,57 @@ TEST(Attachment, UnreferencedAndMasslessVerticesAreAttached) {
   EXPECT_LT(extension_error(attachment, mesh.V, skew(Eigen::Vector3d(1, 2, 3)), Eigen::Vector3d(-1, 0, 1)), 1e-12);
 }
 
+TEST(Attachment, DoubledTrianglesAndABlobHangingByAVertexAreAttached) {
+  // A box with what scans hang on their surfaces: a fin (a triangle laid twice, both ways round,
+  // on two box vertices and a vertex of its own) and a small closed tetrahedron joined to the box
+  // at one vertex. Either would turn freely (zero modes), so their own vertices follow the box.
+  TriangleMesh mesh = bar(3, 3, 3, 1.0, 1.0, 1.0);
+  const auto n = static_cast<int>(mesh.V.rows());
+  const Eigen::Index box_faces = mesh.F.rows();
+  const int pin = 5;
+  mesh.V.conservativeResize(n + 4, 3);
+  mesh.V.row(n) = 0.5 * (mesh.V.row(0) + mesh.V.row(1)) + Eigen::RowVector3d(0.0, 0.0, -0.3);
+  for (int k = 0; k < 3; ++k)
+    mesh.V.row(n + 1 + k) = mesh.V.row(pin) + 0.1 * Eigen::RowVector3d(k == 0, k == 1, k == 2) +
+                            Eigen::RowVector3d(0.05, 0.05, 0.05);
+  mesh.F.conservativeResize(box_faces + 6, 3);
+  mesh.F.bottomRows(6) << 0, 1, n, 1, 0, n,  // the fin
+      pin, n + 1, n + 2, pin, n + 2, n + 3, pin, n + 3, n + 1, n + 1, n + 3, n + 2;  // the blob
+  const Attachment attachment = attach(mesh.V, mesh.F);
+  EXPECT_EQ(static_cast<int>(attachment.simulated.size()), n);
+  EXPECT_EQ(attachment.num_components, 1);
+  EXPECT_EQ(attachment.num_attached_components, 1);
+  ASSERT_EQ(attachment.followers.size(), 2u);
+  EXPECT_EQ(attachment.followers[0].vertices, std::vector<int>{n});
+  EXPECT_EQ(attachment.followers[1].vertices, (std::vector<int>{n + 1, n + 2, n + 3}));
+  EXPECT_EQ(attachment.faces.rows(), box_faces);
+  EXPECT_LT(extension_error(attachment, mesh.V, skew(Eigen::Vector3d(1, -2, 0.5)), Eigen::Vector3d(0, 1, 2)), 1e-12);
+}
+
+TEST(Attachment, LargePiecesJoinedAtAVertexAreOneComponent) {
+  // Two sheets sharing one corner: both simulated, one component (its rigid motions move both;
+  // turning one about the corner is a zero mode of the bake).
+  const TriangleMesh sheet = grid(4, 4, 1.0, 1.0);
+  const auto n = static_cast<int>(sheet.V.rows());
+  Eigen::Index corner = 0, other = 0;
+  (sheet.V.rowwise() - Eigen::RowVector3d(1.0, 1.0, 0.0)).rowwise().squaredNorm().minCoeff(&corner);
+  sheet.V.rowwise().squaredNorm().minCoeff(&other);
+  TriangleMesh mesh;
+  mesh.V.resize(2 * n, 3);
+  mesh.V << sheet.V, (sheet.V.rowwise() + Eigen::RowVector3d(1.0, 1.0, 0.0));
+  mesh.F.resize(2 * sheet.F.rows(), 3);
+  mesh.F << sheet.F, (sheet.F.array() + n).matrix();
+  for (Eigen::Index f = sheet.F.rows(); f < mesh.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k)
+      if (mesh.F(f, k) == n + other) mesh.F(f, k) = static_cast<int>(corner);
+  const Attachment attachment = attach(mesh.V, mesh.F);
+  EXPECT_EQ(static_cast<int>(attachment.simulated.size()), 2 * n - 1);  // the second corner unreferenced
+  EXPECT_EQ(attachment.num_components, 1);
+  EXPECT_EQ(attachment.faces.rows(), mesh.F.rows());
+  ASSERT_EQ(attachment.followers.size(), 1u);
+  EXPECT_EQ(attachment.followers[0].vertices, std::vector<int>{n + static_cast<int>(other)});
+}
+
 TEST(Attachment, ComponentsOfSimilarSizeAreAllSimulated) {
   const TriangleMesh tube = cylinder(12, 6, 0.5, 2.0);
   const TriangleMesh mesh = side_by_side(tube, tube, Eigen::RowVector3d(3, 0, 0));

@@ -58,7 +58,7 @@ class Basis:
     the modal derivatives; ``modes`` is a view of the first ``num_modes`` columns.
     ``eigenvalues`` (num_modes,) are those of the normalised frame, ascending (0 for the rigid
     motions). ``num_floppy`` modes after the rigid ones are zero modes of a floppy mesh
-    (mechanisms, e.g. flaps at non-manifold vertices); ``num_dropped`` derivatives were dropped as
+    (mechanisms, e.g. large parts joined at a single vertex); ``num_dropped`` derivatives were dropped as
     numerically dependent. ``ghost_vertices`` (g, 3), ``ghost_faces`` (h, 3) int32 and
     ``ghost_map`` (n,) int32 describe the ghost (a region bake's ghost is its submesh's, and the
     vertices outside that map to 0), ``ghost_vectors`` (3g, r) the restricted basis.
@@ -243,7 +243,7 @@ def bake(V, F, modes=20, derivatives=52, ghost=1000, energy="shells", bending=1.
     basis = Basis(native)
     if basis.num_floppy:
         warnings.warn(f"the mesh is floppy: it has {basis.num_floppy} zero modes besides its rigid motions "
-                      f"(mechanisms, e.g. flaps at non-manifold edges or vertices, or the rigid motions of a part of "
+                      f"(mechanisms, e.g. large parts of the mesh joined at a single vertex, or the rigid motions of a part of "
                       f"the region that touches nothing outside it); they are in the basis on top of the {modes} "
                       f"modes asked for, without modal derivatives", stacklevel=2)
     return basis
