@@ -14,8 +14,10 @@ ShiftedNewton::ShiftedNewton(const PoseObjective& objective)
   const Eigen::Index size = objective.mass_diagonal().size();
   for (Eigen::VectorXd* v : {&step_, &shifted_diagonal_, &residual_, &preconditioned_, &direction_, &product_})
     v->resize(size);
-  trial_.y.resize(size);
-  trial_.gradient.resize(size);
+  for (NewtonPoint* p : {&trial_, &extended_}) {
+    p->y.resize(size);
+    p->gradient.resize(size);
+  }
 }
 
 int ShiftedNewton::minimize(NewtonPoint& point, double target, int budget, double exact_below,
@@ -84,6 +86,7 @@ bool ShiftedNewton::iterate(NewtonPoint& point, bool near_minimum, double forcin
       search.step > 0 ? (point.value - trial_.value) / predicted_decrease(search.step, slope, curvature) : 0;
   NewtonIteration record{exact, shift_, search.step, guarded, ratio, cg_iterations};
   update_shift(guarded ? 1 : search.step, ratio);
+  if (search.step == 1 && ratio > kExtendAbove) record.step = extend(point, within_smooth_part);
   if (search.step > 0) {
     record.progress =
         point.value - trial_.value > noise || trial_.gradient.norm() < 0.5 * point.gradient.norm();
@@ -93,6 +96,18 @@ bool ShiftedNewton::iterate(NewtonPoint& point, bool near_minimum, double forcin
   record.gradient_norm = point.gradient.norm();
   history_.push_back(record);
   return record.progress;
+}
+
+double ShiftedNewton::extend(const NewtonPoint& point, const Objective& objective) {
+  double step = 1;
+  while (step < kMaxExtension) {
+    extended_.y = point.y + 2 * step * step_;
+    extended_.value = objective(extended_.y, extended_.gradient);
+    if (!(extended_.value < trial_.value)) break;
+    std::swap(trial_, extended_);
+    step *= 2;
+  }
+  return step;
 }
 
 void ShiftedNewton::set_shifted_diagonal() {

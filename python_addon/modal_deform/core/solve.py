@@ -271,9 +271,9 @@ def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, ene
     and needles, which the ghost does not see) relaxed on their own before Newton's iterations. A solve that did not converge says so in "converged";
     only a converged one is a reference. "stalled": it stopped because the objective no longer
     decreased. "history": one dict per Newton iteration with "model" ("projected" or "exact": the
-    Hessian the step solved with), "shift" (τ), "step" (the line search's α; 0 when it found no decrease),
-    "guarded" (α < 1 only because longer steps turned a triangle over), "ratio" (the decrease over
-    the model's), "cg_iterations" (conjugate gradient iterations of the step; 0: a new
+    Hessian the step solved with), "shift" (τ), "step" (the line search's α, above 1 when a full
+    step was extended; 0 when it found no decrease), "guarded" (α < 1 only because longer steps
+    turned a triangle over), "ratio" (the decrease over the model's, at α ≤ 1), "cg_iterations" (conjugate gradient iterations of the step; 0: a new
     factorisation solved it), "progress", "energy" and "gradient_norm" after it.
     """
     V, F = _arrays.vertices(V), _arrays.faces(F)
