@@ -38,8 +38,6 @@ namespace {
 // 0.45 s plus 13 ms per pair on the shared machine), and the bar moves between calls. 64 takes
 // the paper's 52 derivatives in one pass and its 110 in two, for a temporary of 64 columns.
 constexpr int kPairsPerPass = 64;
-// Modes asked for beyond those wanted, for the zero modes of a floppy mesh.
-constexpr int kZeroModeAllowance = 6;
 
 // Vibration modes past the rigid motions: the zero modes of a floppy mesh (λ below
 // kZeroEigenvalue · tr K / tr M; their vectors are the pencil's kernel past the rigid motions),
@@ -50,9 +48,10 @@ struct Modes {
   int num_zero = 0;
 };
 
-// Asks Lanczos for kZeroModeAllowance modes more than `flexible`, which covers the zero modes of
-// the scans measured (3 to 9) at the price of a few solves; a mesh with more is solved again with
-// the zero modes found deflated, until the flexible modes are complete. So is a mesh whose
+// Asks Lanczos for `flexible` modes; when zero modes come among them, it is solved again with the
+// zero modes found deflated, until the flexible modes are complete. (Asking for 6 more, room for
+// the zero modes the scans had before their debris was attached, cost the 100k dragon's bake
+// 2 s of Lanczos iterations on 6 more flexible modes than it keeps.) So is a mesh whose
 // flexible modes miss their residual tolerance next to zero modes (two cones joined at their
 // apex: with the zero modes in K, their transformed eigenvalue 1/|σ| is about 1e10 times the
 // others', which are left to rounding), or whose Lanczos run returned as soon as its zero modes
@@ -64,7 +63,7 @@ Modes flexible_modes(ShiftedPencil& pencil, const SparseMatrix& K, const Eigen::
   std::vector<double> zero_values;
   for (;;) {
     const int known = static_cast<int>(zero_values.size());
-    const int count = std::min(flexible + kZeroModeAllowance, free - known - 1);
+    const int count = std::min(flexible, free - known - 1);
     if (count < flexible)
       throw InputError(message("modes: the simulated mesh has only ", free - known,
                                " degrees of freedom besides its rigid motions and ", known,
