@@ -145,12 +145,15 @@ Attachment::Follower follow(const VerticesRef& V, const RowMatrixX3d& P, const V
   return follower;
 }
 
-// Faces that share their three vertices with another face, in either orientation (a scan's
-// doubled triangles). The copies fold onto each other, their common hinges at an angle of π whose
-// sign is undefined, and a vertex on them alone is held by nothing across them: on the shared
-// 100k dragon each such fin gave a zero mode, M-orthonormalised to 1e6 times the median entry at
-// its tiny mass, and the derivatives' largest entries sat there too (a reduced pose drew spikes).
-std::vector<char> doubled_faces(const FacesRef& F) {
+// Faces laid again on the three vertices of an earlier face, in either orientation (a scan's
+// doubled triangles): the copy counts once. Two copies fold onto each other, their common hinges
+// at an angle of π whose sign is undefined, and a fin (a vertex on such a pair alone) was held by
+// nothing across them: on the shared 100k dragon each fin gave a zero mode, M-orthonormalised to
+// 1e6 times the median entry at its tiny mass, and the derivatives' largest entries sat there too
+// (a reduced pose drew spikes). One copy is a flap welded to the surface at its non-manifold edge.
+// Leaving both out freed the doubled triangles that bridge surface vertices: a reduced pose
+// stretched some 15 times and turned them over.
+std::vector<char> later_copies(const FacesRef& F) {
   const auto m = static_cast<int>(F.rows());
   std::vector<std::array<int, 4>> keys(static_cast<size_t>(m));  // sorted vertices, then the face
   for (int f = 0; f < m; ++f) {
@@ -158,11 +161,11 @@ std::vector<char> doubled_faces(const FacesRef& F) {
     std::sort(keys[static_cast<size_t>(f)].begin(), keys[static_cast<size_t>(f)].begin() + 3);
   }
   std::sort(keys.begin(), keys.end());
-  std::vector<char> doubled(static_cast<size_t>(m), 0);
+  std::vector<char> copy(static_cast<size_t>(m), 0);
   for (size_t i = 1; i < keys.size(); ++i)
     if (std::equal(keys[i].begin(), keys[i].begin() + 3, keys[i - 1].begin()))
-      doubled[static_cast<size_t>(keys[i][3])] = doubled[static_cast<size_t>(keys[i - 1][3])] = 1;
-  return doubled;
+      copy[static_cast<size_t>(keys[i][3])] = 1;
+  return copy;
 }
 
 // Joins the `sound` faces that share an edge into pieces (face indices in `pieces`).
@@ -188,10 +191,10 @@ Attachment attach(const VerticesRef& V, const FacesRef& F) {
   const Eigen::VectorXd area = face_areas(V, F);
 
   // Pieces: the sound faces joined across edges, and the area of each (at its root face).
-  const std::vector<char> doubled = doubled_faces(F);
+  const std::vector<char> copy = later_copies(F);
   std::vector<char> sound(static_cast<size_t>(m));
   for (int f = 0; f < m; ++f)
-    sound[static_cast<size_t>(f)] = !doubled[static_cast<size_t>(f)] && face_shape_ratio(V, F, f) > kMinSimulatedShape;
+    sound[static_cast<size_t>(f)] = !copy[static_cast<size_t>(f)] && face_shape_ratio(V, F, f) > kMinSimulatedShape;
   UnionFind pieces(m);
   join_across_edges(F, sound, pieces);
   std::vector<double> piece_area(static_cast<size_t>(m), 0.0);
@@ -200,7 +203,7 @@ Attachment attach(const VerticesRef& V, const FacesRef& F) {
   const double largest = *std::max_element(piece_area.begin(), piece_area.end());
   if (!(largest > 0))
     throw InputError(message("F: every face is degenerate or a sliver (twice its area below ", kMinSimulatedShape,
-                             " of its longest edge squared) or laid twice; the mesh has nothing to simulate"));
+                             " of its longest edge squared) or a copy; the mesh has nothing to simulate"));
   const double threshold = kSimulatedAreaFraction * largest;
   std::vector<char> large(static_cast<size_t>(m), 0);  // a sound face of a simulated piece
   for (int f = 0; f < m; ++f)
@@ -208,9 +211,10 @@ Attachment attach(const VerticesRef& V, const FacesRef& F) {
 
   // Vertices: simulated on a large piece's face, the large pieces that share a vertex one
   // component (pinned there: they share rigid motions, and turning about the pin is a zero mode);
-  // the other vertices of a small piece's faces one attached group.
+  // attached vertices joined by any other face one group, an affine body (a small piece, with the
+  // copies and slivers on it).
   UnionFind sets(n);
-  std::vector<char> simulated(static_cast<size_t>(n), 0), on_small_piece(static_cast<size_t>(n), 0);
+  std::vector<char> simulated(static_cast<size_t>(n), 0), in_a_face(static_cast<size_t>(n), 0);
   for (int f = 0; f < m; ++f)
     if (large[static_cast<size_t>(f)]) {
       sets.unite(F(f, 0), F(f, 1));
@@ -218,11 +222,11 @@ Attachment attach(const VerticesRef& V, const FacesRef& F) {
       for (int k = 0; k < 3; ++k) simulated[static_cast<size_t>(F(f, k))] = 1;
     }
   for (int f = 0; f < m; ++f) {
-    if (!sound[static_cast<size_t>(f)] || large[static_cast<size_t>(f)]) continue;
+    if (large[static_cast<size_t>(f)]) continue;
     int first = -1;
     for (int k = 0; k < 3; ++k) {
       const int v = F(f, k);
-      on_small_piece[static_cast<size_t>(v)] = 1;
+      in_a_face[static_cast<size_t>(v)] = 1;
       if (simulated[static_cast<size_t>(v)]) continue;
       if (first < 0) first = v;
       sets.unite(first, v);
@@ -236,7 +240,7 @@ Attachment attach(const VerticesRef& V, const FacesRef& F) {
   std::vector<Group> groups;
   std::vector<int> labels;
   for (int v = 0; v < n; ++v) {
-    if (!simulated[static_cast<size_t>(v)] && !on_small_piece[static_cast<size_t>(v)]) {
+    if (!simulated[static_cast<size_t>(v)] && !in_a_face[static_cast<size_t>(v)]) {
       groups.push_back({{v}});
       continue;
     }

@@ -2,22 +2,24 @@
 //
 // Every connected component adds 6 zero modes, every mechanism more, and real scans come with
 // debris: tiny components, unreferenced vertices, vertices whose faces have no area, doubled
-// triangles, blobs hanging from the surface by one vertex. The bake spends its modes only on
+// triangles (folded fins), blobs hanging from the surface by one vertex. The bake spends its modes only on
 // the simulated vertices; the others are attached and ride along.
 //
 // The rule. Sound faces are neither degenerate nor slivers (face_shape_ratio above
-// kMinSimulatedShape) nor doubled (another face on the same three vertices: a scan's folded
-// copies). Sound faces sharing an edge form pieces; a piece is simulated when its area is at least
-// kSimulatedAreaFraction (10%) of the largest piece's, and so are its vertices. Every other vertex
-// is attached: unreferenced vertices, vertices on degenerate, sliver or doubled faces only, and the
+// kMinSimulatedShape) nor copies (laid again on an earlier face's three vertices: a scan's
+// doubled triangles count once). Sound faces sharing an edge form pieces; a piece is simulated
+// when its area is at least kSimulatedAreaFraction (10%) of the largest piece's, and so are its
+// vertices. Every other vertex
+// is attached: unreferenced vertices, vertices on degenerate or sliver faces only, and the
 // vertices of smaller pieces (scan debris; Suzanne's eyes, about 7% of her vertices each; a small
 // closed blob or flap joined to the surface at one vertex, which would turn about it at no cost).
 // Simulated pieces that share a vertex are one component: they share rigid motions, and turning
 // about the shared vertex is a zero mode of the bake. The energy, the mass and the eigenproblem
 // use only the simulated submesh: the sound faces of the simulated pieces.
 //
-// How attached vertices follow. The vertices of one attached piece (or a single attached
-// vertex) move as one affine body with the surface around them: their displacement is the affine
+// How attached vertices follow. Attached vertices joined by faces (a small piece, less any vertex
+// it shares with a simulated one) or a single attached vertex
+// move as one affine body with the surface around them: their displacement is the affine
 // field t + A (p − m) fitted by mass-weighted least squares to the displacements of the simulated
 // vertices nearby, m their mean. The region: the simulated vertices within 1.5 times the
 // group's radius from its centre, grown until it holds at least 16 vertices and is not flat
@@ -68,7 +70,9 @@ struct Attachment {
     Eigen::Vector3d normal;     // the flat region's normal, zero when the region is not flat
   };
   std::vector<Follower> followers;  // one per group, in the order of their first vertex
-  int num_attached_components = 0;  // small pieces attached (each one group, less any vertex it shares)
+  // Groups of attached vertices joined by faces (small pieces, less any vertex shared with the
+  // simulated surface; a lone vertex on slivers), each following one region.
+  int num_attached_components = 0;
 };
 
 // The simulated submesh of (V #V by 3, F #F by 3) and how the other vertices follow it (rule

