@@ -42,7 +42,8 @@ class VertexGrid {
     cells_ = std::max(1, static_cast<int>(std::cbrt(0.5 * static_cast<double>(P.rows()))));
     size_ = extent > 0 ? extent / cells_ : 1.0;
     sorted_.resize(static_cast<size_t>(P.rows()));
-    for (int s = 0; s < static_cast<int>(P.rows()); ++s) sorted_[static_cast<size_t>(s)] = {key(cell(P.row(s).transpose().array())), s};
+    for (int s = 0; s < static_cast<int>(P.rows()); ++s)
+      sorted_[static_cast<size_t>(s)] = {key(cell(P.row(s).transpose().array())), s};
     std::sort(sorted_.begin(), sorted_.end());
   }
 
@@ -53,8 +54,9 @@ class VertexGrid {
     for (int i = from[0]; i <= to[0]; ++i)
       for (int j = from[1]; j <= to[1]; ++j)
         for (int k = from[2]; k <= to[2]; ++k) {
-          const auto first = std::lower_bound(sorted_.begin(), sorted_.end(), std::pair<long, int>{key({i, j, k}), -1});
-          for (auto it = first; it != sorted_.end() && it->first == key({i, j, k}); ++it)
+          const long here = key({i, j, k});
+          const auto first = std::lower_bound(sorted_.begin(), sorted_.end(), std::pair<long, int>{here, -1});
+          for (auto it = first; it != sorted_.end() && it->first == here; ++it)
             if ((P_.row(it->second) - c).norm() <= r) found.push_back(it->second);
         }
     std::sort(found.begin(), found.end());
@@ -90,10 +92,9 @@ Attachment::Follower follow(const VerticesRef& V, const RowMatrixX3d& P, const V
 
   // The nearest simulated vertices: those within a radius doubled until it holds kMinNeighbours.
   const int k = std::min(kMinNeighbours, S) - 1;
-  std::vector<int> near;
-  for (double r = std::max(radius, 1e-12 * (P.colwise().maxCoeff() - P.colwise().minCoeff()).norm());
-       static_cast<int>((near = grid.within(centre.transpose(), r)).size()) <= k; r *= 2) {
-  }
+  double r = std::max(radius, 1e-12 * (P.colwise().maxCoeff() - P.colwise().minCoeff()).norm());
+  std::vector<int> near = grid.within(centre.transpose(), r);
+  while (static_cast<int>(near.size()) <= k) near = grid.within(centre.transpose(), r *= 2);
   std::vector<double> sorted(near.size());
   for (size_t i = 0; i < near.size(); ++i) sorted[i] = (P.row(near[i]) - centre.transpose()).norm();
   const double nearest = *std::min_element(sorted.begin(), sorted.end());
@@ -179,7 +180,8 @@ void join_across_edges(const FacesRef& F, const std::vector<char>& sound, UnionF
       }
   std::sort(edges.begin(), edges.end());
   for (size_t i = 1; i < edges.size(); ++i)
-    if (edges[i][0] == edges[i - 1][0] && edges[i][1] == edges[i - 1][1]) pieces.unite(edges[i][2], edges[i - 1][2]);
+    if (edges[i][0] == edges[i - 1][0] && edges[i][1] == edges[i - 1][1])
+      pieces.unite(edges[i][2], edges[i - 1][2]);
 }
 
 }  // namespace
@@ -194,7 +196,8 @@ Attachment attach(const VerticesRef& V, const FacesRef& F) {
   const std::vector<char> copy = later_copies(F);
   std::vector<char> sound(static_cast<size_t>(m));
   for (int f = 0; f < m; ++f)
-    sound[static_cast<size_t>(f)] = !copy[static_cast<size_t>(f)] && face_shape_ratio(V, F, f) > kMinSimulatedShape;
+    sound[static_cast<size_t>(f)] =
+        !copy[static_cast<size_t>(f)] && face_shape_ratio(V, F, f) > kMinSimulatedShape;
   UnionFind pieces(m);
   join_across_edges(F, sound, pieces);
   std::vector<double> piece_area(static_cast<size_t>(m), 0.0);
@@ -207,7 +210,8 @@ Attachment attach(const VerticesRef& V, const FacesRef& F) {
   const double threshold = kSimulatedAreaFraction * largest;
   std::vector<char> large(static_cast<size_t>(m), 0);  // a sound face of a simulated piece
   for (int f = 0; f < m; ++f)
-    large[static_cast<size_t>(f)] = sound[static_cast<size_t>(f)] && piece_area[static_cast<size_t>(pieces.find(f))] >= threshold;
+    large[static_cast<size_t>(f)] =
+        sound[static_cast<size_t>(f)] && piece_area[static_cast<size_t>(pieces.find(f))] >= threshold;
 
   // Vertices: simulated on a large piece's face, the large pieces that share a vertex one
   // component (pinned there: they share rigid motions, and turning about the pin is a zero mode);
