@@ -621,9 +621,8 @@ def section_strong_poses(result):
 
 def zero_modes_note(run):
     """What the bake-limit record says of the dragon's zero modes (on top of the dimensions)."""
-    extra = {int(dims) - int(r["dimension_with_zero_modes"]) for dims, r in run.items()}
-    extra = {-e for e in extra if e < 0}
-    return f" The dragon's {min(extra)} floppy zero modes came on top of the dimensions." if extra else ""
+    zero_modes = max(int(r["dimension_with_zero_modes"]) - int(dims) for dims, r in run.items())
+    return f" The dragon's {zero_modes} floppy zero modes came on top of the dimensions." if zero_modes > 0 else ""
 
 
 def section_bake_limit(result):

@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <functional>
-#include <set>
 
 #include "mesh/normalization.h"
 #include "util/errors.h"
@@ -46,6 +45,21 @@ bool is_degenerate_face(const VerticesRef& V, const FacesRef& F, int f) {
   return face_shape_ratio(V, F, f) <= kDegenerateAreaRatio;
 }
 
+std::vector<int> duplicate_faces(const FacesRef& F) {
+  const auto m = static_cast<int>(F.rows());
+  std::vector<std::array<int, 4>> keys(static_cast<size_t>(m));  // sorted vertices, then the face
+  for (int f = 0; f < m; ++f) {
+    keys[static_cast<size_t>(f)] = {F(f, 0), F(f, 1), F(f, 2), f};
+    std::sort(keys[static_cast<size_t>(f)].begin(), keys[static_cast<size_t>(f)].begin() + 3);
+  }
+  std::sort(keys.begin(), keys.end());
+  std::vector<int> copies;
+  for (size_t i = 1; i < keys.size(); ++i)
+    if (std::equal(keys[i].begin(), keys[i].begin() + 3, keys[i - 1].begin())) copies.push_back(keys[i][3]);
+  std::sort(copies.begin(), copies.end());
+  return copies;
+}
+
 MeshReport check_mesh(const VerticesRef& V, const FacesRef& F) {
   validate_mesh(V, F);
   const MeshTopology topology = build_topology(V, F);
@@ -67,20 +81,15 @@ MeshReport check_mesh(const VerticesRef& V, const FacesRef& F) {
     report.findings.push_back(std::move(finding));
   };
 
-  std::vector<int> degenerate, duplicate;
-  std::set<std::array<int, 3>> seen;
-  for (int f = 0; f < F.rows(); ++f) {
+  std::vector<int> degenerate;
+  for (int f = 0; f < F.rows(); ++f)
     if (is_degenerate_face(V, F, f)) degenerate.push_back(f);
-    std::array<int, 3> key{F(f, 0), F(f, 1), F(f, 2)};
-    std::sort(key.begin(), key.end());
-    if (!seen.insert(key).second) duplicate.push_back(f);
-  }
   add("boundary_edges", topology.boundary_edges);
   add("nonmanifold_edges", topology.nonmanifold_edges);
   add("nonmanifold_vertices", topology.nonmanifold_vertices);
   add("unreferenced_vertices", topology.unreferenced_vertices);
   add("degenerate_faces", degenerate);
-  add("duplicate_faces", duplicate);
+  add("duplicate_faces", duplicate_faces(F));
   return report;
 }
 

@@ -34,6 +34,10 @@ double face_shape_ratio(const VerticesRef& V, const FacesRef& F, int f);
 // kDegenerateAreaRatio.
 bool is_degenerate_face(const VerticesRef& V, const FacesRef& F, int f);
 
+// The faces laid again on the three vertices of an earlier face, in either orientation (a scan's
+// doubled triangles), ascending: every copy but the first.
+std::vector<int> duplicate_faces(const FacesRef& F);
+
 // Counts of each awkward feature with the first few offending indices (at most kExamples).
 struct MeshReport {
   static constexpr int kExamples = 10;

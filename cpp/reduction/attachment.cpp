@@ -146,29 +146,6 @@ Attachment::Follower follow(const VerticesRef& V, const RowMatrixX3d& P, const V
   return follower;
 }
 
-// Faces laid again on the three vertices of an earlier face, in either orientation (a scan's
-// doubled triangles): the copy counts once. Two copies fold onto each other, their common hinges
-// at an angle of π whose sign is undefined, and a fin (a vertex on such a pair alone) was held by
-// nothing across them: on the shared 100k dragon each fin gave a zero mode, M-orthonormalised to
-// 1e6 times the median entry at its tiny mass, and the derivatives' largest entries sat there too
-// (a reduced pose drew spikes). One copy is a flap welded to the surface at its non-manifold edge.
-// Leaving both out freed the doubled triangles that bridge surface vertices: a reduced pose
-// stretched some 15 times and turned them over.
-std::vector<char> later_copies(const FacesRef& F) {
-  const auto m = static_cast<int>(F.rows());
-  std::vector<std::array<int, 4>> keys(static_cast<size_t>(m));  // sorted vertices, then the face
-  for (int f = 0; f < m; ++f) {
-    keys[static_cast<size_t>(f)] = {F(f, 0), F(f, 1), F(f, 2), f};
-    std::sort(keys[static_cast<size_t>(f)].begin(), keys[static_cast<size_t>(f)].begin() + 3);
-  }
-  std::sort(keys.begin(), keys.end());
-  std::vector<char> copy(static_cast<size_t>(m), 0);
-  for (size_t i = 1; i < keys.size(); ++i)
-    if (std::equal(keys[i].begin(), keys[i].begin() + 3, keys[i - 1].begin()))
-      copy[static_cast<size_t>(keys[i][3])] = 1;
-  return copy;
-}
-
 // Joins the `sound` faces that share an edge into pieces (face indices in `pieces`).
 void join_across_edges(const FacesRef& F, const std::vector<char>& sound, UnionFind& pieces) {
   std::vector<std::array<int, 3>> edges;  // both ends ascending, then the face
@@ -192,12 +169,18 @@ Attachment attach(const VerticesRef& V, const FacesRef& F) {
   const auto m = static_cast<int>(F.rows());
   const Eigen::VectorXd area = face_areas(V, F);
 
-  // Pieces: the sound faces joined across edges, and the area of each (at its root face).
-  const std::vector<char> copy = later_copies(F);
-  std::vector<char> sound(static_cast<size_t>(m));
+  // Pieces: the sound faces joined across edges, and the area of each (at its root face). A
+  // doubled triangle counts once: two copies fold onto each other, their common hinges at an angle
+  // of π whose sign is undefined, and a fin (a vertex on such a pair alone) was held by nothing
+  // across them. On the shared 100k dragon each fin gave a zero mode, M-orthonormalised to 1e6
+  // times the median entry at its tiny mass, and the derivatives' largest entries sat there too (a
+  // reduced pose drew spikes). One copy is a flap welded to the surface at its non-manifold edge;
+  // leaving both out freed the doubled triangles that bridge surface vertices (a reduced pose
+  // stretched some 15 times and turned them over).
+  std::vector<char> sound(static_cast<size_t>(m), 1);
+  for (int f : duplicate_faces(F)) sound[static_cast<size_t>(f)] = 0;
   for (int f = 0; f < m; ++f)
-    sound[static_cast<size_t>(f)] =
-        !copy[static_cast<size_t>(f)] && face_shape_ratio(V, F, f) > kMinSimulatedShape;
+    sound[static_cast<size_t>(f)] = sound[static_cast<size_t>(f)] && face_shape_ratio(V, F, f) > kMinSimulatedShape;
   UnionFind pieces(m);
   join_across_edges(F, sound, pieces);
   std::vector<double> piece_area(static_cast<size_t>(m), 0.0);
