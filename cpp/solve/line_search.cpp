@@ -123,12 +123,13 @@ LineSearchResult wolfe_line_search(const Objective& objective, const Eigen::Vect
 BacktrackingResult backtracking_line_search(const Objective& objective, const Eigen::VectorXd& x, double value,
                                             const Eigen::VectorXd& gradient, const Eigen::VectorXd& p,
                                             Eigen::VectorXd& x_new, double& value_new, Eigen::VectorXd& gradient_new,
-                                            double noise, double sufficient_decrease, int max_halvings) {
+                                            double noise, double initial_step, double sufficient_decrease,
+                                            int max_halvings) {
   BacktrackingResult result;
   const double slope = gradient.dot(p);
   if (slope < 0) {
     const double gradient_norm = gradient.norm();
-    double step = 1;
+    double step = initial_step;
     for (int halving = 0; halving <= max_halvings; ++halving, step /= 2) {
       x_new = x + step * p;
       value_new = objective(x_new, gradient_new);

@@ -47,7 +47,7 @@ struct BacktrackingResult {
   int insufficient = 0;  // trials rejected because f did not decrease enough
 };
 
-// Halves α from 1 until f(x + αp) ≤ f(x) + c1 α ∇f(x)ᵀp (a point where f returns +inf or NaN
+// Halves α from `initial_step` (≤ 1) until f(x + αp) ≤ f(x) + c1 α ∇f(x)ᵀp (a point where f returns +inf or NaN
 // counts as too far), at most max_halvings times. Near a minimum the decrease a step promises
 // falls below the rounding of f; with noise > 0 (an absolute bound on that rounding) a step whose
 // promised decrease is below it is also taken when f does not rise by more than noise and ‖∇f‖
@@ -57,7 +57,7 @@ struct BacktrackingResult {
 BacktrackingResult backtracking_line_search(const Objective& objective, const Eigen::VectorXd& x, double value,
                                             const Eigen::VectorXd& gradient, const Eigen::VectorXd& p,
                                             Eigen::VectorXd& x_new, double& value_new, Eigen::VectorXd& gradient_new,
-                                            double noise = 0, double sufficient_decrease = 1e-4,
-                                            int max_halvings = 40);
+                                            double noise = 0, double initial_step = 1,
+                                            double sufficient_decrease = 1e-4, int max_halvings = 40);
 
 }  // namespace modal_deform

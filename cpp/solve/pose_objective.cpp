@@ -1,6 +1,7 @@
 #include "solve/pose_objective.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <utility>
 
@@ -9,6 +10,14 @@
 #include "util/require_positions.h"
 
 namespace modal_deform {
+namespace {
+
+// The side of a triangle from vertex `from` to vertex `to`, in y (3#V): y_to − y_from.
+Eigen::Vector3d side(const Eigen::VectorXd& y, int from, int to) {
+  return y.segment<3>(3 * static_cast<Eigen::Index>(to)) - y.segment<3>(3 * static_cast<Eigen::Index>(from));
+}
+
+}  // namespace
 
 PoseObjective::PoseObjective(const VerticesRef& V, const FacesRef& F, const Handles& handles,
                              const Eigen::VectorXd& weights, double stiffness, EnergyKind energy, double bending,
@@ -105,13 +114,35 @@ SparseMatrix PoseObjective::without_held(SparseMatrix hessian) const {
 bool PoseObjective::turns_a_triangle_over(const Eigen::VectorXd& y, const Eigen::VectorXd& y_new) const {
   for (Eigen::Index f = 0; f < faces_.rows(); ++f) {
     const int a = faces_(f, 0), b = faces_(f, 1), c = faces_(f, 2);
-    const Eigen::Vector3d n =
-        (y.segment<3>(3 * b) - y.segment<3>(3 * a)).cross(y.segment<3>(3 * c) - y.segment<3>(3 * a));
-    const Eigen::Vector3d n_new =
-        (y_new.segment<3>(3 * b) - y_new.segment<3>(3 * a)).cross(y_new.segment<3>(3 * c) - y_new.segment<3>(3 * a));
-    if (n.dot(n_new) < 0) return true;
+    if (side(y, a, b).cross(side(y, a, c)).dot(side(y_new, a, b).cross(side(y_new, a, c))) < 0) return true;
   }
   return false;
+}
+
+double PoseObjective::step_to_turning(const Eigen::VectorXd& y, const Eigen::VectorXd& p) const {
+  double smallest = std::numeric_limits<double>::infinity();
+  for (Eigen::Index f = 0; f < faces_.rows(); ++f) {
+    const int a = faces_(f, 0), b = faces_(f, 1), c = faces_(f, 2);
+    const Eigen::Vector3d e1 = side(y, a, b), e2 = side(y, a, c), d1 = side(p, a, b), d2 = side(p, a, c);
+    // n(α) = n + α (e1 × d2 + d1 × e2) + α² d1 × d2, so n·n(α) = c0 + c1 α + c2 α².
+    const Eigen::Vector3d n = e1.cross(e2);
+    const double c0 = n.squaredNorm(), c1 = n.dot(e1.cross(d2) + d1.cross(e2)), c2 = n.dot(d1.cross(d2));
+    if (c0 == 0) continue;  // collapsed already: not counted, as in turns_a_triangle_over
+    double root = std::numeric_limits<double>::infinity();
+    if (c2 == 0) {
+      if (c1 < 0) root = -c0 / c1;
+    } else {
+      const double discriminant = c1 * c1 - 4 * c2 * c0;
+      if (discriminant >= 0) {
+        // Both roots by the stable formula; the smaller positive one.
+        const double q = -0.5 * (c1 + std::copysign(std::sqrt(discriminant), c1));
+        for (const double r : {q / c2, c0 / q})
+          if (r > 0) root = std::min(root, r);
+      }
+    }
+    smallest = std::min(smallest, root);
+  }
+  return smallest;
 }
 
 void PoseObjective::set_transforms(Transforms transforms) {

@@ -53,6 +53,10 @@ class PoseObjective {
   // hinges' angles flip by π as its normal does), and a step through it lands beyond the smooth
   // part of F that Newton's method can converge in, often lower: iterates are kept out of it.
   bool turns_a_triangle_over(const Eigen::VectorXd& y, const Eigen::VectorXd& y_new) const;
+  // The smallest α > 0 at which y + αp turns a triangle over, to within rounding: where its normal
+  // first stands perpendicular to its normal at y (n(y)·n(y + αp) = 0, quadratic in α); +inf when
+  // no triangle turns for any α.
+  double step_to_turning(const Eigen::VectorXd& y, const Eigen::VectorXd& p) const;
 
   // Transforms (one per handle) in mesh units, applied to the handle term in the normalised frame.
   void set_transforms(Transforms transforms);

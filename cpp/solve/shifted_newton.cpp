@@ -77,8 +77,12 @@ bool ShiftedNewton::iterate(NewtonPoint& point, bool near_minimum, double forcin
     if (objective_.turns_a_triangle_over(point.y, trial)) return std::numeric_limits<double>::infinity();
     return objective_(trial, trial_gradient);
   };
-  const BacktrackingResult search = backtracking_line_search(within_smooth_part, point.y, point.value, point.gradient,
-                                                             step_, trial_.y, trial_.value, trial_.gradient, noise);
+  // The first trial stops short of the first triangle's turning point (an interior point method's
+  // fraction to the boundary): halving from 1 lands anywhere between half of it and all of it.
+  const double initial_step = std::min(1.0, kToTurning * objective_.step_to_turning(point.y, step_));
+  const BacktrackingResult search =
+      backtracking_line_search(within_smooth_part, point.y, point.value, point.gradient, step_, trial_.y,
+                               trial_.value, trial_.gradient, noise, initial_step);
   // Cut only by the guard: every longer trial turned a triangle over (or left F's domain), none
   // fell short of the decrease.
   const bool guarded = search.step > 0 && search.step < 1 && search.insufficient == 0;

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <limits>
 
 #include "mesh/mass.h"
 #include "mesh/normalization.h"
@@ -196,6 +198,36 @@ TEST(PoseObjective, AroundFewVerticesIsTheObjectiveOfTheirCoordinates) {
           << "vertex " << vertices[i];
     }
   }
+}
+
+// The turning point along a step is where turns_a_triangle_over starts to say so: a vertex pushed
+// through the opposite edge of one triangle (linear in α), and a random step on the tube (quadratic).
+TEST(PoseObjective, StepToTurningIsWhereTheFirstTriangleTurnsOver) {
+  const SmallTube tube;
+  const int n = static_cast<int>(tube.mesh.V.rows());
+  const PoseObjective objective(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd::Ones(2), 1e3,
+                                EnergyKind::kShells, 1, 1, StiffnessPaint{});
+  const Eigen::VectorXd y = objective.rest_positions();
+  const int a = tube.mesh.F(0, 0), b = tube.mesh.F(0, 1), c = tube.mesh.F(0, 2);
+  // Moving a by twice its height over bc flattens the triangle halfway, at α = 1/2 (its neighbours
+  // sharing a turn no sooner: a moves within their plane or away from it less steeply).
+  const Eigen::Vector3d pa = y.segment<3>(3 * a), pb = y.segment<3>(3 * b), pc = y.segment<3>(3 * c);
+  const Eigen::Vector3d along = (pc - pb).normalized();
+  const Eigen::Vector3d foot = pb + along * along.dot(pa - pb);
+  Eigen::VectorXd p = Eigen::VectorXd::Zero(3 * n);
+  p.segment<3>(3 * a) = 2 * (foot - pa);
+  const double turning = objective.step_to_turning(y, p);
+  EXPECT_LE(turning, 0.5 + 1e-12);
+  EXPECT_FALSE(objective.turns_a_triangle_over(y, y + 0.999 * turning * p));
+  EXPECT_TRUE(objective.turns_a_triangle_over(y, y + 1.001 * turning * p));
+
+  std::srand(3);
+  const Eigen::VectorXd random = Eigen::VectorXd::Random(3 * n);
+  const double random_turning = objective.step_to_turning(y, random);
+  ASSERT_TRUE(std::isfinite(random_turning));
+  EXPECT_FALSE(objective.turns_a_triangle_over(y, y + 0.999 * random_turning * random));
+  EXPECT_TRUE(objective.turns_a_triangle_over(y, y + 1.001 * random_turning * random));
+  EXPECT_EQ(objective.step_to_turning(y, Eigen::VectorXd::Zero(3 * n)), std::numeric_limits<double>::infinity());
 }
 
 // A vertex pulled far off the tube (30 edge lengths: its edges stretched 20 times and more) is put back on its own,
