@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <omp.h>
+
 #include <Eigen/SparseCholesky>
 #include <random>
 
@@ -156,6 +158,21 @@ TEST(CholmodLLT, IndefiniteMatrixThrowsWithoutPrinting) {
   A.coeffRef(123, 123) = 100.0;
   llt.factorize(A);
   EXPECT_EQ(llt.failed_row(), -1);
+}
+
+// CHOLMOD's own OpenMP loops run on the calling thread during a factorisation (cholmod_llt.cpp);
+// the caller's setting is back afterwards, also when the factorisation throws.
+TEST(CholmodLLT, FactorizationLeavesTheCallersOpenMPAsItWas) {
+  const int levels = omp_get_max_active_levels();
+  omp_set_max_active_levels(2);
+  SparseMatrix A = random_spd(300, 4, 9);
+  CholmodLLT llt;
+  llt.factorize(A);
+  EXPECT_EQ(omp_get_max_active_levels(), 2);
+  A.coeffRef(123, 123) = -5.0;
+  EXPECT_THROW(llt.factorize(A), NumericalError);
+  EXPECT_EQ(omp_get_max_active_levels(), 2);
+  omp_set_max_active_levels(levels);
 }
 
 TEST(CholmodLLT, SingularMatricesThrow) {
