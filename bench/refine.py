@@ -14,20 +14,22 @@ ReducedSolver.refine from it; the table reports the reduced pose's objective gap
 dragon converges at 30 and 90 degrees; Refine converges at 23k within 15 s and at 100k within 60 s.
 
     PYTHONPATH=python_addon /usr/bin/python3 bench/run.py --only refine
-    PYTHONPATH=python_addon /usr/bin/python3 bench/refine.py [--quick] [--meshes dragon_res3 ...]
+    PYTHONPATH=python_addon:bench /usr/bin/python3 bench/refine.py [--quick] [--meshes dragon_res3 ...]
+        [--poses "dragon_res2=turn 30" ...] [--record]
 """
 import argparse
 import json
 import os
+import shlex
 import sys
 import time
 
 import numpy as np
 
+import common
 import modal_deform.core as mdc
 import raw_scans
 import shapes
-from common import rms_error
 
 STIFFNESS = 100.0
 TURNS = (30, 90, 170)
@@ -70,7 +72,7 @@ def refine(basis, F, handles, transforms):
     stats["wall_seconds"] = time.perf_counter() - start
     stats.update(reduced_seconds=reduced_seconds, reduced_iterations=reduced["iterations"],
                  reduced_converged=reduced["converged"], reduced_ghost_objective=reduced["energy"],
-                 gap=stats["initial_energy"] - stats["energy"], rms=rms_error(reduced_X, X))
+                 gap=stats["initial_energy"] - stats["energy"], rms=common.rms_error(reduced_X, X))
     return stats
 
 
@@ -86,12 +88,15 @@ def row(stats):
         "load_average": os.getloadavg()[0]}
 
 
-def run(quick=False, meshes=MESHES):
+def run(quick=False, meshes=MESHES, poses_of=None):
+    """poses_of: {mesh: pose names} to run only those poses of a mesh (all of the others')."""
     meshes = ("dragon_res4",) if quick else meshes
     figures = {}
     for name in meshes:
         V, F = mesh(name)
         handles, named_poses = poses(V)
+        if poses_of and name in poses_of:
+            named_poses = {pose: t for pose, t in named_poses.items() if pose in poses_of[name]}
         entry = {"vertices": len(V), "faces": len(F), "handle_vertices": [len(h) for h in handles],
                  "from_rest": {}, "refine": {}}
         start = time.perf_counter()
@@ -117,9 +122,22 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quick", action="store_true", help="the 5k dragon only")
     parser.add_argument("--meshes", nargs="+", default=MESHES, choices=MESHES + ("dragon_res4",))
+    parser.add_argument("--poses", nargs="+", metavar="MESH=POSE", default=[],
+                        help='only these poses of a mesh, e.g. "dragon_res2=turn 30" (a mesh not named runs all)')
+    parser.add_argument("--record", action="store_true",
+                        help="write bench/results/refine.json (as make bench does) instead of printing the figures")
     args = parser.parse_args()
-    parameters, figures = run(args.quick, tuple(args.meshes))
-    json.dump({"parameters": parameters, "figures": figures}, sys.stdout, indent=1)
+    poses_of = {}
+    for item in args.poses:
+        name, pose = item.split("=", 1)
+        poses_of.setdefault(name, []).append(pose)
+    start = time.perf_counter()
+    parameters, figures = run(args.quick, tuple(args.meshes), poses_of)
+    if args.record:
+        command = "PYTHONPATH=python_addon:bench /usr/bin/python3 " + shlex.join(["bench/refine.py"] + sys.argv[1:])
+        print(f"wrote {common.write('refine', command, parameters, figures, time.perf_counter() - start)}")
+    else:
+        json.dump({"parameters": parameters, "figures": figures}, sys.stdout, indent=1)
 
 
 if __name__ == "__main__":
