@@ -32,13 +32,22 @@ void record_cholmod_error(int status, const char* file, int line, const char* te
 // MSVC's OpenMP 2.0 has no active levels; there the loops stay parallel.
 class SerialOpenMP {
  public:
+  SerialOpenMP() {
 #if _OPENMP >= 200805
-  SerialOpenMP() : levels_(omp_get_max_active_levels()) { omp_set_max_active_levels(0); }
-  ~SerialOpenMP() { omp_set_max_active_levels(levels_); }
+    levels_ = omp_get_max_active_levels();
+    omp_set_max_active_levels(0);
+#endif
+  }
+  ~SerialOpenMP() {
+#if _OPENMP >= 200805
+    omp_set_max_active_levels(levels_);
+#endif
+  }
+  SerialOpenMP(const SerialOpenMP&) = delete;
+  SerialOpenMP& operator=(const SerialOpenMP&) = delete;
 
  private:
-  int levels_;
-#endif
+  [[maybe_unused]] int levels_ = 0;
 };
 
 // The lower triangle of A plus diag(shift), with every diagonal entry stored (an unreferenced
