@@ -47,13 +47,13 @@ struct BacktrackingResult {
   int insufficient = 0;  // trials rejected because f did not decrease enough
 };
 
-// Halves α from `initial_step` (≤ 1) until f(x + αp) ≤ f(x) + c1 α ∇f(x)ᵀp (a point where f returns +inf or NaN
-// counts as too far), at most max_halvings times. Near a minimum the decrease a step promises
-// falls below the rounding of f; with noise > 0 (an absolute bound on that rounding) a step whose
-// promised decrease is below it is also taken when f does not rise by more than noise and ‖∇f‖
-// falls (it would otherwise stall on rounding). On return x_new, value_new and gradient_new are
-// the point taken and f, ∇f there (x, value, gradient themselves when α = 0); x_new and
-// gradient_new must be sized like x.
+// Halves α from `initial_step` (≤ 1) until f(x + αp) ≤ f(x) + c1 α ∇f(x)ᵀp (a point where f
+// returns +inf or NaN counts as too far), at most max_halvings times. Near a minimum the decrease
+// a step promises falls below the rounding of f; with noise > 0 (an absolute bound on that
+// rounding) a step whose promised decrease is below it is also taken when f does not rise by more
+// than noise and ‖∇f‖ falls (it would otherwise stall on rounding). On return x_new, value_new and
+// gradient_new are the point taken and f, ∇f there (x, value, gradient themselves when α = 0);
+// x_new and gradient_new must be sized like x.
 BacktrackingResult backtracking_line_search(const Objective& objective, const Eigen::VectorXd& x, double value,
                                             const Eigen::VectorXd& gradient, const Eigen::VectorXd& p,
                                             Eigen::VectorXd& x_new, double& value_new, Eigen::VectorXd& gradient_new,

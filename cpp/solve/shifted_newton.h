@@ -15,9 +15,9 @@
 // rest) that a full step passes through zero area. On the 23k dragon turned by 170° growing τ by
 // the cut kept it at 1e4–1e8 times its floor and the whole mesh crept (300 iterations, not
 // converged); without, 55. Such a search starts at 0.9 of the way to where the first triangle
-// would turn over (PoseObjective::step_to_turning). The Hessian is the projected one (each element's made
-// semidefinite) far from the minimum, and the exact one near it wherever it factors at the
-// current τ (quadratic convergence). A full step that decreased F by more than 1.5 times what the
+// would turn over (PoseObjective::step_to_turning). The Hessian is the projected one (each
+// element's made semidefinite) far from the minimum, and the exact one near it wherever it
+// factors at the current τ (quadratic convergence). A full step that decreased F by more than 1.5 times what the
 // model promised (the projected Hessian overestimating the curvature of a flap bent away from a
 // saddle) is extended to α = 2, 4, 8 while F falls.
 //
