@@ -511,13 +511,21 @@ double DiscreteShells::value_and_gradient(const VectorRef& x, Eigen::Ref<Eigen::
   return energy;
 }
 
-SparseMatrix DiscreteShells::hessian(const VectorRef& x) const { return assemble_hessian(x, false); }
+SparseMatrix DiscreteShells::hessian(const VectorRef& x) const {
+  SparseMatrix H;
+  hessian_into(x, false, H);
+  return H;
+}
 
-SparseMatrix DiscreteShells::projected_hessian(const VectorRef& x) const { return assemble_hessian(x, true); }
+SparseMatrix DiscreteShells::projected_hessian(const VectorRef& x) const {
+  SparseMatrix H;
+  hessian_into(x, true, H);
+  return H;
+}
 
-SparseMatrix DiscreteShells::assemble_hessian(const VectorRef& x, bool projected) const {
+void DiscreteShells::hessian_into(const VectorRef& x, bool projected, SparseMatrix& H) const {
   require_positions(x, rest_.size(), "X");
-  SparseMatrix H = sparsity_.allocate_matrix();
+  sparsity_.allocate_matrix(H);
   double* values = H.valuePtr();
 #pragma omp parallel for schedule(static, 1) if (parallel())
   for (int part = 0; part < partition_.parts(); ++part) {
@@ -551,7 +559,6 @@ SparseMatrix DiscreteShells::assemble_hessian(const VectorRef& x, bool projected
       }
     });
   }
-  return H;
 }
 
 Eigen::VectorXd DiscreteShells::third(const VectorRef& x, const VectorRef& u, const VectorRef& w) const {

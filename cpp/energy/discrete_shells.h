@@ -150,6 +150,7 @@ class DiscreteShells final : public Energy {
   // closed form), but for hinges bent less than 90° from rest, which take the Gauss–Newton block
   // f''(θ)∇θ∇θᵀ (discrete_shells.cpp, block_coefficients, says why).
   SparseMatrix projected_hessian(const VectorRef& x) const override;
+  void hessian_into(const VectorRef& x, bool projected, SparseMatrix& H) const override;
   Eigen::VectorXd third(const VectorRef& x, const VectorRef& u, const VectorRef& w) const override;
 
   // The third derivative contracted with pairs of columns of Phi (3n by k, e.g. vibration
@@ -167,7 +168,6 @@ class DiscreteShells final : public Energy {
   TermCounts term_counts() const;
 
  private:
-  SparseMatrix assemble_hessian(const VectorRef& x, bool projected) const;
   template <typename Visit>
   void for_each_set(Visit&& visit) const {
     visit(edges_);

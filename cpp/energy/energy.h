@@ -29,6 +29,11 @@ class Energy {
   // it at rest. Far from a minimum, Newton's method descends with it where the exact Hessian would
   // need a large shift. An energy that is not a sum over elements returns hessian(x).
   virtual SparseMatrix projected_hessian(const VectorRef& x) const { return hessian(x); }
+  // projected_hessian(x) or hessian(x) written into H; an energy that assembles into a fixed
+  // pattern reuses H's storage from an earlier call.
+  virtual void hessian_into(const VectorRef& x, bool projected, SparseMatrix& H) const {
+    H = projected ? projected_hessian(x) : hessian(x);
+  }
   // ∇³E(x)(u, w) (3n): the Hessian's derivative along u, applied to w.
   virtual Eigen::VectorXd third(const VectorRef& x, const VectorRef& u, const VectorRef& w) const = 0;
 };

@@ -61,20 +61,20 @@ int BlockSparsity::offset(int a, int b) const {
 }
 
 SparseMatrix BlockSparsity::zero_matrix() const {
-  SparseMatrix matrix = allocate_matrix();
+  SparseMatrix matrix;
+  allocate_matrix(matrix);
   zero_columns(matrix, 0, num_vertices());
   return matrix;
 }
 
-SparseMatrix BlockSparsity::allocate_matrix() const {
+void BlockSparsity::allocate_matrix(SparseMatrix& matrix) const {
   const int n = num_vertices();
-  SparseMatrix matrix(3 * n, 3 * n);
+  matrix.resize(3 * n, 3 * n);  // keeps the value and index storage, resizeNonZeros reuses it
   matrix.resizeNonZeros(num_nonzeros());
   int* outer = matrix.outerIndexPtr();
   for (int b = 0; b < n; ++b)
     for (int j = 0; j < 3; ++j) outer[3 * b + j] = 9 * begin_[b] + j * column_stride(b);
   outer[3 * n] = num_nonzeros();
-  return matrix;
 }
 
 void BlockSparsity::zero_columns(SparseMatrix& matrix, int first_vertex, int last_vertex) const {

@@ -34,10 +34,12 @@ class BlockSparsity {
 
   // The 3n by 3n matrix with this pattern and all values zero.
   SparseMatrix zero_matrix() const;
-  // The same in two steps, so that threads can fill their own columns: a matrix with this
-  // pattern's column starts but unset row indices and values, then the row indices and zero
-  // values of the columns of vertices [first_vertex, last_vertex).
-  SparseMatrix allocate_matrix() const;
+  // The same in two steps, so that threads can fill their own columns: `matrix` given this
+  // pattern's column starts but unset row indices and values (its storage kept when large enough:
+  // a Newton solve reassembles a Hessian of 130 MB at 100k vertices each iteration, and fresh
+  // pages cost a page fault each), then the row indices and zero values of the columns of
+  // vertices [first_vertex, last_vertex).
+  void allocate_matrix(SparseMatrix& matrix) const;
   void zero_columns(SparseMatrix& matrix, int first_vertex, int last_vertex) const;
 
  private:

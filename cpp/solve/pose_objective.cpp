@@ -49,7 +49,7 @@ PoseObjective::PoseObjective(RowMatrixX3d rest, double scale, const FacesRef& F,
     if (mass[v] == 0 && hessian_diagonal.segment<3>(3 * v).isZero(0) && handle_diagonal.segment<3>(3 * v).isZero(0))
       constant_diagonal_.segment<3>(3 * v).setConstant(mean_mass);
   smallest_shift_ = 1e-8 * (hessian_diagonal + handle_diagonal).cwiseAbs().mean() / mean_mass;
-  // Held coordinates decouple (without_held) with a diagonal of their own, so their step is 0.
+  // Held coordinates decouple (hessian_into) with a diagonal of their own, so their step is 0.
   if (!held.empty()) held_.assign(3 * static_cast<size_t>(n), 0);
   for (int v : held) {
     std::fill_n(held_.begin() + 3 * static_cast<std::ptrdiff_t>(v), 3, 1);
@@ -103,12 +103,12 @@ PoseObjective PoseObjective::around(const std::vector<int>& free, std::vector<in
   return local;
 }
 
-SparseMatrix PoseObjective::without_held(SparseMatrix hessian) const {
-  if (held_.empty()) return hessian;
-  for (int col = 0; col < hessian.outerSize(); ++col)
-    for (SparseMatrix::InnerIterator entry(hessian, col); entry; ++entry)
+void PoseObjective::hessian_into(const Eigen::VectorXd& y, bool projected, SparseMatrix& H) const {
+  energy_->hessian_into(y, projected, H);
+  if (held_.empty()) return;
+  for (int col = 0; col < H.outerSize(); ++col)
+    for (SparseMatrix::InnerIterator entry(H, col); entry; ++entry)
       if (held_[static_cast<size_t>(entry.row())] || held_[static_cast<size_t>(col)]) entry.valueRef() = 0;
-  return hessian;
 }
 
 bool PoseObjective::turns_a_triangle_over(const Eigen::VectorXd& y, const Eigen::VectorXd& y_new) const {

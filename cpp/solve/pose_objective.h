@@ -35,11 +35,8 @@ class PoseObjective {
   double scale() const { return scale_; }
   Eigen::VectorXd rest_positions() const { return flatten(rest_); }
   // The energy's Hessian at y, exact or projected (each element's made semidefinite), with the held
-  // coordinates' rows and columns zero.
-  SparseMatrix hessian(const Eigen::VectorXd& y) const { return without_held(energy_->hessian(y)); }
-  SparseMatrix projected_hessian(const Eigen::VectorXd& y) const {
-    return without_held(energy_->projected_hessian(y));
-  }
+  // coordinates' rows and columns zero, written into H (its storage reused from an earlier call).
+  void hessian_into(const Eigen::VectorXd& y, bool projected, SparseMatrix& H) const;
   // D (3#V): the normalised lumped mass per coordinate, the shape of the Hessian's shift, floored
   // at 1e-6 of its mean.
   const Eigen::VectorXd& mass_diagonal() const { return mass_diagonal_; }
@@ -80,7 +77,6 @@ class PoseObjective {
   };
   // rest: #V by 3 in the normalised frame, scale the factor it was scaled by from mesh units.
   PoseObjective(RowMatrixX3d rest, double scale, const FacesRef& F, Terms terms, const std::vector<int>& held);
-  SparseMatrix without_held(SparseMatrix hessian) const;
 
   Terms terms_;
   Transforms transforms_;  // normalised frame, as the handle term has them

@@ -50,26 +50,25 @@ bool ShiftedNewton::iterate(NewtonPoint& point, bool near_minimum, double forcin
   set_shifted_diagonal();
   // The exact Hessian by conjugate gradients, else factored; where it does not factor (not definite
   // at τ), the projected one the same way.
-  SparseMatrix hessian;
   bool exact = false;
   int cg_iterations = 0;
   if (try_exact) {
-    hessian = objective_.hessian(point.y);
-    cg_iterations = factored_ ? solve_by_cg(hessian, point.gradient, forcing) : 0;
-    exact = cg_iterations > 0 || try_factorize(hessian);
+    objective_.hessian_into(point.y, false, hessian_);
+    cg_iterations = factored_ ? solve_by_cg(hessian_, point.gradient, forcing) : 0;
+    exact = cg_iterations > 0 || try_factorize(hessian_);
     if (!exact) since_exact_failed_ = 0;
   }
   if (!exact) {
-    hessian = objective_.projected_hessian(point.y);
-    cg_iterations = factored_ ? solve_by_cg(hessian, point.gradient, forcing) : 0;
-    if (cg_iterations == 0) factorize_shifted(hessian);
+    objective_.hessian_into(point.y, true, hessian_);
+    cg_iterations = factored_ ? solve_by_cg(hessian_, point.gradient, forcing) : 0;
+    if (cg_iterations == 0) factorize_shifted(hessian_);
   }
   if (cg_iterations == 0) {
     llt_.solve(point.gradient, step_);
     step_ = -step_;
   }
   const double slope = point.gradient.dot(step_);
-  product_.noalias() = hessian * step_;
+  product_.noalias() = hessian_ * step_;
   const double curvature = step_.dot(product_) + step_.dot(objective_.constant_diagonal().cwiseProduct(step_));
   const double noise = 1e-12 * (1 + std::abs(point.value));
   // A trial point that turns a triangle over counts as too far.

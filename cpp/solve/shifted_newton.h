@@ -152,6 +152,7 @@ class ShiftedNewton {
   Eigen::VectorXd step_, shifted_diagonal_;  // shifted_diagonal_: C + τD
   Eigen::VectorXd residual_, preconditioned_, direction_, product_;  // conjugate gradients' vectors
   NewtonPoint trial_, extended_;
+  SparseMatrix hessian_;  // the last iteration's, its storage reused
   std::vector<NewtonIteration> history_;
 };
 

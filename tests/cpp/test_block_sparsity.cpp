@@ -32,7 +32,8 @@ TEST(BlockSparsity, PatternHasEveryPairBothWaysAndTheDiagonal) {
 
 TEST(BlockSparsity, ColumnsFilledInPiecesEqualTheWholeMatrix) {
   const BlockSparsity pattern(5, {{0, 4}, {1, 3}, {2, 3}, {0, 1}});
-  SparseMatrix pieces = pattern.allocate_matrix();
+  SparseMatrix pieces;
+  pattern.allocate_matrix(pieces);
   pattern.zero_columns(pieces, 3, 5);
   pattern.zero_columns(pieces, 0, 3);
   const SparseMatrix whole = pattern.zero_matrix();
