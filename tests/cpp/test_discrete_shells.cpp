@@ -358,6 +358,22 @@ void expect_terms_per_rules(const TriangleMesh& mesh, const DiscreteShells& ener
   EXPECT_EQ(energy.term_counts().hinges, hinges) << name;
 }
 
+// Newton reassembles each iteration's Hessian into the last one's storage: the matrix is the one
+// hessian(x) returns, whatever it held before, and no new storage is taken.
+TEST(DiscreteShells, HessianIntoAnEarlierHessianReusesItsStorage) {
+  const TriangleMesh mesh = cylinder(8, 4, 1.0, 3.0);
+  const DiscreteShells energy(mesh.V, mesh.F);
+  const Eigen::VectorXd x = energy.rest() + 0.3 * random_vector(energy.rest().size(), 7);
+  SparseMatrix H = energy.hessian(energy.rest() + 0.1 * random_vector(energy.rest().size(), 8));
+  const double* values = H.valuePtr();
+  for (const bool projected : {false, true}) {
+    energy.hessian_into(x, projected, H);
+    EXPECT_EQ(H.valuePtr(), values);
+    const SparseMatrix expected = projected ? energy.projected_hessian(x) : energy.hessian(x);
+    EXPECT_EQ(Eigen::MatrixXd(H), Eigen::MatrixXd(expected)) << (projected ? "projected" : "exact");
+  }
+}
+
 TEST(DiscreteShells, SharedDragonsGiveFiniteResults) {
   for (const char* file : {"dragon_vrip_res4.ply.gz", "dragon_vrip_res3.ply.gz"}) {
     const TriangleMesh dragon = normalized(shared_mesh(file));
