@@ -71,17 +71,16 @@ bool ShiftedNewton::iterate(NewtonPoint& point, bool near_minimum, double forcin
   product_.noalias() = hessian_ * step_;
   const double curvature = step_.dot(product_) + step_.dot(objective_.constant_diagonal().cwiseProduct(step_));
   const double noise = 1e-12 * (1 + std::abs(point.value));
-  // A trial point that turns a triangle over counts as too far.
-  const Objective within_smooth_part = [&](const Eigen::VectorXd& trial, Eigen::VectorXd& trial_gradient) {
-    if (objective_.turns_a_triangle_over(point.y, trial)) return std::numeric_limits<double>::infinity();
+  // The first trial stops short of the first triangle's turning point (an interior point method's
+  // fraction to the boundary): halving from 1 lands anywhere between half of it and all of it. No
+  // trial of the search turns a triangle over, so only extend() checks for it.
+  const double initial_step = std::min(1.0, kToTurning * objective_.step_to_turning(point.y, step_));
+  const Objective objective = [&](const Eigen::VectorXd& trial, Eigen::VectorXd& trial_gradient) {
     return objective_(trial, trial_gradient);
   };
-  // The first trial stops short of the first triangle's turning point (an interior point method's
-  // fraction to the boundary): halving from 1 lands anywhere between half of it and all of it.
-  const double initial_step = std::min(1.0, kToTurning * objective_.step_to_turning(point.y, step_));
-  const BacktrackingResult search =
-      backtracking_line_search(within_smooth_part, point.y, point.value, point.gradient, step_, trial_.y,
-                               trial_.value, trial_.gradient, noise, initial_step);
+  const BacktrackingResult search = backtracking_line_search(objective, point.y, point.value, point.gradient, step_,
+                                                             trial_.y, trial_.value, trial_.gradient, noise,
+                                                             initial_step);
   // Cut only by the guard: every longer trial turned a triangle over (or left F's domain), none
   // fell short of the decrease.
   const bool guarded = search.step > 0 && search.step < 1 && search.insufficient == 0;
@@ -89,7 +88,13 @@ bool ShiftedNewton::iterate(NewtonPoint& point, bool near_minimum, double forcin
       search.step > 0 ? (point.value - trial_.value) / predicted_decrease(search.step, slope, curvature) : 0;
   NewtonIteration record{exact, shift_, search.step, guarded, ratio, cg_iterations};
   update_shift(guarded ? 1 : search.step, ratio);
-  if (search.step == 1 && ratio > kExtendAbove) record.step = extend(point, within_smooth_part);
+  if (search.step == 1 && ratio > kExtendAbove) {
+    // A trial point beyond 1 that turns a triangle over counts as too far.
+    record.step = extend(point, [&](const Eigen::VectorXd& trial, Eigen::VectorXd& trial_gradient) {
+      if (objective_.turns_a_triangle_over(point.y, trial)) return std::numeric_limits<double>::infinity();
+      return objective_(trial, trial_gradient);
+    });
+  }
   if (search.step > 0) {
     record.progress =
         point.value - trial_.value > noise || trial_.gradient.norm() < 0.5 * point.gradient.norm();
