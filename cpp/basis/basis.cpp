@@ -17,9 +17,12 @@ void require(bool condition, const std::string& what) {
   if (!condition) throw InputError("basis: " + what);
 }
 
+// Checked as one contiguous vector: Eigen's allFinite on a row-major matrix (vectors) took 0.26 s
+// at 100k vertices and 67 columns, against 0.012 s over its storage.
 template <typename Matrix>
 void require_finite(const Matrix& matrix, const char* name) {
-  require(matrix.allFinite(), message(name, " has non-finite entries"));
+  using Vector = Eigen::Matrix<typename Matrix::Scalar, Eigen::Dynamic, 1>;
+  require(Eigen::Map<const Vector>(matrix.data(), matrix.size()).allFinite(), message(name, " has non-finite entries"));
 }
 
 // Runs one of the core's shared input checks on a basis array, its message prefixed like the others.
@@ -153,7 +156,10 @@ void validate_basis(const Basis& b) {
   } catch (const InputError& error) {
     throw InputError(message("basis: ghost_vertices and ghost_faces (scaled) are not a usable mesh: ", error.what()));
   }
-  const Eigen::VectorXf largest = b.vectors.cwiseAbs().colwise().maxCoeff().transpose();
+  // Row by row, along vectors' storage (a column-wise reduction of the row-major array took 0.07 s).
+  Eigen::RowVectorXf largest_row = Eigen::RowVectorXf::Zero(r);
+  for (Eigen::Index i = 0; i < b.vectors.rows(); ++i) largest_row = largest_row.cwiseMax(b.vectors.row(i).cwiseAbs());
+  const Eigen::VectorXf largest = largest_row.transpose();
   for (Eigen::Index j = 0; j < r; ++j) {
     Eigen::Index i = 0;
     const double bound = 1.000001 * static_cast<double>(largest[j]) + std::numeric_limits<float>::min();

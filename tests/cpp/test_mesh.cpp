@@ -64,6 +64,20 @@ TEST(Mesh, NonManifoldEdgeGetsOneHingePerNeighbouringPair) {
   EXPECT_EQ(pairs, expected);
 }
 
+TEST(Mesh, EdgesAreNumberedInOrderOfFirstAppearance) {
+  // Face 1 repeats an index (no edges); face 2 shares its side 0-2 with face 0.
+  RowMatrixX3d V(5, 3);
+  V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 2, 2, 0;
+  RowMatrixX3i F(3, 3);
+  F << 4, 2, 0, 1, 1, 3, 0, 2, 3;
+  const MeshTopology topology = build_topology(V, F);
+  const std::vector<std::array<int, 2>> expected{{2, 4}, {0, 2}, {0, 4}, {2, 3}, {0, 3}};
+  EXPECT_EQ(topology.edges, expected);
+  EXPECT_EQ(topology.face_edges.row(1), Eigen::RowVector3i(-1, -1, -1));
+  EXPECT_EQ(topology.face_edges.row(2), Eigen::RowVector3i(1, 3, 4));
+  EXPECT_EQ(topology.num_edge_faces(1), 2);
+}
+
 TEST(Mesh, HingeRunsAlongItsFirstFace) {
   const TriangleMesh mesh = grid(3, 2, 1.0, 1.0);
   const MeshTopology topology = build_topology(mesh.V, mesh.F);
