@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "mesh/mass.h"
+#include "mesh/mesh_check.h"
 #include "mesh/normalization.h"
 #include "util/require_positions.h"
 
@@ -35,6 +36,10 @@ PoseObjective::PoseObjective(RowMatrixX3d rest, double scale, const FacesRef& F,
       handle_term_(rest_, lumped_mass(rest_, F), terms_.handles, terms_.weights, terms_.stiffness),
       faces_(F) {
   const int n = static_cast<int>(rest_.rows());
+  std::vector<Eigen::Index> oriented;
+  for (Eigen::Index f = 0; f < faces_.rows(); ++f)
+    if (!is_degenerate_face(rest_, faces_, static_cast<int>(f))) oriented.push_back(f);
+  oriented_faces_ = faces_(oriented, Eigen::all);
   const Eigen::VectorXd mass = lumped_mass(rest_, F);
   const Eigen::VectorXd handle_diagonal = handle_term_.hessian_diagonal(n);
   const Eigen::VectorXd hessian_diagonal = energy_->hessian(rest_positions()).diagonal();
@@ -112,8 +117,8 @@ void PoseObjective::hessian_into(const Eigen::VectorXd& y, bool projected, Spars
 }
 
 bool PoseObjective::turns_a_triangle_over(const Eigen::VectorXd& y, const Eigen::VectorXd& y_new) const {
-  for (Eigen::Index f = 0; f < faces_.rows(); ++f) {
-    const int a = faces_(f, 0), b = faces_(f, 1), c = faces_(f, 2);
+  for (Eigen::Index f = 0; f < oriented_faces_.rows(); ++f) {
+    const int a = oriented_faces_(f, 0), b = oriented_faces_(f, 1), c = oriented_faces_(f, 2);
     if (side(y, a, b).cross(side(y, a, c)).dot(side(y_new, a, b).cross(side(y_new, a, c))) < 0) return true;
   }
   return false;
@@ -121,8 +126,8 @@ bool PoseObjective::turns_a_triangle_over(const Eigen::VectorXd& y, const Eigen:
 
 double PoseObjective::step_to_turning(const Eigen::VectorXd& y, const Eigen::VectorXd& p) const {
   double smallest = std::numeric_limits<double>::infinity();
-  for (Eigen::Index f = 0; f < faces_.rows(); ++f) {
-    const int a = faces_(f, 0), b = faces_(f, 1), c = faces_(f, 2);
+  for (Eigen::Index f = 0; f < oriented_faces_.rows(); ++f) {
+    const int a = oriented_faces_(f, 0), b = oriented_faces_(f, 1), c = oriented_faces_(f, 2);
     const Eigen::Vector3d e1 = side(y, a, b), e2 = side(y, a, c), d1 = side(p, a, b), d2 = side(p, a, c);
     // n(α) = n + α (e1 × d2 + d1 × e2) + α² d1 × d2, so n·n(α) = c0 + c1 α + c2 α².
     const Eigen::Vector3d n = e1.cross(e2);

@@ -46,9 +46,11 @@ class PoseObjective {
   double smallest_shift() const { return smallest_shift_; }
 
   // Whether a triangle turns over between y and y_new: its normal reverses (a triangle with no
-  // normal at y, collapsed already, is not counted). F has a kink where a triangle collapses (its
-  // hinges' angles flip by π as its normal does), and a step through it lands beyond the smooth
-  // part of F that Newton's method can converge in, often lower: iterates are kept out of it.
+  // normal at y, collapsed already, is not counted, nor one degenerate at rest: is_degenerate_face,
+  // no orientation and no energy term; a raw scan's zero-area slivers turn over at any step). F has
+  // a kink where a triangle collapses (its hinges' angles flip by π as its normal does), and a
+  // step through it lands beyond the smooth part of F that Newton's method can converge in, often
+  // lower: iterates are kept out of it.
   bool turns_a_triangle_over(const Eigen::VectorXd& y, const Eigen::VectorXd& y_new) const;
   // The smallest α > 0 at which y + αp turns a triangle over, to within rounding: where its normal
   // first stands perpendicular to its normal at y (n(y)·n(y + αp) = 0, quadratic in α); +inf when
@@ -87,6 +89,7 @@ class PoseObjective {
   Eigen::VectorXd mass_diagonal_, constant_diagonal_;
   double smallest_shift_ = 0;
   RowMatrixX3i faces_;
+  RowMatrixX3i oriented_faces_;  // the faces not degenerate at rest: the ones that can turn over
   std::vector<char> held_;  // per coordinate, empty when nothing is held
 };
 

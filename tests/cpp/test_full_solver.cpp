@@ -230,6 +230,25 @@ TEST(PoseObjective, StepToTurningIsWhereTheFirstTriangleTurnsOver) {
   EXPECT_EQ(objective.step_to_turning(y, Eigen::VectorXd::Zero(3 * n)), std::numeric_limits<double>::infinity());
 }
 
+// A face of zero area at rest (a scan's sliver) has no orientation to keep: once a step has given it
+// an area, the next may turn it over. The ordinary face beside it is still guarded.
+TEST(PoseObjective, FaceDegenerateAtRestIsNotGuarded) {
+  RowMatrixX3d V(6, 3);
+  V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 2, 0, 0, 3, 0, 0, 2.5, 0, 0;  // face 1: vertex 5 on the side 3-4
+  RowMatrixX3i F(2, 3);
+  F << 0, 1, 2, 3, 4, 5;
+  const PoseObjective objective(V, F, Handles{{0}}, Eigen::VectorXd::Ones(1), 1e3, EnergyKind::kShells, 1, 1,
+                                StiffnessPaint{});
+  Eigen::VectorXd y = objective.rest_positions(), p = Eigen::VectorXd::Zero(18);
+  y[3 * 5 + 1] += 0.1;  // the sliver lifted into a triangle
+  p[3 * 5 + 1] = -0.2;  // and lowered through its side at α = 1/2
+  EXPECT_EQ(objective.step_to_turning(y, p), std::numeric_limits<double>::infinity());
+  EXPECT_FALSE(objective.turns_a_triangle_over(y, y + p));
+  p[3 * 2 + 1] = -2 * y[3 * 2 + 1];  // vertex 2 through the side 0-1, also at α = 1/2
+  EXPECT_NEAR(objective.step_to_turning(y, p), 0.5, 1e-12);
+  EXPECT_TRUE(objective.turns_a_triangle_over(y, y + p));
+}
+
 // A vertex pulled far off the tube (30 edge lengths: its edges stretched 20 times and more) is put back on its own,
 // with its neighbours: the rest of the mesh stays where it was to the bit, F falls by five orders
 // (the relaxation stops at a thousandth of its gradient) and the vertex is back within 5% of an
