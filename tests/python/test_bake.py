@@ -151,6 +151,8 @@ def corruptions(arrays):
     ghost_vectors = arrays["ghost_vectors"].copy()
     ghost_vectors[0, 0] = np.inf
     yield "ghost_vectors", changed(ghost_vectors=ghost_vectors)
+    # Not the restriction of vectors: larger than every entry of their column.
+    yield "ghost_vectors", changed(ghost_vectors=arrays["ghost_vectors"] * 10)
     yield "mass", changed(mass=-arrays["mass"])
     yield "scale", changed(scale=np.array(0.0))
     yield "scale", changed(scale=np.array(np.nan))
