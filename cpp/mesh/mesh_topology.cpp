@@ -50,34 +50,39 @@ void collect_edges(const FacesRef& F, MeshTopology& topology) {
     }
   }
   std::sort(sides.begin(), sides.end());
-  // Each run of equal keys is one edge; its first side (the smallest 3f + k) is where it appears first.
-  std::vector<int> run_of_first_side(3 * static_cast<size_t>(num_faces), -1), run_of_side(sides.size());
-  int runs = 0;
-  for (size_t i = 0; i < sides.size(); ++i) {
-    if (i == 0 || sides[i].first != sides[i - 1].first) run_of_first_side[static_cast<size_t>(sides[i].second)] = runs++;
-    run_of_side[i] = runs - 1;
-  }
-  std::vector<int> edge_of_run(static_cast<size_t>(runs));
+  // Each run of equal keys is one edge, its sides in ascending 3f + k: the first is where the edge
+  // appears first, and the faces come in ascending order, as edge_faces lists them.
+  std::vector<size_t> run_begin;
+  for (size_t i = 0; i < sides.size(); ++i)
+    if (i == 0 || sides[i].first != sides[i - 1].first) run_begin.push_back(i);
+  run_begin.push_back(sides.size());
+  const size_t runs = run_begin.size() - 1;
+  std::vector<int> run_starting_at(3 * static_cast<size_t>(num_faces), -1);  // per side
+  for (size_t r = 0; r < runs; ++r)
+    run_starting_at[static_cast<size_t>(sides[run_begin[r]].second)] = static_cast<int>(r);
+  std::vector<int> edge_of_run(runs);
   for (int side = 0; side < 3 * num_faces; ++side) {
-    const int run = run_of_first_side[static_cast<size_t>(side)];
+    const int run = run_starting_at[static_cast<size_t>(side)];
     if (run < 0) continue;
     edge_of_run[static_cast<size_t>(run)] = static_cast<int>(topology.edges.size());
     topology.edges.push_back(side_ends(F, side / 3, side % 3));
   }
-  const int num_edges = static_cast<int>(topology.edges.size());
-  std::vector<int> face_count(static_cast<size_t>(num_edges), 0);
-  for (size_t i = 0; i < sides.size(); ++i) {
-    const int e = edge_of_run[static_cast<size_t>(run_of_side[i])];
-    topology.face_edges(sides[i].second / 3, sides[i].second % 3) = e;
-    ++face_count[static_cast<size_t>(e)];
+  topology.edge_face_offsets.assign(runs + 1, 0);
+  for (size_t r = 0; r < runs; ++r) {
+    const auto faces = static_cast<int>(run_begin[r + 1] - run_begin[r]);
+    topology.edge_face_offsets[static_cast<size_t>(edge_of_run[r]) + 1] = faces;
   }
-  topology.edge_face_offsets.assign(num_edges + 1, 0);
-  std::partial_sum(face_count.begin(), face_count.end(), topology.edge_face_offsets.begin() + 1);
-  topology.edge_faces.resize(topology.edge_face_offsets.back());
-  std::vector<int> fill(topology.edge_face_offsets.begin(), topology.edge_face_offsets.end() - 1);
-  for (int f = 0; f < num_faces; ++f)
-    for (int k = 0; k < 3; ++k)
-      if (topology.face_edges(f, k) >= 0) topology.edge_faces[fill[topology.face_edges(f, k)]++] = f;
+  std::partial_sum(topology.edge_face_offsets.begin(), topology.edge_face_offsets.end(),
+                   topology.edge_face_offsets.begin());
+  topology.edge_faces.resize(sides.size());
+  for (size_t r = 0; r < runs; ++r) {
+    const int e = edge_of_run[r];
+    for (size_t i = run_begin[r]; i < run_begin[r + 1]; ++i) {
+      const int f = sides[i].second / 3;
+      topology.face_edges(f, sides[i].second % 3) = e;
+      topology.edge_faces[static_cast<size_t>(topology.edge_face_offsets[e]) + (i - run_begin[r])] = f;
+    }
+  }
 }
 
 // Faces around a non-manifold edge, sorted by the angle of their opposite vertex about the edge.

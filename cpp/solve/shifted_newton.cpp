@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include "solve/line_search.h"
@@ -75,12 +76,9 @@ bool ShiftedNewton::iterate(NewtonPoint& point, bool near_minimum, double forcin
   // fraction to the boundary): halving from 1 lands anywhere between half of it and all of it. No
   // trial of the search turns a triangle over, so only extend() checks for it.
   const double initial_step = std::min(1.0, kToTurning * objective_.step_to_turning(point.y, step_));
-  const Objective objective = [&](const Eigen::VectorXd& trial, Eigen::VectorXd& trial_gradient) {
-    return objective_(trial, trial_gradient);
-  };
-  const BacktrackingResult search = backtracking_line_search(objective, point.y, point.value, point.gradient, step_,
-                                                             trial_.y, trial_.value, trial_.gradient, noise,
-                                                             initial_step);
+  const BacktrackingResult search =
+      backtracking_line_search(std::cref(objective_), point.y, point.value, point.gradient, step_, trial_.y,
+                               trial_.value, trial_.gradient, noise, initial_step);
   // Cut only by the guard: every longer trial turned a triangle over (or left F's domain), none
   // fell short of the decrease.
   const bool guarded = search.step > 0 && search.step < 1 && search.insufficient == 0;

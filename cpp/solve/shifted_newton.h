@@ -17,9 +17,9 @@
 // converged); without, 55. Such a search starts at 0.9 of the way to where the first triangle
 // would turn over (PoseObjective::step_to_turning). The Hessian is the projected one (each
 // element's made semidefinite) far from the minimum, and the exact one near it wherever it
-// factors at the current τ (quadratic convergence). A full step that decreased F by more than 1.5 times what the
-// model promised (the projected Hessian overestimating the curvature of a flap bent away from a
-// saddle) is extended to α = 2, 4, 8 while F falls.
+// factors at the current τ (quadratic convergence). A full step that decreased F by more than 1.5
+// times what the model promised (the projected Hessian overestimating the curvature of a flap
+// bent away from a saddle) is extended to α = 2, 4, 8 while F falls.
 //
 // A factorisation costs as much as a dozen or more solves with the factor (on the 23k dragon 0.6 s
 // against 0.04 s; the Hessian's assembly 0.25 s), and from one iteration to the next the shifted
