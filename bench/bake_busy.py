@@ -9,8 +9,14 @@ shares the cores between sessions first (autogroups), so a `yes` in the bake's s
 of what the session gets, which on a machine loaded by other sessions is far less than the core it
 leaves free on an idle one (the 23k bake then took 1.9 to 2.7 times as long at load 10 to 11, against
 1.09 on an idle machine). The machine is shared, so "quiet" means nothing of ours beside the bake:
-each bake runs quiet and busy back to back (which comes first alternates by round), the ratio is
-taken pair by pair and the load average before each pair is kept; medians over the rounds.
+each bake runs quiet, on one core and busy back to back (the order reverses by round), the ratios are
+taken bake by bake and the load average before each is kept; medians over the rounds.
+
+Each bake also runs quiet on one core (its affinity set to the first core it may use, so the core's
+OpenMP and OpenBLAS see one core): while `yes` runs, the sharing between sessions leaves the bake one
+core's worth of time, so the busy bake cannot beat this one. Busy / one core is what the sharing costs
+beyond losing the core (threads that spin or wait for a descheduled partner); busy / quiet is at least
+one core / quiet, the speed-up the second core gives the quiet bake.
 
 Inside each Python, one bake of the 5k dragon first checks the threads: the OpenMP settings the
 core's runtime reports (OMP_DISPLAY_ENV) and the thread counts of every OpenBLAS in the process
@@ -35,7 +41,7 @@ ROUNDS = 3
 PYTHONS = ("python",) + tuple(f"bpy {version}" for version in common.BPY_VERSIONS)
 #: The bake's environment on top of this process's, by variant.
 VARIANTS = {"shipped": {}, "spinning_openmp": {"GOMP_SPINCOUNT": "300000"}}
-CONDITIONS = ("quiet", "busy")
+CONDITIONS = ("quiet", "one_core", "busy")
 SCRIPT = ROOT / "bench" / "bake_once.py"
 
 
@@ -51,15 +57,23 @@ def name(bake):
     return " ".join(bake)
 
 
-def in_fresh_process(python, arguments, environment, folder):
-    """bake_once.py's JSON and its standard error, in plain Python or in bpy `python`."""
+def on_one_core():
+    """Pins the calling process (a child about to start) to the first core it may use."""
+    os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
+
+
+def in_fresh_process(python, arguments, environment, folder, one_core=False):
+    """bake_once.py's JSON and its standard error, in plain Python or in bpy `python`; with `one_core`,
+    on the first core only."""
+    pin = {"preexec_fn": on_one_core} if one_core else {}
     if python == "python":
         run = subprocess.run([sys.executable, "-W", "ignore", str(SCRIPT), *arguments], cwd=ROOT, capture_output=True,
                              text=True, check=True, env={k: v for k, v in os.environ.items()
-                                                         if k not in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT")} | environment)
+                                                         if k not in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT")} | environment,
+                             **pin)
     else:
         run = common.in_bpy(python.split()[1], SCRIPT, arguments, folder, env=environment, capture_output=True,
-                            text=True)
+                            text=True, **pin)
     return json.loads(run.stdout.strip().splitlines()[-1]), run.stderr
 
 
@@ -71,39 +85,40 @@ def thread_check(python, folder):
             "openblas_threads_seen": result["openblas_threads_seen"]}
 
 
-def bake_pair(bake, mesh, busy_first, folder):
-    """{condition: seconds, "stages": {condition: {stage: seconds}}} of the bake quiet and beside one
-    `yes`, back to back."""
+def bake_triple(bake, mesh, reverse, folder):
+    """{condition: seconds, "stages": {condition: {stage: seconds}}} of the bake quiet, quiet on one core
+    and beside one `yes`, back to back (in reverse order when `reverse`)."""
     python, _, variant = bake
-    pair = {"stages": {}}
-    for condition in (CONDITIONS[::-1] if busy_first else CONDITIONS):
+    timings = {"stages": {}}
+    for condition in (CONDITIONS[::-1] if reverse else CONDITIONS):
         busy = subprocess.Popen(["yes"], stdout=subprocess.DEVNULL, start_new_session=True) \
             if condition == "busy" else None
         try:
-            result = in_fresh_process(python, [mesh], VARIANTS[variant], folder)[0]
+            result = in_fresh_process(python, [mesh], VARIANTS[variant], folder, one_core=condition == "one_core")[0]
         finally:
             if busy is not None:
                 busy.kill()
                 busy.wait()
-        pair[condition] = result["seconds"]
-        pair["stages"][condition] = result["stages"]
-    return pair
+        timings[condition] = result["seconds"]
+        timings["stages"][condition] = result["stages"]
+    return timings
 
 
 def summary(bakes, rounds):
-    """Medians over the rounds per bake: seconds, busy / quiet pair by pair, also per stage; shipped /
-    spinning."""
+    """Medians over the rounds per bake: seconds, busy / quiet and busy / one core bake by bake, busy / quiet
+    also per stage; shipped / spinning."""
     def median(values):
         return statistics.median(list(values))
     out = {}
     for bake in bakes:
-        pairs = [r[name(bake)] for r in rounds]
-        out[name(bake)] = {"quiet": median(p["quiet"] for p in pairs), "busy": median(p["busy"] for p in pairs),
-                           "busy_over_quiet": median(p["busy"] / p["quiet"] for p in pairs),
+        triples = [r[name(bake)] for r in rounds]
+        out[name(bake)] = {**{c: median(p[c] for p in triples) for c in CONDITIONS},
+                           "busy_over_quiet": median(p["busy"] / p["quiet"] for p in triples),
+                           "busy_over_one_core": median(p["busy"] / p["one_core"] for p in triples),
                            "stages_busy_over_quiet": {
-                               stage: median(p["stages"]["busy"][stage] / p["stages"]["quiet"][stage] for p in pairs)
-                               for stage in pairs[0]["stages"]["quiet"] if pairs[0]["stages"]["quiet"][stage] > 0},
-                           "load_before": [min(p["load_before"] for p in pairs), max(p["load_before"] for p in pairs)]}
+                               stage: median(p["stages"]["busy"][stage] / p["stages"]["quiet"][stage] for p in triples)
+                               for stage in triples[0]["stages"]["quiet"] if triples[0]["stages"]["quiet"][stage] > 0},
+                           "load_before": [min(p["load_before"] for p in triples), max(p["load_before"] for p in triples)]}
     shipped, spinning = (name(b) for b in bakes if b[0] == "python" and b[1] == bakes[0][1])
     out["shipped_over_spinning"] = {c: median(r[shipped][c] / r[spinning][c] for r in rounds) for c in CONDITIONS}
     return out
@@ -119,16 +134,18 @@ def run(quick=False):
             print(f"   {python}: OpenMP wait {check['omp_wait_policy']}, spin count {check['gomp_spincount']}; "
                   f"OpenBLAS threads seen {check['openblas_threads_seen']}", flush=True)
         for index in range(1 if quick else ROUNDS):
-            pairs = {}
+            round_ = {}
             for bake in bakes:
                 load = os.getloadavg()[0]
-                pairs[name(bake)] = bake_pair(bake, meshes[bake[1]], index % 2 == 1, folder) | {"load_before": load}
-                p = pairs[name(bake)]
-                print(f"   round {index + 1}, {name(bake)}: quiet {p['quiet']:.1f} s, busy {p['busy']:.1f} s, "
-                      f"{p['busy'] / p['quiet']:.2f} (load {load:.1f})", flush=True)
-            rounds.append(pairs)
+                round_[name(bake)] = bake_triple(bake, meshes[bake[1]], index % 2 == 1, folder) | {"load_before": load}
+                p = round_[name(bake)]
+                print(f"   round {index + 1}, {name(bake)}: quiet {p['quiet']:.1f} s, one core {p['one_core']:.1f} s, "
+                      f"busy {p['busy']:.1f} s, busy / quiet {p['busy'] / p['quiet']:.2f}, busy / one core "
+                      f"{p['busy'] / p['one_core']:.2f} (load {load:.1f})", flush=True)
+            rounds.append(round_)
     result = summary(bakes, rounds)
     parameters = {"meshes": meshes, "check_mesh": CHECK_MESH, "modes": 15, "derivatives": 52, "ghost": 1000,
                   "rounds": len(rounds), "bakes": [list(b) for b in bakes], "variants": VARIANTS,
-                  "busy": "one `yes` process beside the bake", "load_before": os.getloadavg()}
+                  "busy": "one `yes` process beside the bake",
+                  "one_core": "quiet, the affinity set to one core", "load_before": os.getloadavg()}
     return parameters, {"checks": checks, "rounds": rounds, "summary": result}

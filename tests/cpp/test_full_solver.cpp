@@ -275,8 +275,11 @@ TEST(RelaxStretched, PutsBackAVertexPulledOff) {
   EXPECT_EQ(relax_stretched(objective, point), expected);
   EXPECT_LE(point.value, 1e-5 * value_before);
   EXPECT_LE((point.y.segment<3>(3 * pulled) - objective.rest_positions().segment<3>(3 * pulled)).norm(), 0.05 * edge);
-  for (int v = 0; v < n; ++v)
-    if (!neighbourhood[v]) EXPECT_EQ(point.y.segment<3>(3 * v), before.segment<3>(3 * v)) << "vertex " << v;
+  for (int v = 0; v < n; ++v) {
+    if (!neighbourhood[v]) {
+      EXPECT_EQ(point.y.segment<3>(3 * v), before.segment<3>(3 * v)) << "vertex " << v;
+    }
+  }
   // Nothing stretched: nothing to do.
   NewtonPoint rest{objective.rest_positions(), 0, Eigen::VectorXd(3 * n)};
   rest.value = objective(rest.y, rest.gradient);
