@@ -143,9 +143,13 @@ int ShiftedNewton::solve_by_cg(const SparseMatrix& hessian, const Eigen::VectorX
     residual_ -= alpha * product_;
     const double residual_norm = residual_.norm();
     if (residual_norm <= bound) return k;
-    // Given up once the mean decrease so far would not reach the bound within the budget.
+    // Given up once the mean decrease so far would not reach the bound within the budget, from the
+    // first iteration on: most attempts that fail do so while a crushed triangle's Hessian changes
+    // fast, and waiting for a second iteration cost a solve each. Refine of the 100k dragon at turn
+    // 90: 31 iterations, 26 factorisations, 0.86 times the wall time of giving up from the second
+    // (39, 24); at 23k 0.83 at turn 90, 1.04 at turn 170.
     const double mean_log_decrease = std::log(residual_norm / initial_norm) / k;
-    if (k >= 2 && (kMaxCgIterations - k) * mean_log_decrease > std::log(bound / residual_norm)) return 0;
+    if ((kMaxCgIterations - k) * mean_log_decrease > std::log(bound / residual_norm)) return 0;
     llt_.solve(residual_, preconditioned_);
     const double next_dot = residual_.dot(preconditioned_);
     direction_ = preconditioned_ + (next_dot / residual_dot) * direction_;
