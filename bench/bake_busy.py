@@ -13,10 +13,10 @@ each bake runs quiet, on one core and busy back to back (the order reverses by r
 taken bake by bake and the load average before each is kept; medians over the rounds.
 
 Each bake also runs quiet on one core (its affinity set to the first core it may use, so the core's
-OpenMP and OpenBLAS see one core): while `yes` runs, the sharing between sessions leaves the bake one
-core's worth of time, so the busy bake cannot beat this one. Busy / one core is what the sharing costs
-beyond losing the core (threads that spin or wait for a descheduled partner); busy / quiet is at least
-one core / quiet, the speed-up the second core gives the quiet bake.
+OpenMP and OpenBLAS see one core): while `yes` runs, the sharing between sessions leaves the bake about
+one core's worth of time, so the busy bake is at best about as fast as this one. Busy / one core is what
+the sharing costs beyond losing the core (threads that spin or wait for a descheduled partner); busy /
+quiet is then about one core / quiet at least, the speed-up the second core gives the quiet bake.
 
 Inside each Python, one bake of the 5k dragon first checks the threads: the OpenMP settings the
 core's runtime reports (OMP_DISPLAY_ENV) and the thread counts of every OpenBLAS in the process

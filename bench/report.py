@@ -661,9 +661,9 @@ def section_bake_busy(result):
            f"{p['busy']}: in plain Python as shipped (OpenMP's passive wait, OpenBLAS under CHOLMOD on the usable "
            "cores less one) and with GCC OpenMP's default spinning wait, and inside bpy on the installed extension "
            "(Blender's own NumPy and OpenBLAS beside the core's). Each bake also ran quiet on one core (its "
-           "affinity set to one): beside `yes` the bake's session gets one core's worth of time, so busy / one core "
-           "is what the sharing costs beyond the lost core, and busy / quiet is at least one core / quiet, the "
-           "speed-up the second core gives. The machine is shared: each bake ran quiet, on one core and busy back "
+           "affinity set to one): beside `yes` the bake's session gets about one core's worth of time, so busy / one "
+           "core is what the sharing costs beyond the lost core, and busy / quiet is about one core / quiet at "
+           "least, the speed-up the second core gives. The machine is shared: each bake ran quiet, on one core and busy back "
            "to back, the ratios are taken bake by bake, medians over "
            f"{p['rounds']} round(s); the load average (1 min) before each bake's runs is given. Issue 25's target: "
            "busy / quiet at most 1.3.", ""]
