@@ -113,8 +113,8 @@ def summary(bakes, rounds):
     for bake in bakes:
         triples = [r[name(bake)] for r in rounds]
         out[name(bake)] = {**{c: median(p[c] for p in triples) for c in CONDITIONS},
-                           "busy_over_quiet": median(p["busy"] / p["quiet"] for p in triples),
-                           "busy_over_one_core": median(p["busy"] / p["one_core"] for p in triples),
+                           **{f"busy_over_{c}": median(p["busy"] / p[c] for p in triples)
+                              for c in ("quiet", "one_core")},
                            "stages_busy_over_quiet": {
                                stage: median(p["stages"]["busy"][stage] / p["stages"]["quiet"][stage] for p in triples)
                                for stage in triples[0]["stages"]["quiet"] if triples[0]["stages"]["quiet"][stage] > 0},

@@ -26,8 +26,8 @@
 // Hessian changes little. So an iteration first solves its Newton system by conjugate gradients
 // preconditioned by the last factor, to the relative residual of an inexact Newton method
 // (Eisenstat & Walker 1996, choice 2; near the minimum proportional to ‖∇F‖, which keeps Newton's
-// convergence quadratic), and factors the matrix only when that does not converge within
-// kMaxCgIterations or meets nonpositive curvature.
+// convergence quadratic), and factors the matrix only when that meets nonpositive curvature or, by
+// its decrease so far, would not converge within kMaxCgIterations.
 #pragma once
 
 #include <functional>
@@ -118,8 +118,9 @@ class ShiftedNewton {
 
   // Conjugate gradients on (H + C + τD) step_ = −∇F (C the constant diagonal), preconditioned by
   // the last factor, from step_ = 0 until the residual is below `forcing` times ‖∇F‖. Returns the
-  // iterations made, or 0 when they did not converge within kMaxCgIterations or met a direction of
-  // nonpositive curvature (step_ is then not a step).
+  // iterations made, or 0 when they met a direction of nonpositive curvature or would not converge
+  // within kMaxCgIterations, judged from the first iteration on by the mean decrease so far (step_
+  // is then not a step).
   int solve_by_cg(const SparseMatrix& hessian, const Eigen::VectorXd& gradient, double forcing);
   // The relative residual the next Newton system is solved to by conjugate gradients.
   double forcing(double gradient_norm, double target, double exact_below) const;
