@@ -731,8 +731,10 @@ def section_refine(result):
            "native solve's wall time, with the load average when it ended (2 cores shared). Exact / guarded / "
            "failed: iterations on the exact Hessian (the rest on the projected one), steps cut only because "
            "longer ones turned a triangle over, line searches that found no decrease. Relaxed: vertices of edges the "
-           "reduced pose stretched beyond 10 times, relaxed on their own before Newton (fins and needles of the "
-           "scan). Non-converged solves are marked and are no reference.", ""]
+           "reduced pose stretched beyond 3 times, relaxed on their own before Newton (fins and needles of the "
+           "scan). Crushed: faces with less than 5% of their rest area at the start and at the end (Newton keeps "
+           "every face from turning over, so each face the minimum crushes cuts steps on the way). Non-converged "
+           "solves are marked and are no reference.", ""]
     rows = []
     for mesh, entry in result["figures"].items():
         for kind in ("from_rest", "refine"):
@@ -744,10 +746,11 @@ def section_refine(result):
                                                                  "line_search_failures")),
                              f"{r['energy']:.5g}", "yes" if r["converged"] else "**no**",
                              f"{r['gap']:.3g}" if "gap" in r else "", f"{100 * r['rms']:.3f}%" if "rms" in r else "",
-                             r.get("relaxed_vertices", "")])
+                             r.get("relaxed_vertices", ""),
+                             f"{r['crushed_at_start']} → {r['crushed_at_end']}" if "crushed_at_end" in r else ""])
     out.append(table(["mesh", "vertices", "pose", "solve", "load steps", "iterations", "factorisations", "s",
                       "load", "exact/guarded/failed", "objective", "converged", "reduced gap", "reduced RMS",
-                      "relaxed"], rows))
+                      "relaxed", "crushed"], rows))
     older = [f"The {mesh} rows are from an earlier run: commit `{entry['commit'][:12]}`, {entry['date']}."
              for mesh, entry in result["figures"].items() if entry.get("commit", result["commit"]) != result["commit"]]
     out += ["", *(older + [""] if older else []), "Targets:", ""]
