@@ -42,7 +42,8 @@ class PoseObjective {
   const Eigen::VectorXd& mass_diagonal() const { return mass_diagonal_; }
   // The handle term's Hessian (diagonal, constant) and the fixed unreferenced coordinates.
   const Eigen::VectorXd& constant_diagonal() const { return constant_diagonal_; }
-  // The smallest shift τ used: 2.5e-8 of the median curvature per unit mass (‖∇²F_ii‖ / D_i) at rest.
+  // The smallest shift τ used: 2.5e-8 of the median curvature per unit mass (|∇²F_ii| / D_i) at
+  // rest.
   double smallest_shift() const { return smallest_shift_; }
 
   // Whether a triangle turns over between y and y_new: its normal reverses (a triangle with no
