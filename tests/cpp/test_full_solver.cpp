@@ -250,7 +250,7 @@ TEST(PoseObjective, FaceDegenerateAtRestIsNotGuarded) {
 }
 
 // The shift's floor follows the bulk of the mesh, not its few stiffest elements (a raw scan's
-// slivers, here one vertex of 240 painted 1e4 times stiffer): a floor that rose with them would damp
+// slivers, here one vertex of 252 painted 1e4 times stiffer): a floor that rose with them would damp
 // every step of the rest. With the paint the median curvature per unit mass rises 2.5-fold (the
 // elements around the vertex move it up the ranks of the tube's coordinates), the mean 36-fold.
 TEST(PoseObjective, ShiftFloorIgnoresAFewStiffElements) {
