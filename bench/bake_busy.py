@@ -67,10 +67,9 @@ def in_fresh_process(python, arguments, environment, folder, one_core=False):
     on the first core only."""
     pin = {"preexec_fn": on_one_core} if one_core else {}
     if python == "python":
+        inherited = {k: v for k, v in os.environ.items() if k not in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT")}
         run = subprocess.run([sys.executable, "-W", "ignore", str(SCRIPT), *arguments], cwd=ROOT, capture_output=True,
-                             text=True, check=True, env={k: v for k, v in os.environ.items()
-                                                         if k not in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT")} | environment,
-                             **pin)
+                             text=True, check=True, env=inherited | environment, **pin)
     else:
         run = common.in_bpy(python.split()[1], SCRIPT, arguments, folder, env=environment, capture_output=True,
                             text=True, **pin)
@@ -118,7 +117,8 @@ def summary(bakes, rounds):
                            "stages_busy_over_quiet": {
                                stage: median(p["stages"]["busy"][stage] / p["stages"]["quiet"][stage] for p in triples)
                                for stage in triples[0]["stages"]["quiet"] if triples[0]["stages"]["quiet"][stage] > 0},
-                           "load_before": [min(p["load_before"] for p in triples), max(p["load_before"] for p in triples)]}
+                           "load_before": [min(p["load_before"] for p in triples),
+                                           max(p["load_before"] for p in triples)]}
     shipped, spinning = (name(b) for b in bakes if b[0] == "python" and b[1] == bakes[0][1])
     out["shipped_over_spinning"] = {c: median(r[shipped][c] / r[spinning][c] for r in rounds) for c in CONDITIONS}
     return out

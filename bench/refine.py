@@ -60,21 +60,20 @@ def face_areas(X, F):
     return 0.5 * np.linalg.norm(np.cross(X[F[:, 1]] - X[F[:, 0]], X[F[:, 2]] - X[F[:, 0]]), axis=1)
 
 
-def crushed_faces(V, F, X):
-    """Faces of X with less than CRUSHED_BELOW of their rest area in V (faces of no area at rest left out)."""
-    rest = face_areas(V, F)
-    return int(np.sum((rest > 0) & (face_areas(X, F) < CRUSHED_BELOW * rest)))
+def crushed_faces(rest_areas, X, F):
+    """Faces of X with less than CRUSHED_BELOW of their rest area (faces of no area at rest left out)."""
+    return int(np.sum((rest_areas > 0) & (face_areas(X, F) < CRUSHED_BELOW * rest_areas)))
 
 
-def from_rest(V, F, handles, transforms):
+def from_rest(V, F, rest_areas, handles, transforms):
     start = time.perf_counter()
     X, stats = mdc.solve_full(V, F, handles, transforms, stiffness=STIFFNESS, return_stats=True)
     stats["wall_seconds"] = time.perf_counter() - start
-    stats.update(crushed_at_start=0, crushed_at_end=crushed_faces(V, F, X))
+    stats.update(crushed_at_start=0, crushed_at_end=crushed_faces(rest_areas, X, F))
     return stats
 
 
-def refine(basis, V, F, handles, transforms):
+def refine(basis, F, rest_areas, handles, transforms):
     solver = mdc.ReducedSolver(basis, handles, stiffness=STIFFNESS)
     solver.set_transforms(transforms)
     start = time.perf_counter()
@@ -87,7 +86,8 @@ def refine(basis, V, F, handles, transforms):
     stats.update(reduced_seconds=reduced_seconds, reduced_iterations=reduced["iterations"],
                  reduced_converged=reduced["converged"], reduced_ghost_objective=reduced["energy"],
                  gap=stats["initial_energy"] - stats["energy"], rms=common.rms_error(reduced_X, X),
-                 crushed_at_start=crushed_faces(V, F, reduced_X), crushed_at_end=crushed_faces(V, F, X))
+                 crushed_at_start=crushed_faces(rest_areas, reduced_X, F),
+                 crushed_at_end=crushed_faces(rest_areas, X, F))
     return stats
 
 
@@ -110,6 +110,7 @@ def run(quick=False, meshes=MESHES, poses_of=None):
     for name in meshes:
         V, F = mesh(name)
         handles, named_poses = poses(V)
+        rest_areas = face_areas(V, F)
         if poses_of and name in poses_of:
             named_poses = {pose: t for pose, t in named_poses.items() if pose in poses_of[name]}
         entry = {"vertices": len(V), "faces": len(F), "handle_vertices": [len(h) for h in handles],
@@ -118,13 +119,13 @@ def run(quick=False, meshes=MESHES, poses_of=None):
         basis = mdc.bake(V, F, modes=15, derivatives=52, ghost=1000)
         entry["bake_seconds"] = time.perf_counter() - start
         for pose, transforms in named_poses.items():
-            entry["refine"][pose] = row(refine(basis, V, F, handles, transforms))
+            entry["refine"][pose] = row(refine(basis, F, rest_areas, handles, transforms))
             print(name, "refine", pose, json.dumps(entry["refine"][pose]), flush=True)
         if name not in TARGETS["from_rest_converges"]:
             figures[name] = entry
             continue  # from rest at 100k takes most of an hour a pose
         for pose, transforms in named_poses.items():
-            entry["from_rest"][pose] = row(from_rest(V, F, handles, transforms))
+            entry["from_rest"][pose] = row(from_rest(V, F, rest_areas, handles, transforms))
             print(name, "from rest", pose, json.dumps(entry["from_rest"][pose]), flush=True)
         figures[name] = entry
     parameters = {"stiffness": STIFFNESS, "turns": TURNS, "bend": BEND, "basis": "15 modes + 52 derivatives, 1k ghost",

@@ -663,12 +663,13 @@ def section_bake_busy(result):
            "(Blender's own NumPy and OpenBLAS beside the core's). Each bake also ran quiet on one core (its "
            "affinity set to one): beside `yes` the bake's session gets about one core's worth of time, so busy / one "
            "core is what the sharing costs beyond the lost core, and busy / quiet is about one core / quiet at "
-           "least, the speed-up the second core gives. The machine is shared: each bake ran quiet, on one core and busy back "
-           "to back, the ratios are taken bake by bake, medians over "
+           "least, the speed-up the second core gives. The machine is shared: each bake ran quiet, on one core and "
+           "busy back to back, the ratios are taken bake by bake, medians over "
            f"{p['rounds']} round(s); the load average (1 min) before each bake's runs is given. Issue 25's target: "
            "busy / quiet at most 1.3.", ""]
     rows = [[bake.replace("_", " "), f"{s['quiet']:.1f}", f"{s['one_core']:.1f}", f"{s['busy']:.1f}",
-             f"{s['busy_over_quiet']:.2f}", f"{s['busy_over_one_core']:.2f}", "{:.1f}–{:.1f}".format(*s["load_before"])]
+             f"{s['busy_over_quiet']:.2f}", f"{s['busy_over_one_core']:.2f}",
+             "{:.1f}–{:.1f}".format(*s["load_before"])]
             for bake, s in summary.items() if bake != "shipped_over_spinning"]
     out.append(table(["bake", "quiet s", "one core s", "busy s", "busy / quiet", "busy / one core", "load before"],
                      rows))

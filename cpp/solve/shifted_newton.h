@@ -6,20 +6,20 @@
 // τ follows how well the quadratic model predicted the decrease (Levenberg–Marquardt with Nielsen's
 // update: shrunk after a good step, grown after a poor one — at least by the factor the line search
 // cut the step by — and tenfold when the factorisation finds the matrix not positive definite,
-// never below 2.5e-8 of the median curvature per unit mass so that a free component's rigid motions
-// stay regularised: PoseObjective::smallest_shift). A large τ shortens the step where curvature is
-// low (flaps) and leaves it Newton's where curvature is high, unlike a line search, which would
-// shorten it everywhere. The step is then backtracked (Armijo, line_search.h) when F does not
-// decrease enough or a triangle turns over. A step cut only because longer ones turned a triangle
-// over does not grow τ: the model was right wherever F was evaluated, and the triangles are a few
-// crushed ones (area 0.1–10% of rest) that a full step passes through zero area. On the 23k dragon
-// turned by 170° growing τ by the cut kept it at 1e4–1e8 times its floor and the whole mesh crept
-// (300 iterations, not converged); without, 55. Such a search starts at 0.9 of the way to where the
-// first triangle would turn over (PoseObjective::step_to_turning). The Hessian is the projected one
-// (each element's made semidefinite) far from the minimum, and the exact one near it wherever it
-// factors at the current τ (quadratic convergence). A full step that decreased F by more than 1.5
-// times what the model promised (the projected Hessian overestimating the curvature of a flap bent
-// away from a saddle) is extended to α = 2, 4, 8 while F falls.
+// never below PoseObjective::smallest_shift so that a free component's rigid motions stay
+// regularised). A large τ shortens the step where curvature is low (flaps) and leaves it Newton's
+// where curvature is high, unlike a line search, which would shorten it everywhere. The step is
+// then backtracked (Armijo, line_search.h) when F does not decrease enough or a triangle turns
+// over. A step cut only because longer ones turned a triangle over does not grow τ: the model was
+// right wherever F was evaluated, and the triangles are a few crushed ones (area 0.1–10% of rest)
+// that a full step passes through zero area. On the 23k dragon turned by 170° growing τ by the cut
+// kept it at 1e4–1e8 times its floor and the whole mesh crept (300 iterations, not converged);
+// without, 55. Such a search starts at 0.9 of the way to where the first triangle would turn over
+// (PoseObjective::step_to_turning). The Hessian is the projected one (each element's made
+// semidefinite) far from the minimum, and the exact one near it wherever it factors at the current
+// τ (quadratic convergence). A full step that decreased F by more than 1.5 times what the model
+// promised (the projected Hessian overestimating the curvature of a flap bent away from a saddle)
+// is extended to α = 2, 4, 8 while F falls.
 //
 // A factorisation costs as much as a dozen or more solves with the factor (on the 23k dragon 0.6 s
 // against 0.04 s; the Hessian's assembly 0.25 s), and from one iteration to the next the shifted

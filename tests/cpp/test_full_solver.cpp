@@ -24,11 +24,12 @@ using testing::dense_modal_basis;
 using testing::rigid_transform;
 using testing::vertices_where;
 
+// A tube of length 3 held at both ends (6 around and 5 along unless told), the far end moved.
 struct SmallTube {
-  TriangleMesh mesh = cylinder(6, 5, 1.0, 3.0);
+  TriangleMesh mesh;
   Handles handles;
   Transforms transforms;
-  SmallTube() {
+  explicit SmallTube(int around = 6, int along = 5) : mesh(cylinder(around, along, 1.0, 3.0)) {
     handles = {vertices_where(mesh.V, [](const Eigen::Vector3d& x) { return x.z() < 1e-9; }),
                vertices_where(mesh.V, [](const Eigen::Vector3d& x) { return x.z() > 3 - 1e-9; })};
     transforms = {Eigen::Matrix4d::Identity(), rigid_transform({1, 1, 1}, 1.0, {0, 0, 3}, {0.8, 0.2, -0.5})};
@@ -254,12 +255,11 @@ TEST(PoseObjective, FaceDegenerateAtRestIsNotGuarded) {
 // every step of the rest. With the paint the median curvature per unit mass rises 2.5-fold (the
 // elements around the vertex move it up the ranks of the tube's coordinates), the mean 36-fold.
 TEST(PoseObjective, ShiftFloorIgnoresAFewStiffElements) {
-  const TriangleMesh tube = cylinder(12, 20, 1.0, 3.0);
-  const int n = static_cast<int>(tube.V.rows());
-  const Handles ends = {vertices_where(tube.V, [](const Eigen::Vector3d& x) { return x.z() < 1e-9; }),
-                        vertices_where(tube.V, [](const Eigen::Vector3d& x) { return x.z() > 3 - 1e-9; })};
+  const SmallTube tube(12, 20);
+  const int n = static_cast<int>(tube.mesh.V.rows());
   auto floor_with = [&](const StiffnessPaint& paint) {
-    return PoseObjective(tube.V, tube.F, ends, Eigen::VectorXd::Ones(2), 1e3, EnergyKind::kShells, 1, 1, paint)
+    return PoseObjective(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd::Ones(2), 1e3, EnergyKind::kShells,
+                         1, 1, paint)
         .smallest_shift();
   };
   Eigen::VectorXd weights = Eigen::VectorXd::Zero(n);
