@@ -101,8 +101,7 @@ def meshes_for_renders(shape, pose, reference):
 def reference(shape, pose, energy, mass, start=None):
     """solve_full's minimum of the pose: (positions, objective, converged, stats); from rest, or
     from `start` (n, 3), a reduced pose, as Refine does."""
-    X, stats = mdc.solve_full(shape.V, shape.F, shape.handles, pose.at(1.0), stiffness=STIFFNESS, initial=start,
-                              return_stats=True)
+    X, stats = mdc.solve_full(shape.V, shape.F, shape.handles, pose.at(1.0), stiffness=STIFFNESS, initial=start)
     print(f"  {shape.name} {pose.name}: reference {'converged' if stats['converged'] else 'NOT converged'} "
           f"after {stats['iterations']} Newton iterations", flush=True)
     return X, objective(energy, mass, shape, pose.at(1.0), X), bool(stats["converged"]), stats

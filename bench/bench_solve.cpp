@@ -54,7 +54,7 @@ const Basis& dragon_basis(int dimension) {
   if (bases.empty()) {
     const TriangleMesh mesh = read_mesh(MODAL_DEFORM_SHARED_MESHES "/dragon_vrip_res2.ply.gz");
     Progress quiet;
-    Basis full = bake(mesh.V, mesh.F, BakeOptions{25, 105, 1000, EnergyKind::kShells, 1.0, 1.0}, quiet);
+    Basis full = bake(mesh.V, mesh.F, BakeOptions{25, 105, 1000, EnergyKind::kShells, {1.0, 1.0}}, quiet);
     Basis prefix = full;
     prefix.vectors = full.vectors.leftCols(67);
     prefix.ghost_vectors = full.ghost_vectors.leftCols(67);
@@ -102,7 +102,7 @@ void BM_BfgsIteration(benchmark::State& state) {
       const ReducedSolveStats stats = solver.solve(10, 1e-6);
       iterations += stats.iterations;
       evaluations += stats.evaluations;
-      milliseconds += stats.milliseconds;
+      milliseconds += stats.ms;
     }
   }
   state.counters["dimension"] = basis.dimension();
@@ -153,7 +153,7 @@ void run(benchmark::State& state, const Rod& rod) {
   FullSolveResult result;
   for (auto _ : state)
     result = solve_full(rod.mesh.V, rod.mesh.F, rod.handles, Eigen::VectorXd(), rod.transforms, 1000,
-        FullSolveOptions{energy, 1.0, 1.0, 1e-8, 200});
+        FullSolveOptions{energy, {1.0, 1.0}, 1e-8, 200});
   state.SetLabel(energy == EnergyKind::kShells ? "shells" : "arap");
   state.counters["vertices"] = static_cast<double>(rod.mesh.V.rows());
   state.counters["steps"] = result.steps;

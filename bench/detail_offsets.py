@@ -75,7 +75,7 @@ def main():
     diagonal = np.linalg.norm(np.ptp(V, axis=0))
     results = {"vertices": len(V), "proxy_vertices": basis.num_basis_vertices, "poses": {}}
     for degrees in (90, 120):
-        X_full = mdc.solve_full(V, F, handles, bent(degrees))
+        X_full, _ = mdc.solve_full(V, F, handles, bent(degrees))
 
         def converged(b):  # the animation to the pose in six frames, then to convergence
             solver = mdc.ReducedSolver(b, handles)

@@ -83,7 +83,7 @@ def cases():
         V, F = _mesh("dragon_res4")
         handles, poses = shapes.end_turns(V, turns=(30,), bend=None)
         transforms = poses[0].at(1.0)
-        X, stats = mdc.solve_full(V, F, handles, transforms, stiffness=100.0, return_stats=True)
+        X, stats = mdc.solve_full(V, F, handles, transforms, stiffness=100.0)
         arrays = {"full.positions": X, **_stats_arrays("full", stats)}
         solver = mdc.ReducedSolver(mdc.bake(V, F, modes=15), handles, stiffness=100.0)
         solver.set_transforms(transforms)

@@ -67,7 +67,7 @@ def crushed_faces(rest_areas, X, F):
 
 def from_rest(V, F, rest_areas, handles, transforms):
     start = time.perf_counter()
-    X, stats = mdc.solve_full(V, F, handles, transforms, stiffness=STIFFNESS, return_stats=True)
+    X, stats = mdc.solve_full(V, F, handles, transforms, stiffness=STIFFNESS)
     stats["wall_seconds"] = time.perf_counter() - start
     stats.update(crushed_at_start=0, crushed_at_end=crushed_faces(rest_areas, X, F))
     return stats

@@ -156,7 +156,7 @@ _CHILD = textwrap.dedent("""
         # reports it at its start), then Newton on the 100k dragon from the lower of them (Refine:
         # the own bake's pose carries its slivers' strain, about 1000 times the minimum at 30 degrees).
         handles, T = strong_poses.transforms(coarse.V, "turn", degrees, shift=(3, 1.5))
-        full = dict(stiffness=strong_poses.STIFFNESS, return_stats=True)
+        full = dict(stiffness=strong_poses.STIFFNESS)
         poses = dict(fine=fine_X, own=own_X)
         objective = {{pose: mdc.solve_full(coarse.V, coarse.F, handles, T, initial=X, max_iterations=0,
                                            **full)[1]["initial_energy"] for pose, X in poses.items()}}

@@ -27,6 +27,7 @@
 #include "reduction/orthonormalize.h"
 #include "reduction/prolongation.h"
 #include "reduction/region.h"
+#include "util/bake_stages.h"
 #include "util/errors.h"
 #include "util/require_weight.h"
 #include "util/stopwatch.h"
@@ -34,63 +35,10 @@
 namespace modal_deform {
 namespace {
 
-// Pairs per third_batch call: each call is one pass over the elements (on dragon_vrip_res2 about
-// 0.45 s plus 13 ms per pair on the shared machine), and the bar moves between calls. 64 takes
-// the paper's 52 derivatives in one pass and its 110 in two, for a temporary of 64 columns.
+// Pairs per third_batch call: each call is one pass over the elements, and the bar moves between
+// calls. 64 takes the paper's 52 derivatives in one pass and its 110 in two, for a temporary of 64
+// columns.
 constexpr int kPairsPerPass = 64;
-
-// Vibration modes past the rigid motions: the zero modes of a floppy mesh (λ below
-// kZeroEigenvalue · tr K / tr M; their vectors are the pencil's kernel past the rigid motions),
-// then `flexible` modes with λ above it, ascending.
-struct Modes {
-  Eigen::VectorXd eigenvalues;  // num_zero + flexible
-  Eigen::MatrixXd flexible;     // 3n by flexible, M-orthonormal
-  int num_zero = 0;
-};
-
-// Asks Lanczos for `flexible` modes; when zero modes come among them, it is solved again with the
-// zero modes found deflated, until the flexible modes are complete. (Asking for 6 more, room for
-// the zero modes the scans had before their debris was attached, cost the 100k dragon's bake
-// 2 s of Lanczos iterations on 6 more flexible modes than it keeps.) So is a mesh whose
-// flexible modes miss their residual tolerance next to zero modes (two cones joined at their
-// apex: with the zero modes in K, their transformed eigenvalue 1/|σ| is about 1e10 times the
-// others', which are left to rounding), or whose Lanczos run returned as soon as its zero modes
-// converged because the others could not beside them (the 5k dragon's 9 at 60 modes).
-Modes flexible_modes(ShiftedPencil& pencil, const SparseMatrix& K, const Eigen::VectorXd& mass, int flexible,
-                     Progress& progress) {
-  const double zero = kZeroEigenvalue * K.diagonal().sum() / (3 * mass.sum());
-  const auto free = static_cast<int>(K.rows() - pencil.kernel().cols());
-  std::vector<double> zero_values;
-  for (;;) {
-    const int known = static_cast<int>(zero_values.size());
-    const int count = std::min(flexible, free - known - 1);
-    if (count < flexible)
-      throw InputError(message("modes: the simulated mesh has only ", free - known,
-                               " degrees of freedom besides its rigid motions and ", known,
-                               " zero modes; ask for fewer modes"));
-    const VibrationModes modes = pencil.lowest_modes(count, &progress, zero);
-    int found = 0;
-    while (found < count && modes.eigenvalues[found] < zero) ++found;
-    // The zero modes are deflated next, and the flexible ones go into the basis: both must be
-    // accurate. Those past them only correct the derivative solves, which check their residuals.
-    const int wanted = std::min(count, found + flexible);
-    const auto within = (modes.residuals.array() <= modes.tolerances.array()).eval();
-    require_accurate(modes, 0, found);
-    if (found == 0) require_accurate(modes, 0, wanted);  // nothing to deflate: no second try
-    pencil.deflate(found);
-    zero_values.insert(zero_values.end(), modes.eigenvalues.data(), modes.eigenvalues.data() + found);
-    if (within.segment(found, wanted - found).all() && count - found >= flexible) {
-      Modes result;
-      result.num_zero = static_cast<int>(zero_values.size());
-      result.eigenvalues.resize(result.num_zero + flexible);
-      result.eigenvalues.head(result.num_zero) =
-          Eigen::Map<const Eigen::VectorXd>(zero_values.data(), result.num_zero);
-      result.eigenvalues.tail(flexible) = modes.eigenvalues.segment(found, flexible);
-      result.flexible = modes.modes.middleCols(found, flexible);
-      return result;
-    }
-  }
-}
 
 // How a bake error names a vertex of the mesh being baked: as the vertex of the artist's mesh it
 // stands for, with its position (vertex_at).
@@ -101,8 +49,8 @@ std::string vertex_at(const VerticesRef& V, int vertex) {
 }
 
 // The ghost mesh, simplified on its own thread while CHOLMOD orders the stiffness matrix: both are
-// serial, so together they take the time of the longer (on dragon_vrip_res2 the ghost 0.65 s,
-// the ordering 0.95 s), and the factorisation after them has both cores for its BLAS. When the
+// serial, so together they take the time of the longer, and the factorisation after them has
+// both cores for its BLAS. When the
 // bake stops early, the destructor cancels the ghost and waits, so nothing outlives the bake.
 class GhostInBackground {
  public:
@@ -147,10 +95,8 @@ void check_options(const BakeOptions& o, Eigen::Index num_vertices) {
   if (o.energy == EnergyKind::kArap && o.derivatives > 0)
     throw InputError(message("derivatives: the ARAP energy has no third derivative, so it has no modal derivatives; ",
                              "bake it with derivatives = 0, or use the shells energy (asked for ", o.derivatives, ")"));
-  require_weight(o.bending, "bending");
-  require_weight(o.membrane, "membrane");
-  require_stiffness_paint(o.paint, num_vertices);
-  require_paintable(o.energy, o.paint);
+  require_material(o.material, num_vertices);
+  require_paintable(o.energy, o.material.paint);
 }
 
 // What every step of one bake shares: the options, the basis it fills (its rest state first, its
@@ -184,10 +130,7 @@ Basis rest_state(const VerticesRef& V, const FacesRef& F, const BakeOptions& opt
   basis.rest = V;
   basis.mass = lumped_mass(V, F);
   basis.scale = scale;
-  basis.bending = options.bending;
-  basis.membrane = options.membrane;
-  basis.stiffness_weights = options.paint.weights;
-  basis.max_stiffness = options.paint.max_stiffness;
+  basis.material = options.material;
   basis.region = options.region;
   std::sort(basis.region.begin(), basis.region.end());
   return basis;
@@ -228,17 +171,16 @@ Attachment region_attachment(const RegionMesh& region, Eigen::Index num_vertices
   return attachment;
 }
 
-// 2. Which vertices are simulated and which follow them (attachment.h); refuses mode counts the
-// submesh cannot give.
-Simulated simulated_submesh(const VerticesRef& V, const FacesRef& F, BakeRun& run) {
+// 2. Which vertices are simulated and which follow them (attachment.h), or a region bake's
+// (`region`, null for the whole mesh); refuses mode counts the submesh cannot give.
+Simulated simulated_submesh(const VerticesRef& V, const FacesRef& F, const RegionMesh* region_or_null, BakeRun& run) {
   const BakeOptions& options = run.options;
   const Basis& basis = run.basis;
   Simulated sim;
-  RegionMesh region;
+  static const RegionMesh kWholeMesh;  // no clamped vertices
+  const RegionMesh& region = region_or_null ? *region_or_null : kWholeMesh;
   sim.attachment = run.stage(stages::kAttachment, [&] {
-    if (options.region.size() == 0) return attach(V, F);
-    region = region_mesh(F, basis.mass, options.region);
-    return region_attachment(region, V.rows());
+    return region_or_null ? region_attachment(region, V.rows()) : attach(V, F);
   });
   const std::vector<int>& simulated = sim.attachment.simulated;
   const auto S = static_cast<Eigen::Index>(simulated.size());
@@ -251,10 +193,11 @@ Simulated simulated_submesh(const VerticesRef& V, const FacesRef& F, BakeRun& ru
   const std::vector<int> clamped(region.vertices.begin() + region.num_free, region.vertices.end());
   sim.region_vertices = region.vertices;
   sim.clamped = basis.scale * V(clamped, Eigen::all);
-  sim.paint.max_stiffness = options.paint.max_stiffness;
-  if (options.paint.weights.size() > 0) {
+  const StiffnessPaint& paint = options.material.paint;
+  sim.paint.max_stiffness = paint.max_stiffness;
+  if (paint.weights.size() > 0) {
     sim.paint.weights.resize(S + static_cast<Eigen::Index>(clamped.size()));
-    sim.paint.weights << options.paint.weights(simulated), options.paint.weights(clamped);
+    sim.paint.weights << paint.weights(simulated), paint.weights(clamped);
   }
   const int components = sim.attachment.num_components;
   sim.num_rigid = 6 * components;
@@ -283,7 +226,8 @@ Stiffness stiffness_at_rest(const Simulated& sim, BakeRun& run) {
     const RowMatrixX3d V = sim.energy_vertices();
     if (options.energy == EnergyKind::kShells) {
       stiffness.shells =
-          std::make_unique<DiscreteShells>(V, sim.attachment.faces, options.bending, options.membrane, sim.paint);
+          std::make_unique<DiscreteShells>(V, sim.attachment.faces, options.material.bending,
+                                                           options.material.membrane, sim.paint);
       stiffness.K = stiffness.shells->hessian(stiffness.shells->rest());
     } else {
       const Arap arap(V, sim.attachment.faces);
@@ -346,10 +290,12 @@ Ghost order_beside_the_ghost(const MovingPart& source, const SparseMatrix& K, Sh
 // 5. The vibration modes (eigenvalue problem K φ = λ M φ), the zero modes of a floppy mesh
 // deflated into the pencil's kernel. A breakdown of the factorisation names the artist's vertex of
 // the failing row (`name`).
-Modes vibration_stage(const VertexName& name, const Simulated& sim, const SparseMatrix& K, ShiftedPencil& pencil,
+FlexibleModes vibration_stage(const VertexName& name, const Simulated& sim, const SparseMatrix& K,
+                              ShiftedPencil& pencil,
                       BakeRun& run) {
   try {
-    return flexible_modes(pencil, K, sim.mass, sim.flexible, run.progress);
+    return pencil.flexible_modes(sim.flexible, kZeroEigenvalue * K.diagonal().sum() / (3 * sim.mass.sum()),
+                                 &run.progress);
   } catch (const NumericalError& e) {
     const int row = pencil.failed_row();
     if (row < 0) throw;
@@ -366,7 +312,7 @@ struct PairedModes {
   std::vector<std::array<int, 2>> pairs;  // options.derivatives of them, in the paper's order
 };
 
-PairedModes paired_modes(const Simulated& sim, const Eigen::MatrixXd& rigid, const Modes& modes,
+PairedModes paired_modes(const Simulated& sim, const Eigen::MatrixXd& rigid, const FlexibleModes& modes,
                          const BakeOptions& options) {
   const Eigen::Index S = sim.size();
   const int paired_rotations = options.rotation_pairs ? 3 * sim.attachment.num_components : 0;
@@ -402,9 +348,9 @@ Eigen::MatrixXd third_derivatives(const DiscreteShells& shells, const PairedMode
 }
 
 // The derivatives, solved in the pencil. The shells energy and the paired modes are freed before
-// the solves, where the bake's memory peaks (on dragon_vrip_res2 with 20 + 110, with the even
-// blocks of solve_in_range, the peak falls from 2137 to 1933 MiB).
-Eigen::MatrixXd derivative_stage(const Simulated& sim, Stiffness& stiffness, const Modes& modes, ShiftedPencil& pencil,
+// the solves, where the bake's memory peaks (bench/results/bake_limit.json).
+Eigen::MatrixXd derivative_stage(const Simulated& sim, Stiffness& stiffness, const FlexibleModes& modes,
+                                 ShiftedPencil& pencil,
                                  BakeRun& run) {
   if (run.options.derivatives == 0) return Eigen::MatrixXd(3 * sim.size(), 0);
   Eigen::MatrixXd B =
@@ -415,7 +361,7 @@ Eigen::MatrixXd derivative_stage(const Simulated& sim, Stiffness& stiffness, con
 
 // 7. [rigid motions, zero modes, modes, derivatives], M-orthonormal; derivatives that came out
 // dependent are dropped (basis.num_dropped).
-Eigen::MatrixXd orthonormal_basis(const Simulated& sim, const ShiftedPencil& pencil, const Modes& modes,
+Eigen::MatrixXd orthonormal_basis(const Simulated& sim, const ShiftedPencil& pencil, const FlexibleModes& modes,
                                   Eigen::MatrixXd derivatives, BakeRun& run) {
   Basis& basis = run.basis;
   const Eigen::MatrixXd& kernel = pencil.kernel();  // the rigid motions, then the zero modes
@@ -449,7 +395,7 @@ Eigen::MatrixXd orthonormal_basis(const Simulated& sim, const ShiftedPencil& pen
 void fine_and_ghost_vectors(Eigen::MatrixXd U, const Simulated& sim, const MovingPart& source, Ghost coarse,
                             BakeRun& run) {
   Basis& basis = run.basis;
-  const StiffnessPaint& paint = run.options.paint;
+  const StiffnessPaint& paint = run.options.material.paint;
   run.stage(stages::kAssembly, [&] {
     if (U.rows() < basis.rest.size()) U = extend_to_attached(sim.attachment, U);
     U /= basis.scale;
@@ -476,19 +422,20 @@ void fine_and_ghost_vectors(Eigen::MatrixXd U, const Simulated& sim, const Movin
   });
 }
 
-// The bake of (V, F) itself, stages 2 to 8 on the rest state `basis`; errors name V's vertices by
+// The bake of (V, F) itself, stages 2 to 8 on the rest state `basis`, for a region bake in
+// `region` (region_mesh of options.region; null for the whole mesh); errors name V's vertices by
 // `name`.
-Basis bake_stages(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Basis basis,
-                  const VertexName& name, Progress& progress) {
+Basis bake_stages(const VerticesRef& V, const FacesRef& F, const RegionMesh* region, const BakeOptions& options,
+                  Basis basis, const VertexName& name, Progress& progress) {
   BakeRun run{options, basis, progress};
-  const Simulated sim = simulated_submesh(V, F, run);
+  const Simulated sim = simulated_submesh(V, F, region, run);
   Stiffness stiffness = stiffness_at_rest(sim, run);
   const MovingPart source(V, F, basis.mass, sim.region_vertices, sim.attachment.faces);
   ShiftedPencil pencil(stiffness.K, sim.mass,
                        sim.num_rigid > 0 ? rigid_motions(sim.V, sim.attachment.component, sim.mass)
                                          : Eigen::MatrixXd(3 * sim.size(), 0));
   Ghost coarse = order_beside_the_ghost(source, stiffness.K, pencil, run);
-  const Modes modes = vibration_stage(name, sim, stiffness.K, pencil, run);
+  const FlexibleModes modes = vibration_stage(name, sim, stiffness.K, pencil, run);
   Eigen::MatrixXd derivatives = derivative_stage(sim, stiffness, modes, pencil, run);
   const ShiftedPencil::Timings pencil_timings = pencil.timings();
   basis.timings[stages::kFactorisation] = pencil_timings.factorisation;
@@ -537,9 +484,9 @@ Basis bake_on_proxy(const VerticesRef& V, const FacesRef& F, const RegionMesh* r
   // The proxy's elements carry the fine paint's means (restrict_to_ghost).
   BakeOptions on_proxy = options;
   const int num_proxy = static_cast<int>(proxy.V.rows());
-  StiffnessPaint paint = options.paint;
-  if (region && paint.weights.size() > 0) paint.weights = options.paint.weights(region->vertices).eval();
-  on_proxy.paint = restrict_to_ghost(proxy.map, num_proxy, source.mass, paint);
+  StiffnessPaint paint = options.material.paint;
+  if (region && paint.weights.size() > 0) paint.weights = paint.weights(region->vertices).eval();
+  on_proxy.material.paint = restrict_to_ghost(proxy.map, num_proxy, source.mass, paint);
   // A region with nothing clamped around it (a free component) is its whole proxy.
   const bool clamped = region && region->num_free < static_cast<int>(region->vertices.size());
   on_proxy.region = clamped ? proxy_region(proxy, *region) : Eigen::VectorXi();
@@ -551,7 +498,10 @@ Basis bake_on_proxy(const VerticesRef& V, const FacesRef& F, const RegionMesh* r
     return message(vertex_at(V, region ? region->vertices[static_cast<size_t>(s)] : s),
                    ", the nearest of the mesh's vertices to the proxy's vertex ", p);
   };
-  basis = bake_stages(proxy.V, proxy.F, on_proxy, std::move(basis), fine_vertex, progress);
+  const RegionMesh proxy_region_mesh =
+      clamped ? region_mesh(proxy.F, basis.mass, on_proxy.region) : RegionMesh();
+  basis = bake_stages(proxy.V, proxy.F, clamped ? &proxy_region_mesh : nullptr, on_proxy, std::move(basis),
+                      fine_vertex, progress);
   BakeRun{options, basis, progress}.stage(stages::kProlongation, [&] {
     Prolongation onto_proxy = prolongation_to_proxy(source.V, proxy.V, proxy.F, proxy.map);
     Eigen::VectorXi ghost_map = basis.ghost_map(proxy.map);
@@ -569,7 +519,7 @@ Basis bake_on_proxy(const VerticesRef& V, const FacesRef& F, const RegionMesh* r
     }
     basis.rest = std::move(fine.rest);
     basis.mass = std::move(fine.mass);
-    basis.stiffness_weights = std::move(fine.stiffness_weights);
+    basis.material.paint.weights = std::move(fine.material.paint.weights);
     basis.region = std::move(fine.region);
   });
   return basis;
@@ -586,13 +536,14 @@ Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, 
     const VertexName own_vertex = [&V](int vertex) { return vertex_at(V, vertex); };
     Basis basis;
     if (options.region.size() == 0) {
-      basis = proxies && V.rows() > options.proxy_above ? bake_on_proxy(V, F, nullptr, options, std::move(fine), progress)
-                                                        : bake_stages(V, F, options, std::move(fine), own_vertex, progress);
+      basis = proxies && V.rows() > options.proxy_above
+                  ? bake_on_proxy(V, F, nullptr, options, std::move(fine), progress)
+                  : bake_stages(V, F, nullptr, options, std::move(fine), own_vertex, progress);
     } else {
       const RegionMesh region = region_mesh(F, fine.mass, options.region);
       basis = proxies && region.num_free > options.proxy_above
                   ? bake_on_proxy(V, F, &region, options, std::move(fine), progress)
-                  : bake_stages(V, F, options, std::move(fine), own_vertex, progress);
+                  : bake_stages(V, F, &region, options, std::move(fine), own_vertex, progress);
     }
     validate_basis(basis);
     return basis;

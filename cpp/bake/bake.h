@@ -41,7 +41,7 @@
 // is its submesh's, simplified with the free and clamped vertices kept apart (so the line between
 // them stays), baked as a region, and every fine vertex outside the region gets zero weights.
 //
-// Stages (kBakeStages in util/progress.h, in the order they run) are timed into Basis::timings and
+// Stages (kBakeStages in util/bake_stages.h, in the order they run) are timed into Basis::timings and
 // reported through Progress with the same names: for a proxy bake "proxy" first; "attachment",
 // "hessian", "factorisation" (CHOLMOD's analysis, reported before the ghost, and the numeric
 // factorisation of the pencil; the pencil times its own parts), "ghost" (the wait for the ghost beyond the analysis: it is
@@ -49,8 +49,8 @@
 // "derivative solves", "orthonormalisation", "assembly" (step 8: the fine and the ghost's
 // vectors); for a proxy bake "prolongation" last; seconds.
 // A cancel throws Cancelled at the next report and leaves nothing behind. CHOLMOD cannot report
-// during its analysis and factorisation (about 1 s and 2.5 s at 100k vertices), nor a blocked
-// solve during its right-hand sides (1 s for 47): the bar pauses there.
+// during its analysis and factorisation, nor a blocked solve during its right-hand sides: the bar
+// pauses there (bench/results/bake_busy.json times them).
 #pragma once
 
 #include <string>
@@ -63,10 +63,8 @@
 namespace modal_deform {
 
 // A mode with λ below this fraction of tr K / tr M (a mass-weighted mean of the spectrum, which
-// grows with the resolution as rounding in K does) is a zero mode. Measured on the shells
-// Hessians of the dragons, zero modes / lowest flexible mode relative to that mean: res4 (9 zero
-// modes) 2e-15 / 1.7e-7, res3 (3) 4e-14 / 9e-9, res2 (6) 3e-15 / 1.8e-10 (their doubled faces and
-// pieces hanging by one vertex, attached since, made those zero modes).
+// grows with the resolution as rounding in K does) is a zero mode: on the shared scans the zero
+// modes lie orders of magnitude below it and the lowest flexible modes orders of magnitude above.
 constexpr double kZeroEigenvalue = 1e-12;
 
 struct BakeOptions {
@@ -74,23 +72,38 @@ struct BakeOptions {
   int derivatives = 52;           // modal derivatives
   int ghost = 1000;               // ghost vertices to aim for (≥ 4; the mesh itself when ≥ #V)
   EnergyKind energy = EnergyKind::kShells;  // or ARAP, with derivatives = 0
-  double bending = 1.0;           // shells: α (finite, ≥ 0)
-  double membrane = 1.0;          // shells: β (finite, ≥ 0)
+  // Shells: α, β and the stiffness painted per vertex; every stage that sees the energy sees the
+  // paint, a proxy with its fine vertices' means; the basis keeps it for the solver's ghost.
+  Material material = {};
   // Derivatives of pairs with the linearised rotations too (the paper's rule), or of pairs of
   // flexible modes only (false; needs more modes for as many derivatives).
   bool rotation_pairs = true;
   // A mesh of more than proxy_above vertices (0: never) is baked on a proxy of about `proxy`
   // vertices (4 ≤ proxy ≤ proxy_above; a ghost of as many or more is the proxy itself), made by
-  // edge collapse, and its basis prolongated to the fine vertices (prolongation.h).
-  int proxy_above = 0;
+  // edge collapse, and its basis prolongated to the fine vertices (prolongation.h). The sizes: a
+  // mesh of proxy_above bakes as it is within the memory of an artist's machine, and a proxy of
+  // `proxy` poses as closely as the mesh's own basis (bench/results/multires.json).
+  int proxy_above = 150000;
   int proxy = 50000;
-  // Stiffness painted per vertex (shells only): every stage that sees the energy sees it, a proxy
-  // with its fine vertices' means; the basis keeps the weights for the solver's ghost.
-  StiffnessPaint paint = {};
   // Fine vertex indices that may move (any order; empty: the whole mesh). Every other vertex
   // stays at rest, clamped (region.h); the region's free vertices decide on a proxy.
   Eigen::VectorXi region = {};
 };
+
+// The options by the names the bindings take them as keywords, with their defaults from
+// BakeOptions{}: visit(name, field) with `field` an accessor o -> o.member.
+template <typename Visit>
+void for_each_bake_option(Visit&& visit) {
+  visit("modes", [](auto& o) -> auto& { return o.modes; });
+  visit("derivatives", [](auto& o) -> auto& { return o.derivatives; });
+  visit("ghost", [](auto& o) -> auto& { return o.ghost; });
+  visit("energy", [](auto& o) -> auto& { return o.energy; });
+  for_each_material_option(visit);
+  visit("rotation_pairs", [](auto& o) -> auto& { return o.rotation_pairs; });
+  visit("proxy_above", [](auto& o) -> auto& { return o.proxy_above; });
+  visit("proxy", [](auto& o) -> auto& { return o.proxy; });
+  visit("region", [](auto& o) -> auto& { return o.region; });
+}
 
 // The reduced space of (V #V by 3, F #F by 3, any length unit) per the pipeline above: a Basis in
 // the mesh's units with num_modes = modes + num_floppy and r = num_modes + derivatives − dropped

@@ -19,10 +19,8 @@ namespace {
 // the dragons; up to 12 are allowed, but memory never written is not taken); during the
 // derivative solves eight blocks as wide as the derivatives (right-hand sides, their projection,
 // the solution, residual, correction, CHOLMOD's solution and workspace, and one for what the
-// allocator holds back). Peak resident size of a whole Python process
-// baking 20 modes + 47 derivatives (it holds 0.1 to 0.3 GB before the bake): dragon_vrip_res3
-// 0.50 GB (estimate 0.42 GB), dragon_vrip_res2 2.07 GB (estimate 1.92 GB), the 406k raw scan of
-// bench/raw_scans.py 9.04 GB (estimate 8.36 GB: factor 2.86, vectors 3.90, K 1.11, mesh 0.49).
+// allocator holds back). The estimates against the measured peaks of whole processes:
+// bench/results/raw_scan.json.
 constexpr double kLanczosColumnsPerMode = 6;
 constexpr double kDerivativeBlocks = 8;
 // Bytes per vertex for the mesh, its topology, the energy's terms, the ghost and the attachment.

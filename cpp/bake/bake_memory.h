@@ -2,8 +2,8 @@
 //
 // The bake's peak is the stiffness matrix, CHOLMOD's factor of K − σM and the dense vectors of its
 // widest step. The factor's size is known from CHOLMOD's symbolic analysis, before the numeric
-// factorisation (which is where a raw scan used to run out, after half a minute); the rest
-// follows from the counts. Measured peaks against this estimate: bench/raw_scan.py.
+// factorisation (where a raw scan would run out, long into the bake); the rest follows from the
+// counts. Measured peaks against this estimate: bench/results/raw_scan.json.
 #pragma once
 
 #include "util/types.h"

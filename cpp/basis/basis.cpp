@@ -113,12 +113,10 @@ void validate_basis(const Basis& b) {
                   " by ", r));
   require(std::isfinite(b.scale) && b.scale > 0, message("scale ", b.scale, " is not a positive number"));
   require_shared([&] {
-    require_weight(b.bending, "bending");
-    require_weight(b.membrane, "membrane");
-    require_stiffness_paint(b.paint(), n);
-    require_stiffness_paint(ghost_paint(b), g, "ghost_stiffness_weights");
+    require_material(b.material, n);
+    require_stiffness_paint(ghost_material(b).paint, g, "ghost_stiffness_weights");
   });
-  require((b.stiffness_weights.size() == 0) == (b.ghost_stiffness_weights.size() == 0),
+  require((b.material.paint.weights.size() == 0) == (b.ghost_stiffness_weights.size() == 0),
           "ghost_stiffness_weights: the ghost is painted when and only when the mesh is");
   require(b.num_dropped >= 0, "num_dropped is negative");
   require_shared([&] { require_vertices(b.rest, "rest"); });

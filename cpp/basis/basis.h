@@ -9,7 +9,7 @@
 #include <map>
 #include <string>
 
-#include "energy/stiffness_paint.h"
+#include "energy/material.h"
 #include "reduction/prolongation.h"
 #include "util/types.h"
 
@@ -43,14 +43,10 @@ struct Basis {
   // #G: the painted stiffness of the ghost (mass-weighted means of the fine weights over each
   // ghost vertex's preimage, restrict_to_ghost), empty when stiffness_weights is.
   Eigen::VectorXd ghost_stiffness_weights;
-  // Energy the basis was built for and the scale of the normalised frame.
+  // The scale of the normalised frame and the material the basis was baked with (a basis stored
+  // before stiffness was painted has none: max_stiffness 1).
   double scale = 1.0;
-  double bending = 1.0;
-  double membrane = 1.0;
-  // The painted material (stiffness_weights.h): #V weights in [0, 1] (empty: uniform) and the
-  // multiplier of the energy's weights where a weight is 1.
-  Eigen::VectorXd stiffness_weights;
-  double max_stiffness = 1.0;
+  Material material = {1.0, 1.0, StiffnessPaint{}};
   // A region bake's region (region.h): its fine vertices, ascending; empty for the whole mesh.
   // The rows of vectors of every other vertex are zero.
   Eigen::VectorXi region;
@@ -64,7 +60,6 @@ struct Basis {
   // Vertices the rows of `vectors` belong to: the proxy's, or the fine mesh's own.
   int num_basis_vertices() const { return static_cast<int>(vectors.rows() / 3); }
   bool on_proxy() const { return !prolongation.empty(); }
-  StiffnessPaint paint() const { return {stiffness_weights, max_stiffness}; }
   // The 3 by r rows of the fine basis at fine vertex v (in double): P U's rows on a proxy.
   Eigen::Matrix<double, 3, Eigen::Dynamic> vertex_rows(int v) const;
 };
@@ -88,13 +83,13 @@ void for_each_stored_field(Visit&& visit) {
   visit("ghost_map", 1, [](auto& b) -> auto& { return b.ghost_map; });
   visit("ghost_vectors", 1, [](auto& b) -> auto& { return b.ghost_vectors; });
   visit("scale", 1, [](auto& b) -> auto& { return b.scale; });
-  visit("bending", 1, [](auto& b) -> auto& { return b.bending; });
-  visit("membrane", 1, [](auto& b) -> auto& { return b.membrane; });
+  visit("bending", 1, [](auto& b) -> auto& { return b.material.bending; });
+  visit("membrane", 1, [](auto& b) -> auto& { return b.material.membrane; });
   visit("num_dropped", 1, [](auto& b) -> auto& { return b.num_dropped; });
   visit("prolongation_vertices", 2, [](auto& b) -> auto& { return b.prolongation.vertices; });
   visit("prolongation_weights", 2, [](auto& b) -> auto& { return b.prolongation.weights; });
-  visit("stiffness_weights", 3, [](auto& b) -> auto& { return b.stiffness_weights; });
-  visit("max_stiffness", 3, [](auto& b) -> auto& { return b.max_stiffness; });
+  visit("stiffness_weights", 3, [](auto& b) -> auto& { return b.material.paint.weights; });
+  visit("max_stiffness", 3, [](auto& b) -> auto& { return b.material.paint.max_stiffness; });
   visit("region", 3, [](auto& b) -> auto& { return b.region; });
   visit("ghost_stiffness_weights", 3, [](auto& b) -> auto& { return b.ghost_stiffness_weights; });
 }
@@ -110,9 +105,11 @@ void for_each_stored_field(Visit&& visit) {
 // a region's vertices ascending and in range, not on a proxy, with zero rows outside it.
 void validate_basis(const Basis& basis);
 
-// The painted stiffness of the basis's ghost.
-inline StiffnessPaint ghost_paint(const Basis& basis) {
-  return {basis.ghost_stiffness_weights, basis.max_stiffness};
+// The material of the basis's ghost: the basis's, with the ghost's painted weights.
+inline Material ghost_material(const Basis& basis) {
+  Material ghost = basis.material;
+  ghost.paint.weights = basis.ghost_stiffness_weights;
+  return ghost;
 }
 
 }  // namespace modal_deform

@@ -8,8 +8,10 @@
 #include <utility>
 
 #include "bindings/bindings.h"
+#include "bindings/named_fields.h"
 #include "bindings/python_progress.h"
 #include "bake/bake.h"
+#include "util/bake_stages.h"
 
 namespace py = pybind11;
 
@@ -89,22 +91,18 @@ void bind_bake(py::module_& m) {
   for (size_t i = 0; i < kBakeStages.size(); ++i) stages[i] = kBakeStages[i];
   m.attr("BAKE_STAGES") = stages;
 
+  // The options by keyword, names and defaults from for_each_bake_option.
+  m.attr("BAKE_OPTIONS") = defaults<BakeOptions>([](auto visit) { for_each_bake_option(visit); });
   m.def(
       "bake",
-      [](const VerticesRef& V, const FacesRef& F, int modes, int derivatives, int ghost, const std::string& energy,
-         double bending, double membrane, bool rotation_pairs, int proxy_above, int proxy,
-         const Eigen::VectorXd& stiffness_weights, double max_stiffness, const Eigen::VectorXi& region,
-         const py::object& progress) {
-        const BakeOptions options{modes,    derivatives,    ghost,       energy_kind(energy),
-                                  bending,  membrane,       rotation_pairs, proxy_above,
-                                  proxy,    StiffnessPaint{stiffness_weights, max_stiffness}, region};
+      [](const VerticesRef& V, const FacesRef& F, const py::object& progress, const py::kwargs& keywords) {
+        const auto options =
+            from_keywords<BakeOptions>(keywords, [](auto visit) { for_each_bake_option(visit); }, "bake");
         Progress reporter(python_progress(progress));
         py::gil_scoped_release release;
         return bake(V, F, options, reporter);
       },
-      py::arg("V"), py::arg("F"), py::arg("modes"), py::arg("derivatives"), py::arg("ghost"), py::arg("energy"),
-      py::arg("bending"), py::arg("membrane"), py::arg("rotation_pairs"), py::arg("proxy_above"), py::arg("proxy"),
-      py::arg("stiffness_weights"), py::arg("max_stiffness"), py::arg("region"), py::arg("progress"));
+      py::arg("V"), py::arg("F"), py::kw_only(), py::arg("progress") = py::none());
 }
 
 }  // namespace modal_deform

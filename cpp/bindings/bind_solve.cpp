@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "bindings/bindings.h"
+#include "bindings/named_fields.h"
 #include "bindings/python_progress.h"
 #include "solve/full_solver.h"
 #include "solve/reduced_solver.h"
@@ -30,7 +31,9 @@ Handles to_handles(const std::vector<Eigen::VectorXi>& arrays) {
 }  // namespace
 
 void bind_solve(py::module_& m) {
-  m.attr("FULL_SOLVE_MAX_ITERATIONS") = FullSolveOptions{}.max_iterations;
+  // The options of solve_full by keyword, names and defaults from for_each_full_solve_option.
+  const auto full_solve_options = [](auto visit) { for_each_full_solve_option(visit); };
+  m.attr("FULL_SOLVE_OPTIONS") = defaults<FullSolveOptions>(full_solve_options);
   py::class_<ReducedSolver>(m, "ReducedSolver")
       .def(py::init([](const Basis& basis, const std::vector<Eigen::VectorXi>& handles, const VectorRef& weights,
                        double stiffness, const std::string& energy, bool warm_start) {
@@ -49,11 +52,7 @@ void bind_solve(py::module_& m) {
               py::gil_scoped_release release;
               stats = solver.solve(max_iterations, tolerance, budget_ms);
             }
-            return py::dict(py::arg("iterations") = stats.iterations, py::arg("energy") = stats.energy,
-                            py::arg("converged") = stats.converged, py::arg("ms") = stats.milliseconds,
-                            py::arg("evaluations") = stats.evaluations, py::arg("gradient_norm") = stats.gradient_norm,
-                            py::arg("stalled") = stats.stalled,
-                            py::arg("line_search_failures") = stats.line_search_failures);
+            return to_dict(stats, [](auto visit) { for_each_reduced_solve_stat(visit); });
           },
           py::arg("max_iterations"), py::arg("tolerance"), py::arg("budget_ms"))
       .def("reset", &ReducedSolver::reset)
@@ -78,49 +77,27 @@ void bind_solve(py::module_& m) {
 
   m.def(
       "solve_full",
-      [](const VerticesRef& V, const FacesRef& F, const std::vector<Eigen::VectorXi>& handles,
-         const Transforms& transforms, const VectorRef& weights, double stiffness, const std::string& energy,
-         double bending, double membrane, const Eigen::VectorXd& stiffness_weights, double max_stiffness,
-         double tolerance, int max_iterations, const std::optional<RowMatrixX3d>& initial,
-         const py::object& progress, const std::vector<int>& held) {
-        FullSolveOptions options;
-        options.energy = energy_kind(energy);
-        options.bending = bending;
-        options.membrane = membrane;
-        options.paint = {stiffness_weights, max_stiffness};
-        options.tolerance = tolerance;
-        options.max_iterations = max_iterations;
+      [full_solve_options](const VerticesRef& V, const FacesRef& F, const std::vector<Eigen::VectorXi>& handles,
+                           const Transforms& transforms, const VectorRef& weights, double stiffness,
+                           const std::optional<RowMatrixX3d>& initial, const py::object& progress,
+                           const py::kwargs& keywords) {
+        FullSolveOptions options = from_keywords<FullSolveOptions>(keywords, full_solve_options, "solve_full");
         options.progress = python_progress(progress);
-        options.held = held;
         FullSolveResult result;
         {
           py::gil_scoped_release release;
           result = solve_full(V, F, to_handles(handles), weights, transforms, stiffness, options,
                               initial ? &*initial : nullptr);
         }
-        py::dict stats(py::arg("steps") = result.steps, py::arg("iterations") = result.iterations,
-                       py::arg("energy") = result.energy, py::arg("converged") = result.converged,
-                       py::arg("gradient_norm") = result.gradient_norm,
-                       py::arg("gradient_scale") = result.gradient_scale,
-                       py::arg("factorizations") = result.factorizations,
-                       py::arg("initial_energy") = result.initial_energy,
-                       py::arg("relaxed_vertices") = result.relaxed_vertices, py::arg("seconds") = result.seconds,
-                       py::arg("stalled") = result.stalled);
-        // Per iteration: the Hessian model, τ, the step and why it was cut, the model's accuracy.
+        py::dict stats = to_dict(result, [](auto visit) { for_each_full_solve_stat(visit); });
         py::list history;
         for (const NewtonIteration& it : result.history)
-          history.append(py::dict(py::arg("model") = it.exact ? "exact" : "projected", py::arg("shift") = it.shift,
-                                  py::arg("step") = it.step, py::arg("guarded") = it.guarded,
-                                  py::arg("ratio") = it.ratio, py::arg("cg_iterations") = it.cg_iterations,
-                                  py::arg("progress") = it.progress,
-                                  py::arg("energy") = it.value, py::arg("gradient_norm") = it.gradient_norm));
+          history.append(to_dict(it, [](auto visit) { for_each_newton_iteration_field(visit); }));
         stats["history"] = history;
         return py::make_tuple(std::move(result.positions), stats);
       },
       py::arg("V"), py::arg("F"), py::arg("handles"), py::arg("transforms"), py::arg("weights"), py::arg("stiffness"),
-      py::arg("energy"), py::arg("bending"), py::arg("membrane"), py::arg("stiffness_weights"),
-      py::arg("max_stiffness"), py::arg("tolerance"), py::arg("max_iterations"),
-      py::arg("initial"), py::arg("progress"), py::arg("held"));
+      py::kw_only(), py::arg("initial") = py::none(), py::arg("progress") = py::none());
 }
 
 }  // namespace modal_deform

@@ -15,9 +15,9 @@ namespace modal_deform {
 namespace {
 
 // Below this many vertices the cells run on the calling thread. The reduced solver evaluates a
-// ghost mesh of 500-5000 vertices (0.6 ms per 1k serially) every BFGS iteration; there a thread
-// team saves at most half of that on idle cores and, measured on a loaded 2-core machine, doubles
-// it when the second thread is descheduled (every call waits for it at the barrier).
+// ghost mesh of 500-5000 vertices every BFGS iteration; there a thread team saves at most half of
+// a short call on idle cores, and doubles it on a loaded machine when the second thread is
+// descheduled (every call waits for it at the barrier).
 constexpr int kParallelVertices = 8192;
 
 // Eigenvalues of f_ωω below this fraction of its largest, or of its value at rest, are treated as

@@ -48,8 +48,8 @@
 //   to rounding. Measured ratio to the equilateral stiffness: the bunny's largest hinge 46,
 //   dragon_vrip_res2's median 2.5, 99th percentile 210, largest 2.9e8.
 // - a hinge's angle jumps by π when one of its triangles passes through zero area (its normal
-//   turns over), which made a bending term, and so E, jump by up to 2w there: the reduced
-//   solver's line search stalled on ghost triangles crushed during strong poses (issue 22). So a
+//   turns over), which would make a bending term, and so E, jump by up to 2w there, and the reduced
+//   solver's line search stall on ghost triangles crushed during strong poses. So a
 //   bending term fades out as either triangle is crushed: it is multiplied by φ(t1) φ(t2), with
 //   t_k = ‖n_k‖² / ‖n̄_k‖² (the squared ratio of deformed to rest area) and the quintic
 //   smoothstep φ(t) = u³(10 − 15u + 6u²), u = t / kHingeFade², for t below kHingeFade², 1

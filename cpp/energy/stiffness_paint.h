@@ -1,4 +1,4 @@
-// Stiffness painted per vertex (issue 24), as Blender's Cloth takes it from a vertex group: a
+// Stiffness painted per vertex, as Blender's Cloth takes it from a vertex group: a
 // weight w_v in [0, 1] per vertex and a maximum; each element of the energy (an edge, a triangle,
 // a hinge) has its material weights α, β multiplied by
 //

@@ -27,8 +27,8 @@ void record_cholmod_error(int status, const char* file, int line, const char* te
 // While it lives, the OpenMP parallel regions the calling thread starts run on that thread alone.
 // CHOLMOD's supernodal factorisation has loops of its own (clearing and assembling each supernode)
 // with a team size fixed when it was compiled (4 in Debian's SuiteSparse 5), a team woken and put
-// to sleep again for each of thousands of supernodes: on 2 cores the 100k dragon's factorisation
-// took 3.7 s with them, 2.3 s without (bench_linalg). The BLAS does the factorisation's work.
+// to sleep again for each of thousands of supernodes, which slows the factorisation on 2 cores
+// (bench/results/native.json, BM_CholmodFactorize). The BLAS does the factorisation's work.
 // MSVC's OpenMP 2.0 has no active levels; there the loops stay parallel.
 class SerialOpenMP {
  public:

@@ -9,12 +9,13 @@
 #include <vector>
 
 #include "mesh/mesh_check.h"
+#include "util/bake_stages.h"
 #include "util/errors.h"
+#include "util/math_constants.h"
 
 namespace modal_deform {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Weight of a boundary edge's constraint plane (through the edge, perpendicular to its face),
 // per edge length squared; face planes weigh their area.
 constexpr double kBoundaryWeight = 10.0;
@@ -471,8 +472,8 @@ void Simplifier::collapse(int u, int v, const Eigen::Vector3d& p) {
 // cheaper half is collapsed in that order, skipping the edges of a vertex that grew earlier in the
 // round (a cost depends only on the edge's two clusters, so the others are up to date). A round
 // costs a sort and a sweep instead of heap operations with cache misses per candidate and the
-// candidates pushed again after every collapse: 1.6M vertices to 100k took 22 s with the heap
-// alone, 14 s so. The heap then finishes in the exact greedy order near the target.
+// candidates pushed again after every collapse (bench/results/native.json, BM_GhostMesh). The heap
+// then finishes in the exact greedy order near the target.
 void Simplifier::collapse_in_rounds(int until, const std::function<void()>& report) {
   std::vector<Candidate> round;
   std::vector<int> locked(alive_.size(), -1);  // the last round each vertex grew in

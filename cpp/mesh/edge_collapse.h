@@ -9,10 +9,9 @@
 // scans: bench/subdivision.split_edges cuts the two copies of a face along different diagonals)
 // is not a copy of a face until its vertices merge. Two faces a collapse lays on each other cancel
 // when they are such a sheet already (their four vertices in one plane, folded onto each other);
-// the two sides of a thin part are not, and are never merged. A vertex whose faces all cancel leaves the mesh. Refusing
-// every such collapse instead left each vertex of such a sheet a cluster of its own: 2,310 single
-// fine vertices in the 50k proxy of the dragon refined to 3.2M, whose stiffness per mass, up to
-// 1e9 times the median, made K − σM numerically indefinite (issue 23). Every collapse merges
+// the two sides of a thin part are not, and are never merged. A vertex whose faces all cancel
+// leaves the mesh. (Refusing such collapses would leave each vertex of a sheet a cluster of its
+// own, a proxy vertex whose stiffness per mass makes K − σM numerically indefinite.) Every collapse merges
 // two clusters of fine vertices and puts the merged vertex at the mass-weighted centroid of its
 // cluster's rest positions (the plain mean for a cluster without mass), which is where the ghost
 // needs it; the quadric (plus a small compactness term) only ranks the candidates.
@@ -27,10 +26,10 @@
 //     kMaxNormalTurnDegrees (a needle's normal is noise), no changed face points against the input
 //     face it descends from or becomes degenerate, and the worst face around the merged vertex is
 //     no needle (quality below kMinFaceQuality) unless it is no worse than the worst face around
-//     the two vertices before (the removed faces included). Judged face by face, the last two rules
-//     left islands of uncollapsed fine vertices among large clusters on subdivided scans (every
-//     collapse there thins some needle a little or turns its normal): tiny ghost triangles that a
-//     pose crushes first (issue 22).
+//     the two vertices before (the removed faces included). The worst face is judged around the
+//     vertex, not face by face: on subdivided scans every collapse thins some needle a little or
+//     turns its normal, and face by face would leave islands of uncollapsed fine vertices, tiny
+//     ghost triangles that a pose crushes first.
 //   - sides: vertices of different sides (a region bake's free and clamped vertices) never merge,
 //     and a vertex next to the other side merges only with another such vertex along an edge of a
 //     face that reaches the other side, so the line between the sides stays where it is.

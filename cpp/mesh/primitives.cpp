@@ -5,11 +5,11 @@
 #include <vector>
 
 #include "util/errors.h"
+#include "util/math_constants.h"
 
 namespace modal_deform {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 void require_positive(int count, const char* name) {
   if (count < 1) throw InputError(message(name, ": needs at least 1, got ", count));

@@ -11,6 +11,7 @@
 #include "linalg/sparse_operations.h"
 #include "mesh/union_find.h"
 #include "modes/stiffness_and_mass.h"
+#include "util/bake_stages.h"
 #include "util/errors.h"
 
 namespace modal_deform {
@@ -189,37 +190,10 @@ std::vector<std::vector<int>> components_moved(const Eigen::Ref<const Eigen::Mat
   return moved;
 }
 
-std::vector<int> kernel_pins(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z) {
-  return pins_for(K, checked_kernel(K, mass, Z));
-}
-
 Eigen::MatrixXd solve_in_range(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z,
                                const Eigen::Ref<const Eigen::MatrixXd>& B, Progress* progress) {
   const Kernel kernel = checked_kernel(K, mass, Z);
   return solve_with_pins(K, mass, kernel, B, pins_for(K, kernel), progress);
-}
-
-Eigen::MatrixXd solve_in_range(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z,
-                               const Eigen::Ref<const Eigen::MatrixXd>& B, const std::vector<int>& pins,
-                               Progress* progress) {
-  const Kernel kernel = checked_kernel(K, mass, Z);
-  if (static_cast<Eigen::Index>(pins.size()) != Z.cols())
-    throw InputError(message("pins: expected one per column of Z (", Z.cols(), "), got ", pins.size()));
-  std::vector<bool> taken(static_cast<size_t>(K.rows()), false);
-  Eigen::MatrixXd pinned_rows(Z.cols(), Z.cols());
-  for (size_t a = 0; a < pins.size(); ++a) {
-    const int s = pins[a];
-    if (s < 0 || s >= K.rows()) throw InputError(message("pins[", a, "] = ", s, ": not a DOF"));
-    if (taken[static_cast<size_t>(s)]) throw InputError(message("pins[", a, "] = ", s, ": pinned twice"));
-    taken[static_cast<size_t>(s)] = true;
-    pinned_rows.row(static_cast<Eigen::Index>(a)) = kernel.Z.row(s);
-  }
-  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(pinned_rows);
-  qr.setThreshold(kRankThreshold);
-  if (qr.rank() != Z.cols())
-    throw InputError(message("pins: Z restricted to the pinned DOFs has rank ", qr.rank(), " of ", Z.cols(),
-                             "; they do not pin the kernel"));
-  return solve_with_pins(K, mass, kernel, B, pins, progress);
 }
 
 }  // namespace modal_deform

@@ -30,28 +30,20 @@ std::vector<std::array<int, 2>> derivative_pairs(const std::vector<std::vector<i
 std::vector<std::vector<int>> components_moved(const Eigen::Ref<const Eigen::MatrixXd>& Phi,
                                                const Eigen::Ref<const Eigen::VectorXi>& component);
 
-// The DOFs to pin so that K plus a stiffness at them is definite: in each connected component of
-// K's graph, as many DOFs as Z has rank there, chosen by column-pivoted QR of Z's rows (for rigid
-// motions a well-conditioned "3-2-1" set). K: 3n by 3n; mass: n; Z: 3n by z, M-orthonormal,
-// spanning the kernel of K. Returns z DOF indices. Throws InputError when Z does not split over
-// the components of K, as a basis of its kernel does.
-std::vector<int> kernel_pins(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z);
-
 // Ψ (3n by p) with K Ψ = P B and Zᵀ M Ψ = 0, where P projects onto the range of K (Euclidean-
 // orthogonal to its kernel): at rest, the right-hand sides ∇³E(x̄)(φᵢ, φⱼ) have components in the
 // kernel proportional to λᵢ and λⱼ, which eq. 13 cannot match.
 // K: 3n by 3n symmetric positive semidefinite; mass: n vertex masses; Z: 3n by z, M-orthonormal,
 // spanning the kernel of K (rigid_motions for a rigid-invariant energy); B: 3n by p.
-// K plus a stiffness at the pinned DOFs (kernel_pins unless given) is factored once and solved
-// for blocks of columns, reporting ("derivative solves", fraction) to `progress`. DOFs without
-// mass and stiffness (stiffness_and_mass.h) get zero rows. Throws InputError for inconsistent
-// input (Z not M-orthonormal or not in the kernel, bad pins) and NumericalError when the pinned
-// matrix is singular (Z misses part of the kernel) or a solution fails its residual check.
+// K plus a stiffness at pinned DOFs is factored once and solved for blocks of columns, reporting
+// ("derivative solves", fraction) to `progress`. The pins: in each connected component of K's
+// graph as many DOFs as Z has rank there, chosen by column-pivoted QR of Z's rows (for rigid
+// motions a well-conditioned "3-2-1" set). DOFs without mass and stiffness (stiffness_and_mass.h)
+// get zero rows. Throws InputError for inconsistent input (Z not M-orthonormal, not in the kernel
+// or not split over the components of K) and NumericalError when the pinned matrix is singular
+// (Z misses part of the kernel) or a solution fails its residual check.
 Eigen::MatrixXd solve_in_range(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z,
                                const Eigen::Ref<const Eigen::MatrixXd>& B, Progress* progress = nullptr);
-Eigen::MatrixXd solve_in_range(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z,
-                               const Eigen::Ref<const Eigen::MatrixXd>& B, const std::vector<int>& pins,
-                               Progress* progress = nullptr);
 
 // What the solves in the range above share, for a caller with a solver of its own (ShiftedPencil):
 // Ψ written over B, block by block of at most 64 columns, each block's P B handed to

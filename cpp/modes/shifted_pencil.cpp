@@ -13,6 +13,7 @@
 #include "linalg/sparse_operations.h"
 #include "modes/modal_derivatives.h"
 #include "modes/stiffness_and_mass.h"
+#include "util/bake_stages.h"
 #include "util/errors.h"
 #include "util/stopwatch.h"
 
@@ -25,15 +26,12 @@ namespace {
 // eigenvalues are 0.024 and 0.037), so σ sits just below λ = 0 while K − σM stays far from
 // singular. Zero modes left in K (undeflated ones, a floppy mesh's mechanisms) want σ not too
 // close to 0: at 1e-10 the residuals of the other modes of two small spring networks exceed
-// 1e-8 of the top eigenvalue. The wanted modes want it not far below them: deflating the rigid
-// motions, Spectra's single-vector Lanczos (used before the block solver) took on the 100k
-// dragon 111 solves for 14 modes at 1e-8, 50 at 1e-10 or 1e-12; on the 23k dragon 20 modes took
-// 93 solves for every fraction from 1e-12 to 1e-8 (106 at 1e-6).
+// 1e-8 of the top eigenvalue. The wanted modes want it not far below them, or Lanczos needs more
+// solves per mode.
 // The deflated fraction also sets how often the bake's derivative solves refine: their
-// contraction −σ/(λ − σ) on the 100k dragon's 15 + 52 is 4.3e-3 at 1e-10 (two steps to 1e-3),
-// 4.3e-4 at 1e-11 (one step, a 52-wide solve saved; its 88 Lanczos solves unchanged). 1e-12
-// leaves small meshes' modes above their residual tolerance (the ARAP bake of a 3 by 3 by 3
-// bar: 5.3e-7 against 3.0e-7); 1e-11 keeps them within.
+// contraction is −σ/(λ − σ), so a σ ten times closer to 0 saves a refinement step (a solve as wide
+// as the derivatives); much closer (1e-12) leaves small meshes' modes above their residual
+// tolerance (the ARAP bake of a 3 by 3 by 3 bar, tests/cpp/test_bake.cpp).
 constexpr double kShiftFraction = 1e-8;
 constexpr double kDeflatedShiftFraction = 1e-11;
 // A mode fails when its residual exceeds kResidualTolerance · (|λ| + the largest λ computed) +
@@ -42,10 +40,8 @@ constexpr double kDeflatedShiftFraction = 1e-11;
 constexpr double kResidualTolerance = 1e-6;
 constexpr double kRoundingFloor = 1e-12;
 
-// Lanczos stops when ‖T y − ν y‖_M ≤ kEigenTolerance |ν| for each wanted Ritz pair (Spectra's
-// criterion, used here before the block solver): 1e-8 left residuals of 9e-11 on the bunny's
-// springs after the final inverse iteration, 1e-10 5e-13 (tests/cpp/test_vibration_modes.cpp
-// asks for 2.5e-11). On dragon_vrip_res2 each block of 8 takes the estimate down 30 to 60 times.
+// Lanczos stops when ‖T y − ν y‖_M ≤ kEigenTolerance |ν| for each wanted Ritz pair: tight enough
+// for the residuals tests/cpp/test_vibration_modes.cpp asks for after the final inverse iteration.
 constexpr double kEigenTolerance = 1e-10;
 // A Ritz estimate stops falling near the rounding of the largest ν, ε ν_max: on the 5k dragon with
 // its 9 zero modes undeflated (ν = 1.4e5), the estimates of the modes with tolerances of 0.6 to
@@ -64,11 +60,10 @@ constexpr double kDependentNorm = 1e-8;
 // 4 lowest modes took more than 56), plus the first block. The dragons take 5 to 6 per mode.
 constexpr int kMaxColumnsPerMode = 12;
 constexpr int kMinColumns = 120;
-// Right-hand sides per block solve. A single solve streams the whole factor (92 ms on
-// dragon_vrip_res2, whose factor is 572 MB); blocks share the stream: 27 ms per right-hand side
-// in blocks of 8, 20 in blocks of 16. 15 modes of that dragon took 103 right-hand sides in blocks
-// of 8 (3.5 s) where Spectra's single-vector Lanczos took 52 (5.0 s); blocks of 16 need about 1.4
-// times as many, which their cheaper solves do not repay, and keep more vectors.
+// Right-hand sides per block solve. A single solve streams the whole factor; a block shares the
+// stream among its columns, so a solve per column costs less in wider blocks, but wider blocks
+// need more columns for the same modes and keep more vectors: 8 balances the two (the cost per
+// column: bench/results/native.json, BM_CholmodSolve/1 against BM_CholmodSolve/64).
 constexpr int kBlockWidth = 8;
 
 // solve_in_range refines until the error left on each eigenvector it does not know is below this
@@ -390,6 +385,40 @@ VibrationModes ShiftedPencil::lowest_modes(int count, Progress* progress, double
     ++deflatable_;
   if (progress) progress->report(stages::kModes, 1.0);
   return result;
+}
+
+FlexibleModes ShiftedPencil::flexible_modes(int flexible, double zero, Progress* progress) {
+  const auto free = static_cast<int>(K_.rows() - kernel_.cols());
+  std::vector<double> zero_values;
+  for (;;) {
+    const int known = static_cast<int>(zero_values.size());
+    const int count = std::min(flexible, free - known - 1);
+    if (count < flexible)
+      throw InputError(message("modes: the simulated mesh has only ", free - known,
+                               " degrees of freedom besides its rigid motions and ", known,
+                               " zero modes; ask for fewer modes"));
+    const VibrationModes modes = lowest_modes(count, progress, zero);
+    int found = 0;
+    while (found < count && modes.eigenvalues[found] < zero) ++found;
+    // The zero modes are deflated next, and the flexible ones go into the basis: both must be
+    // accurate. Those past them only correct the derivative solves, which check their residuals.
+    const int wanted = std::min(count, found + flexible);
+    const auto within = (modes.residuals.array() <= modes.tolerances.array()).eval();
+    require_accurate(modes, 0, found);
+    if (found == 0) require_accurate(modes, 0, wanted);  // nothing to deflate: no second try
+    deflate(found);
+    zero_values.insert(zero_values.end(), modes.eigenvalues.data(), modes.eigenvalues.data() + found);
+    if (within.segment(found, wanted - found).all() && count - found >= flexible) {
+      FlexibleModes result;
+      result.num_zero = static_cast<int>(zero_values.size());
+      result.eigenvalues.resize(result.num_zero + flexible);
+      result.eigenvalues.head(result.num_zero) =
+          Eigen::Map<const Eigen::VectorXd>(zero_values.data(), result.num_zero);
+      result.eigenvalues.tail(flexible) = modes.eigenvalues.segment(found, flexible);
+      result.flexible = modes.modes.middleCols(found, flexible);
+      return result;
+    }
+  }
 }
 
 void ShiftedPencil::deflate(int count) {

@@ -35,6 +35,14 @@ struct VibrationModes {
 // tolerance.
 void require_accurate(const VibrationModes& modes, int first, int last);
 
+// Vibration modes past a pencil's kernel (ShiftedPencil::flexible_modes): the zero modes of a
+// floppy mesh, deflated into the kernel, then the flexible modes, ascending.
+struct FlexibleModes {
+  Eigen::VectorXd eigenvalues;  // num_zero + flexible
+  Eigen::MatrixXd flexible;     // 3n by flexible, M-orthonormal
+  int num_zero = 0;
+};
+
 class ShiftedPencil {
  public:
   // kernel: 3n by z, M-orthonormal, in the kernel of K (rigid_motions for a rigid-invariant
@@ -63,6 +71,16 @@ class ShiftedPencil {
   // the eigensolver does not converge, OutOfMemory.
   VibrationModes lowest_modes(int count, Progress* progress = nullptr, double zero_modes_below = 0);
 
+  // The zero modes (λ below `zero`) of a floppy mesh, deflated into the kernel, and `flexible`
+  // modes above them. Lanczos is asked for `flexible` modes; when zero modes come among them, it is
+  // asked again with those deflated, until the flexible modes are complete (asking for spare modes
+  // up front would cost every bake Lanczos iterations on modes it does not keep). So is a mesh
+  // whose flexible modes miss their residual tolerance next to zero modes (two cones joined at
+  // their apex: with the zero modes in K, their transformed eigenvalue 1/|σ| dwarfs the others',
+  // which are left to rounding), or whose Lanczos run returned as soon as its zero modes converged
+  // because the others could not beside them. Throws InputError when the pencil has too few
+  // degrees of freedom, and as lowest_modes and require_accurate.
+  FlexibleModes flexible_modes(int flexible, double zero, Progress* progress = nullptr);
   // The `count` lowest modes of the last lowest_modes join the kernel (a floppy mesh's zero
   // modes); the next lowest_modes is M-orthogonal to them. Throws InputError past those modes.
   void deflate(int count);
@@ -71,8 +89,8 @@ class ShiftedPencil {
   // of K (as solve_in_range in modal_derivatives.h) through this factor of K − σM: exact on the
   // eigenpairs of the last lowest_modes within their tolerance and not deflated, each off by
   // λ/(λ − σ) on the others, so refined (ψ += (K − σM)⁻¹(P b − K ψ)) until each such component
-  // is within 1e-3 (one step on the 100k dragon). Saves a factorisation (2.5 s at 100k
-  // vertices) for a solve and a product with K per step. B (3n by p) is taken by value and Ψ is
+  // is within 1e-3 (usually one step). Saves a factorisation for a solve and a product with K per
+  // step. B (3n by p) is taken by value and Ψ is
   // written over it. Reports ("derivative solves", fraction). Throws InputError for a bad B or
   // before any eigenpair is known; NumericalError when a column fails its residual check.
   Eigen::MatrixXd solve_in_range(Eigen::MatrixXd B, Progress* progress = nullptr);

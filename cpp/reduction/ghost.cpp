@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "mesh/edge_collapse.h"
+#include "util/bake_stages.h"
 #include "util/errors.h"
 
 namespace modal_deform {

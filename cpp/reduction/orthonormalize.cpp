@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "linalg/row_blocks.h"
+#include "util/bake_stages.h"
 #include "util/errors.h"
 
 namespace modal_deform {

@@ -8,10 +8,9 @@
 namespace modal_deform {
 namespace {
 
-// A step whose predicted decrease −∇fᵀp is below this fraction of 1 + |f| is lost in the rounding
-// of f (a sum of thousands of rounded terms): a line search failing on it finds x a minimum at
-// working precision, not a stall.
-constexpr double kUnresolvableDecrease = 1e-12;
+// The update is skipped unless sᵀy exceeds this fraction of ‖s‖‖y‖: a pair with less curvature
+// along the step would make H near singular or indefinite.
+constexpr double kMinCurvatureCosine = 1e-12;
 
 }  // namespace
 
@@ -90,7 +89,7 @@ BfgsResult Bfgs::minimize(const Objective& objective, int max_iterations, double
     value_ = value_new_;
     ++result.iterations;
     const double sy = s_.dot(y_);
-    if (sy > 1e-12 * s_.norm() * y_.norm()) {
+    if (sy > kMinCurvatureCosine * s_.norm() * y_.norm()) {
       // H ← (I − ρsyᵀ) H (I − ρysᵀ) + ρssᵀ, ρ = 1/yᵀs, expanded to rank-one updates (H symmetric).
       const double rho = 1 / sy;
       Hy_.noalias() = H_ * y_;

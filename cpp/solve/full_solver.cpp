@@ -23,8 +23,7 @@ constexpr int kIterationsPerIntermediateStep = 20;
 // Newton uses the exact Hessian once ‖∇F‖ is below this fraction of its scale (quadratic
 // convergence near the minimum), the projected one above it (each element's Hessian made
 // semidefinite: a sliver hinge bent far from rest is strongly indefinite, and the shift that
-// would make the exact Hessian definite damps the whole mesh; on the 5k dragon it reached 1e5
-// times the mean curvature, and iterations crept).
+// would make the exact Hessian definite damps the whole mesh, so iterations creep).
 constexpr double kExactHessianBelow = 1e-3;
 
 // The checks solve_full makes before any work; returns the handles' weights.
@@ -78,8 +77,7 @@ FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handle
   Progress progress(options.progress);
   progress.report("solve", 0);
 
-  PoseObjective objective(V, F, handles, handle_weights, stiffness, options.energy, options.bending,
-                          options.membrane, options.paint, options.held);
+  PoseObjective objective(V, F, handles, handle_weights, stiffness, options.energy, options.material, options.held);
   const LoadPath path(V, handles, transforms);
   ShiftedNewton newton(objective);
 

@@ -33,24 +33,32 @@ namespace modal_deform {
 
 struct FullSolveOptions {
   EnergyKind energy = EnergyKind::kShells;
-  double bending = 1.0;  // the shells weights (ignored by ARAP)
-  double membrane = 1.0;
+  Material material = {};  // the shells weights and their painting (ignored by ARAP, which takes no paint)
   // In (0, 1): the factor by which ‖∇F‖ must drop below the larger of its values at rest and at
   // `initial` at the full load.
   double tolerance = 1e-8;
-  // ≥ 0: Newton iterations at most, all load steps together (also the Python API's default, exported
-  // as FULL_SOLVE_MAX_ITERATIONS). Strong poses of scans need hundreds while F falls steadily: the
-  // 23k dragon bent by 90° converges in 346 from its reduced pose and in 771 from rest (triangles
-  // on the inside of the bend are crushed one after another, each cutting a step); 300 left both
-  // unconverged.
+  // ≥ 0: Newton iterations at most, all load steps together. Strong poses of scans need hundreds
+  // while F falls steadily (triangles on the inside of a bend are crushed one after another, each
+  // cutting a step): bench/results/refine.json, the 23k dragon's bend.
   int max_iterations = 1000;
   // Called as ("solve", fraction done) at most every 0.1 s; returning false cancels (Cancelled).
   ProgressCallback progress = nullptr;
-  StiffnessPaint paint = {};  // the shells weights painted per vertex (stiffness_paint.h; not with ARAP)
   // Vertices held exactly where the solve starts (at rest, or at `initial`): a region bake's
   // outside, which Refine keeps still. Their coordinates leave the unknowns.
   std::vector<int> held = {};
 };
+
+// The options by the names the bindings take them as keywords, with their defaults from
+// FullSolveOptions{} (the callback apart): visit(name, field) with `field` an accessor
+// o -> o.member.
+template <typename Visit>
+void for_each_full_solve_option(Visit&& visit) {
+  visit("energy", [](auto& o) -> auto& { return o.energy; });
+  for_each_material_option(visit);
+  visit("tolerance", [](auto& o) -> auto& { return o.tolerance; });
+  visit("max_iterations", [](auto& o) -> auto& { return o.max_iterations; });
+  visit("held", [](auto& o) -> auto& { return o.held; });
+}
 
 struct FullSolveResult {
   RowMatrixX3d positions;     // #V by 3, mesh units
@@ -67,6 +75,23 @@ struct FullSolveResult {
   bool stalled = false;       // stopped because F no longer decreased (not converged)
   std::vector<NewtonIteration> history;  // every Newton iteration, all load steps together
 };
+
+// The scalar fields of a FullSolveResult by name (the Python API's stats; positions and history
+// apart): visit(name, field) with `field` an accessor r -> r.member.
+template <typename Visit>
+void for_each_full_solve_stat(Visit&& visit) {
+  visit("steps", [](auto& r) -> auto& { return r.steps; });
+  visit("iterations", [](auto& r) -> auto& { return r.iterations; });
+  visit("energy", [](auto& r) -> auto& { return r.energy; });
+  visit("converged", [](auto& r) -> auto& { return r.converged; });
+  visit("gradient_norm", [](auto& r) -> auto& { return r.gradient_norm; });
+  visit("gradient_scale", [](auto& r) -> auto& { return r.gradient_scale; });
+  visit("factorizations", [](auto& r) -> auto& { return r.factorizations; });
+  visit("initial_energy", [](auto& r) -> auto& { return r.initial_energy; });
+  visit("relaxed_vertices", [](auto& r) -> auto& { return r.relaxed_vertices; });
+  visit("seconds", [](auto& r) -> auto& { return r.seconds; });
+  visit("stalled", [](auto& r) -> auto& { return r.stalled; });
+}
 
 // V: #V by 3 rest positions, F: #F by 3 triangles (validate_mesh); handles and weights as in
 // checked_handle_weights; transforms: one rigid 4 by 4 transform per handle (check_transforms);

@@ -47,6 +47,11 @@ struct BacktrackingResult {
   int insufficient = 0;  // trials rejected because f did not decrease enough
 };
 
+// A decrease below this fraction of 1 + |f| is lost in the rounding of f (a sum of thousands of
+// rounded terms): the `noise` the searches' callers pass, and the predicted decrease below which a
+// failed search finds x a minimum at working precision, not a stall.
+constexpr double kUnresolvableDecrease = 1e-12;
+
 // Halves α from `initial_step` (≤ 1) until f(x + αp) ≤ f(x) + c1 α ∇f(x)ᵀp (a point where f
 // returns +inf or NaN counts as too far), at most max_halvings times. Near a minimum the decrease
 // a step promises falls below the rounding of f; with noise > 0 (an absolute bound on that

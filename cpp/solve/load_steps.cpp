@@ -4,11 +4,11 @@
 #include <cmath>
 
 #include "mesh/normalization.h"
+#include "util/math_constants.h"
 
 namespace modal_deform {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kMaxLoadSteps = 100;
 // From rest, the first load step is this fraction of the suggested one.
 constexpr double kFirstStepDivisor = 6;

@@ -21,10 +21,10 @@ Eigen::Vector3d side(const Eigen::VectorXd& y, int from, int to) {
 }  // namespace
 
 PoseObjective::PoseObjective(const VerticesRef& V, const FacesRef& F, const Handles& handles,
-                             const Eigen::VectorXd& weights, double stiffness, EnergyKind energy, double bending,
-                             double membrane, const StiffnessPaint& paint, const std::vector<int>& held)
+                             const Eigen::VectorXd& weights, double stiffness, EnergyKind energy,
+                             const Material& material, const std::vector<int>& held)
     : PoseObjective(normalizing_scale(V) * V, normalizing_scale(V), F,
-                    Terms{handles, weights, stiffness, energy, bending, membrane, paint}, held) {}
+                    Terms{handles, weights, stiffness, energy, material}, held) {}
 
 PoseObjective::PoseObjective(RowMatrixX3d rest, double scale, const FacesRef& F, Terms terms,
                              const std::vector<int>& held)
@@ -32,7 +32,7 @@ PoseObjective::PoseObjective(RowMatrixX3d rest, double scale, const FacesRef& F,
       transforms_(terms_.handles.size(), Eigen::Matrix4d::Identity()),
       scale_(scale),
       rest_(std::move(rest)),
-      energy_(make_energy(terms_.energy, rest_, F, terms_.bending, terms_.membrane, terms_.paint)),
+      energy_(make_energy(terms_.energy, rest_, F, terms_.material)),
       handle_term_(rest_, lumped_mass(rest_, F), terms_.handles, terms_.weights, terms_.stiffness),
       faces_(F) {
   const int n = static_cast<int>(rest_.rows());
@@ -54,11 +54,9 @@ PoseObjective::PoseObjective(RowMatrixX3d rest, double scale, const FacesRef& F,
     if (mass[v] == 0 && hessian_diagonal.segment<3>(3 * v).isZero(0) && handle_diagonal.segment<3>(3 * v).isZero(0))
       constant_diagonal_.segment<3>(3 * v).setConstant(mean_mass);
   // The floor of the shift: a fraction of the median curvature per unit mass at rest (coordinates
-  // in no term left out). The mean, 1e-8 of which it was, follows a raw scan's slivers, whose terms
-  // are far stiffer than the rest: on the raw-scan-like 23k dragon the floor was 650 times the clean
-  // dragon's, τ sat on it and every step was damped (Refine at turn 30: 141 iterations and 158
-  // factorisations; now 74 and 67, in 0.49 of the time). On the clean dragons the mean is 2.2 to
-  // 2.4 times the median, hence 2.5e-8: their floor stays about where it was.
+  // in no term left out). The median, not the mean: a raw scan's slivers have terms far stiffer than
+  // the rest, which would lift a mean, and τ sitting on a high floor damps every step
+  // (bench/results/refine.json, the raw-scan-like dragon).
   std::vector<double> curvature;
   for (Eigen::Index i = 0; i < mass_diagonal_.size(); ++i)
     if (const double c = std::abs(hessian_diagonal[i] + handle_diagonal[i]) / mass_diagonal_[i]; c > 0)
@@ -102,11 +100,12 @@ PoseObjective PoseObjective::around(const std::vector<int>& free, std::vector<in
   RowMatrixX3d rest(static_cast<Eigen::Index>(vertices.size()), 3);
   std::vector<int> held;
   Terms terms = terms_;
-  if (!terms_.paint.uniform()) terms.paint.weights.resize(static_cast<Eigen::Index>(vertices.size()));
+  const StiffnessPaint& paint = terms_.material.paint;
+  if (!paint.uniform()) terms.material.paint.weights.resize(static_cast<Eigen::Index>(vertices.size()));
   for (size_t i = 0; i < vertices.size(); ++i) {
     const auto local = static_cast<Eigen::Index>(i);
     rest.row(local) = rest_.row(vertices[i]);
-    if (!terms_.paint.uniform()) terms.paint.weights[local] = terms_.paint.weights[vertices[i]];
+    if (!paint.uniform()) terms.material.paint.weights[local] = paint.weights[vertices[i]];
     if (!is_free[vertices[i]]) held.push_back(static_cast<int>(i));
   }
   for (std::vector<int>& handle : terms.handles) {

@@ -17,13 +17,12 @@ namespace modal_deform {
 class PoseObjective {
  public:
   // V: #V by 3 rest positions and F: #F by 3 triangles (validated); handles and weights as
-  // checked_handle_weights returns them; stiffness μ > 0; energy, bending, membrane and paint as
-  // make_energy takes them.
+  // checked_handle_weights returns them; stiffness μ > 0; energy and material as make_energy takes
+  // them.
   // `held` (vertex indices in range) stay where y puts them: their gradient and their Hessian rows
   // are zero.
   PoseObjective(const VerticesRef& V, const FacesRef& F, const Handles& handles, const Eigen::VectorXd& weights,
-                double stiffness, EnergyKind energy, double bending, double membrane, const StiffnessPaint& paint,
-                const std::vector<int>& held = {});
+                double stiffness, EnergyKind energy, const Material& material, const std::vector<int>& held = {});
 
   // The same objective, up to a constant, as a function of the `free` vertices' coordinates (none
   // held) with every other vertex held: only the faces that touch a free vertex or a neighbour of
@@ -75,8 +74,7 @@ class PoseObjective {
     Eigen::VectorXd weights;
     double stiffness;
     EnergyKind energy;
-    double bending, membrane;
-    StiffnessPaint paint;
+    Material material;
   };
   // rest: #V by 3 in the normalised frame, scale the factor it was scaled by from mesh units.
   PoseObjective(RowMatrixX3d rest, double scale, const FacesRef& F, Terms terms, const std::vector<int>& held);

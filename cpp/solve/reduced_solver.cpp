@@ -31,8 +31,7 @@ ReducedSolver::ReducedSolver(const Basis& basis, const Handles& handles, const V
                              EnergyKind energy, bool warm_start)
     : basis_(checked(basis)),
       num_handles_(static_cast<int>(handles.size())),
-      energy_(make_energy(energy, basis.scale * basis.ghost_vertices, basis.ghost_faces, basis.bending,
-                          basis.membrane, ghost_paint(basis))),
+      energy_(make_energy(energy, basis.scale * basis.ghost_vertices, basis.ghost_faces, ghost_material(basis))),
       ghost_rest_(basis.scale * flatten(basis.ghost_vertices)),
       ghost_vectors_(basis.scale * basis.ghost_vectors),
       handle_term_(HandleTerm(basis.rest, basis.mass, handles,
@@ -90,7 +89,7 @@ ReducedSolveStats ReducedSolver::solve(int max_iterations, double tolerance, dou
   stats.line_search_failures = result.line_search_failures;
   stats.energy = bfgs_.value();
   stats.gradient_norm = bfgs_.gradient().norm();
-  stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  stats.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return stats;
 }
 

@@ -40,13 +40,27 @@ struct ReducedSolveStats {
   bool converged = false;    // the stopping test holds (bfgs.h)
   bool stalled = false;      // not converged, and no step decreases f (BfgsResult::stalled)
   int line_search_failures = 0;  // line searches of this call that found no decrease
-  double milliseconds = 0;   // wall time of the call
+  double ms = 0;             // wall time of the call, milliseconds
 };
+
+// The fields of ReducedSolveStats by name (the Python API's stats dict): visit(name, field) with
+// `field` an accessor s -> s.member.
+template <typename Visit>
+void for_each_reduced_solve_stat(Visit&& visit) {
+  visit("iterations", [](auto& s) -> auto& { return s.iterations; });
+  visit("energy", [](auto& s) -> auto& { return s.energy; });
+  visit("converged", [](auto& s) -> auto& { return s.converged; });
+  visit("ms", [](auto& s) -> auto& { return s.ms; });
+  visit("evaluations", [](auto& s) -> auto& { return s.evaluations; });
+  visit("gradient_norm", [](auto& s) -> auto& { return s.gradient_norm; });
+  visit("stalled", [](auto& s) -> auto& { return s.stalled; });
+  visit("line_search_failures", [](auto& s) -> auto& { return s.line_search_failures; });
+}
 
 class ReducedSolver {
  public:
   // positions() is within this fraction of the rest's bounding-box diagonal of the float32 map: a
-  // third of what the pose may differ by (issue 23: 1e-4), far below what shows (60 µm on 2 m).
+  // third of the 1e-4 the pose may differ by, far below what shows (60 µm on 2 m).
   static constexpr double kMapTolerance = 3e-5;
 
   // basis: validated here (validate_basis); it must outlive the solver, which keeps a reference

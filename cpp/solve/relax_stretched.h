@@ -2,11 +2,10 @@
 //
 // A reduced pose moves a scan's fins and needles (a vertex hanging from the mesh by a doubled or
 // sliver triangle) with the basis, and the ghost the reduced solver minimises on does not see
-// them: on the 100k dragon turned by 30° three such vertices sit 0.15–0.23 units (2% of its
-// length) off, their edges stretched 260–530 times, and they hold 98% of F at the start. A full
-// Newton step swings them through their base edges, so the turn-over guard cuts the step of the
-// whole mesh: 12 iterations at α from 1e-4 to 0.06 before the steps grew. Relaxing those
-// vertices alone first, on the few faces around them, costs milliseconds.
+// them: such a vertex sits far off, its edges stretched hundreds of times, and holds most of F at
+// the start. A full Newton step swings it through its base edges, so the turn-over guard cuts the
+// step of the whole mesh for many iterations. Relaxing those vertices alone first, on the few
+// faces around them, costs milliseconds (bench/results/refine.json, "relaxed").
 #pragma once
 
 #include "solve/pose_objective.h"
@@ -14,12 +13,9 @@
 
 namespace modal_deform {
 
-// Edges longer than this many times their rest length mark their vertices as stretched. The
-// 100k dragon turned by 30° has 38 such edges at its reduced pose (17 vertices, fins); the 23k
-// dragon's reduced poses 0 to 6, by at most 9 times. The outcome is sensitive to the set: on the
-// 100k turn, 17 vertices relaxed took Newton 21 iterations / 15 factorisations, the 15 beyond
-// 10 times 46 / 30, and 23 (also triangles crushed below a third) 16 / 11, which cost the 23k turn
-// by 170° 234 iterations instead of 56 (its crushed triangles are what the pose needs).
+// Edges longer than this many times their rest length mark their vertices as stretched: the fins
+// of a scan's reduced pose, not the triangles a strong pose crushes (those are what the pose
+// needs, and relaxing them costs Newton iterations).
 inline constexpr double kStretchedBeyond = 3.0;
 
 // Minimises F over the coordinates of the vertices (not held) of the edges `point` stretches

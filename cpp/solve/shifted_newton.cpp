@@ -71,7 +71,7 @@ bool ShiftedNewton::iterate(NewtonPoint& point, bool near_minimum, double forcin
   const double slope = point.gradient.dot(step_);
   product_.noalias() = hessian_ * step_;
   const double curvature = step_.dot(product_) + step_.dot(objective_.constant_diagonal().cwiseProduct(step_));
-  const double noise = 1e-12 * (1 + std::abs(point.value));
+  const double noise = kUnresolvableDecrease * (1 + std::abs(point.value));
   // The first trial stops short of the first triangle's turning point (an interior point method's
   // fraction to the boundary): halving from 1 lands anywhere between half of it and all of it. No
   // trial of the search turns a triangle over, so only extend() checks for it.
@@ -84,7 +84,8 @@ bool ShiftedNewton::iterate(NewtonPoint& point, bool near_minimum, double forcin
   const bool guarded = search.step > 0 && search.step < 1 && search.insufficient == 0;
   const double ratio =
       search.step > 0 ? (point.value - trial_.value) / predicted_decrease(search.step, slope, curvature) : 0;
-  NewtonIteration record{exact, shift_, search.step, guarded, ratio, cg_iterations};
+  NewtonIteration record{exact ? HessianModel::kExact : HessianModel::kProjected, shift_, search.step, guarded, ratio,
+                         cg_iterations};
   update_shift(guarded ? 1 : search.step, ratio);
   if (search.step == 1 && ratio > kExtendAbove) {
     // A trial point beyond 1 that turns a triangle over counts as too far.
@@ -98,7 +99,7 @@ bool ShiftedNewton::iterate(NewtonPoint& point, bool near_minimum, double forcin
         point.value - trial_.value > noise || trial_.gradient.norm() < 0.5 * point.gradient.norm();
     std::swap(point, trial_);
   }
-  record.value = point.value;
+  record.energy = point.value;
   record.gradient_norm = point.gradient.norm();
   history_.push_back(record);
   return record.progress;
@@ -145,9 +146,7 @@ int ShiftedNewton::solve_by_cg(const SparseMatrix& hessian, const Eigen::VectorX
     if (residual_norm <= bound) return k;
     // Given up once the mean decrease so far would not reach the bound within the budget, from the
     // first iteration on: most attempts that fail do so while a crushed triangle's Hessian changes
-    // fast, and waiting for a second iteration cost a solve each. Refine of the 100k dragon at turn
-    // 90: 31 iterations, 26 factorisations, 0.86 times the wall time of giving up from the second
-    // (39, 24); at 23k 0.83 at turn 90, 1.04 at turn 170.
+    // fast, and waiting for a second iteration costs a solve each (bench/results/refine.json).
     const double mean_log_decrease = std::log(residual_norm / initial_norm) / k;
     if ((kMaxCgIterations - k) * mean_log_decrease > std::log(bound / residual_norm)) return 0;
     llt_.solve(residual_, preconditioned_);
@@ -179,9 +178,8 @@ bool ShiftedNewton::try_factorize(const SparseMatrix& hessian) {
   factored_ = false;
   try {
     // Not refused for CHOLMOD's cheap condition estimate: ∇²F + τD with τ > 0 is definite when it
-    // factors, and on the 100k dragon the estimate fell below 1e-13 for every τ below 4 times its
-    // floor. Refusing it held τ there, and the steps crept: Refine at turn 30 took 120 iterations
-    // and 268 factorisations; without, 24 and 27 (79 s).
+    // factors, and on large scans the estimate is tiny for every τ near its floor; refusing it would
+    // hold τ above the floor, and the steps would creep.
     set_shifted_diagonal();
     llt_.factorize(hessian, shifted_diagonal_, 0);
     factored_ = true;

@@ -12,17 +12,17 @@
 // then backtracked (Armijo, line_search.h) when F does not decrease enough or a triangle turns
 // over. A step cut only because longer ones turned a triangle over does not grow τ: the model was
 // right wherever F was evaluated, and the triangles are a few crushed ones (area 0.1–10% of rest)
-// that a full step passes through zero area. On the 23k dragon turned by 170° growing τ by the cut
-// kept it at 1e4–1e8 times its floor and the whole mesh crept (300 iterations, not converged);
-// without, 55. Such a search starts at 0.9 of the way to where the first triangle would turn over
+// that a full step passes through zero area; growing τ by such cuts would keep it far above its
+// floor and the whole mesh would creep. Such a search starts at 0.9 of the way to where the first
+// triangle would turn over
 // (PoseObjective::step_to_turning). The Hessian is the projected one (each element's made
 // semidefinite) far from the minimum, and the exact one near it wherever it factors at the current
 // τ (quadratic convergence). A full step that decreased F by more than 1.5 times what the model
 // promised (the projected Hessian overestimating the curvature of a flap bent away from a saddle)
 // is extended to α = 2, 4, 8 while F falls.
 //
-// A factorisation costs as much as a dozen or more solves with the factor (on the 23k dragon 0.6 s
-// against 0.04 s; the Hessian's assembly 0.25 s), and from one iteration to the next the shifted
+// A factorisation costs as much as a dozen or more solves with the factor (bench/results/native.json,
+// BM_CholmodFactorize against BM_CholmodSolve/1), and from one iteration to the next the shifted
 // Hessian changes little. So an iteration first solves its Newton system by conjugate gradients
 // preconditioned by the last factor, to the relative residual of an inexact Newton method
 // (Eisenstat & Walker 1996, choice 2; near the minimum proportional to ‖∇F‖, which keeps Newton's
@@ -47,17 +47,39 @@ struct NewtonPoint {
 };
 
 // What one iteration did, for the solve's statistics.
+// The Hessian a Newton step solves with: each element's made semidefinite, or the exact one.
+enum class HessianModel { kProjected, kExact };
+// "projected" or "exact".
+inline const char* hessian_model_name(HessianModel model) {
+  return model == HessianModel::kExact ? "exact" : "projected";
+}
+
 struct NewtonIteration {
-  bool exact = false;     // the exact Hessian (else the projected one)
+  HessianModel model = HessianModel::kProjected;
   double shift = 0;       // τ it was factored with
   double step = 0;        // α taken (above 1: extended); 0: the line search found no decrease (the iterate stays)
   bool guarded = false;   // α < 1 only because longer steps turned a triangle over
   double ratio = 0;       // F's decrease over the model's at α
   int cg_iterations = 0;  // conjugate gradient iterations of the step; 0: solved with a new factor
   bool progress = false;  // as iterate() returns
-  double value = 0;       // F and ‖∇F‖ after the iteration
+  double energy = 0;      // F and ‖∇F‖ after the iteration
   double gradient_norm = 0;
 };
+
+// The fields of a NewtonIteration by name (the Python API's stats, one dict per iteration):
+// visit(name, field) with `field` an accessor it -> it.member.
+template <typename Visit>
+void for_each_newton_iteration_field(Visit&& visit) {
+  visit("model", [](auto& it) -> auto& { return it.model; });
+  visit("shift", [](auto& it) -> auto& { return it.shift; });
+  visit("step", [](auto& it) -> auto& { return it.step; });
+  visit("guarded", [](auto& it) -> auto& { return it.guarded; });
+  visit("ratio", [](auto& it) -> auto& { return it.ratio; });
+  visit("cg_iterations", [](auto& it) -> auto& { return it.cg_iterations; });
+  visit("progress", [](auto& it) -> auto& { return it.progress; });
+  visit("energy", [](auto& it) -> auto& { return it.energy; });
+  visit("gradient_norm", [](auto& it) -> auto& { return it.gradient_norm; });
+}
 
 class ShiftedNewton {
  public:
@@ -111,8 +133,8 @@ class ShiftedNewton {
   static constexpr double kToTurning = 0.9;
 
   // trial_ (the full step's point, F lower there than the model promised: the projected Hessian
-  // clamps the negative curvature of a flap bent away from a saddle, and on the 5k dragon
-  // such steps crept, ‖∇F‖ rising, for 30 iterations) moved on to α = 2, 4, ... kMaxExtension
+  // clamps the negative curvature of a flap bent away from a saddle, and such steps creep, ‖∇F‖
+  // rising, for many iterations) moved on to α = 2, 4, ... kMaxExtension
   // while F keeps falling and no triangle turns over; returns the α kept.
   double extend(const NewtonPoint& point, const Objective& objective);
 

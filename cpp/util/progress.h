@@ -1,11 +1,10 @@
-// Progress reporting for long native calls (the bake).
+// Progress reporting for long native calls (the bake, the full solve).
 //
 // A Progress forwards (stage, fraction) to the caller's callback no more often than every
 // `interval` seconds (the first and the last report of a stage always go through), and throws
 // Cancelled when the callback returns false, so a cancel takes effect at the next report.
 #pragma once
 
-#include <array>
 #include <chrono>
 #include <functional>
 #include <string>
@@ -13,27 +12,6 @@
 #include "util/errors.h"
 
 namespace modal_deform {
-
-// The bake's stages in the order they run (cpp/bake/bake.h): the names its progress reports and
-// Basis::timings use, exported to Python as BAKE_STAGES so that one bar runs over the whole bake.
-// A bake without a proxy skips the first and the last.
-namespace stages {
-inline constexpr const char* kProxy = "proxy";
-inline constexpr const char* kAttachment = "attachment";
-inline constexpr const char* kHessian = "hessian";
-inline constexpr const char* kFactorisation = "factorisation";
-inline constexpr const char* kGhost = "ghost";
-inline constexpr const char* kModes = "modes";
-inline constexpr const char* kThirdDerivatives = "third derivatives";
-inline constexpr const char* kDerivativeSolves = "derivative solves";
-inline constexpr const char* kOrthonormalisation = "orthonormalisation";
-inline constexpr const char* kAssembly = "assembly";
-inline constexpr const char* kProlongation = "prolongation";
-}  // namespace stages
-inline constexpr std::array<const char*, 11> kBakeStages = {
-    stages::kProxy,           stages::kAttachment,         stages::kHessian,  stages::kFactorisation,
-    stages::kGhost,           stages::kModes,              stages::kThirdDerivatives,
-    stages::kDerivativeSolves, stages::kOrthonormalisation, stages::kAssembly, stages::kProlongation};
 
 using ProgressCallback = std::function<bool(const std::string& stage, double fraction)>;
 

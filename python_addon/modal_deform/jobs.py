@@ -146,7 +146,8 @@ class RefineJob(_ThreadJob):
 
     thread_name = "modal_deform refine"
 
-    def __init__(self, context, obj, tolerance=1e-8, max_iterations=mdc.FULL_SOLVE_MAX_ITERATIONS):
+    def __init__(self, context, obj, tolerance=mdc.FULL_SOLVE_OPTIONS["tolerance"],
+                 max_iterations=mdc.FULL_SOLVE_MAX_ITERATIONS):
         self.object_name = obj.name
         self.pose = posing.Pose(context, obj)
         self.pose.follow_controllers()

@@ -29,6 +29,8 @@ running = None
 #: than a budget of milliseconds allows (an iteration costs 0.2 ms at 67 dimensions), so the
 #: budget or convergence ends an update.
 MAX_ITERATIONS_PER_UPDATE = 1000
+#: BFGS iterations at most of a solve to convergence (the Solve operator, scripts).
+CONVERGE_MAX_ITERATIONS = 2000
 
 
 class Pose:
@@ -61,7 +63,7 @@ class Pose:
         self.stats = self.solver.solve(max_iterations=MAX_ITERATIONS_PER_UPDATE, budget_ms=budget_ms)
         return self.stats
 
-    def converge(self, max_iterations=2000, tolerance=1e-6):
+    def converge(self, max_iterations=CONVERGE_MAX_ITERATIONS, tolerance=mdc.SOLVE_TOLERANCE):
         """Iterate until the stopping test holds (or max_iterations): the result a script wants."""
         stats = self.solver.solve(max_iterations=max_iterations, tolerance=tolerance)
         self.stats = stats

@@ -77,15 +77,15 @@ class ModalDeformBakeStatus(bpy.types.PropertyGroup):
 
 class ModalDeformSettings(bpy.types.PropertyGroup):
     modes: IntProperty(
-        name="Modes", default=20, min=7, soft_max=60,
+        name="Modes", default=mdc.BAKE_OPTIONS["modes"], min=7, soft_max=60,
         description="Vibration modes in the basis, the rigid motions (6 per part) included: more modes let the "
                     "mesh deform in more ways and make the bake and each solver iteration slower")
     derivatives: IntProperty(
-        name="Derivatives", default=52, min=0, soft_max=200,
+        name="Derivatives", default=mdc.BAKE_OPTIONS["derivatives"], min=0, soft_max=200,
         description="Modal derivatives in the basis: they let large rotations and bends stay smooth instead of "
                     "shrinking; more of them cost bake time and solver time (Discrete Shells only)")
     ghost: IntProperty(
-        name="Ghost Size", default=1000, min=4, soft_min=200, soft_max=5000,
+        name="Ghost Size", default=mdc.BAKE_OPTIONS["ghost"], min=4, soft_min=200, soft_max=5000,
         description="Vertices of the coarse mesh the energy is evaluated on while posing: more follow the "
                     "energy of the full mesh more closely, fewer make each iteration faster")
     proxy: IntProperty(
@@ -96,17 +96,17 @@ class ModalDeformSettings(bpy.types.PropertyGroup):
         name="Proxy Above", default=mdc.PROXY_ABOVE, min=0, soft_max=500000,
         description="Meshes with more vertices than this are baked on a proxy (0: never)")
     energy: EnumProperty(
-        name="Energy", default="SHELLS",
+        name="Energy", default=mdc.BAKE_OPTIONS["energy"].upper(),
         items=(("SHELLS", "Discrete Shells", "Resists bending and stretching like a thin shell (the paper's energy)"),
                ("ARAP", "As-Rigid-As-Possible", "Keeps every vertex neighbourhood rigid; bakes vibration modes "
                                                 "only, no modal derivatives")),
         description="The deformation energy the mesh resists with")
     bending: FloatProperty(
-        name="Bending", default=1.0, min=0.0, soft_max=10.0,
+        name="Bending", default=mdc.BAKE_OPTIONS["bending"], min=0.0, soft_max=10.0,
         description="Discrete Shells: weight of the bending term; higher keeps the surface's curvature, so "
                     "poses bend less and stretch more")
     membrane: FloatProperty(
-        name="Membrane", default=1.0, min=0.0, soft_max=10.0,
+        name="Membrane", default=mdc.BAKE_OPTIONS["membrane"], min=0.0, soft_max=10.0,
         description="Discrete Shells: weight of the stretching terms (edge lengths, triangle areas); higher "
                     "keeps the surface's size, so poses stretch less and bend more")
     stiffness_group: StringProperty(
@@ -115,7 +115,7 @@ class ModalDeformSettings(bpy.types.PropertyGroup):
                     "and membrane weights are multiplied by 1 + (Max - 1) times its vertices' mean weight, as "
                     "Cloth does; empty for a uniform material. Painting it anew makes the bake stale")
     max_stiffness: FloatProperty(
-        name="Max Stiffness", default=100.0, min=1.0, max=1e4, soft_max=1000.0,
+        name="Max Stiffness", default=mdc.BAKE_OPTIONS["max_stiffness"], min=1.0, max=1e4, soft_max=1000.0,
         description="How many times stiffer than the material a vertex of weight 1 in the stiffness group is")
     region_group: StringProperty(
         name="Region Group",

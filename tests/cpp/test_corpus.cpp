@@ -25,6 +25,7 @@
 #include "test_support.h"
 #include "util/errors.h"
 #include "util/require_weight.h"
+#include "util/math_constants.h"
 
 namespace modal_deform {
 namespace {
@@ -75,7 +76,7 @@ TriangleMesh two_fans() {
   for (double side : {1.0, -1.0}) {
     const int ring = static_cast<int>(positions.size() / 3);
     for (int k = 0; k < 5; ++k) {
-      const double angle = 2 * 3.14159265358979323846 * k / 5;
+      const double angle = 2 * kPi * k / 5;
       positions.insert(positions.end(), {std::cos(angle), std::sin(angle), side});
     }
     for (int k = 0; k < 5; ++k) faces.insert(faces.end(), {0, ring + k, ring + (k + 1) % 5});
@@ -237,7 +238,7 @@ void run(const std::string& entry, const TriangleMesh& mesh) {
     } else {
       const FullSolveResult result =
           solve_full(mesh.V, mesh.F, {{0}}, Eigen::VectorXd(), {T}, 1e3,
-              FullSolveOptions{EnergyKind::kShells, 1, 1, 1e-6, 10});
+              FullSolveOptions{EnergyKind::kShells, {1, 1}, 1e-6, 10});
       expect_finite(result.positions, "solve_full");
     }
   }
@@ -287,7 +288,7 @@ TEST(Corpus, WeightsBeyondTheLimitAreRefused) {
   const Eigen::Matrix4d I = Eigen::Matrix4d::Identity();
   expect_input_error(
       [&] { solve_full(mesh.V, mesh.F, {{0}}, Eigen::VectorXd(), {I}, 1e300,
-          FullSolveOptions{EnergyKind::kShells, 1, 1, 1e-6, 3}); },
+          FullSolveOptions{EnergyKind::kShells, {1, 1}, 1e-6, 3}); },
       "stiffness: expected a finite value > 0 and at most 1e+12");
   expect_input_error([&] { checked_handle_weights({{0}}, Eigen::VectorXd::Constant(1, 1e300), 16); },
                      "weights[0] = 1e+300 is not a finite number in [0, 1e+12]");

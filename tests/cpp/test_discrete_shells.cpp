@@ -19,6 +19,7 @@
 #include "finite_differences.h"
 #include "test_support.h"
 #include "util/errors.h"
+#include "util/math_constants.h"
 
 namespace modal_deform {
 namespace {
@@ -31,7 +32,6 @@ using testing::normalized;
 using testing::random_vector;
 using testing::shared_mesh;
 using testing::side_by_side;
-constexpr double kPi = 3.14159265358979323846;
 
 Eigen::VectorXd flat(const RowMatrixX3d& X) { return Eigen::Map<const Eigen::VectorXd>(X.data(), X.size()); }
 

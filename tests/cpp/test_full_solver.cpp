@@ -16,6 +16,7 @@
 #include "test_posing.h"
 #include "test_support.h"
 #include "util/errors.h"
+#include "util/math_constants.h"
 
 namespace modal_deform {
 namespace {
@@ -42,7 +43,7 @@ TEST(SolveFull, ConvergesToAStationaryPointWithTheHandlesNearTheirTargets) {
   const SmallTube tube;
   for (EnergyKind kind : {EnergyKind::kShells, EnergyKind::kArap}) {
     const FullSolveResult result = solve_full(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd(),
-                                              tube.transforms, 1e3, FullSolveOptions{kind, 1.0, 1.0, 1e-10, 100});
+                                              tube.transforms, 1e3, FullSolveOptions{kind, {1.0, 1.0}, 1e-10, 100});
     ASSERT_TRUE(result.converged) << "iterations " << result.iterations;
     EXPECT_LE(result.gradient_norm, 1e-10 * result.gradient_scale);
     EXPECT_TRUE(result.positions.allFinite());
@@ -61,7 +62,7 @@ TEST(SolveFull, HandlesAtRestLeaveTheMeshAtRest) {
   const SmallTube tube;
   const Transforms identity(2, Eigen::Matrix4d::Identity());
   const FullSolveResult result = solve_full(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd(), identity, 1e3,
-                                            FullSolveOptions{EnergyKind::kShells, 1.0, 1.0, 1e-8, 20});
+                                            FullSolveOptions{EnergyKind::kShells, {1.0, 1.0}, 1e-8, 20});
   EXPECT_TRUE(result.converged);
   EXPECT_EQ(result.iterations, 0);
   EXPECT_LE((result.positions - tube.mesh.V).cwiseAbs().maxCoeff(), 1e-14);
@@ -73,7 +74,7 @@ TEST(SolveFull, EqualsTheReducedSolveInAFullBasis) {
   const Basis basis = dense_modal_basis(tube.mesh, r);
   for (EnergyKind kind : {EnergyKind::kShells, EnergyKind::kArap}) {
     const FullSolveResult full = solve_full(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd(), tube.transforms,
-                                            1e3, FullSolveOptions{kind, 1.0, 1.0, 1e-12, 100});
+                                            1e3, FullSolveOptions{kind, {1.0, 1.0}, 1e-12, 100});
     ASSERT_TRUE(full.converged);
     ReducedSolver solver(basis, tube.handles, Eigen::VectorXd(), 1e3, kind);
     solver.set_transforms(tube.transforms);
@@ -102,16 +103,16 @@ TEST(SolveFull, LargeMotionsAreTakenInSteps) {
   auto turn = [](double angle) {
     return Transforms{Eigen::Matrix4d::Identity(), rigid_transform({0, 0, 1}, angle, {0.5, 0.5, 0}, {0, 0, 0})};
   };
-  const double pi = 3.14159265358979323846;
+  const double pi = kPi;
   const FullSolveResult stepped =
       solve_full(mesh.V, mesh.F, handles, Eigen::VectorXd(), turn(pi / 2), 1e3,
-          FullSolveOptions{EnergyKind::kShells, 1, 1, 1e-9, 100});
+          FullSolveOptions{EnergyKind::kShells, {1, 1}, 1e-9, 100});
   EXPECT_TRUE(stepped.converged);
   EXPECT_GE(stepped.steps, 2);
   RowMatrixX3d X = mesh.V;
   for (int step = 1; step <= 3; ++step)
     X = solve_full(mesh.V, mesh.F, handles, Eigen::VectorXd(), turn(pi / 2 * step / 3), 1e3,
-        FullSolveOptions{EnergyKind::kShells, 1, 1, 1e-9, 100}, &X)
+        FullSolveOptions{EnergyKind::kShells, {1, 1}, 1e-9, 100}, &X)
             .positions;
   EXPECT_LE((stepped.positions - X).cwiseAbs().maxCoeff(), 1e-6);
   // Mid-bar, the cross-section has turned by about 45° and kept its size.
@@ -140,7 +141,7 @@ TEST(SolveFull, AnIndefiniteHessianIsProjectedOrShifted) {
   for (EnergyKind kind : {EnergyKind::kShells, EnergyKind::kArap}) {
     const FullSolveResult result =
         solve_full(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd(),
-                   Transforms(2, Eigen::Matrix4d::Identity()), 1e3, FullSolveOptions{kind, 1, 1, 1e-10, 200}, &crushed);
+                   Transforms(2, Eigen::Matrix4d::Identity()), 1e3, FullSolveOptions{kind, {1, 1}, 1e-10, 200}, &crushed);
     EXPECT_TRUE(result.converged);
     if (kind == EnergyKind::kShells) {
       EXPECT_EQ(result.factorizations, factored_iterations(result));
@@ -158,7 +159,7 @@ TEST(SolveFull, UnreferencedVerticesStayAtRest) {
   tube.mesh.V.conservativeResize(loose + 1, 3);
   tube.mesh.V.row(loose) << 5, 5, 5;
   const FullSolveResult result = solve_full(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd(), tube.transforms,
-                                            1e3, FullSolveOptions{EnergyKind::kShells, 1.0, 1.0, 1e-10, 100});
+                                            1e3, FullSolveOptions{EnergyKind::kShells, {1.0, 1.0}, 1e-10, 100});
   EXPECT_TRUE(result.converged);
   EXPECT_LE((result.positions.row(loose) - tube.mesh.V.row(loose)).norm(), 1e-14);
 }
@@ -171,8 +172,8 @@ TEST(PoseObjective, AroundFewVerticesIsTheObjectiveOfTheirCoordinates) {
   const int n = static_cast<int>(tube.mesh.V.rows());
   const StiffnessPaint paint{Eigen::VectorXd::LinSpaced(n, 0, 1), 10};
   for (EnergyKind kind : {EnergyKind::kShells, EnergyKind::kArap}) {
-    PoseObjective whole(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::Vector2d(1, 0.5), 1e3, kind, 1, 2,
-                        kind == EnergyKind::kShells ? paint : StiffnessPaint{});
+    PoseObjective whole(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::Vector2d(1, 0.5), 1e3, kind,
+                        Material{1, 2, kind == EnergyKind::kShells ? paint : StiffnessPaint{}});
     whole.set_transforms(tube.transforms);
     const std::vector<int> free = {7, 12, tube.handles[1][2]};
     std::vector<int> vertices;
@@ -207,7 +208,8 @@ TEST(PoseObjective, StepToTurningIsWhereTheFirstTriangleTurnsOver) {
   const SmallTube tube;
   const int n = static_cast<int>(tube.mesh.V.rows());
   const PoseObjective objective(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd::Ones(2), 1e3,
-                                EnergyKind::kShells, 1, 1, StiffnessPaint{});
+                                EnergyKind::kShells,
+                                Material{1, 1, StiffnessPaint{}});
   const Eigen::VectorXd y = objective.rest_positions();
   const int a = tube.mesh.F(0, 0), b = tube.mesh.F(0, 1), c = tube.mesh.F(0, 2);
   // Moving a by twice its height over bc flattens the triangle halfway, at α = 1/2 (its neighbours
@@ -238,8 +240,8 @@ TEST(PoseObjective, FaceDegenerateAtRestIsNotGuarded) {
   V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 2, 0, 0, 3, 0, 0, 2.5, 0, 0;  // face 1: vertex 5 on the side 3-4
   RowMatrixX3i F(2, 3);
   F << 0, 1, 2, 3, 4, 5;
-  const PoseObjective objective(V, F, Handles{{0}}, Eigen::VectorXd::Ones(1), 1e3, EnergyKind::kShells, 1, 1,
-                                StiffnessPaint{});
+  const PoseObjective objective(V, F, Handles{{0}}, Eigen::VectorXd::Ones(1), 1e3, EnergyKind::kShells,
+                                Material{1, 1, StiffnessPaint{}});
   Eigen::VectorXd y = objective.rest_positions(), p = Eigen::VectorXd::Zero(18);
   y[3 * 5 + 1] += 0.1;  // the sliver lifted into a triangle
   p[3 * 5 + 1] = -0.2;  // and lowered through its side at α = 1/2
@@ -259,7 +261,7 @@ TEST(PoseObjective, ShiftFloorIgnoresAFewStiffElements) {
   const int n = static_cast<int>(tube.mesh.V.rows());
   auto floor_with = [&](const StiffnessPaint& paint) {
     return PoseObjective(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd::Ones(2), 1e3, EnergyKind::kShells,
-                         1, 1, paint)
+                         Material{1, 1, paint})
         .smallest_shift();
   };
   Eigen::VectorXd weights = Eigen::VectorXd::Zero(n);
@@ -277,7 +279,7 @@ TEST(RelaxStretched, PutsBackAVertexPulledOff) {
   const SmallTube tube;
   const int n = static_cast<int>(tube.mesh.V.rows());
   PoseObjective objective(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd::Ones(2), 1e3, EnergyKind::kShells,
-                          1, 1, StiffnessPaint{});
+                          Material{1, 1, StiffnessPaint{}});
   objective.set_transforms(Transforms(2, Eigen::Matrix4d::Identity()));
   const int pulled = 14;  // mid-tube, in no handle
   std::vector<char> neighbourhood(n, 0);
@@ -316,7 +318,7 @@ TEST(RelaxStretched, LeavesZeroLengthRestEdgesAlone) {
   tube.mesh.F.conservativeResize(tube.mesh.F.rows() + 1, 3);
   tube.mesh.F.bottomRows<1>() << 14, n, 15;
   PoseObjective objective(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd::Ones(2), 1e3, EnergyKind::kShells,
-                          1, 1, StiffnessPaint{});
+                          Material{1, 1, StiffnessPaint{}});
   objective.set_transforms(Transforms(2, Eigen::Matrix4d::Identity()));
   NewtonPoint point{objective.rest_positions(), 0, Eigen::VectorXd(3 * (n + 1))};
   point.y(3 * n) += 1e-7;
@@ -332,7 +334,7 @@ TEST(RelaxStretched, LeavesZeroLengthRestEdgesAlone) {
 TEST(SolveFull, AFarMoveEndsWhenTheIterationsAreSpent) {
   const TriangleMesh mesh = grid(3, 3, 1.0, 1.0);
   const int last = static_cast<int>(mesh.V.rows()) - 1;
-  const FullSolveOptions three_iterations{EnergyKind::kShells, 1, 1, 1e-6, 3};
+  const FullSolveOptions three_iterations{EnergyKind::kShells, {1, 1}, 1e-6, 3};
   for (double distance : {1e6, 1e12}) {
     const Eigen::Matrix4d far = rigid_transform({0, 0, 1}, 0.3, {0, 0, 0}, {distance, 0, 0});
     const FullSolveResult rigid =
@@ -357,13 +359,13 @@ TEST(SolveFull, TheMeshIsCheckedBeforeTheHandles) {
   testing::expect_input_error(
       [&] {
         solve_full(V, mesh.F, {{0}}, Eigen::VectorXd(), {Eigen::Matrix4d::Identity()}, 1e3,
-            FullSolveOptions{EnergyKind::kShells, 1, 1, 1e-6, 3});
+            FullSolveOptions{EnergyKind::kShells, {1, 1}, 1e-6, 3});
       },
       "V[4]");
   testing::expect_input_error(
       [&] {
         solve_full(RowMatrixX3d(0, 3), RowMatrixX3i(0, 3), {{0}}, Eigen::VectorXd(), {Eigen::Matrix4d::Identity()}, 1e3,
-                   FullSolveOptions{EnergyKind::kShells, 1, 1, 1e-6, 3});
+                   FullSolveOptions{EnergyKind::kShells, {1, 1}, 1e-6, 3});
       },
       "V: the mesh has no vertices");
 }
@@ -374,7 +376,7 @@ TEST(SolveFull, BadInputIsRefused) {
   auto solve = [&](const Handles& handles, const Transforms& transforms, double stiffness, double tolerance,
                    int iterations) {
     solve_full(tube.mesh.V, tube.mesh.F, handles, none, transforms, stiffness,
-        FullSolveOptions{EnergyKind::kShells, 1.0, 1.0, tolerance, iterations});
+        FullSolveOptions{EnergyKind::kShells, {1.0, 1.0}, tolerance, iterations});
   };
   EXPECT_THROW(solve(tube.handles, {Eigen::Matrix4d::Identity()}, 1.0, 1e-8, 10), InputError);
   EXPECT_THROW(solve({{0, 999}}, {Eigen::Matrix4d::Identity()}, 1.0, 1e-8, 10), InputError);
@@ -385,7 +387,7 @@ TEST(SolveFull, BadInputIsRefused) {
   F(2, 1) = 1000;
   EXPECT_THROW(
       solve_full(tube.mesh.V, F, tube.handles, none, tube.transforms, 1.0,
-          FullSolveOptions{EnergyKind::kShells, 1.0, 1.0, 1e-8, 10}),
+          FullSolveOptions{EnergyKind::kShells, {1.0, 1.0}, 1e-8, 10}),
       InputError);
 }
 

@@ -4,6 +4,7 @@
 
 #include "solve/load_steps.h"
 #include "test_posing.h"
+#include "util/math_constants.h"
 
 namespace modal_deform {
 namespace {
@@ -41,7 +42,7 @@ TEST(LoadPath, TurnsAboutTheHandleCentreByTheFraction) {
   RowMatrixX3d V(4, 3);
   V << 0, 0, 0, 2, 0, 0, 0, 2, 0, 2, 2, 10;
   const Handles handles = {{0, 1, 2}};  // centre (2/3, 2/3, 0)
-  const double pi = 3.14159265358979323846;
+  const double pi = kPi;
   const Eigen::Matrix4d T = rigid_transform({0, 0, 1}, 2 * pi / 3, {2.0 / 3, 2.0 / 3, 0}, {0, 0, 0.1});
   const LoadPath path(V, handles, {T});
   EXPECT_EQ(path.suggested_steps(), 4);

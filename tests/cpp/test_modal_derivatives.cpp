@@ -1,9 +1,6 @@
 #include <gtest/gtest.h>
 
-#include <Eigen/QR>
 #include <algorithm>
-#include <numeric>
-#include <random>
 
 #include "mesh/mass.h"
 #include "mesh/mesh_topology.h"
@@ -53,29 +50,6 @@ Eigen::MatrixXd project_to_range(const Eigen::MatrixXd& Z, const Eigen::MatrixXd
   return B - Z * (Z.transpose() * Z).ldlt().solve(Z.transpose() * B);
 }
 
-// Another valid set of pins: for each component, DOFs in random order, kept while Z's rows
-// restricted to them stay independent.
-std::vector<int> random_pins(const Problem& p, unsigned seed) {
-  std::vector<int> order(static_cast<size_t>(p.Z.rows()));
-  std::iota(order.begin(), order.end(), 0);
-  std::shuffle(order.begin(), order.end(), std::mt19937(seed));
-  std::vector<int> pins;
-  Eigen::MatrixXd rows(0, p.Z.cols());
-  for (int d : order) {
-    if (p.mass[d / 3] == 0) continue;
-    Eigen::MatrixXd candidate(rows.rows() + 1, p.Z.cols());
-    candidate << rows, p.Z.row(d);
-    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(candidate);
-    qr.setThreshold(1e-3);
-    if (qr.rank() == candidate.rows()) {
-      rows = candidate;
-      pins.push_back(d);
-    }
-    if (rows.rows() == p.Z.cols()) break;
-  }
-  return pins;
-}
-
 TEST(DerivativePairs, FollowThePapersOrder) {
   const auto one_component = [](int k) { return std::vector<std::vector<int>>(static_cast<size_t>(k), {0}); };
   const std::vector<std::array<int, 2>> expected{{0, 0}, {0, 1}, {1, 1}, {0, 2}, {1, 2}, {2, 2}};
@@ -115,19 +89,6 @@ TEST(DerivativePairs, ComponentsMovedAreThoseCarryingTheMode) {
   EXPECT_THROW(components_moved(Phi, -labels), InputError);
 }
 
-TEST(KernelPins, PinSixWellChosenDofsPerComponent) {
-  const Problem p = two_boxes();
-  const std::vector<int> pins = kernel_pins(p.K, p.mass, p.Z);
-  ASSERT_EQ(pins.size(), 12u);
-  int first = 0;
-  for (int s : pins) first += p.labels[s / 3] == 0;
-  EXPECT_EQ(first, 6);
-  Eigen::MatrixXd rows(12, 12);
-  for (int a = 0; a < 12; ++a) rows.row(a) = p.Z.row(pins[static_cast<size_t>(a)]);
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(rows);
-  EXPECT_GT(svd.singularValues().minCoeff(), 0.1 * svd.singularValues().maxCoeff());
-}
-
 TEST(SolveInRange, SolvesTheProjectedSystemOrthogonalToTheKernel) {
   const Problem p = two_boxes();
   // 70 columns: two blocks. Random columns have kernel components, which P removes.
@@ -140,18 +101,6 @@ TEST(SolveInRange, SolvesTheProjectedSystemOrthogonalToTheKernel) {
             1e-10 * Psi.cwiseAbs().maxCoeff());
   // The unreferenced vertex stays still.
   EXPECT_EQ(Psi.bottomRows(3).cwiseAbs().maxCoeff(), 0.0);
-}
-
-TEST(SolveInRange, DoesNotDependOnThePinnedDofs) {
-  const Problem p = two_boxes();
-  const Eigen::MatrixXd B = random_block(p.K.rows(), 5, 2);
-  const Eigen::MatrixXd reference = solve_in_range(p.K, p.mass, p.Z, B);
-  for (unsigned seed : {3u, 4u}) {
-    const std::vector<int> pins = random_pins(p, seed);
-    ASSERT_EQ(pins.size(), 12u);
-    EXPECT_NE(pins, kernel_pins(p.K, p.mass, p.Z));
-    EXPECT_LT((solve_in_range(p.K, p.mass, p.Z, B, pins) - reference).norm(), 1e-9 * reference.norm());
-  }
 }
 
 TEST(SolveInRange, ReportsProgressPerBlock) {
@@ -192,15 +141,6 @@ TEST(SolveInRange, RejectsAKernelBasisThatIsWrong) {
   Eigen::MatrixXd translations(p.Z.rows(), 6);
   translations << p.Z.leftCols(3), p.Z.middleCols(6, 3);
   EXPECT_THROW(solve_in_range(p.K, p.mass, translations, B), NumericalError);
-  // Bad pins: too few, repeated, or not pinning the kernel.
-  std::vector<int> pins = kernel_pins(p.K, p.mass, p.Z);
-  EXPECT_THROW(solve_in_range(p.K, p.mass, p.Z, B, std::vector<int>(pins.begin(), pins.end() - 1)), InputError);
-  std::vector<int> repeated = pins;
-  repeated[1] = repeated[0];
-  EXPECT_THROW(solve_in_range(p.K, p.mass, p.Z, B, repeated), InputError);
-  std::vector<int> one_component(12);
-  std::iota(one_component.begin(), one_component.end(), 0);
-  EXPECT_THROW(solve_in_range(p.K, p.mass, p.Z, B, one_component), InputError);
   EXPECT_THROW(solve_in_range(p.K, p.mass, p.Z, B.topRows(6)), InputError);
 }
 

@@ -26,6 +26,7 @@
 #include "solve/reduced_solver.h"
 #include "test_posing.h"
 #include "test_support.h"
+#include "util/math_constants.h"
 
 namespace modal_deform {
 namespace {
@@ -33,7 +34,6 @@ namespace {
 using testing::rigid_transform;
 using testing::vertices_where;
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kStiffness = 1000;
 
 struct Scenario {
@@ -89,7 +89,7 @@ const Basis& basis(const std::string& mesh_name, const TriangleMesh& mesh, bool 
   if (it == cache.end()) {
     Progress quiet;
     const BakeOptions options{derivatives ? 15 : 67, derivatives ? 52 : 0, static_cast<int>(mesh.V.rows()),
-                              EnergyKind::kShells, 1.0, 1.0};
+                              EnergyKind::kShells, {1.0, 1.0}};
     it = cache.emplace(key, bake(mesh.V, mesh.F, options, quiet)).first;
   }
   return it->second;
@@ -103,7 +103,7 @@ Errors pose(const std::string& name, const std::string& mesh_name, const Scenari
     // From rest the full solve takes its own load steps; later steps continue from the last answer.
     const FullSolveResult full =
         solve_full(s.mesh.V, s.mesh.F, s.handles, Eigen::VectorXd(), s.at(double(step) / s.steps), s.stiffness,
-            FullSolveOptions{energy, 1.0, 1.0, 1e-9, 300},
+            FullSolveOptions{energy, {1.0, 1.0}, 1e-9, 300},
                    step == 1 ? nullptr : &reference);
     EXPECT_TRUE(full.converged) << name << ", step " << step;
     reference = full.positions;

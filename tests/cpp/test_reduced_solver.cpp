@@ -11,6 +11,7 @@
 #include "finite_differences.h"
 #include "test_posing.h"
 #include "util/errors.h"
+#include "util/math_constants.h"
 
 namespace modal_deform {
 namespace {
@@ -20,7 +21,6 @@ using testing::expect_slope_matches;
 using testing::rigid_transform;
 using testing::vertices_where;
 
-constexpr double kPi = 3.14159265358979323846;
 
 // A tube along z, 4 long, held at its bottom ring; the top ring is turned and pushed sideways.
 struct Tube {

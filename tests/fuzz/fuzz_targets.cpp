@@ -194,8 +194,8 @@ void bake_and_pose(const std::uint8_t* data, std::size_t size) {
   options.ghost = in.integer(3, 20);
   options.energy = in.flag() ? EnergyKind::kArap : EnergyKind::kShells;
   if (options.energy == EnergyKind::kArap && in.byte() < 200) options.derivatives = 0;
-  options.bending = in.positive();
-  options.membrane = in.positive();
+  options.material.bending = in.positive();
+  options.material.membrane = in.positive();
   Progress progress;
   Basis basis;
   if (!runs("bake", [&] { basis = bake(mesh.V, mesh.F, options, progress); })) return;
@@ -231,7 +231,7 @@ void bake_and_pose(const std::uint8_t* data, std::size_t size) {
   runs("solve_full", [&] {
     const FullSolveResult result =
         solve_full(mesh.V, mesh.F, handles, weights, transforms, stiffness,
-                   FullSolveOptions{kind, options.bending, options.membrane, tolerance, iterations});
+                   FullSolveOptions{kind, {options.material.bending, options.material.membrane}, tolerance, iterations});
     require_finite(result.positions, "solve_full: positions");
     require_finite(result.energy, "solve_full: energy");
   });
@@ -303,18 +303,18 @@ void stored_basis(const std::uint8_t* data, std::size_t size) {
   for (Eigen::Index i = 0; i < b.ghost_map.size(); ++i) b.ghost_map[i] = vertex_index(in, g);
   const double extent = bounding_box_extent(b.rest);
   b.scale = baked && in.byte() < 240 && extent > 0 ? kNormalizedExtent / extent : in.positive();
-  b.bending = in.positive();
-  b.membrane = in.positive();
+  b.material.bending = in.positive();
+  b.material.membrane = in.positive();
   b.num_dropped = in.integer(-1, 1);
   // Now and then painted (weights mostly in [0, 1], on the fine mesh and the ghost) or baked in a
   // region (mostly ascending vertices, the rows outside mostly zero).
   const auto weight = [&in] { return in.byte() > 250 ? in.number() : in.byte() / 255.0; };
   if (in.byte() > 220) {
-    b.stiffness_weights.resize(std::max(0, n + off()));
-    for (Eigen::Index i = 0; i < b.stiffness_weights.size(); ++i) b.stiffness_weights[i] = weight();
+    b.material.paint.weights.resize(std::max(0, n + off()));
+    for (Eigen::Index i = 0; i < b.material.paint.weights.size(); ++i) b.material.paint.weights[i] = weight();
     b.ghost_stiffness_weights.resize(std::max(0, g + off()));
     for (Eigen::Index i = 0; i < b.ghost_stiffness_weights.size(); ++i) b.ghost_stiffness_weights[i] = weight();
-    b.max_stiffness = in.byte() > 250 ? in.number() : 1.0 + in.byte();
+    b.material.paint.max_stiffness = in.byte() > 250 ? in.number() : 1.0 + in.byte();
   }
   if (in.byte() > 220 && n > 0) {
     std::vector<int> region;

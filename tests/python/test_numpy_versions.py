@@ -26,8 +26,7 @@ COPIED_INTO_THE_CORE = {
         assert np.isfinite(value) and gradient.shape == solver.q.shape
     """,
     "an initial pose": """
-        X, stats = mdc.solve_full(V, F, handles, transforms, stiffness=100.0, initial=V.copy(), max_iterations=3,
-                                  return_stats=True)
+        X, stats = mdc.solve_full(V, F, handles, transforms, stiffness=100.0, initial=V.copy(), max_iterations=3)
         assert np.isfinite(X).all()
     """,
 }

@@ -7,17 +7,17 @@ shells, ARAP), ``modes`` (vibration modes, rigid motions, modal-derivative solve
 (the ghost), ``bake`` (the whole preprocess, mesh to Basis).
 """
 from .._native import Cancelled, OutOfMemoryError
-from .bake import BAKE_STAGES, PROXY, PROXY_ABOVE, Basis, bake, bake_fraction
+from .bake import BAKE_OPTIONS, BAKE_STAGES, PROXY, PROXY_ABOVE, Basis, bake, bake_fraction
 from .energy import Arap, DiscreteShells
 from .frame_budget import FrameBudget
 from .mesh import bar, bumpy_plane, check, cylinder, grid, mass, read_mesh
 from .modes import rigid_motions, solve_in_range, vibration_modes
 from .reduction import ghost_mesh, restrict_to_ghost
-from .solve import FULL_SOLVE_MAX_ITERATIONS, ReducedSolver, nearest_rigid, solve_full
+from .solve import FULL_SOLVE_MAX_ITERATIONS, FULL_SOLVE_OPTIONS, SOLVE_TOLERANCE, ReducedSolver, nearest_rigid, solve_full
 
 __all__ = [
-    "Arap", "BAKE_STAGES", "Basis", "FrameBudget", "PROXY", "PROXY_ABOVE", "Cancelled", "DiscreteShells", "OutOfMemoryError", "bake", "bake_fraction", "bar", "bumpy_plane", "check", "cylinder",
+    "Arap", "BAKE_OPTIONS", "BAKE_STAGES", "Basis", "FrameBudget", "PROXY", "PROXY_ABOVE", "Cancelled", "DiscreteShells", "OutOfMemoryError", "bake", "bake_fraction", "bar", "bumpy_plane", "check", "cylinder",
     "ghost_mesh", "grid", "mass", "read_mesh", "restrict_to_ghost", "rigid_motions", "solve_in_range",
     "vibration_modes",
 ]
-__all__ += ["FULL_SOLVE_MAX_ITERATIONS", "ReducedSolver", "nearest_rigid", "solve_full"]
+__all__ += ["FULL_SOLVE_MAX_ITERATIONS", "FULL_SOLVE_OPTIONS", "SOLVE_TOLERANCE", "ReducedSolver", "nearest_rigid", "solve_full"]

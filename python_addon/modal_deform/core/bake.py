@@ -21,13 +21,13 @@ from . import _arrays
 # max_stiffness). Each field's version comes from the native schema.
 FORMAT_VERSION = 3
 
+#: ``bake``'s options and their defaults, the native core's (cpp/bake/bake.h, BakeOptions):
+#: {name: default}. Arrays default to empty ones, which ``bake`` takes as None.
+BAKE_OPTIONS = dict(_native.BAKE_OPTIONS)
 #: ``bake``'s defaults for dense meshes: more than PROXY_ABOVE vertices are baked on a proxy of
-#: about PROXY vertices. Measured on the shared 2-core machine (bench/multires.py, docs): the
-#: 100k dragon bakes as it is in about 20 s within 2.1 GB, while a raw scan of 406k took
-#: 1120 s and 9 GB; on the dragon subdivided twice (1.6M), a 50k proxy bakes in about 24 s and a
-#: 100k one in 34 s, and both pose within 0.3% RMS of the 100k dragon's own bake.
-PROXY_ABOVE = 150_000
-PROXY = 50_000
+#: about PROXY vertices (cpp/bake/bake.h says why; bench/results/multires.json).
+PROXY_ABOVE = BAKE_OPTIONS["proxy_above"]
+PROXY = BAKE_OPTIONS["proxy"]
 
 #: The bake's stages in the order they run, the names its progress reports and ``Basis.timings``
 #: use (the native core's list). A bake without a proxy skips the first and the last.
@@ -184,9 +184,10 @@ def _flag(value, name):
     return bool(value)
 
 
-def bake(V, F, modes=20, derivatives=52, ghost=1000, energy="shells", bending=1.0, membrane=1.0, progress=None,
-         rotation_pairs=True, proxy=PROXY, proxy_above=PROXY_ABOVE, stiffness_weights=None, max_stiffness=100.0,
-         region=None):
+def bake(V, F, modes=BAKE_OPTIONS["modes"], derivatives=BAKE_OPTIONS["derivatives"], ghost=BAKE_OPTIONS["ghost"],
+         energy=BAKE_OPTIONS["energy"], bending=BAKE_OPTIONS["bending"], membrane=BAKE_OPTIONS["membrane"], progress=None,
+         rotation_pairs=BAKE_OPTIONS["rotation_pairs"], proxy=PROXY, proxy_above=PROXY_ABOVE, stiffness_weights=None,
+         max_stiffness=BAKE_OPTIONS["max_stiffness"], region=None):
     """Bake the reduced space of the triangle mesh (V (n, 3), F (m, 3)) for posing.
 
     modes: vibration modes, the rigid motions of the simulated components (6 each) included;
@@ -232,14 +233,16 @@ def bake(V, F, modes=20, derivatives=52, ghost=1000, energy="shells", bending=1.
         raise ValueError(f"energy: expected \"shells\" or \"arap\", got {energy!r}")
     if progress is not None and not callable(progress):
         raise ValueError(f"progress: expected a callable progress(stage, fraction) or None, got {progress!r}")
-    native = _native.bake(V, F, _count(modes, "modes", 1), _count(derivatives, "derivatives", 0),
-                          _count(ghost, "ghost", 4), energy, _arrays.number(bending, "bending"),
-                          _arrays.number(membrane, "membrane"), _flag(rotation_pairs, "rotation_pairs"),
-                          0 if proxy is None else _count(proxy_above, "proxy_above", 1),
-                          4 if proxy is None else _count(proxy, "proxy", 4),
-                          _arrays.stiffness_weights(stiffness_weights, len(V)),
-                          _arrays.number(max_stiffness, "max_stiffness"),
-                          np.zeros(0, np.int32) if region is None else region, progress)
+    native = _native.bake(V, F, progress=progress, modes=_count(modes, "modes", 1),
+                          derivatives=_count(derivatives, "derivatives", 0), ghost=_count(ghost, "ghost", 4),
+                          energy=energy, bending=_arrays.number(bending, "bending"),
+                          membrane=_arrays.number(membrane, "membrane"),
+                          rotation_pairs=_flag(rotation_pairs, "rotation_pairs"),
+                          proxy_above=0 if proxy is None else _count(proxy_above, "proxy_above", 1),
+                          proxy=4 if proxy is None else _count(proxy, "proxy", 4),
+                          stiffness_weights=_arrays.stiffness_weights(stiffness_weights, len(V)),
+                          max_stiffness=_arrays.number(max_stiffness, "max_stiffness"),
+                          region=np.zeros(0, np.int32) if region is None else region)
     basis = Basis(native)
     if basis.num_floppy:
         warnings.warn(f"the mesh is floppy: it has {basis.num_floppy} zero modes besides its rigid motions "

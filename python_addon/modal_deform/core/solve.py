@@ -19,10 +19,15 @@ from .bake import PROXY_ABOVE, Basis
 
 #: The most vertices ReducedSolver.refine takes: the size bake takes without a proxy.
 REFINE_MAX_VERTICES = PROXY_ABOVE
-#: Newton iterations a full solve (and Refine) takes at most by default: the native core's
-#: (cpp/solve/full_solver.h says why so many).
-FULL_SOLVE_MAX_ITERATIONS = _native.FULL_SOLVE_MAX_ITERATIONS
+#: ``solve_full``'s options and their defaults, the native core's (cpp/solve/full_solver.h,
+#: FullSolveOptions): {name: default}; Refine takes the same.
+FULL_SOLVE_OPTIONS = dict(_native.FULL_SOLVE_OPTIONS)
+#: Newton iterations a full solve (and Refine) takes at most by default (full_solver.h says why so many).
+FULL_SOLVE_MAX_ITERATIONS = FULL_SOLVE_OPTIONS["max_iterations"]
 
+
+#: The default tolerance ε of ReducedSolver.solve's stopping test (paper eq. 14).
+SOLVE_TOLERANCE = 1e-6
 
 #: The default handle stiffness μ: stiff enough that handles land within a small fraction of a
 #: percent of the model's size in the test poses, soft enough to keep BFGS well conditioned.
@@ -141,7 +146,7 @@ class ReducedSolver:
         self._native.set_transforms(transforms)
         self._transforms = transforms
 
-    def solve(self, max_iterations=10, tolerance=1e-6, budget_ms=None):
+    def solve(self, max_iterations=10, tolerance=SOLVE_TOLERANCE, budget_ms=None):
         """Up to ``max_iterations`` BFGS iterations from the current state.
 
         Stops early when the Gill–Murray–Wright test holds (paper eq. 14, tolerance ε), and begins
@@ -158,7 +163,8 @@ class ReducedSolver:
                                   _arrays.number(tolerance, "tolerance"),
                                   float("inf") if budget_ms is None else _arrays.number(budget_ms, "budget_ms"))
 
-    def refine(self, F, initial=None, tolerance=1e-8, max_iterations=FULL_SOLVE_MAX_ITERATIONS, progress=None):
+    def refine(self, F, initial=None, tolerance=FULL_SOLVE_OPTIONS["tolerance"], max_iterations=FULL_SOLVE_MAX_ITERATIONS,
+               progress=None):
         """Refine: the pose's exact minimum on the full mesh, by ``solve_full`` from a start.
 
         ``F`` (m, 3): the fine mesh's triangles (the basis keeps only its rest positions).
@@ -202,7 +208,7 @@ class ReducedSolver:
                               weights=problem["weights"], energy=problem["energy"], bending=basis.bending,
                               membrane=basis.membrane, stiffness_weights=basis.stiffness_weights,
                               max_stiffness=basis.max_stiffness, tolerance=tolerance, max_iterations=iterations,
-                              initial=initial, progress=report, return_stats=True, held=held)
+                              initial=initial, progress=report, held=held)
 
         X, stats = solve(start, max_iterations, (0.0, 0.5))
         stats["from_rest"] = False
@@ -245,9 +251,10 @@ class ReducedSolver:
         return out
 
 
-def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, energy="shells", bending=1.0,
-               membrane=1.0, tolerance=1e-8, max_iterations=FULL_SOLVE_MAX_ITERATIONS, initial=None, progress=None,
-               return_stats=False, stiffness_weights=None, max_stiffness=1.0, held=None):
+def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, energy=FULL_SOLVE_OPTIONS["energy"],
+               bending=FULL_SOLVE_OPTIONS["bending"], membrane=FULL_SOLVE_OPTIONS["membrane"], tolerance=FULL_SOLVE_OPTIONS["tolerance"],
+               max_iterations=FULL_SOLVE_OPTIONS["max_iterations"], initial=None, progress=None, stiffness_weights=None,
+               max_stiffness=FULL_SOLVE_OPTIONS["max_stiffness"], held=None):
     """The reference: Newton's method on the full mesh for the reduced solver's objective.
 
     V (n, 3), F (m, 3): the rest mesh; handles, transforms, weights, stiffness, energy as for
@@ -263,8 +270,8 @@ def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, ene
     they converge fast, else by factoring it anew (see cpp/solve/shifted_newton.h). Stops when the
     gradient norm is below ``tolerance`` times its value at rest (or at ``initial``, if larger), or after
     ``max_iterations`` Newton iterations in all. ``progress(stage, fraction) -> bool`` is called
-    about every 0.1 s (False cancels: ``Cancelled``). Returns the positions (n, 3) float64, or with
-    ``return_stats=True`` the pair (positions, stats) with stats = {"steps", "iterations",
+    about every 0.1 s (False cancels: ``Cancelled``). Returns the pair (positions (n, 3) float64,
+    stats) with stats = {"steps", "iterations",
     "energy", "converged", "gradient_norm", "gradient_scale", "factorizations", "seconds",
     "initial_energy", "relaxed_vertices", "stalled", "history"}. "relaxed_vertices": with ``initial``,
     the vertices of edges it stretched beyond three times their rest length (a reduced pose's fins
@@ -281,12 +288,12 @@ def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, ene
     max_iterations = _arrays.integer(max_iterations, "max_iterations")
     if progress is not None and not callable(progress):
         raise ValueError(f"progress: expected a callable or None, got {type(progress).__name__}")
-    X, stats = _native.solve_full(V, F, handles, _transforms(transforms, len(handles)), _weights(weights, len(handles)),
-                                  _arrays.number(stiffness, "stiffness"), str(energy), _arrays.number(bending, "bending"),
-                                  _arrays.number(membrane, "membrane"),
-                                  _arrays.stiffness_weights(stiffness_weights, len(V)),
-                                  _arrays.number(max_stiffness, "max_stiffness"), _arrays.number(tolerance, "tolerance"),
-                                  max_iterations,
-                                  None if initial is None else _arrays.vertices(initial, "initial"), progress,
-                                  [] if held is None else _arrays.indices(held, "held"))
-    return (X, stats) if return_stats else X
+    return _native.solve_full(V, F, handles, _transforms(transforms, len(handles)), _weights(weights, len(handles)),
+                              _arrays.number(stiffness, "stiffness"),
+                              initial=None if initial is None else _arrays.vertices(initial, "initial"),
+                              progress=progress, energy=str(energy), bending=_arrays.number(bending, "bending"),
+                              membrane=_arrays.number(membrane, "membrane"),
+                              stiffness_weights=_arrays.stiffness_weights(stiffness_weights, len(V)),
+                              max_stiffness=_arrays.number(max_stiffness, "max_stiffness"),
+                              tolerance=_arrays.number(tolerance, "tolerance"), max_iterations=max_iterations,
+                              held=[] if held is None else _arrays.indices(held, "held"))
