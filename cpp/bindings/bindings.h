@@ -12,5 +12,6 @@ void bind_reduction(pybind11::module_& m);
 void bind_modes(pybind11::module_& m);
 void bind_solve(pybind11::module_& m);
 void bind_bake(pybind11::module_& m);
+void bind_dynamics(pybind11::module_& m);
 
 }  // namespace modal_deform
