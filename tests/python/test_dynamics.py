@@ -77,6 +77,38 @@ def test_damping_ratio_gives_the_logarithmic_decrement(bar, damping):
     assert abs(period - 12.0 / np.sqrt(1 - damping**2)) <= 0.02 * 12
 
 
+@pytest.fixture(scope="module")
+def tube_bases():
+    """The tube baked as a whole, with a painted stiffness, on a proxy, and as a region (its upper
+    half)."""
+    V, F = mdc.cylinder(25, 40, radius=1.0, length=4.0)
+    sizes = dict(modes=16, derivatives=30, ghost=400)
+    upper = np.flatnonzero(V[:, 2] > 2.0)
+    bases = {"whole": mdc.bake(V, F, **sizes),
+             "painted": mdc.bake(V, F, **sizes, stiffness_weights=np.clip(V[:, 2] / 4, 0, 1), max_stiffness=20.0),
+             "proxy": mdc.bake(V, F, **sizes, proxy=400, proxy_above=500),
+             "region": mdc.bake(V, F, **sizes, region=upper)}
+    return V, F, upper, bases
+
+
+@pytest.mark.parametrize("kind", ["whole", "painted", "proxy", "region"])
+def test_every_kind_of_basis_keeps_the_period_and_follows_a_controller(tube_bases, kind):
+    V, F, upper, bases = tube_bases
+    basis = bases[kind]
+    assert basis.on_proxy == (kind == "proxy")
+    period, _ = damped_oscillation(released(basis, 25, damping=0.0))
+    assert abs(period - 12.0) <= 0.02 * 12.0
+    top = np.flatnonzero(V[:, 2] > 4 - 1e-9)
+    sim = mdc.Simulation(basis, [top])
+    for frame in range(1, 13):
+        X = sim.step([rigid([1, 0, 0], np.radians(5 * frame), V[top].mean(axis=0))])
+        assert np.isfinite(X).all() and X.shape == V.shape
+    assert np.abs(X[top] - V[top]).max() > 0.1  # it followed
+    if kind == "region":
+        outside = np.setdiff1d(np.arange(len(V)), upper)
+        assert np.array_equal(X[outside], V[outside].astype(np.float32))
+
+
 def random_controller(rng, centre):
     """A random rigid move of the controller: turns up to 150° about a random axis, jumps up to about
     a bar's length."""
