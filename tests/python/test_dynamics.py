@@ -203,3 +203,25 @@ def test_parameters_are_defined_once_and_checked(bar):
         sim.set_state(np.zeros(r), np.full(r, np.nan))
     with pytest.raises(ValueError, match="q"):
         sim.set_state(np.full(r, 1e300), np.zeros(r))
+
+
+def test_an_unconverged_step_says_so_and_stays_finite(tube):
+    V, F, handles, basis = tube
+    sim = mdc.Simulation(basis, handles, max_iterations=1)
+    rng = np.random.default_rng(5)
+    centre = V[handles[1]].mean(axis=0)
+    stats = []
+    for _ in range(10):
+        X = sim.step([np.eye(4), random_controller(rng, centre)])
+        assert np.isfinite(X).all() and np.isfinite(sim.energy())
+        stats.append(sim.stats)
+    assert not all(s["converged"] for s in stats)
+    assert all(s["substeps"] == 2 and s["iterations"] <= 2 * (1 + s["implicit_euler"]) for s in stats)
+
+
+def test_the_motion_in_frames_does_not_depend_on_the_frame_rate(bar):
+    """Period and damping are in frames: at another fps the frames are the same (velocities, per
+    second, scale with it)."""
+    *_, basis = bar
+    traces = [released(basis, 30, fps=fps) for fps in (24.0, 30.0)]
+    assert np.allclose(traces[0], traces[1], rtol=0, atol=1e-9 * np.abs(traces[0]).max())
