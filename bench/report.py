@@ -797,14 +797,18 @@ def section_dynamics(result):
     for name, c in list(f["cost"].items()) + [("subdivided twice, on a proxy", f["proxy"])]:
         rows.append([name, c["vertices"], c.get("proxy_vertices", "-"), c["dimension"], f"{c['bake_s']:.1f}",
                      f"{c['step_ms']['median']:.2f} / {c['step_ms']['p95']:.2f}",
-                     f"{c['map_ms']['median']:.2f} / {c['map_ms']['p95']:.2f}",
-                     f"{c['iterations']['median']:g} / {c['iterations']['max']:g}"])
+                     f"{c['iterations']['median']:g} / {c['iterations']['max']:g}",
+                     f"{c['evaluations']['median']:g}", f"{c['ms_per_evaluation']['median']:.3f}",
+                     f"{c['map_ms']['median']:.2f} / {c['map_ms']['p95']:.2f}", f"{c['map_back_to_back_ms']:.2f}"])
     out += ["", "Cost per frame: the tail held, the head's controller turning 60° in 12 frames and still after "
-            "(the demo's motion), 60 frames (30 on the proxy). Step: the core's integrator (`stats['ms']`); map: "
-            "`Simulation.positions` into a float32 buffer (what Blender's `foreach_set` takes); median / 95th "
-            "percentile. Blender's own evaluation (foreach_set and the mesh update) is not included.", ""]
-    out.append(table(["mesh", "vertices", "proxy", "dimensions", "bake s", "step ms", "map ms",
-                      "BFGS iterations (median / max)"], rows))
+            "(the demo's motion), 60 frames (30 on the proxy). Step: the core's integrator (`stats['ms']`), its "
+            "BFGS iterations and evaluations of the ghost energy a frame and its time per evaluation (what a "
+            "frame costs is evaluations times that); map: `Simulation.positions` into a float32 buffer (what "
+            "Blender's `foreach_set` takes) after each step, and back to back (a busy machine wakes the map's "
+            "threads late after each serial step); median / 95th percentile. Blender's own evaluation "
+            "(foreach_set and the mesh update) is not included.", ""]
+    out.append(table(["mesh", "vertices", "proxy", "dimensions", "bake s", "step ms", "BFGS iterations (median / max)",
+                      "evaluations", "ms per evaluation", "map ms", "map back to back ms"], rows))
     s = f["stress"]
     out += ["", f"Stress: the {s['mesh']} ({s['vertices']} vertices), {s['frames']} frames of random controller "
             f"moves (turns up to 150°, jumps of a third of its length), damping {s['damping']:g}: "

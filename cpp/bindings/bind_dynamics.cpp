@@ -26,7 +26,8 @@ py::dict to_dict(const SimulationStepStats& stats) {
   return py::dict(py::arg("substeps") = stats.substeps, py::arg("iterations") = stats.iterations,
                   py::arg("evaluations") = stats.evaluations, py::arg("converged") = stats.converged,
                   py::arg("stalled") = stats.stalled, py::arg("line_search_failures") = stats.line_search_failures,
-                  py::arg("implicit_euler") = stats.implicit_euler, py::arg("energy_removed") = stats.energy_removed, py::arg("ms") = stats.milliseconds);
+                  py::arg("implicit_euler") = stats.implicit_euler, py::arg("energy_removed") = stats.energy_removed,
+                  py::arg("ms") = stats.milliseconds);
 }
 
 }  // namespace

@@ -213,8 +213,8 @@ SimulationStepStats ReducedDynamics::step(const Transforms& transforms) {
   return stats;
 }
 
-BfgsResult ReducedDynamics::minimize(Bfgs& bfgs, bool& started, const Eigen::MatrixXd& initial_inverse_hessian,
-                                     const Eigen::VectorXd& start, SimulationStepStats& stats) {
+void ReducedDynamics::minimize(Bfgs& bfgs, bool& started, const Eigen::MatrixXd& initial_inverse_hessian,
+                               const Eigen::VectorXd& start, SimulationStepStats& stats) {
   // Φ changes from substep to substep by linear terms only: BFGS keeps what it learnt of its
   // curvature within a frame, and starts each frame afresh, so that a frame depends on nothing
   // but the state it starts from (a cached state continues as the run did).
@@ -231,7 +231,6 @@ BfgsResult ReducedDynamics::minimize(Bfgs& bfgs, bool& started, const Eigen::Mat
   stats.converged = stats.converged && result.converged;
   stats.stalled = stats.stalled || result.stalled;
   stats.line_search_failures += result.line_search_failures;
-  return result;
 }
 
 void ReducedDynamics::substep(const Transforms& start, const Transforms& middle, const Transforms& end,
@@ -248,7 +247,8 @@ void ReducedDynamics::substep(const Transforms& start, const Transforms& middle,
   handle_term_.set_transforms(middle);
   ghost_x_.noalias() = ghost_vectors_ * prediction_;
   ghost_x_ += ghost_rest_;
-  minimize(midpoint_bfgs_, midpoint_started_, midpoint_inverse_hessian_, positions_in_range(ghost_x_) ? prediction_ : q_, stats);
+  const Eigen::VectorXd& start_state = positions_in_range(ghost_x_) ? prediction_ : q_;
+  minimize(midpoint_bfgs_, midpoint_started_, midpoint_inverse_hessian_, start_state, stats);
   const Eigen::VectorXd& middle_state = midpoint_bfgs_.x();
   Eigen::VectorXd q_next = 2 * middle_state - q_;
   Eigen::VectorXd v_next = (4 / h_) * (middle_state - q_) - v_;

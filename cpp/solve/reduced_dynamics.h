@@ -137,10 +137,10 @@ class ReducedDynamics {
   double incremental_potential(const Eigen::VectorXd& x, Eigen::VectorXd& gradient);
   // The inverse of I + potential_weight damping_weight (K + 2A): Φ's Hessian at rest.
   Eigen::MatrixXd inverse_rest_hessian(const Eigen::MatrixXd& K, double potential_weight, double damping_weight) const;
-  // Minimises the current Φ with `bfgs` from `start`; `started`: bfgs has minimised this scheme's
-  // Φ earlier in the frame.
-  BfgsResult minimize(Bfgs& bfgs, bool& started, const Eigen::MatrixXd& initial_inverse_hessian,
-                      const Eigen::VectorXd& start, SimulationStepStats& stats);
+  // Minimises the current Φ with `bfgs` from `start`, adding to `stats`; `started`: bfgs has
+  // minimised this scheme's Φ earlier in the frame.
+  void minimize(Bfgs& bfgs, bool& started, const Eigen::MatrixXd& initial_inverse_hessian,
+                const Eigen::VectorXd& start, SimulationStepStats& stats);
   // Transforms at fraction a of the way from start_ to target (per handle).
   Transforms interpolated(const Transforms& target, double a) const;
   void substep(const Transforms& start, const Transforms& middle, const Transforms& end,
