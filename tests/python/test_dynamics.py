@@ -217,6 +217,14 @@ def test_an_unconverged_step_says_so_and_stays_finite(tube):
         stats.append(sim.stats)
     assert not all(s["converged"] for s in stats)
     assert all(s["substeps"] == 2 and s["iterations"] <= 2 * (1 + s["implicit_euler"]) for s in stats)
+    # Unconverged steps cannot create energy either: with the controllers still it never grows.
+    still = [np.eye(4), random_controller(rng, centre)]
+    sim.step(still)
+    energies = [sim.energy()]
+    for _ in range(40):
+        sim.step(still)
+        energies.append(sim.energy())
+    assert (np.diff(energies) <= 1e-12 * energies[0]).all() and energies[-1] < energies[0]
 
 
 def test_the_motion_in_frames_does_not_depend_on_the_frame_rate(bar):
