@@ -82,8 +82,6 @@ void bind_dynamics(py::module_& m) {
       .def_property_readonly("dimension", &ReducedDynamics::dimension)
       .def_property_readonly("num_handles", &ReducedDynamics::num_handles)
       .def_property_readonly("mass_scale", &ReducedDynamics::mass_scale)
-      .def_property_readonly("rayleigh_stiffness", &ReducedDynamics::rayleigh_stiffness)
-      .def_property_readonly("lowest_eigenvalue", &ReducedDynamics::lowest_eigenvalue)
       .def_property_readonly("lowest_mode", [](const ReducedDynamics& s) { return Eigen::VectorXd(s.lowest_mode()); });
 }
 

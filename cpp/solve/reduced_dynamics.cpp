@@ -93,7 +93,7 @@ ReducedDynamics::ReducedDynamics(const Basis& basis, const Handles& handles, con
   if (lowest == r || !(largest > 0))
     throw InputError("basis: no flexible mode (every direction of the basis is a rigid motion or a mechanism); "
                      "the period is that of the lowest flexible mode");
-  lowest_eigenvalue_ = eigen.eigenvalues()[lowest];
+  const double lowest_eigenvalue = eigen.eigenvalues()[lowest];
   lowest_mode_ = eigen.eigenvectors().col(lowest);
 
   // The poles the artist asks for, and the model's that the midpoint rule maps onto them.
@@ -107,7 +107,7 @@ ReducedDynamics::ReducedDynamics(const Basis& basis, const Handles& handles, con
     product *= model_pole;
     sum += model_pole;
   }
-  mass_scale_ = lowest_eigenvalue_ / product.real();
+  mass_scale_ = lowest_eigenvalue / product.real();
   rayleigh_ = -sum.real() / product.real();
   midpoint_weight_ = h_ * h_ / (4 * mass_scale_);
   euler_weight_ = h_ * h_ / mass_scale_;

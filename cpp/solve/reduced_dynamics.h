@@ -123,11 +123,8 @@ class ReducedDynamics {
 
   int dimension() const { return static_cast<int>(ghost_vectors_.cols()); }
   int num_handles() const { return static_cast<int>(centres_.size()); }
-  double mass_scale() const { return mass_scale_; }          // ρ
-  double rayleigh_stiffness() const { return rayleigh_; }    // β, seconds
-  double lowest_eigenvalue() const { return lowest_eigenvalue_; }  // λ₁ of K
-  const Eigen::VectorXd& lowest_mode() const { return lowest_mode_; }  // its unit eigenvector of K
-  const SimulationOptions& options() const { return options_; }
+  double mass_scale() const { return mass_scale_; }                   // ρ
+  const Eigen::VectorXd& lowest_mode() const { return lowest_mode_; }  // λ₁'s unit eigenvector of K
 
  private:
   // E(q) with ∇E(q) in `gradient` (r): +inf where the ghost leaves the coordinate range.
@@ -157,7 +154,7 @@ class ReducedDynamics {
   QuantizedVectors quantized_vectors_;
   double map_tolerance_;
 
-  double lowest_eigenvalue_ = 0, mass_scale_ = 0, rayleigh_ = 0, h_ = 0;
+  double mass_scale_ = 0, rayleigh_ = 0, h_ = 0;  // ρ, β (seconds), the substep (seconds)
   Eigen::VectorXd lowest_mode_;
   // The midpoint rule's Φ (κ = h²/(4ρ)) and implicit Euler's (h²/ρ): weight, inverse Hessian at
   // rest, minimiser.
