@@ -18,17 +18,13 @@
 namespace py = pybind11;
 
 namespace modal_deform {
-namespace {
 
-// Handles arrive as a list of int32 arrays (checked by modal_deform.core.solve).
 Handles to_handles(const std::vector<Eigen::VectorXi>& arrays) {
   Handles handles;
   handles.reserve(arrays.size());
   for (const Eigen::VectorXi& a : arrays) handles.emplace_back(a.data(), a.data() + a.size());
   return handles;
 }
-
-}  // namespace
 
 void bind_solve(py::module_& m) {
   // The options of solve_full by keyword, names and defaults from for_each_full_solve_option.

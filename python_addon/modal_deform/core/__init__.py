@@ -4,10 +4,12 @@
 
 The pipeline, one module per stage: ``mesh`` (check, mass, test shapes), ``energy`` (discrete
 shells, ARAP), ``modes`` (vibration modes, rigid motions, modal-derivative solves), ``reduction``
-(the ghost), ``bake`` (the whole preprocess, mesh to Basis).
+(the ghost), ``bake`` (the whole preprocess, mesh to Basis), ``solve`` (posing), ``dynamics``
+(secondary motion).
 """
 from .._native import Cancelled, OutOfMemoryError
 from .bake import BAKE_OPTIONS, BAKE_STAGES, PROXY, PROXY_ABOVE, Basis, bake, bake_fraction
+from .dynamics import MAX_SUBSTEPS, MIN_PERIOD_FRAMES, SIMULATION_DEFAULTS, Simulation
 from .energy import Arap, DiscreteShells
 from .frame_budget import FrameBudget
 from .mesh import bar, bumpy_plane, check, cylinder, grid, mass, read_mesh
@@ -21,3 +23,4 @@ __all__ = [
     "vibration_modes",
 ]
 __all__ += ["FULL_SOLVE_MAX_ITERATIONS", "FULL_SOLVE_OPTIONS", "SOLVE_TOLERANCE", "ReducedSolver", "nearest_rigid", "solve_full"]
+__all__ += ["MAX_SUBSTEPS", "MIN_PERIOD_FRAMES", "SIMULATION_DEFAULTS", "Simulation"]

@@ -1,0 +1,60 @@
+// Secondary motion: the reduced dynamics (solve/reduced_dynamics.h).
+#include <pybind11/eigen.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bindings/bindings.h"
+#include "bindings/named_fields.h"
+#include "solve/reduced_dynamics.h"
+
+namespace py = pybind11;
+
+namespace modal_deform {
+
+void bind_dynamics(py::module_& m) {
+  // The options by keyword, names and defaults from for_each_simulation_option.
+  const auto simulation_options = [](auto visit) { for_each_simulation_option(visit); };
+  m.attr("SIMULATION_DEFAULTS") = defaults<SimulationOptions>(simulation_options);
+  m.attr("MIN_PERIOD_FRAMES") = kMinPeriodFrames;
+  m.attr("MAX_SUBSTEPS") = kMaxSubsteps;
+  py::class_<ReducedDynamics>(m, "Simulation")
+      .def(py::init([simulation_options](const Basis& basis, const std::vector<Eigen::VectorXi>& handles,
+                                         const VectorRef& weights, const std::string& energy,
+                                         const py::kwargs& keywords) {
+             const SimulationOptions options =
+                 from_keywords<SimulationOptions>(keywords, simulation_options, "Simulation");
+             const EnergyKind kind = energy_kind(energy);
+             py::gil_scoped_release release;
+             return std::make_unique<ReducedDynamics>(basis, to_handles(handles), weights, options, kind);
+           }),
+           py::arg("basis"), py::arg("handles"), py::arg("weights"), py::arg("energy"), py::keep_alive<1, 2>())
+      .def(
+          "step",
+          [](ReducedDynamics& simulation, const Transforms& transforms) {
+            SimulationStepStats stats;
+            {
+              py::gil_scoped_release release;
+              stats = simulation.step(transforms);
+            }
+            return to_dict(stats, [](auto visit) { for_each_simulation_stat(visit); });
+          },
+          py::arg("transforms"))
+      .def("set_state", &ReducedDynamics::set_state, py::arg("q"), py::arg("v"), py::arg("transforms"))
+      .def("positions", &ReducedDynamics::positions, py::arg("out").noconvert(),
+           py::call_guard<py::gil_scoped_release>())
+      .def_property_readonly("q", [](const ReducedDynamics& s) { return Eigen::VectorXd(s.q()); })
+      .def_property_readonly("v", [](const ReducedDynamics& s) { return Eigen::VectorXd(s.v()); })
+      .def("energy", &ReducedDynamics::energy)
+      .def("kinetic_energy", &ReducedDynamics::kinetic_energy)
+      .def("potential_energy", &ReducedDynamics::potential_energy)
+      .def_property_readonly("dimension", &ReducedDynamics::dimension)
+      .def_property_readonly("num_handles", &ReducedDynamics::num_handles)
+      .def_property_readonly("mass_scale", &ReducedDynamics::mass_scale)
+      .def_property_readonly("lowest_mode", [](const ReducedDynamics& s) { return Eigen::VectorXd(s.lowest_mode()); });
+}
+
+}  // namespace modal_deform

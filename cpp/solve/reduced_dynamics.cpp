@@ -1,0 +1,308 @@
+#include "solve/reduced_dynamics.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <chrono>
+#include <cmath>
+#include <complex>
+#include <limits>
+
+#include "mesh/normalization.h"
+#include "reduction/region.h"
+#include "solve/reduced_solver.h"
+#include "util/errors.h"
+#include "util/math_constants.h"
+#include "util/require_positions.h"
+#include "util/require_weight.h"
+
+namespace modal_deform {
+namespace {
+
+
+// An eigenvalue of the reduced rest Hessian below this fraction of the largest is a rigid motion's
+// or a mechanism's (numerically zero), not a flexible mode's.
+constexpr double kZeroEigenvalue = 1e-8;
+
+const Basis& checked(const Basis& basis) {
+  validate_basis(basis);
+  return basis;
+}
+
+const SimulationOptions& checked(const SimulationOptions& options) {
+  check_simulation_options(options);
+  return options;
+}
+
+// The handles' weights; a free body has neither handles nor weights.
+Eigen::VectorXd checked_weights(const Handles& handles, const VectorRef& weights, int num_vertices) {
+  if (!handles.empty()) return checked_handle_weights(handles, weights, num_vertices);
+  if (weights.size() != 0)
+    throw InputError(message("weights: expected none (no handles: a free body), got ", weights.size()));
+  return Eigen::VectorXd();
+}
+
+}  // namespace
+
+void check_simulation_options(const SimulationOptions& options) {
+  require_stiffness(options.stiffness);
+  if (!(options.fps > 0 && options.fps <= 1000))
+    throw InputError(message("fps: expected frames per second in (0, 1000], got ", options.fps));
+  if (!(options.period >= kMinPeriodFrames && options.period <= 1e6))
+    throw InputError(message("period: expected a period in frames in [", kMinPeriodFrames, ", 1e6], got ",
+                             options.period));
+  if (!(options.damping >= 0 && options.damping <= 1))
+    throw InputError(message("damping: expected a damping ratio in [0, 1], got ", options.damping));
+  if (options.substeps < 1 || options.substeps > kMaxSubsteps)
+    throw InputError(message("substeps: expected an integer in [1, ", kMaxSubsteps, "], got ", options.substeps));
+  if (options.max_iterations < 1)
+    throw InputError(message("max_iterations: expected at least 1, got ", options.max_iterations));
+  if (!(options.tolerance > 0 && options.tolerance < 1))
+    throw InputError(message("tolerance: expected a value in (0, 1), got ", options.tolerance));
+}
+
+ReducedDynamics::ReducedDynamics(const Basis& basis, const Handles& handles, const VectorRef& weights,
+                                 const SimulationOptions& options, EnergyKind energy)
+    : basis_(checked(basis)),
+      options_(checked(options)),
+      energy_(make_energy(energy, basis.scale * basis.ghost_vertices, basis.ghost_faces, ghost_material(basis))),
+      ghost_rest_(basis.scale * flatten(basis.ghost_vertices)),
+      ghost_vectors_(basis.scale * basis.ghost_vectors),
+      handle_term_(HandleTerm(basis.rest, basis.mass, handles, checked_weights(handles, weights, basis.num_vertices()),
+                              options.stiffness * std::pow(basis.scale, 4)),
+                   [&basis](int v) { return basis.vertex_rows(v); }, basis.dimension()),
+      transforms_(handles.size(), Eigen::Matrix4d::Identity()),
+      quantized_vectors_(basis.vectors),
+      map_tolerance_(ReducedSolver::kMapTolerance * bounding_box_diagonal(basis.rest)) {
+  require_handles_in_region(handles, basis.region);
+  for (const std::vector<int>& handle : handles) {
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (int v : handle) centre += basis.rest.row(v).transpose();
+    centres_.push_back(centre / static_cast<double>(handle.size()));
+  }
+  const Eigen::Index r = basis.dimension();
+  // K = U_sᵀ ∇²E(x̄_s) U_s and its lowest flexible mode.
+  const SparseMatrix hessian = energy_->hessian(ghost_rest_);
+  Eigen::MatrixXd K = ghost_vectors_.transpose() * (hessian * ghost_vectors_);
+  K = 0.5 * (K + K.transpose()).eval();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(K);
+  if (eigen.info() != Eigen::Success) throw NumericalError("simulation: the reduced rest Hessian has no eigenvalues");
+  const double largest = eigen.eigenvalues().maxCoeff();
+  Eigen::Index lowest = 0;
+  while (lowest < r && !(eigen.eigenvalues()[lowest] > kZeroEigenvalue * largest)) ++lowest;
+  if (lowest == r || !(largest > 0))
+    throw InputError("basis: no flexible mode (every direction of the basis is a rigid motion or a mechanism); "
+                     "the period is that of the lowest flexible mode");
+  const double lowest_eigenvalue = eigen.eigenvalues()[lowest];
+  lowest_mode_ = eigen.eigenvectors().col(lowest);
+
+  // The poles the artist asks for, and the model's that the midpoint rule maps onto them.
+  h_ = 1.0 / (options.fps * options.substeps);
+  const double omega = 2 * kPi * options.fps / options.period;
+  const std::complex<double> root = std::sqrt(std::complex<double>(options.damping * options.damping - 1, 0));
+  std::complex<double> product = 1, sum = 0;
+  for (const double sign : {1.0, -1.0}) {
+    const std::complex<double> pole = omega * (-options.damping + sign * root);
+    const std::complex<double> model_pole = (2 / h_) * std::tanh(pole * (h_ / 2));
+    product *= model_pole;
+    sum += model_pole;
+  }
+  mass_scale_ = lowest_eigenvalue / product.real();
+  rayleigh_ = -sum.real() / product.real();
+  midpoint_weight_ = h_ * h_ / (4 * mass_scale_);
+  euler_weight_ = h_ * h_ / mass_scale_;
+  midpoint_inverse_hessian_ = inverse_rest_hessian(K, midpoint_weight_, 1 + 2 * rayleigh_ / h_);
+  euler_inverse_hessian_ = inverse_rest_hessian(K, euler_weight_, 1);
+
+  ghost_x_.resize(ghost_rest_.size());
+  ghost_gradient_.resize(ghost_rest_.size());
+  work_gradient_.resize(r);
+  handle_gradient_.resize(r);
+  if (basis.on_proxy()) proxy_displacement_.resize(basis.vectors.rows());
+  set_state(Eigen::VectorXd::Zero(r), Eigen::VectorXd::Zero(r));
+}
+
+Eigen::MatrixXd ReducedDynamics::inverse_rest_hessian(const Eigen::MatrixXd& K, double potential_weight,
+                                                      double damping_weight) const {
+  Eigen::MatrixXd H = (potential_weight * damping_weight) * (K + handle_term_.hessian());
+  H.diagonal().array() += 1;
+  H = 0.5 * (H + H.transpose()).eval();
+  const Eigen::LLT<Eigen::MatrixXd> llt(H);
+  if (llt.info() != Eigen::Success)
+    throw NumericalError("simulation: the incremental potential's Hessian at rest is not positive definite");
+  Eigen::MatrixXd inverse = llt.solve(Eigen::MatrixXd::Identity(H.rows(), H.cols()));
+  return 0.5 * (inverse + inverse.transpose());
+}
+
+void ReducedDynamics::set_state(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Transforms& transforms) {
+  const Eigen::Index r = dimension();
+  if (q.size() != r) throw InputError(message("q: expected ", r, " reduced coordinates, got ", q.size()));
+  if (v.size() != r) throw InputError(message("v: expected ", r, " reduced velocities, got ", v.size()));
+  if (!q.allFinite()) throw InputError("q: has non-finite entries");
+  if (!v.allFinite() || !std::isfinite(0.5 * mass_scale_ * v.squaredNorm()))
+    throw InputError("v: has non-finite entries, or a kinetic energy beyond double precision");
+  if (!transforms.empty()) check_transforms(transforms, num_handles());
+  Eigen::VectorXd gradient(r);
+  const double elastic_energy = elastic(q, gradient);
+  if (!std::isfinite(elastic_energy))
+    throw InputError(message("q: moves the mesh beyond the coordinates the energies take (", kMaxCoordinate, ")"));
+  if (!transforms.empty()) {
+    transforms_ = transforms;
+    handle_term_.set_transforms(transforms_);
+  }
+  q_ = q;
+  v_ = v;
+  elastic_gradient_ = std::move(gradient);
+  potential_ = elastic_energy + handle_term_.value_and_gradient(q_, handle_gradient_);
+  q_float_ = q_.cast<float>();
+}
+
+double ReducedDynamics::elastic(const Eigen::VectorXd& q, Eigen::VectorXd& gradient) {
+  ghost_x_.noalias() = ghost_vectors_ * q;
+  ghost_x_ += ghost_rest_;
+  if (!positions_in_range(ghost_x_)) return std::numeric_limits<double>::infinity();
+  const double value = energy_->value_and_gradient(ghost_x_, ghost_gradient_);
+  gradient.noalias() = ghost_vectors_.transpose() * ghost_gradient_;
+  return value;
+}
+
+double ReducedDynamics::incremental_potential(const Eigen::VectorXd& x, Eigen::VectorXd& gradient) {
+  const double elastic_energy = elastic(x, work_gradient_);
+  if (!std::isfinite(elastic_energy)) return elastic_energy;
+  const double handles = handle_term_.value_and_gradient(x, handle_gradient_);
+  gradient = x - prediction_;
+  const double inertia = 0.5 * gradient.squaredNorm();
+  gradient += potential_weight_ * (damping_weight_ * (work_gradient_ + handle_gradient_) - damping_pull_);
+  return inertia + potential_weight_ * (damping_weight_ * (elastic_energy + handles) - damping_pull_.dot(x));
+}
+
+Transforms ReducedDynamics::interpolated(const Transforms& target, double a) const {
+  if (a == 1) return target;
+  Transforms result(target.size());
+  for (size_t h = 0; h < target.size(); ++h) {
+    const Eigen::Matrix4d& from = transforms_[h];
+    const Eigen::Matrix4d& to = target[h];
+    const Eigen::Quaterniond rotation_from(Eigen::Matrix3d(from.topLeftCorner<3, 3>()));
+    const Eigen::Quaterniond rotation_to(Eigen::Matrix3d(to.topLeftCorner<3, 3>()));
+    const Eigen::Matrix3d R = rotation_from.normalized().slerp(a, rotation_to.normalized()).toRotationMatrix();
+    const Eigen::Vector3d centre_from = from.topLeftCorner<3, 3>() * centres_[h] + from.topRightCorner<3, 1>();
+    const Eigen::Vector3d centre_to = to.topLeftCorner<3, 3>() * centres_[h] + to.topRightCorner<3, 1>();
+    result[h].setIdentity();
+    result[h].topLeftCorner<3, 3>() = R;
+    result[h].topRightCorner<3, 1>() = (1 - a) * centre_from + a * centre_to - R * centres_[h];
+  }
+  return result;
+}
+
+SimulationStepStats ReducedDynamics::step(const Transforms& transforms) {
+  const auto start = std::chrono::steady_clock::now();
+  check_transforms(transforms, num_handles());
+  SimulationStepStats stats;
+  const int substeps = options_.substeps;
+  Transforms substep_start = transforms_;
+  midpoint_started_ = euler_started_ = false;
+  for (int k = 0; k < substeps; ++k) {
+    const Transforms middle = interpolated(transforms, (k + 0.5) / substeps);
+    const Transforms end = interpolated(transforms, static_cast<double>(k + 1) / substeps);
+    substep(substep_start, middle, end, stats);
+    substep_start = end;
+  }
+  transforms_ = transforms;
+  q_float_ = q_.cast<float>();
+  stats.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return stats;
+}
+
+void ReducedDynamics::minimize(Bfgs& bfgs, bool& started, const Eigen::MatrixXd& initial_inverse_hessian,
+                               const Eigen::VectorXd& start, SimulationStepStats& stats) {
+  // Φ changes from substep to substep by linear terms only: BFGS keeps what it learnt of its
+  // curvature within a frame, and starts each frame afresh, so that a frame depends on nothing
+  // but the state it starts from (a cached state continues as the run did).
+  if (started)
+    bfgs.move_to(start);
+  else
+    bfgs.start(start, initial_inverse_hessian);
+  started = true;
+  const BfgsResult result = bfgs.minimize(
+      [this](const Eigen::VectorXd& x, Eigen::VectorXd& gradient) { return incremental_potential(x, gradient); },
+      options_.max_iterations, options_.tolerance);
+  stats.iterations += result.iterations;
+  stats.evaluations += result.evaluations;
+  stats.converged = stats.converged && result.converged;
+  stats.stalled = stats.stalled || result.stalled;
+  stats.line_search_failures += result.line_search_failures;
+}
+
+void ReducedDynamics::substep(const Transforms& start, const Transforms& middle, const Transforms& end,
+                              SimulationStepStats& stats) {
+  ++stats.substeps;
+  const double energy_before = energy();
+  // The midpoint rule: Φ over the middle state, from the inertial prediction (from q_n, inside
+  // the energies' range, when the prediction leaves it).
+  prediction_ = q_ + (h_ / 2) * v_;
+  handle_term_.value_and_gradient(q_, handle_gradient_);
+  damping_pull_ = (2 * rayleigh_ / h_) * (elastic_gradient_ + handle_gradient_);
+  damping_weight_ = 1 + 2 * rayleigh_ / h_;
+  potential_weight_ = midpoint_weight_;
+  handle_term_.set_transforms(middle);
+  ghost_x_.noalias() = ghost_vectors_ * prediction_;
+  ghost_x_ += ghost_rest_;
+  const Eigen::VectorXd& start_state = positions_in_range(ghost_x_) ? prediction_ : q_;
+  minimize(midpoint_bfgs_, midpoint_started_, midpoint_inverse_hessian_, start_state, stats);
+  const Eigen::VectorXd& middle_state = midpoint_bfgs_.x();
+  Eigen::VectorXd q_next = 2 * middle_state - q_;
+  Eigen::VectorXd v_next = (4 / h_) * (middle_state - q_) - v_;
+  // The handles' work over the substep, at the middle state.
+  handle_term_.set_transforms(start);
+  double work = -handle_term_.value_and_gradient(middle_state, handle_gradient_);
+  handle_term_.set_transforms(end);
+  work += handle_term_.value_and_gradient(middle_state, handle_gradient_);
+  Eigen::VectorXd gradient_next(q_.size());
+  double potential_next = elastic(q_next, gradient_next) + handle_term_.value_and_gradient(q_next, handle_gradient_);
+  if (!(potential_next <= energy_before + work)) {
+    // The end state holds more energy than the step had (a non-quadratic energy's error, amplified by
+    // an unconverged minimisation in a violent motion): take the substep by implicit Euler instead,
+    // Φ_E(x) = ½‖x − q_n − h v_n‖² + (h²/ρ) V(x, t_{n+1}), undamped, from q_n. BFGS only decreases Φ_E,
+    // so V(q_{n+1}, t_{n+1}) ≤ Φ_E(q_n) ρ/h² = ½ρ‖v_n‖² + V(q_n, t_{n+1}): within the energy the
+    // step had plus the handles' work at q_n, and the velocity check below holds the total there.
+    ++stats.implicit_euler;
+    prediction_ = q_ + h_ * v_;
+    damping_pull_.setZero();
+    damping_weight_ = 1;
+    potential_weight_ = euler_weight_;
+    minimize(euler_bfgs_, euler_started_, euler_inverse_hessian_, q_, stats);
+    q_next = euler_bfgs_.x();
+    v_next = (q_next - q_) / h_;
+    handle_term_.set_transforms(start);
+    work = -handle_term_.value_and_gradient(q_, handle_gradient_);
+    handle_term_.set_transforms(end);
+    work += handle_term_.value_and_gradient(q_, handle_gradient_);
+    potential_next = elastic(q_next, gradient_next) + handle_term_.value_and_gradient(q_next, handle_gradient_);
+  }
+  // The energy check: the excess over the energy the step had and the work done on it comes out of
+  // the kinetic energy.
+  const double kinetic_next = 0.5 * mass_scale_ * v_next.squaredNorm();
+  const double excess = kinetic_next + potential_next - (energy_before + work);
+  if (excess > 0) {
+    const double removed = std::min(excess, kinetic_next);
+    v_next *= kinetic_next > removed ? std::sqrt((kinetic_next - removed) / kinetic_next) : 0.0;
+    stats.energy_removed += removed;
+  }
+  q_ = std::move(q_next);
+  v_ = std::move(v_next);
+  elastic_gradient_ = std::move(gradient_next);
+  potential_ = potential_next;
+}
+
+void ReducedDynamics::positions(Eigen::Ref<Eigen::VectorXf> out) const {
+  const Eigen::Index fine_rows = 3 * static_cast<Eigen::Index>(basis_.num_vertices());
+  if (out.size() != fine_rows)
+    throw InputError(message("out: expected ", fine_rows, " values (3 per vertex), got ", out.size()));
+  if (!basis_.on_proxy()) {
+    quantized_vectors_.map(basis_.vectors, q_float_, basis_.rest.data(), map_tolerance_, out.data());
+    return;
+  }
+  quantized_vectors_.map(basis_.vectors, q_float_, nullptr, map_tolerance_, proxy_displacement_.data());
+  prolongate_positions(basis_.prolongation, basis_.rest.data(), proxy_displacement_.data(), out.data());
+}
+
+}  // namespace modal_deform

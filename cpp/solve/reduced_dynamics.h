@@ -1,0 +1,206 @@
+// Secondary motion: the dynamics M ẍ + D ẋ + ∇E(x) = f whose quasi-static limits are the poses
+// (paper section 3, "connection to physical simulation"), in the reduced space x = x̄ + U q of a
+// baked basis, the energy on the ghost and the handle term exact on the fine mesh, as in
+// ReducedSolver.
+//
+// Mass: the basis is M-orthonormal in the normalised frame (basis.h), so the reduced mass matrix
+// is ρI, with ρ the mass scale the artist's period sets. Time runs in seconds; the artist gives
+// frames: `period` is the period of the lowest flexible mode in frames at `fps`.
+//
+// Integrator: the implicit midpoint rule, q_{n+1} = q_n + h v_m, ρ(v_{n+1} − v_n) = −h (∇V(q_m) +
+// D v_m), with q_m and v_m the means of the step's ends (Hairer, Lubich & Wanner, Geometric
+// Numerical Integration, 2nd ed., I.1.2 and VI.3). It is symplectic and conserves the energy of a
+// quadratic potential for every h: no numerical damping, where a 12-frame vibration at 2 substeps
+// a frame keeps 45% of its amplitude a period under implicit Euler and 97.6% under BDF2 (their
+// amplification factors at ωh = π/12). Its one error on a linear system, a phase lag, is removed
+// for the lowest mode by the mass scale (below). As a minimisation over the middle state x = q_m
+// (an incremental potential, h the substep):
+//
+//   Φ(x) = ½‖x − q_n − (h/2) v_n‖² + κ [(1 + 2β/h) V(x, t_m) − (2β/h) ∇V(q_n, t_n)ᵀx],
+//   κ = h²/(4ρ),  V = E + E_C,
+//
+// whose stationarity is the scheme with the Rayleigh damping force D v_m = β (2/h)(∇V(q_m, t_m) −
+// ∇V(q_n, t_n)) ≈ β d(∇V)/dt: stiffness-proportional damping with the tangent stiffness of the energy
+// and of the handles' springs, relative to the controllers' motion, so neither a rigid motion nor
+// following the controllers is damped. E_C at the substep's middle time, the controllers'
+// transforms interpolated between frames (rotation by slerp, each handle's centre on a line). Then
+// q_{n+1} = 2x − q_n, v_{n+1} = 4(x − q_n)/h − v_n. Φ is minimised by Bfgs, started from the
+// inertial prediction q_n + (h/2) v_n with the inverse of Φ's Hessian at rest, computed once.
+//
+// Parameters from the artist's (exact for the lowest flexible mode of the linearised system): the
+// target poles s = ω(−ζ ± i√(1 − ζ²)), ω = 2π fps/period, are reached in discrete time when the
+// model's poles are s_c = (2/h) tanh(s h/2) (the midpoint rule maps s_c to
+// (1 + s_c h/2)/(1 − s_c h/2) = e^{sh}); with λ₁ the lowest flexible eigenvalue of the reduced rest
+// Hessian K of the ghost energy, ρ = λ₁/(s_c s̄_c) and β = −(s_c + s̄_c)/(s_c s̄_c) (for ζ = 1 a
+// double real pole).
+//
+// Energy: H = ½ρ‖v‖² + E(q) + E_C(q). Away from a quadratic potential the midpoint rule's energy
+// drifts, and an unconverged minimisation (a violent motion) extrapolated to q_{n+1} = 2x − q_n
+// can create energy: so every substep is checked. H_{n+1} may exceed H_n by at most the work the
+// moving handles did, W = E_C(x, t_{n+1}) − E_C(x, t_n); an excess is taken from the kinetic
+// energy (the velocity scaled down); when the potential energy alone exceeds it, the substep is
+// taken by implicit Euler instead (substep() says why that one cannot exceed it). A simulation
+// thus never gains energy it was not given, and never blows up; the step's statistics say how
+// often the check intervened.
+//
+// Not thread-safe: one simulation per thread.
+#pragma once
+
+#include <memory>
+
+#include "basis/basis.h"
+#include "energy/energy.h"
+#include "energy/make_energy.h"
+#include "solve/bfgs.h"
+#include "solve/handle_term.h"
+#include "solve/quantized_vectors.h"
+
+namespace modal_deform {
+
+// The artist's parameters and their defaults (the Python API and the add-on take them from here).
+struct SimulationOptions {
+  double stiffness = 100.0;  // μ of the handle term (handle_term.h)
+  double period = 12.0;      // of the lowest flexible mode, in frames
+  double damping = 0.05;     // ζ of the lowest flexible mode, in [0, 1]
+  double fps = 24.0;         // frames per second
+  int substeps = 2;          // midpoint steps per frame
+  // BFGS per substep: at most this many iterations, and the stopping tolerance (bfgs.h), which
+  // keeps the frames within the map's precision (ReducedSolver::kMapTolerance) of a tight solve's
+  // (bench/results/dynamics.json, "tolerance").
+  int max_iterations = 20;
+  double tolerance = 1e-8;
+};
+
+// The fields of SimulationOptions by name (the Python API's keywords and SIMULATION_DEFAULTS):
+// visit(name, field) with field the accessor o -> o.member.
+template <typename Visit>
+void for_each_simulation_option(Visit&& visit) {
+  visit("stiffness", [](auto& o) -> auto& { return o.stiffness; });
+  visit("period", [](auto& o) -> auto& { return o.period; });
+  visit("damping", [](auto& o) -> auto& { return o.damping; });
+  visit("fps", [](auto& o) -> auto& { return o.fps; });
+  visit("substeps", [](auto& o) -> auto& { return o.substeps; });
+  visit("max_iterations", [](auto& o) -> auto& { return o.max_iterations; });
+  visit("tolerance", [](auto& o) -> auto& { return o.tolerance; });
+}
+
+// The shortest period accepted: a vibration faster than this is not seen as one at the frame rate,
+// and the mass scale's map (tanh of ω h/2) needs ω h < π.
+constexpr double kMinPeriodFrames = 3.0;
+constexpr int kMaxSubsteps = 64;
+
+// Throws InputError naming the first option out of range.
+void check_simulation_options(const SimulationOptions& options);
+
+struct SimulationStepStats {
+  int substeps = 0;
+  int iterations = 0;              // BFGS iterations, all substeps
+  int evaluations = 0;             // evaluations of Φ, all substeps
+  bool converged = true;           // every substep's minimisation converged (bfgs.h)
+  bool stalled = false;            // a substep's BFGS could not decrease Φ (its state was still taken)
+  int line_search_failures = 0;
+  int implicit_euler = 0;          // substeps the energy check took by implicit Euler instead
+  double energy_removed = 0;       // energy taken from the kinetic energy by the energy check
+  double ms = 0;                   // wall time of the step, milliseconds
+};
+
+// The fields of SimulationStepStats by name (Simulation.stats in Python).
+template <typename Visit>
+void for_each_simulation_stat(Visit&& visit) {
+  visit("substeps", [](auto& s) -> auto& { return s.substeps; });
+  visit("iterations", [](auto& s) -> auto& { return s.iterations; });
+  visit("evaluations", [](auto& s) -> auto& { return s.evaluations; });
+  visit("converged", [](auto& s) -> auto& { return s.converged; });
+  visit("stalled", [](auto& s) -> auto& { return s.stalled; });
+  visit("line_search_failures", [](auto& s) -> auto& { return s.line_search_failures; });
+  visit("implicit_euler", [](auto& s) -> auto& { return s.implicit_euler; });
+  visit("energy_removed", [](auto& s) -> auto& { return s.energy_removed; });
+  visit("ms", [](auto& s) -> auto& { return s.ms; });
+}
+
+class ReducedDynamics {
+ public:
+  // basis: validated (validate_basis), must outlive the simulation. handles: fine vertex indices
+  // (checked_handle_weights; may be empty: a free body), weights one per handle (empty: 1).
+  // Starts at rest (q = v = 0) with identity transforms. Throws InputError when the basis has no
+  // flexible mode to set the period by.
+  ReducedDynamics(const Basis& basis, const Handles& handles, const VectorRef& weights,
+                  const SimulationOptions& options, EnergyKind energy = EnergyKind::kShells);
+  ReducedDynamics(const ReducedDynamics&) = delete;
+  ReducedDynamics& operator=(const ReducedDynamics&) = delete;
+
+  // Advances one frame, the controllers reaching `transforms` (one rigid 4 by 4 per handle,
+  // check_transforms) at its end.
+  SimulationStepStats step(const Transforms& transforms);
+
+  // The state: q (r) and v = dq/dt (r, per second); transforms: the controllers' at this state
+  // (one per handle; empty keeps the current ones). Throws InputError for a wrong size, a
+  // non-finite entry or a q whose ghost leaves the coordinates the energies take.
+  void set_state(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Transforms& transforms = {});
+  const Eigen::VectorXd& q() const { return q_; }
+  const Eigen::VectorXd& v() const { return v_; }
+
+  // H = ½ρ‖v‖² + E(q) + E_C(q) at the current transforms (normalised frame).
+  double energy() const { return kinetic_energy() + potential_; }
+  double kinetic_energy() const { return 0.5 * mass_scale_ * v_.squaredNorm(); }
+  double potential_energy() const { return potential_; }
+
+  // x̄ + U q on the fine mesh, as ReducedSolver::positions.
+  void positions(Eigen::Ref<Eigen::VectorXf> out) const;
+
+  int dimension() const { return static_cast<int>(ghost_vectors_.cols()); }
+  int num_handles() const { return static_cast<int>(centres_.size()); }
+  double mass_scale() const { return mass_scale_; }                   // ρ
+  const Eigen::VectorXd& lowest_mode() const { return lowest_mode_; }  // λ₁'s unit eigenvector of K
+
+ private:
+  // E(q) with ∇E(q) in `gradient` (r): +inf where the ghost leaves the coordinate range.
+  double elastic(const Eigen::VectorXd& q, Eigen::VectorXd& gradient);
+  // Φ (above) for the current substep and scheme: ½‖x − prediction‖² + potential_weight
+  // (damping_weight V(x) − damping_pullᵀx), V = E + E_C.
+  double incremental_potential(const Eigen::VectorXd& x, Eigen::VectorXd& gradient);
+  // The inverse of I + potential_weight damping_weight (K + 2A): Φ's Hessian at rest.
+  Eigen::MatrixXd inverse_rest_hessian(const Eigen::MatrixXd& K, double potential_weight, double damping_weight) const;
+  // Minimises the current Φ with `bfgs` from `start`, adding to `stats`; `started`: bfgs has
+  // minimised this scheme's Φ earlier in the frame.
+  void minimize(Bfgs& bfgs, bool& started, const Eigen::MatrixXd& initial_inverse_hessian,
+                const Eigen::VectorXd& start, SimulationStepStats& stats);
+  // Transforms at fraction a of the way from start_ to target (per handle).
+  Transforms interpolated(const Transforms& target, double a) const;
+  void substep(const Transforms& start, const Transforms& middle, const Transforms& end,
+               SimulationStepStats& stats);
+
+  const Basis& basis_;
+  SimulationOptions options_;
+  std::unique_ptr<Energy> energy_;  // of the ghost, normalised frame
+  Eigen::VectorXd ghost_rest_;      // s x̄_s
+  Eigen::MatrixXd ghost_vectors_;   // s U_s
+  ReducedHandleTerm handle_term_;
+  std::vector<Eigen::Vector3d> centres_;  // each handle's rest centre (interpolation)
+  Transforms transforms_;                 // the controllers' at the current state
+  QuantizedVectors quantized_vectors_;
+  double map_tolerance_;
+
+  double mass_scale_ = 0, rayleigh_ = 0, h_ = 0;  // ρ, β (seconds), the substep (seconds)
+  Eigen::VectorXd lowest_mode_;
+  // The midpoint rule's Φ (κ = h²/(4ρ)) and implicit Euler's (h²/ρ): weight, inverse Hessian at
+  // rest, minimiser.
+  double midpoint_weight_ = 0, euler_weight_ = 0;
+  Eigen::MatrixXd midpoint_inverse_hessian_, euler_inverse_hessian_;
+  Bfgs midpoint_bfgs_, euler_bfgs_;
+  bool midpoint_started_ = false, euler_started_ = false;
+
+  // State: q, v, E(q) + E_C(q), ∇E(q).
+  Eigen::VectorXd q_, v_, elastic_gradient_;
+  double potential_ = 0;
+  Eigen::VectorXf q_float_;
+  mutable Eigen::VectorXf proxy_displacement_;
+  // The current Φ's terms: the prediction (q_n + (h/2) v_n for the midpoint rule), the damping
+  // term's pull ((2β/h) ∇V(q_n, t_n)) and the weights (κ, 1 + 2β/h).
+  Eigen::VectorXd prediction_, damping_pull_;
+  double damping_weight_ = 1, potential_weight_ = 0;
+  // Work space, sized once.
+  Eigen::VectorXd ghost_x_, ghost_gradient_, work_gradient_, handle_gradient_;
+};
+
+}  // namespace modal_deform

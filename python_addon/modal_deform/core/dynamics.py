@@ -1,0 +1,142 @@
+"""Secondary motion: the mesh follows its controllers with inertia, in the basis it was baked with.
+
+The dynamics whose quasi-static limits are the poses (paper section 3), integrated in the reduced
+space x = x̄ + U q by the implicit midpoint rule written as a minimisation, each step solved by
+the warm-started BFGS of posing (cpp/solve/reduced_dynamics.h has the scheme and its reasons).
+The artist's parameters are in frames: ``period``, the period of the lowest flexible mode (it sets
+the mass), and ``damping``, that mode's damping ratio ζ (Rayleigh damping, stiffer modes damped
+more). Both hold exactly for the lowest mode of small motions, whatever ``fps`` and ``substeps``.
+"""
+import numpy as np
+
+from .. import _native
+from . import _arrays
+from .bake import Basis
+from .solve import _handles, _transforms, _weights
+
+#: The defaults of Simulation's parameters (the native core's SimulationOptions):
+#: stiffness, period (frames), damping (ratio), fps, substeps, max_iterations, tolerance.
+SIMULATION_DEFAULTS = dict(_native.SIMULATION_DEFAULTS)
+#: The shortest period accepted, in frames, and the most substeps a frame.
+MIN_PERIOD_FRAMES = _native.MIN_PERIOD_FRAMES
+MAX_SUBSTEPS = _native.MAX_SUBSTEPS
+
+
+class Simulation:
+    """Reduced dynamics of a baked basis driven by handles.
+
+    ``basis``: from ``mdc.bake`` (kept alive). ``handles``: a list of vertex index arrays, one per
+    controller, possibly empty (a free body). ``stiffness``: μ of the handle term, as for
+    ReducedSolver. ``period``: of the lowest flexible mode, in frames (≥ MIN_PERIOD_FRAMES).
+    ``damping``: its damping ratio in [0, 1]. ``fps``: frames per second (velocities are per
+    second). ``substeps``: midpoint steps per frame (1 to MAX_SUBSTEPS). ``weights``: one per
+    handle (default 1); ``energy``: "shells" or "arap"; ``max_iterations``, ``tolerance``: BFGS's
+    per substep. Starts at rest, at rest velocity, with every controller at the identity.
+    Raises ValueError naming the argument that is wrong.
+    """
+
+    def __init__(self, basis, handles, stiffness=SIMULATION_DEFAULTS["stiffness"],
+                 period=SIMULATION_DEFAULTS["period"], damping=SIMULATION_DEFAULTS["damping"],
+                 fps=SIMULATION_DEFAULTS["fps"], substeps=SIMULATION_DEFAULTS["substeps"], weights=None,
+                 energy="shells", max_iterations=SIMULATION_DEFAULTS["max_iterations"],
+                 tolerance=SIMULATION_DEFAULTS["tolerance"]):
+        if not isinstance(basis, Basis):
+            raise ValueError(f"basis: expected a modal_deform.core.Basis (from bake or Basis.from_arrays), "
+                             f"got {type(basis).__name__}")
+        handles = [] if _is_empty(handles) else _handles(handles)
+        weights = np.zeros(0) if not handles else _weights(weights, len(handles))
+        self._native = _native.Simulation(
+            basis._native, handles, weights, str(energy), stiffness=_arrays.number(stiffness, "stiffness"),
+            period=_arrays.number(period, "period"), damping=_arrays.number(damping, "damping"),
+            fps=_arrays.number(fps, "fps"), substeps=_arrays.integer(substeps, "substeps"),
+            max_iterations=_arrays.integer(max_iterations, "max_iterations"),
+            tolerance=_arrays.number(tolerance, "tolerance"))
+        self._basis = basis
+        self.stats = None  #: the last step's: see step()
+
+    @property
+    def num_vertices(self):
+        return self._basis.num_vertices
+
+    @property
+    def dimension(self):
+        """r, the number of reduced coordinates (basis.vectors' columns)."""
+        return self._native.dimension
+
+    @property
+    def num_handles(self):
+        return self._native.num_handles
+
+    def step(self, transforms, out=None):
+        """Advances one frame: the controllers reach ``transforms`` (one rigid 4x4 per handle; [] for
+        a free body) at its end, moving there from the previous frame's (rotations by slerp, each
+        handle's centre on a straight line). Returns the positions at the frame's end, as
+        ``positions(out)``. ``self.stats`` then holds {"substeps", "iterations", "evaluations",
+        "converged", "stalled", "line_search_failures", "energy_removed", "ms"}: "converged" when
+        every substep's minimisation met its stopping test, "stalled" when one could not decrease
+        its objective (its state is taken all the same: the step never fails), "energy_removed"
+        the energy the energy check took from the motion (nonzero only where the midpoint rule
+        or an unconverged substep would have created energy).
+        """
+        self.stats = self._native.step(self._checked_transforms(transforms))
+        return self.positions(out)
+
+    @property
+    def state(self):
+        """(q, v): the reduced coordinates (r,) and their velocity (r,) per second (copies), in the
+        coordinates of basis.vectors' columns: what a cache stores."""
+        return self._native.q, self._native.v
+
+    def set_state(self, q, v, transforms=None):
+        """Puts the simulation at (q, v), e.g. a cached frame's, or a pose's ``ReducedSolver.q``
+        with zero velocity. ``transforms``: the controllers' at that state (one 4x4 per handle), the
+        start of the next step; None keeps the current ones."""
+        r = self.dimension
+        q = _arrays.values(q, "q", r)
+        v = _arrays.values(v, "v", r)
+        self._native.set_state(q, v, [] if transforms is None else self._checked_transforms(transforms))
+
+    def energy(self):
+        """The total energy, kinetic plus potential (deformation energy plus handle term), in the
+        normalised frame at the current transforms."""
+        return self._native.energy()
+
+    def kinetic_energy(self):
+        return self._native.kinetic_energy()
+
+    def potential_energy(self):
+        return self._native.potential_energy()
+
+    @property
+    def lowest_mode(self):
+        """The lowest flexible mode of the reduced rest Hessian (r,), unit norm: the motion whose
+        period is ``period``."""
+        return self._native.lowest_mode
+
+    @property
+    def mass_scale(self):
+        """ρ: the reduced mass matrix is ρ I."""
+        return self._native.mass_scale
+
+    def positions(self, out=None):
+        """x̄ + U q on the fine mesh: (n, 3) float32, mesh units; written into ``out`` (a C-contiguous
+        float32 array of shape (n, 3) or (3n,)) when given."""
+        n = self.num_vertices
+        if out is None:
+            out = np.empty((n, 3), dtype=np.float32)
+        elif not (isinstance(out, np.ndarray) and out.dtype == np.float32 and out.flags.c_contiguous
+                  and out.flags.writeable and out.shape in ((n, 3), (3 * n,))):
+            raise ValueError(f"out: expected a writeable C-contiguous float32 array of shape ({n}, 3) or ({3 * n},), "
+                             f"got {getattr(out, 'dtype', type(out).__name__)} {getattr(out, 'shape', '')}")
+        self._native.positions(out.reshape(-1))
+        return out
+
+    def _checked_transforms(self, transforms):
+        if _is_empty(transforms):
+            transforms = []
+        return _transforms(transforms, self._native.num_handles)
+
+
+def _is_empty(sequence):
+    """True for None, an empty list/tuple or an empty array."""
+    return sequence is None or (hasattr(sequence, "__len__") and len(sequence) == 0)

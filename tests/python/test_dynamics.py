@@ -1,0 +1,235 @@
+"""Secondary motion through the Python API: mdc.Simulation (cpp/solve/reduced_dynamics.h)."""
+import numpy as np
+import pytest
+
+import modal_deform.core as mdc
+
+
+def rigid(axis, angle, centre, translation=(0, 0, 0)):
+    """4x4: rotation by ``angle`` about ``axis`` through ``centre``, then a translation."""
+    axis = np.asarray(axis, float) / np.linalg.norm(axis)
+    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    R = np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+    T = np.eye(4)
+    T[:3, :3] = R
+    T[:3, 3] = np.asarray(centre) + np.asarray(translation) - R @ centre
+    return T
+
+
+@pytest.fixture(scope="module")
+def bar():
+    """A closed bar, baked small: a free body for the period and damping checks."""
+    V, F = mdc.bar(4, 4, 16, 1, 1, 4)
+    return V, F, mdc.bake(V, F, modes=12, derivatives=20, ghost=300)
+
+
+@pytest.fixture(scope="module")
+def tube():
+    """A tube of 1000 vertices held at its bottom ring, its top ring on a controller."""
+    V, F = mdc.cylinder(25, 40, radius=1.0, length=4.0)
+    handles = [np.flatnonzero(V[:, 2] < 1e-9), np.flatnonzero(V[:, 2] > 4 - 1e-9)]
+    return V, F, handles, mdc.bake(V, F, modes=16, derivatives=30, ghost=400)
+
+
+def released(basis, frames, amplitude=0.01, **parameters):
+    """A free body released at rest from ``amplitude`` along its lowest flexible mode: the mode's
+    coordinate at the end of each frame."""
+    sim = mdc.Simulation(basis, [], **parameters)
+    mode = sim.lowest_mode
+    sim.set_state(amplitude * mode, np.zeros_like(mode))
+    trace = []
+    for _ in range(frames):
+        sim.step([])
+        trace.append(sim.state[0] @ mode)
+    return np.array(trace)
+
+
+def damped_oscillation(trace):
+    """(period in frames, logarithmic decrement a period) of a sampled damped oscillation
+    p_k = A r^k cos(θk + φ), from its recurrence p_{k+1} = 2r cos θ p_k − r² p_{k−1} fitted by least
+    squares."""
+    (a, b), *_ = np.linalg.lstsq(np.column_stack([trace[1:-1], trace[:-2]]), trace[2:], rcond=None)
+    r = np.sqrt(-b)
+    theta = np.arccos(a / (2 * r))
+    return 2 * np.pi / theta, -np.log(r) * 2 * np.pi / theta
+
+
+@pytest.mark.parametrize("period, fps, substeps", [(12.0, 24.0, 2), (12.0, 24.0, 1), (6.0, 60.0, 3)])
+def test_undamped_free_body_keeps_its_period_and_amplitude(bar, period, fps, substeps):
+    *_, basis = bar
+    frames = int(10 * period) + 1
+    trace = released(basis, frames, period=period, damping=0.0, fps=fps, substeps=substeps)
+    measured, decrement = damped_oscillation(trace)
+    assert abs(measured - period) <= 0.02 * period
+    # After 10 periods: at least 90% of the amplitude (the largest value over the last period).
+    last_period = np.abs(trace[-int(np.ceil(period)):]).max()
+    assert last_period >= 0.9 * 0.01
+    assert last_period <= 1.0001 * 0.01
+
+
+@pytest.mark.parametrize("damping", [0.02, 0.05, 0.2, 0.5])
+def test_damping_ratio_gives_the_logarithmic_decrement(bar, damping):
+    *_, basis = bar
+    trace = released(basis, 48, damping=damping)
+    period, decrement = damped_oscillation(trace)
+    expected = 2 * np.pi * damping / np.sqrt(1 - damping**2)
+    assert abs(decrement - expected) <= 0.1 * expected
+    assert abs(period - 12.0 / np.sqrt(1 - damping**2)) <= 0.02 * 12
+
+
+@pytest.fixture(scope="module")
+def tube_bases():
+    """The tube baked as a whole, with a painted stiffness, on a proxy, and as a region (its upper
+    half)."""
+    V, F = mdc.cylinder(25, 40, radius=1.0, length=4.0)
+    sizes = dict(modes=16, derivatives=30, ghost=400)
+    upper = np.flatnonzero(V[:, 2] > 2.0)
+    bases = {"whole": mdc.bake(V, F, **sizes),
+             "painted": mdc.bake(V, F, **sizes, stiffness_weights=np.clip(V[:, 2] / 4, 0, 1), max_stiffness=20.0),
+             "proxy": mdc.bake(V, F, **sizes, proxy=400, proxy_above=500),
+             "region": mdc.bake(V, F, **sizes, region=upper)}
+    return V, F, upper, bases
+
+
+@pytest.mark.parametrize("kind", ["whole", "painted", "proxy", "region"])
+def test_every_kind_of_basis_keeps_the_period_and_follows_a_controller(tube_bases, kind):
+    V, F, upper, bases = tube_bases
+    basis = bases[kind]
+    assert basis.on_proxy == (kind == "proxy")
+    period, _ = damped_oscillation(released(basis, 25, damping=0.0))
+    assert abs(period - 12.0) <= 0.02 * 12.0
+    top = np.flatnonzero(V[:, 2] > 4 - 1e-9)
+    sim = mdc.Simulation(basis, [top])
+    for frame in range(1, 13):
+        X = sim.step([rigid([1, 0, 0], np.radians(5 * frame), V[top].mean(axis=0))])
+        assert np.isfinite(X).all() and X.shape == V.shape
+    assert np.abs(X[top] - V[top]).max() > 0.1  # it followed
+    if kind == "region":
+        outside = np.setdiff1d(np.arange(len(V)), upper)
+        assert np.array_equal(X[outside], V[outside].astype(np.float32))
+
+
+def random_controller(rng, centre):
+    """A random rigid move of the controller: turns up to 150° about a random axis, jumps up to about
+    a bar's length."""
+    return rigid(rng.normal(size=3), rng.uniform(0, np.radians(150)), centre, rng.normal(scale=1.5, size=3))
+
+
+def test_fast_random_controllers_then_settling_to_the_pose(tube):
+    V, F, handles, basis = tube
+    diagonal = np.linalg.norm(np.ptp(V, axis=0))
+    sim = mdc.Simulation(basis, handles, stiffness=100.0, damping=0.3)
+    rng = np.random.default_rng(7)
+    top_centre = V[handles[1]].mean(axis=0)
+    for _ in range(60):
+        T = random_controller(rng, top_centre)
+        X = sim.step([np.eye(4), T])
+        assert np.isfinite(X).all() and np.isfinite(sim.energy())
+        # No blow-up: the mesh stays within a few diagonals of its controllers.
+        assert np.abs(X - V.mean(axis=0)).max() <= 5 * diagonal
+    # The controllers stop in a moderate pose (a strong one has several equilibria, and where the
+    # motion ends up among them is its own business): no more work is done on the mesh, and its
+    # energy never grows.
+    T = rigid([1, 0, 0], np.radians(60), top_centre, [0.5, 0, -0.5])
+    sim.step([np.eye(4), T])
+    energies = [sim.energy()]
+    for _ in range(240):
+        X = sim.step([np.eye(4), T])
+        energies.append(sim.energy())
+    energies = np.array(energies)
+    assert (np.diff(energies) <= 1e-12 * energies[0]).all()
+    assert energies[-1] < energies[0]
+    # It settles where the quasi-static solver poses it.
+    solver = mdc.ReducedSolver(basis, handles, stiffness=100.0)
+    solver.set_transforms([np.eye(4), T])
+    assert solver.solve(max_iterations=500, tolerance=1e-12)["converged"]
+    assert np.abs(X - solver.positions()).max() <= 1e-4 * diagonal
+
+
+def test_a_run_is_deterministic_and_its_state_reloads_bit_identical(tube):
+    V, F, handles, basis = tube
+    rng = np.random.default_rng(3)
+    centre = V[handles[1]].mean(axis=0)
+    moves = [[np.eye(4), random_controller(rng, centre)] for _ in range(16)]
+
+    def run(sim, transforms):
+        return [sim.step(T).copy() for T in transforms]
+
+    first, second = mdc.Simulation(basis, handles), mdc.Simulation(basis, handles)
+    a, b = run(first, moves), run(second, moves)
+    assert all(np.array_equal(x, y) for x, y in zip(a, b))
+    assert all(np.array_equal(x, y) for x, y in zip(first.state, second.state))
+    # A cache: the state after frame 8, reloaded into a fresh simulation, continues bit-identical.
+    cached = mdc.Simulation(basis, handles)
+    run(cached, moves[:8])
+    q, v = cached.state
+    reloaded = mdc.Simulation(basis, handles)
+    reloaded.set_state(q, v, moves[7])
+    assert all(np.array_equal(x, y) for x, y in zip(reloaded.state, (q, v)))
+    assert reloaded.energy() == cached.energy()
+    assert np.array_equal(reloaded.positions(), cached.positions())
+    assert all(np.array_equal(x, y) for x, y in zip(run(reloaded, moves[8:]), a[8:]))
+
+
+def test_parameters_are_defined_once_and_checked(bar):
+    V, F, basis = bar
+    assert mdc.SIMULATION_DEFAULTS["period"] == 12.0 and mdc.SIMULATION_DEFAULTS["substeps"] == 2
+    sim = mdc.Simulation(basis, [])
+    assert sim.dimension == basis.vectors.shape[1] and sim.num_handles == 0
+    X = sim.step([])
+    assert X.shape == V.shape and X.dtype == np.float32
+    assert np.array_equal(X, sim.positions())
+    for name, value in [("period", 2.0), ("damping", -0.1), ("damping", 1.5), ("fps", 0.0), ("stiffness", -1.0),
+                        ("period", float("nan"))]:
+        with pytest.raises(ValueError, match=name):
+            mdc.Simulation(basis, [], **{name: value})
+    with pytest.raises(ValueError, match="substeps"):
+        mdc.Simulation(basis, [], substeps=0)
+    with pytest.raises(ValueError, match="basis"):
+        mdc.Simulation(V, [])
+    with pytest.raises(ValueError, match=r"handles\[0\]"):
+        mdc.Simulation(basis, [[len(V)]])
+    held = mdc.Simulation(basis, [[0, 1, 2]])
+    with pytest.raises(ValueError, match="transforms"):
+        held.step([])
+    sheared = np.eye(4)
+    sheared[0, 1] = 0.5
+    with pytest.raises(ValueError, match=r"transforms\[0\]"):
+        held.step([sheared])
+    r = sim.dimension
+    with pytest.raises(ValueError, match="q"):
+        sim.set_state(np.zeros(r + 1), np.zeros(r))
+    with pytest.raises(ValueError, match="v"):
+        sim.set_state(np.zeros(r), np.full(r, np.nan))
+    with pytest.raises(ValueError, match="q"):
+        sim.set_state(np.full(r, 1e300), np.zeros(r))
+
+
+def test_an_unconverged_step_says_so_and_stays_finite(tube):
+    V, F, handles, basis = tube
+    sim = mdc.Simulation(basis, handles, max_iterations=1)
+    rng = np.random.default_rng(5)
+    centre = V[handles[1]].mean(axis=0)
+    stats = []
+    for _ in range(10):
+        X = sim.step([np.eye(4), random_controller(rng, centre)])
+        assert np.isfinite(X).all() and np.isfinite(sim.energy())
+        stats.append(sim.stats)
+    assert not all(s["converged"] for s in stats)
+    assert all(s["substeps"] == 2 and s["iterations"] <= 2 * (1 + s["implicit_euler"]) for s in stats)
+    # Unconverged steps cannot create energy either: with the controllers still it never grows.
+    still = [np.eye(4), random_controller(rng, centre)]
+    sim.step(still)
+    energies = [sim.energy()]
+    for _ in range(40):
+        sim.step(still)
+        energies.append(sim.energy())
+    assert (np.diff(energies) <= 1e-12 * energies[0]).all() and energies[-1] < energies[0]
+
+
+def test_the_motion_in_frames_does_not_depend_on_the_frame_rate(bar):
+    """Period and damping are in frames: at another fps the frames are the same (velocities, per
+    second, scale with it)."""
+    *_, basis = bar
+    traces = [released(basis, 30, fps=fps) for fps in (24.0, 30.0)]
+    assert np.allclose(traces[0], traces[1], rtol=0, atol=1e-9 * np.abs(traces[0]).max())
