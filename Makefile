@@ -1,6 +1,7 @@
 # Modal Deform — build, test and run everything from a fresh Debian machine (as root).
 #   make demo    install what is missing, build, bake and pose Suzanne headless -> out/demo.{blend,png}
-#   make test    install, build, run the C++, Python and Blender tests (Blender 3.4.1 app; bpy 4.2.0, 4.5, 5.3)
+#   make test    install, build, run the C++, Python and Blender tests (Blender 3.4.1 app; bpy 4.2.0, 4.5, 5.3;
+#                windows of Debian 12's 3.4.1 and of Debian 13's 4.3.2 in a Debian 13 root, .debian13/)
 #   make addon   dist/: the core's manylinux wheels (CPython 3.10 to 3.13), the two extension zips
 #                (Blender 4.2 to 5.0, Blender 5.1 and later) and the legacy zip (Blender 3.4 to 4.1,
 #                and distributions' Blenders with their own Python)
@@ -148,9 +149,13 @@ test-bpy: $(BPY_VERSIONS:%=test-bpy-%)
 test-bpy-%: bpy-venv-%
 	BLENDER_PYTHON=$(CURDIR)/$(VENV)/bpy-$*/bin/python $(PYTHON) -m pytest -q tests/blender
 
-# Blender with a window under Xvfb, driven by simulated mouse and keyboard events.
-test-gui:
-	PYTHONPATH=python_addon $(PYTHON) -m pytest -q tests/gui
+include tests/gui/debian13.mk
+
+# Blender with a window under Xvfb, driven by simulated mouse and keyboard events, every panel drawn
+# and screenshotted (build/test-artefacts/gui-<version>/): Debian 12's 3.4.1 with the source tree's
+# add-on, and Debian 13's 4.3.2 in its root with the legacy zip of dist/ (make addon).
+test-gui: debian13-root
+	DEBIAN13_ROOT=$(CURDIR)/$(DEBIAN13_ROOT) PYTHONPATH=python_addon $(PYTHON) -m pytest -q tests/gui
 
 demo: build
 	@mkdir -p out

@@ -6,6 +6,7 @@ import json
 import os
 import pathlib
 import re
+import shutil
 import subprocess
 
 import pytest
@@ -14,12 +15,36 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 SCRIPTS = pathlib.Path(__file__).resolve().parent / "scripts"
 XVFB = ["xvfb-run", "-a", "-s", "-screen 0 1280x800x24"]
 
+# The Debian 13 root of `make debian13-root` (tests/gui/debian13.mk) and the command that runs in it.
+DEBIAN13_ROOT = pathlib.Path(os.environ.get("DEBIAN13_ROOT", ROOT / ".debian13" / "root"))
+IN_DEBIAN13 = [str(pathlib.Path(__file__).resolve().parent / "in-debian13.sh"), str(DEBIAN13_ROOT)]
+LEGACY_ZIP = "modal_deform-*-legacy-linux_x64.zip"
+
+
 def debian12():
     """Debian 12's Blender 3.4.1 app with the add-on of the source tree."""
     return [], dict(ADDON_PATH=str(ROOT / "python_addon"))
 
 
-@pytest.fixture(scope="module", params=[debian12], ids=lambda window: window.__name__)
+def debian13():
+    """Debian 13's Blender 4.3.2 (Python 3.13) in the root, with the legacy zip of dist/ installed by
+    Blender's own installer (Preferences > Add-ons > Install from Disk) into a fresh user folder."""
+    assert DEBIAN13_ROOT.is_dir(), f"{DEBIAN13_ROOT}: no Debian 13 root (make debian13-root)"
+    zips = sorted((ROOT / "dist").glob(LEGACY_ZIP))
+    assert len(zips) == 1, f"expected one dist/{LEGACY_ZIP} (make addon), found {zips}"
+    home = ROOT / "build" / "debian13-home"
+    shutil.rmtree(home, ignore_errors=True)
+    home.mkdir(parents=True)
+    env = dict(os.environ, HOME=str(home))
+    install = f"import bpy; bpy.ops.preferences.addon_install(filepath={str(zips[0])!r})"
+    subprocess.run(IN_DEBIAN13 + ["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python-expr",
+                                  install], capture_output=True, env=env, check=True, timeout=300)
+    [addons] = home.glob(".config/blender/*/scripts/addons")
+    assert list((addons / "modal_deform").glob("_native.cpython-313-*.so")), "the legacy zip has no core for 3.13"
+    return IN_DEBIAN13, dict(ADDON_PATH=str(addons), HOME=str(home), MODAL_DEFORM_GRAB="x11")
+
+
+@pytest.fixture(scope="module", params=[debian12, debian13], ids=lambda window: window.__name__)
 def window(request):
     """(command prefix, environment, artefacts folder) of a window; the folder is emptied first, so
     that a result left by an earlier run cannot pass this one."""
@@ -84,3 +109,33 @@ def test_viewport_frame_time_while_posing_100k(window):
     assert result["ok"], "\n".join(result["log"])
     print("\n".join(result["log"]))
     assert result["vertices"] == 100250 and set(result["displays"]) == {"positions", "stand_in", "shape_key"}
+
+
+# Installs a zip as an extension with Blender's own installer and prints what is enabled after.
+INSTALL_EXTENSION = """
+import sys, bpy
+try:
+    result = bpy.ops.extensions.package_install_files(filepath=sys.argv[-1], repo="user_default",
+                                                      enable_on_install=True)
+except RuntimeError as error:
+    result = str(error).strip()
+enabled = [addon.module for addon in bpy.context.preferences.addons if "modal_deform" in addon.module]
+print("ENABLED", enabled, hasattr(bpy.types.Object, "modal_deform"), "|", result)
+"""
+
+
+@pytest.mark.parametrize("blenders", ["blender_4.2_to_5.0", "blender_5.1_and_later"])
+def test_debian13_blender_enables_no_extension_zip(blenders, tmp_path):
+    """Debian 13's Blender 4.3.2 embeds Python 3.13. Blender's own installer (Get Extensions > Install
+    from Disk) refuses the zip for Blender 5.1 and later ("doesn't meet the minimum supported
+    version"), and unpacks the one with the cp311 wheel but does not enable it ("This Python version
+    (3.13) isn't compatible with (3.11)"): such a Blender takes the legacy zip (the windows above)."""
+    assert DEBIAN13_ROOT.is_dir(), f"{DEBIAN13_ROOT}: no Debian 13 root (make debian13-root)"
+    [extension] = (ROOT / "dist").glob(f"modal_deform-*-{blenders}-linux_x64.zip")
+    run = subprocess.run(IN_DEBIAN13 + ["blender", "-b", "--factory-startup", "--python-exit-code", "1",
+                                        "--python-expr", INSTALL_EXTENSION, "--", str(extension)],
+                         capture_output=True, text=True, timeout=300, env=dict(os.environ, HOME=str(tmp_path)))
+    output = run.stdout + run.stderr
+    assert run.returncode == 0 and "ENABLED [] False" in output, output[-4000:]
+    assert ("isn't compatible with (3.11)" if blenders == "blender_4.2_to_5.0" else
+            "doesn't meet the minimum supported version (5.1.0)") in output, output[-4000:]

@@ -16,11 +16,16 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from window import click, enable_addon, output, override, run, say, screenshot, show_sidebar_tab, sidebar, view3d  # noqa: E402,E501
 
+# Seconds for the sidebar to settle after a change: Blender 4.x animates panels opening and moving.
+SETTLE = 1.0
 
-def cut(path, x, y, width, height, cut_path):
-    """Write the rectangle (x, y from the bottom left, as Blender's regions) of the PNG at path."""
+
+def cut(path, window_size, x, y, width, height, cut_path):
+    """Write the rectangle (x, y from the bottom left, as Blender's regions) of the window's PNG at
+    path; an X grab is of the whole screen, which the window fills (no window manager)."""
     image = bpy.data.images.load(path)
     full_width, full_height = image.size
+    assert (full_width, full_height) == window_size, f"{path}: {image.size[:]}, not the window's {window_size}"
     pixels = np.empty(full_width * full_height * 4, np.float32)
     image.pixels.foreach_get(pixels)
     part = pixels.reshape(full_height, full_width, 4)[y:y + height, x:x + width]
@@ -48,7 +53,7 @@ def screenshots(state):
     while True:
         part += 1
         grab = screenshot("grab.png")
-        cut(grab, region.x - window.x, region.y - window.y, region.width, region.height,
+        cut(grab, (window.width, window.height), region.x, region.y, region.width, region.height,
             os.path.join(output, f"sidebar-{state}-{part}.png"))
         os.remove(grab)
         before = scroll_offset(region)
@@ -65,7 +70,7 @@ def scroll(region, wheel, clicks):
     window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x, y=y)
     for _ in range(clicks):
         window.event_simulate(type=wheel, value="PRESS", x=x, y=y)
-    yield 0.3
+    yield SETTLE
 
 
 def select_vertices(obj, mask):
@@ -103,7 +108,7 @@ def steps():
         bpy.ops.object.shade_smooth()
         bpy.ops.view3d.view_axis(type="FRONT")
         bpy.ops.view3d.view_all()
-    show_sidebar_tab()
+    yield from show_sidebar_tab()
     yield 0.5
     window, _, _ = view3d()
     region = sidebar()
@@ -129,18 +134,18 @@ def steps():
     with override():
         bpy.context.view_layer.objects.active = obj
         assert bpy.ops.modal_deform.bake() == {"FINISHED"}
-    yield 0.5
+    yield SETTLE
     # Mode Preview starts closed: open it with a click on its header, the last of the tab's panels.
     yield from scroll(region, "WHEELDOWNMOUSE", 40)
     click(region.x + 60, region.y + int(24 * bpy.context.preferences.system.ui_scale))
-    yield 0.3
+    yield SETTLE
     yield from scroll(region, "WHEELUPMOUSE", 40)
     yield from screenshots("baked")
 
     # A vertex moved after the bake: the panels say the basis is stale.
     obj.data.vertices[0].co.x += 0.1
     obj.data.update()
-    yield 0.3
+    yield SETTLE
     yield from screenshots("stale")
 
 

@@ -155,7 +155,7 @@ def steps():
     followed = pose[group].mean(axis=0) - rest[group].mean(axis=0)
     assert np.linalg.norm(followed - moved) < 0.05 * np.linalg.norm(moved), (followed, moved)
     say("mesh followed by", np.round(followed, 3).tolist(), "at", f"{posing.running.tick_ms:.1f} ms per update")
-    show_sidebar_tab()
+    yield from show_sidebar_tab()
     yield 0.5
     screenshot("pose.png")
 

@@ -54,6 +54,10 @@ def screenshot(path):
     """The whole window as a PNG at path (relative: in OUTPUT)."""
     path = os.path.join(output, path)
     if os.environ.get("MODAL_DEFORM_GRAB") == "x11":
+        # The X server shows the last frame Blender swapped, which may predate the latest events.
+        window, _, _ = view3d()
+        with bpy.context.temp_override(window=window):
+            bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=1)
         subprocess.run(f"xwd -root -silent | convert xwd:- png:{path}", shell=True, check=True)
     else:
         window, _, _ = view3d()
@@ -70,16 +74,25 @@ def click(x, y):
 
 
 def show_sidebar_tab():
-    """Open the sidebar on its Modal Deform tab: set where Blender has it in Python (4.2 and later),
-    else a click on the fourth tab of a factory-startup sidebar (Item, Tool, View, Modal Deform) at
-    its right edge."""
+    """Open the sidebar on its Modal Deform tab (a generator: yield from it) with clicks on its tabs
+    (at the sidebar's right edge), as an artist does. Blender 4.x tells the active tab: the clicks
+    walk down the tabs until it is Modal Deform. Blender 3.4 does not: a click on the fourth tab of a
+    factory-startup sidebar (Item, Tool, View, Modal Deform)."""
     _, area, _ = view3d()
     area.spaces.active.show_region_ui = True
+    yield 0.3
     region = sidebar()
-    if hasattr(region, "active_panel_category"):
-        region.active_panel_category = "Modal Deform"
-    else:
-        click(region.x + region.width - 10, region.y + region.height - 182)
+    x, top = region.x + region.width - 10, region.y + region.height
+    if not hasattr(region, "active_panel_category"):
+        click(x, top - 182)
+        yield 0.3
+        return
+    for y in range(top - 10, top - 400, -15):
+        click(x, y)
+        yield 0.2
+        if region.active_panel_category == "Modal Deform":
+            return
+    raise AssertionError(f"no Modal Deform tab at the sidebar's edge (on {region.active_panel_category})")
 
 
 def run(steps):
