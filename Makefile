@@ -59,7 +59,7 @@ export CCACHE_BASEDIR := $(CURDIR)
 export CMAKE_CXX_COMPILER_LAUNCHER := ccache
 CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 
-# Debian packages the project needs, with the reason for each in README.md.
+# Debian packages the project needs, with the reason for each in docs/design.md.
 PACKAGES := cmake g++ make pkg-config ninja-build binutils ccache \
 	libeigen3-dev libsuitesparse-dev libopenblas0-pthread zlib1g-dev \
 	python3-dev python3-numpy python3-scipy python3-pytest \
