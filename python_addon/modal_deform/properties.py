@@ -32,15 +32,15 @@ class ModalDeformHandle(bpy.types.PropertyGroup):
     # `name` (the label in the list) comes with PropertyGroup.
     vertex_group: StringProperty(
         name="Vertex Group",
-        description="Vertices this handle moves (every vertex with a weight above 0 in the group)")
+        description="The vertices this handle grabs: every vertex with a weight above 0 in this group")
     controller: PointerProperty(
         type=bpy.types.Object, name="Controller", poll=_controller_poll, update=_controller_changed,
-        description="Object whose motion since it was assigned moves the handle's vertices rigidly (its scale and "
-                    "shear are ignored); without one the vertices stay where they are (pinned)")
+        description="The object you move to move the handle's vertices (usually the Empty Add Handle made): they "
+                    "follow its moves and turns, not its scale. Empty: the vertices stay where they are (pinned)")
     weight: FloatProperty(
         name="Weight", default=1.0, min=1e-3, soft_max=10.0,
-        description="How strongly this handle pulls its vertices, relative to the other handles: where handles "
-                    "overlap, the shared vertices settle between their targets in proportion to the weights")
+        description="How strongly this handle pulls compared with the other handles: where handles share "
+                    "vertices, those settle between the handles' targets in proportion to their weights")
     bound_controller: StringProperty(
         name="Bound Controller", options={"HIDDEN"},
         description="Name of the controller when it was assigned, to tell a deleted controller from none")
@@ -78,73 +78,78 @@ class ModalDeformBakeStatus(bpy.types.PropertyGroup):
 class ModalDeformSettings(bpy.types.PropertyGroup):
     modes: IntProperty(
         name="Modes", default=mdc.BAKE_OPTIONS["modes"], min=7, soft_max=60,
-        description="Vibration modes in the basis, the rigid motions (6 per part) included: more modes let the "
-                    "mesh deform in more ways and make the bake and each solver iteration slower")
+        description="How many natural ways of bending the mesh the bake finds (its vibration modes, 6 of them "
+                    "just move and turn it): more let poses take more shapes, and make the bake and posing slower")
     derivatives: IntProperty(
         name="Derivatives", default=mdc.BAKE_OPTIONS["derivatives"], min=0, soft_max=200,
-        description="Modal derivatives in the basis: they let large rotations and bends stay smooth instead of "
-                    "shrinking; more of them cost bake time and solver time (Discrete Shells only)")
+        description="Extra shapes that let large bends and twists keep the mesh's volume instead of shrinking it "
+                    "(modal derivatives, Discrete Shells only): more make strong poses better and cost bake and "
+                    "posing time")
     ghost: IntProperty(
         name="Ghost Size", default=mdc.BAKE_OPTIONS["ghost"], min=4, soft_min=200, soft_max=5000,
-        description="Vertices of the coarse mesh the energy is evaluated on while posing: more follow the "
-                    "energy of the full mesh more closely, fewer make each iteration faster")
+        description="Vertices of the coarse copy of the mesh (the ghost) that posing weighs the deformation on: "
+                    "more follow the full mesh more closely, fewer make posing faster")
     proxy: IntProperty(
         name="Proxy Size", default=mdc.PROXY, min=4, soft_min=10000, soft_max=150000,
-        description="A dense mesh (more vertices than Proxy Above) is baked on a simplified proxy of about this "
-                    "many vertices, and every vertex follows it with its own detail")
+        description="A dense mesh (more vertices than Proxy Over) is baked on a simplified copy of about this "
+                    "many vertices, which every vertex follows with its own detail: fewer bake faster")
     proxy_above: IntProperty(
-        name="Proxy Above", default=mdc.PROXY_ABOVE, min=0, soft_max=500000,
-        description="Meshes with more vertices than this are baked on a proxy (0: never)")
+        name="Proxy Over", default=mdc.PROXY_ABOVE, min=0, soft_max=500000,
+        description="Meshes with more vertices than this are baked on a simplified copy of Proxy Size vertices, "
+                    "which bakes much faster (0: never)")
     energy: EnumProperty(
         name="Energy", default=mdc.BAKE_OPTIONS["energy"].upper(),
         items=(("SHELLS", "Discrete Shells", "Resists bending and stretching like a thin shell (the paper's energy)"),
                ("ARAP", "As-Rigid-As-Possible", "Keeps every vertex neighbourhood rigid; bakes vibration modes "
                                                 "only, no modal derivatives")),
-        description="The deformation energy the mesh resists with")
+        description="How the surface resists being deformed: like a thin shell that keeps its curvature, or "
+                    "keeping every small neighbourhood rigid")
     bending: FloatProperty(
         name="Bending", default=mdc.BAKE_OPTIONS["bending"], min=0.0, soft_max=10.0,
-        description="Discrete Shells: weight of the bending term; higher keeps the surface's curvature, so "
-                    "poses bend less and stretch more")
+        description="How much the surface resists bending (Discrete Shells): higher keeps its curves, so poses "
+                    "bend less and stretch more")
     membrane: FloatProperty(
         name="Membrane", default=mdc.BAKE_OPTIONS["membrane"], min=0.0, soft_max=10.0,
-        description="Discrete Shells: weight of the stretching terms (edge lengths, triangle areas); higher "
-                    "keeps the surface's size, so poses stretch less and bend more")
+        description="How much the surface resists stretching and squashing (Discrete Shells): higher keeps its "
+                    "size, so poses stretch less and bend more")
     stiffness_group: StringProperty(
         name="Stiffness Group",
-        description="Vertex group painting where the surface is stiffer (Discrete Shells): each element's bending "
-                    "and membrane weights are multiplied by 1 + (Max - 1) times its vertices' mean weight, as "
-                    "Cloth does; empty for a uniform material. Painting it anew makes the bake stale")
+        description="Vertex group painting where the surface is stiffer, as in Cloth (Discrete Shells): weight 0 "
+                    "is the material, weight 1 is Max times as stiff. Empty: the same material everywhere. "
+                    "Painting it anew needs a re-bake")
     max_stiffness: FloatProperty(
         name="Max Stiffness", default=mdc.BAKE_OPTIONS["max_stiffness"], min=1.0, max=1e4, soft_max=1000.0,
-        description="How many times stiffer than the material a vertex of weight 1 in the stiffness group is")
+        description="How many times stiffer than the material the Stiffness group's weight 1 is")
     region_group: StringProperty(
         name="Region Group",
-        description="Vertex group of the vertices that may move (weight above 0), as Laplacian Deform takes one: "
-                    "every other vertex stays exactly where it is, and the whole basis is spent inside the region, "
-                    "so a hand or a head of a dense character bakes quickly; handles must lie in it. Empty for the "
-                    "whole mesh")
+        description="Vertex group of the only vertices that may move (weight above 0), as in Laplacian Deform: "
+                    "every other vertex stays exactly where it is, so a hand or a head of a dense character bakes "
+                    "quickly; handles must lie in it. Empty: the whole mesh moves")
     stiffness: FloatProperty(
-        name="Stiffness", default=1000.0, min=1e-3, soft_min=1.0, soft_max=1e5,
+        name="Pull", default=1000.0, min=1e-3, soft_min=1.0, soft_max=1e5,
         description="How hard the handles pull their vertices toward the controllers: higher follows the "
-                    "controllers more exactly, lower lets the surface's energy hold them back")
+                    "controllers more exactly, lower lets the surface hold them back")
     budget: FloatProperty(
-        name="Milliseconds per Update", default=5.0, min=0.5, soft_max=50.0,
-        description="Milliseconds the interactive pose spends in the solver per update at most: more converge "
-                    "faster and may lower the frame rate. Less when the rest of the update (writing the mesh, "
-                    "Blender's evaluation and drawing) leaves less of a 60 fps frame")
-    handles: CollectionProperty(type=ModalDeformHandle, name="Handles")
+        name="Budget", default=5.0, min=0.5, soft_max=50.0,
+        description="Milliseconds Pose may spend solving per viewport update: more reach the final shape in "
+                    "fewer updates and may lower the frame rate. Pose takes less when Blender's own work leaves "
+                    "less of a 60 fps frame")
+    handles: CollectionProperty(
+        type=ModalDeformHandle, name="Handles",
+        description="The handles: each moves the vertices of a vertex group with a controller, or pins them")
     active_handle: IntProperty(name="Active Handle", description="The handle shown below the list")
     basis: PointerProperty(
         type=bpy.types.Palette, name="Basis",
         description="Datablock holding the baked basis (hidden: its name starts with a dot)")
-    status: PointerProperty(type=ModalDeformBakeStatus)
+    status: PointerProperty(type=ModalDeformBakeStatus, name="Bake Status",
+                            description="What the stored basis is and which mesh it was baked from")
     preview_vector: IntProperty(
-        name="Basis Vector", default=6, min=0, update=_preview_changed,
-        description="Which basis vector the preview deforms along: rigid motions first, then vibration modes "
-                    "(low to high frequency), then modal derivatives")
+        name="Vector", default=6, min=0, update=_preview_changed,
+        description="Which of the baked shapes the preview shows: moves and turns first, then the natural "
+                    "bends from the softest up (vibration modes), then the modal derivatives")
     preview_amplitude: FloatProperty(
         name="Amplitude", default=0.1, soft_min=-0.5, soft_max=0.5, update=_preview_changed,
-        description="Largest displacement of the preview, as a fraction of the model's longest bounding-box edge")
+        description="How far the preview moves the mesh, as a fraction of its longest side")
 
 
 CLASSES = (ModalDeformHandle, ModalDeformBakeStatus, ModalDeformSettings)

@@ -1,20 +1,37 @@
-"""The sidebar (View3D > N > Modal Deform): bake settings and status, handles, pose, animation, preview."""
+"""The sidebar (View3D > N > Modal Deform): bake settings and status, handles, pose, animation, preview.
+
+Every label fits the sidebar at its default width: short property labels beside their fields
+(use_property_split), and sentences wrapped to the sidebar's width (wrapped_label)."""
+import textwrap
+
 import bpy
 
 from . import handles, ops_preview, posing, storage
 
 
+# Width of a character of the interface font at scale 1, in pixels, for wrapping text (a little above
+# the mean of Blender's font, so a wrapped line is never cut).
+CHARACTER_WIDTH = 7.0
+
+
+def wrapped_label(layout, context, text, icon="NONE"):
+    """text as labels of as many lines as the region's width needs, the icon on the first."""
+    scale = context.preferences.system.ui_scale
+    characters = max(12, int((context.region.width - 50 * scale) / (CHARACTER_WIDTH * scale)))
+    column = layout.column(align=True)
+    for i, line in enumerate(textwrap.wrap(text, characters)):
+        column.label(text=line, icon=icon if i == 0 else "BLANK1" if icon != "NONE" else "NONE")
+
+
 class MODAL_DEFORM_UL_handles(bpy.types.UIList):
-    """A row per handle: name, vertex group, controller (or pinned), weight."""
+    """A row per handle: "group → controller", the vertex group it moves and the controller that moves
+    it, or "group (pinned)"."""
 
     def draw_item(self, context, layout, data, item, icon, active_data, active_property, index=0, flt_flag=0):
-        row = layout.row(align=True)
-        row.prop(item, "name", text="", emboss=False, icon="GROUP_VERTEX")
         if item.controller is not None:
-            row.label(text=item.controller.name, icon="EMPTY_AXIS")
+            layout.label(text=f"{item.vertex_group} \u2192 {item.controller.name}")
         else:
-            row.label(text="pinned", icon="PINNED")
-        row.prop(item, "weight", text="", emboss=False)
+            layout.label(text=f"{item.vertex_group} (pinned)")
 
 
 def stale_reason(obj):
@@ -41,12 +58,12 @@ class VIEW3D_PT_modal_deform(_Panel, bpy.types.Panel):
         settings = obj.modal_deform
         layout = self.layout
         if settings.basis is None:
-            layout.label(text="Not baked: set the basis up and Bake", icon="INFO")
+            wrapped_label(layout, context, "Not baked: set up the basis below, then Bake", icon="INFO")
             return
         reason = stale_reason(obj)
         if reason:
             layout.alert = True
-            layout.label(text=f"Mesh edited after the bake ({reason}): re-bake", icon="ERROR")
+            wrapped_label(layout, context, f"Mesh changed since the bake ({reason}): re-bake", icon="ERROR")
         else:
             layout.label(text="Ready to pose", icon="CHECKMARK")
 
@@ -79,30 +96,32 @@ class VIEW3D_PT_modal_deform_bake(_Panel, bpy.types.Panel):
         shells.prop(settings, "membrane")
         # Laid out as Cloth's stiffness group: the group, then its Max.
         painted = column.column(align=True)
-        painted.prop_search(settings, "stiffness_group", obj, "vertex_groups", text="Stiffness Group")
+        painted.prop_search(settings, "stiffness_group", obj, "vertex_groups", text="Stiffness")
         row = painted.row()
         row.enabled = bool(settings.stiffness_group)
         row.prop(settings, "max_stiffness", text="Max")
-        column.prop_search(settings, "region_group", obj, "vertex_groups", text="Region Group")
+        column.prop_search(settings, "region_group", obj, "vertex_groups", text="Region")
 
         box = layout.box()
         if settings.basis is None:
             box.label(text="Not baked", icon="INFO")
         else:
             status = settings.status
-            box.label(text=f"{status.dimension} dimensions: {status.num_modes} modes, "
-                           f"{status.num_derivatives} derivatives", icon="OUTLINER_DATA_LIGHTPROBE")
+            lines = box.column(align=True)
+            lines.label(text=f"{status.dimension} dimensions ({status.energy.title()})", icon="OUTLINER_DATA_LIGHTPROBE")
+            lines.label(text=f"{status.num_modes} modes, {status.num_derivatives} derivatives", icon="BLANK1")
+            lines.label(text=f"Ghost: {status.ghost_vertices:,} vertices", icon="BLANK1")
             if status.proxy_vertices:
-                box.label(text=f"Proxy: {status.proxy_vertices} of {status.num_vertices} vertices")
-            box.label(text=f"Ghost: {status.ghost_vertices} vertices ({status.energy.title()})")
-            box.label(text=f"Baked {status.baked_at} in {status.seconds:.1f} s")
+                lines.label(text=f"Proxy: {status.proxy_vertices:,} vertices", icon="BLANK1")
+            lines.label(text=f"Baked {status.baked_at}", icon="TIME")
+            lines.label(text=f"in {status.seconds:.1f} s", icon="BLANK1")
             if status.num_floppy:
-                box.label(text=f"{status.num_floppy} floppy zero modes (parts joined at a vertex)", icon="INFO")
+                wrapped_label(box, context, f"{status.num_floppy} floppy modes: parts joined at a vertex", icon="INFO")
             reason = stale_reason(obj)
             if reason:
                 row = box.row()
                 row.alert = True
-                row.label(text=f"Stale ({reason}): re-bake", icon="ERROR")
+                wrapped_label(row, context, f"Stale ({reason}): re-bake", icon="ERROR")
         row = layout.row(align=True)
         row.operator("modal_deform.bake", text="Re-bake" if settings.basis else "Bake", icon="RENDER_STILL")
         row.operator("modal_deform.clear_basis", text="", icon="X")
@@ -116,17 +135,17 @@ class VIEW3D_PT_modal_deform_handles(_Panel, bpy.types.Panel):
         obj = handles.owner(context.object)
         settings = obj.modal_deform
         layout = self.layout
-        row = layout.row()
-        row.template_list("MODAL_DEFORM_UL_handles", "", settings, "handles", settings, "active_handle", rows=3)
-        column = row.column(align=True)
-        column.operator("modal_deform.add_handle", text="", icon="ADD")
-        column.operator("modal_deform.remove_handle", text="", icon="REMOVE")
+        # The list spans the sidebar (its buttons below it) so that a row has room for both names.
+        layout.template_list("MODAL_DEFORM_UL_handles", "", settings, "handles", settings, "active_handle", rows=3)
+        row = layout.row(align=True)
+        row.operator("modal_deform.add_handle", icon="ADD")
+        row.operator("modal_deform.remove_handle", text="", icon="REMOVE")
         if 0 <= settings.active_handle < len(settings.handles):
             item = settings.handles[settings.active_handle]
             column = layout.column()
             column.use_property_split = True
             column.use_property_decorate = False
-            column.prop_search(item, "vertex_group", obj, "vertex_groups")
+            column.prop_search(item, "vertex_group", obj, "vertex_groups", text="Group")
             column.prop(item, "controller")
             column.prop(item, "weight")
         layout.use_property_split = True
@@ -150,9 +169,9 @@ class VIEW3D_PT_modal_deform_pose(_Panel, bpy.types.Panel):
         row.operator("modal_deform.solve", icon="CHECKMARK")
         row.operator("modal_deform.refine", icon="SHADERFX")
         layout.operator("modal_deform.reset", icon="LOOP_BACK")
-        row = layout.row(align=True)
-        row.operator("modal_deform.bake_animation", icon="RENDER_ANIMATION")
-        row.operator("modal_deform.bake_animation", text="Refined", icon="SHADERFX").refine = True
+        column = layout.column(align=True)
+        column.operator("modal_deform.bake_animation", icon="RENDER_ANIMATION")
+        column.operator("modal_deform.bake_animation", text="Bake Refined Animation", icon="SHADERFX").refine = True
 
 
 class VIEW3D_PT_modal_deform_preview(_Panel, bpy.types.Panel):
@@ -172,7 +191,7 @@ class VIEW3D_PT_modal_deform_preview(_Panel, bpy.types.Panel):
         status = settings.status
         if settings.basis is not None:
             index = min(settings.preview_vector, status.dimension - 1)
-            layout.label(text=f"Vector {index} of {status.dimension}: {ops_preview.describe(status, index)}")
+            wrapped_label(layout, context, f"Vector {index} of {status.dimension}: {ops_preview.describe(status, index)}")
         showing = ops_preview.showing(obj)
         layout.operator("modal_deform.preview_mode", text="Hide Preview" if showing else "Show Preview",
                         icon="HIDE_OFF" if showing else "HIDE_ON", depress=showing)

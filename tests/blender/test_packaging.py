@@ -98,6 +98,14 @@ def test_legacy_zip_holds_the_add_on_folder_with_a_core_per_python(legacy):
     assert not any("__pycache__" in name or name.endswith(".toml") for name in names)
 
 
+def test_legacy_zip_carries_a_core_for_every_python_from_3_10_to_3_13(legacy):
+    """Blenders of Linux distributions embed the distribution's Python (Debian 13's 4.3.2: 3.13,
+    Ubuntu 24.04's 4.0: 3.12) and install the legacy zip: it has a core for each of them."""
+    cores = [re.fullmatch(r"modal_deform/_native\.cpython-3(\d+)-x86_64-linux-gnu\.so", name)
+             for name in zipfile.ZipFile(legacy).namelist()]
+    assert sorted(f"3.{core[1]}" for core in cores if core) == ["3.10", "3.11", "3.12", "3.13"]
+
+
 @pytest.mark.parametrize("blenders", EXTENSIONS)
 def test_manifest_fields_and_version_match_bl_info(blenders):
     manifest = zip_manifest(zip_for(blenders))

@@ -7,43 +7,22 @@ the rest mesh and the pose in its shape key; entering Edit Mode mid-pose keeps t
 and edits the rest mesh; the converged pose equals the Solve operator's; undo takes a bake back; Esc
 takes an animation bake's frames back; disabling the add-on mid-pose restores as Esc does (from the
 shape key and from the positions).
-Each step runs from bpy.app.timers so Blender handles the simulated events in between.
+Each step runs from bpy.app.timers so Blender handles the simulated events in between (window.run).
 Writes OUTPUT/result.json ({"ok": bool, "log": [...]}) and screenshots, then quits.
 """
 import importlib
-import json
 import os
 import sys
 import threading
 import time
-import traceback
 
 import addon_utils
 import bpy
 import numpy as np
 from mathutils import Vector
 
-output = sys.argv[sys.argv.index("--") + 1]
-sys.path.insert(0, os.environ["ADDON_PATH"])
-bpy.context.preferences.view.show_splash = False
-log = []
-
-
-def say(*words):
-    log.append(" ".join(map(str, words)))
-    print("GUI:", *words, flush=True)
-
-
-def view3d():
-    window = bpy.context.window_manager.windows[0]
-    area = next(a for a in window.screen.areas if a.type == "VIEW_3D")
-    region = next(r for r in area.regions if r.type == "WINDOW")
-    return window, area, region
-
-
-def override():
-    window, area, region = view3d()
-    return bpy.context.temp_override(window=window, screen=window.screen, area=area, region=region)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from window import enable_addon, override, output, run, say, screenshot, show_sidebar_tab, view3d  # noqa: E402
 
 
 def key_positions(obj, name):
@@ -59,23 +38,6 @@ def base_positions(obj):
     return co.reshape(-1, 3)
 
 
-def screenshot(name):
-    window, _, _ = view3d()
-    with bpy.context.temp_override(window=window):
-        bpy.ops.screen.screenshot(filepath=os.path.join(output, name))
-
-
-def show_sidebar_tab():
-    """Click the sidebar's "Modal Deform" tab (3.4 has no Python access to the active tab): the
-    fourth tab of a factory-startup sidebar (Item, Tool, View, Modal Deform) at the right edge."""
-    window, area, _ = view3d()
-    sidebar = next(r for r in area.regions if r.type == "UI")
-    x, y = sidebar.x + sidebar.width - 10, sidebar.y + sidebar.height - 182
-    window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x, y=y)
-    window.event_simulate(type="LEFTMOUSE", value="PRESS", x=x, y=y)
-    window.event_simulate(type="LEFTMOUSE", value="RELEASE", x=x, y=y)
-
-
 def wait_until(condition, seconds):
     """Yield to Blender until condition() holds; fail after `seconds`."""
     start = time.time()
@@ -85,7 +47,7 @@ def wait_until(condition, seconds):
 
 
 def steps():
-    addon_utils.enable("modal_deform", default_set=True)
+    enable_addon()
     from modal_deform import ops_pose, posing
 
     # Scene: Suzanne (2 subdivision levels, 7,958 vertices) seen from the front, sidebar open.
@@ -193,7 +155,7 @@ def steps():
     followed = pose[group].mean(axis=0) - rest[group].mean(axis=0)
     assert np.linalg.norm(followed - moved) < 0.05 * np.linalg.norm(moved), (followed, moved)
     say("mesh followed by", np.round(followed, 3).tolist(), "at", f"{posing.running.tick_ms:.1f} ms per update")
-    show_sidebar_tab()
+    yield from show_sidebar_tab()
     yield 0.5
     screenshot("pose.png")
 
@@ -361,22 +323,4 @@ def steps():
     say("disabling the add-on mid-pose restored the vertex positions")
 
 
-def drive(generator=steps()):
-    try:
-        delay = next(generator)
-        return delay
-    except StopIteration:
-        finish(True)
-    except Exception:
-        say(traceback.format_exc())
-        finish(False)
-    return None
-
-
-def finish(ok):
-    with open(os.path.join(output, "result.json"), "w") as f:
-        json.dump({"ok": ok, "log": log}, f, indent=1)
-    bpy.ops.wm.quit_blender()
-
-
-bpy.app.timers.register(drive, first_interval=0.5)
+run(steps)
