@@ -326,6 +326,35 @@ TEST(RelaxStretched, LeavesZeroLengthRestEdgesAlone) {
   EXPECT_EQ(relax_stretched(objective, point), 0);
 }
 
+// A full step that decreased F by more than kExtendAbove times the model's promise is extended
+// (α = 2, 4, 8 while F falls). A strip of 3 by 1 quads, its left end held, starts with its right
+// half folded back by 175° over the middle of the centre quad: the flap bent away from a saddle,
+// where the projected Hessian overestimates the curvature. Full steps there fall F by 1.6 to 2
+// times the model's promise, and F keeps falling beyond them: 6 of the 20 iterations are extended.
+TEST(SolveFull, AFullStepThatBeatsItsModelIsExtended) {
+  const TriangleMesh mesh = grid(3, 1, 2.0, 1.0);
+  const Handles held_end = {vertices_where(mesh.V, [](const Eigen::Vector3d& x) { return x.x() < -1 + 1e-9; })};
+  const double fold = 175 * 3.14159265358979323846 / 180;
+  RowMatrixX3d folded = mesh.V;
+  for (Eigen::Index v = 0; v < folded.rows(); ++v) {
+    const double x = mesh.V(v, 0);
+    if (x > 0) folded.row(v) << x * std::cos(fold), mesh.V(v, 1), x * std::sin(fold);
+  }
+  const FullSolveResult result = solve_full(mesh.V, mesh.F, held_end, Eigen::VectorXd(), {Eigen::Matrix4d::Identity()},
+                                            1e3, FullSolveOptions{EnergyKind::kShells, 1, 1, 1e-10, 100}, &folded);
+  EXPECT_TRUE(result.converged);
+  int extended = 0;
+  for (size_t i = 0; i < result.history.size(); ++i) {
+    const NewtonIteration& it = result.history[i];
+    if (!(it.step > 1)) continue;
+    ++extended;
+    EXPECT_GT(it.ratio, 1.5) << "iteration " << i;
+    EXPECT_LT(it.value, i == 0 ? result.initial_energy : result.history[i - 1].value) << "iteration " << i;
+  }
+  EXPECT_GE(extended, 1);
+  std::printf("folded strip: %d iterations, %d of them extended\n", result.iterations, extended);
+}
+
 // Regression (robustness corpus): a handle moved a million diagonals took 1e7 load steps, and a
 // move beyond 2^31 tenths of the diagonal overflowed the step count. Load steps now double while
 // they are easy (a rigid move, which the predictor follows: the path's 100 steps and the first

@@ -372,12 +372,10 @@ def test_refine_of_a_strong_turn_is_not_held_back_by_crushed_triangles(shared_me
     their rest area) over, and the line search cuts those steps ("guarded"). The model was right
     there, so the shift stays: growing it by the cut, as for a poor model, kept it 1e4-1e8 times
     its floor (the 23k dragon crept for 300 iterations and did not converge; here 108 against 80).
-    Near the minimum a flap bent away from a saddle makes the exact Hessian indefinite, and the
-    projected one overestimates its curvature: full steps fell F by about twice what the model
-    promised while ‖∇F‖ rose, for some 30 iterations. Such steps are extended (α = 2, 4, 8 while
-    F falls): 80 iterations, 130 without. A step that would turn a triangle over starts at 0.9 of the
-    way to where the first one turns (not at 1, halved): 84 iterations here against 80, on the
-    23k dragon 45 against 75."""
+    A step that would turn a triangle over starts at 0.9 of the way to where the first one turns
+    (not at 1, halved): 84 iterations here against 80, on the 23k dragon 45 against 75. (Whether
+    this path takes an extended step depends on rounding; test_full_solver's
+    AFullStepThatBeatsItsModelIsExtended tests the extension.)"""
     V, F = shared_mesh("dragon_vrip_res4.ply.gz")
     basis = mdc.bake(V, F, modes=15, derivatives=52, ghost=1000)
     handles, transforms = dragon_turn(V, 170)
@@ -395,7 +393,6 @@ def test_refine_of_a_strong_turn_is_not_held_back_by_crushed_triangles(shared_me
                if history[i + 1]["model"] == "projected")
     assert min(history[i]["step"] for i in guarded) < 0.5
     assert any(not float(np.log2(history[i]["step"])).is_integer() for i in guarded)  # started short of a turn
-    assert any(it["step"] > 1 for it in history)
     assert history[-1]["model"] == "exact"  # quadratic convergence at the end
 
 
