@@ -59,7 +59,7 @@ win_tag      = cp$(subst .,,$(1))
 PIP_WINDOWS  = $(HOST_PYTHON) -m pip install -q --disable-pip-version-check --no-deps --only-binary=:all: --ignore-requires-python \
 	--platform win_amd64 --implementation cp
 
-.PHONY: wheels-windows test-windows test-windows-packaging bench-windows
+.PHONY: wheels-windows test-windows test-windows-packaging test-windows-bpy bench-windows
 wheels-windows: $(WIN_PYTHONS:%=wheel-windows-%)
 .PRECIOUS: $(WIN)/python-%/stamp
 addon: wheels-windows
@@ -162,11 +162,29 @@ win-install-%: win-env-%
 
 # tests/python on the installed Windows wheel in Windows CPython 3.11 (NumPy 1.26) and 3.13
 # (NumPy 2), under Wine; the packaging test reads the import tables of the Windows wheels and zips.
-test-windows: test-windows-packaging $(WIN_PYTHONS:%=test-windows-%)
+test-windows: test-windows-packaging $(WIN_PYTHONS:%=test-windows-%) test-windows-bpy
 test-windows-%: win-install-%
 	$(call wine_python,$*,-m pytest -q -p no:cacheprovider $(WIN_SUITE_$*) $(WIN_DESELECT))
 test-windows-packaging:
 	$(PYTHON) -m pytest -q -p no:cacheprovider tests/windows/test_windows_packaging.py
+
+# The Blender suite's install, bake, pose, save, reload and refusal scripts in Windows bpy under Wine
+# (tests/windows/test_windows_bpy.py), through Blender's own installer: bpy 4.5 LTS with the NumPy
+# it was made with. bpy 5.x needs Python 3.13 with NumPy 2.5, which Wine 8.0 cannot import (crealf,
+# above); on Windows the 5.1+ zip would be tested the same way.
+WIN_BPY_VERSIONS := 4.5
+WIN_BPY_4.5 := bpy==4.5.15 numpy==1.26.4 $(BPY_DEPS)
+win-bpy-env-%: $(WIN)/python-3.11/stamp $(WIN)/wine/system.reg
+	@test "$$(cat $(WIN)/env-bpy-$*/pins 2>/dev/null)" = "$(WIN_BPY_$*)" || { rm -rf $(WIN)/env-bpy-$* \
+		&& cp -r $(WIN)/python-3.11/cp311 $(WIN)/env-bpy-$* \
+		&& printf 'python311.zip\n.\nLib\\site-packages\nimport site\n' > $(WIN)/env-bpy-$*/python311._pth \
+		&& $(PIP_WINDOWS) --python-version 3.11 --abi cp311 --target $(WIN)/env-bpy-$*/Lib/site-packages $(WIN_BPY_$*) \
+		&& echo "$(WIN_BPY_$*)" > $(WIN)/env-bpy-$*/pins; }
+test-windows-bpy: $(WIN_BPY_VERSIONS:%=test-windows-bpy-%)
+test-windows-bpy-%: win-bpy-env-%
+	$(WINE_ENV) /usr/lib/wine/wineserver -p5 < /dev/null > /dev/null 2>&1; \
+	WINEPREFIX=$(CURDIR)/$(WIN)/wine WINDOWS_BPY_PYTHON=$(CURDIR)/$(WIN)/env-bpy-$*/python.exe \
+		$(PYTHON) -m pytest -q -p no:cacheprovider tests/windows/test_windows_bpy.py
 
 # The 23k and 100k dragons baked and posed natively (the in-tree build) and under Wine (the cp311
 # wheel), one after the other: JSON lines in bench/results/windows.jsonl, with how far the two
