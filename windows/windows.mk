@@ -169,10 +169,11 @@ test-windows-packaging:
 	$(PYTHON) -m pytest -q -p no:cacheprovider tests/windows/test_windows_packaging.py
 
 # The Blender suite's install, bake, pose, save, reload and refusal scripts in Windows bpy under Wine
-# (tests/windows/test_windows_bpy.py), through Blender's own installer: bpy 4.5 LTS with the NumPy
-# it was made with. bpy 5.x needs Python 3.13 with NumPy 2.5, which Wine 8.0 cannot import (crealf,
+# (tests/windows/test_windows_bpy.py), through Blender's own installer: bpy 4.2.0 and 4.5 LTS with
+# the NumPy blender.org's Windows builds bring (1.26). bpy 5.x needs Python 3.13 with NumPy 2.5, which Wine 8.0 cannot import (crealf,
 # above); on Windows the 5.1+ zip would be tested the same way.
-WIN_BPY_VERSIONS := 4.5
+WIN_BPY_VERSIONS := 4.2 4.5
+WIN_BPY_4.2 := bpy==4.2.0 numpy==1.26.4 $(BPY_DEPS)
 WIN_BPY_4.5 := bpy==4.5.15 numpy==1.26.4 $(BPY_DEPS)
 win-bpy-env-%: $(WIN)/python-3.11/stamp $(WIN)/wine/system.reg
 	@test "$$(cat $(WIN)/env-bpy-$*/pins 2>/dev/null)" = "$(WIN_BPY_$*)" || { rm -rf $(WIN)/env-bpy-$* \
