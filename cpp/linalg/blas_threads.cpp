@@ -1,7 +1,14 @@
 #include "linalg/blas_threads.h"
 
+#ifdef _WIN32
+#ifndef NOMINMAX
+#define NOMINMAX  // windows.h defines min and max as macros otherwise
+#endif
+#include <windows.h>
+#else
 #include <dlfcn.h>
 #include <sched.h>
+#endif
 
 #include <algorithm>
 #include <mutex>
@@ -17,6 +24,24 @@ struct OpenBlasThreads {
   void (*set)(int) = nullptr;
 };
 
+#ifdef _WIN32
+// The Windows extension links CHOLMOD statically against the OpenBLAS DLL it bundles
+// (windows/windows.mk): its thread controls are imported by name from that DLL.
+extern "C" int openblas_get_num_threads(void);
+extern "C" void openblas_set_num_threads(int);
+
+const OpenBlasThreads& openblas_threads() {
+  static const OpenBlasThreads found{openblas_get_num_threads, openblas_set_num_threads};
+  return found;
+}
+
+int usable_cores() {
+  DWORD_PTR process = 0, system = 0;
+  if (GetProcessAffinityMask(GetCurrentProcess(), &process, &system) && process != 0)
+    return __builtin_popcountll(process);
+  return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+}
+#else
 // The thread controls of the OpenBLAS that CHOLMOD itself calls: looked up among CHOLMOD's own
 // dependencies, since a process may hold several BLAS libraries (NumPy's, a wheel's bundled copy).
 const OpenBlasThreads& openblas_threads() {
@@ -40,6 +65,7 @@ int usable_cores() {
   if (sched_getaffinity(0, sizeof(cpus), &cpus) == 0) return CPU_COUNT(&cpus);
   return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 }
+#endif
 
 // Limits nest and may live on several threads at once (two bakes): the first one saves the
 // caller's setting, the last one restores it.

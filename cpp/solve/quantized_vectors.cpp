@@ -21,8 +21,9 @@ float row_dot(const float* u, const float* q, Eigen::Index r) {
 // sum[k] = Σ_j values[j count + k] scaled_q[j] for the `count` rows of a block stored column by
 // column: one multiply-add per entry along the rows, no sum across a vector per row. Compiled
 // twice where the compiler can dispatch on the CPU: for AVX2 and FMA (8 entries per instruction,
-// any x86-64 since 2013) and for the wheel's baseline (SSE4.2, 4).
-#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
+// any x86-64 since 2013) and for the wheel's baseline (SSE4.2, 4). Dispatch needs ELF's ifunc: the
+// Windows build has the baseline only.
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__) && defined(__ELF__)
 __attribute__((target_clones("arch=x86-64-v3", "default")))
 #endif
 void accumulate_columns(const std::int16_t* values, const float* scaled_q, Eigen::Index count, Eigen::Index r,

@@ -5,6 +5,7 @@ the bpy-free API and imports without Blender, so the Blender modules are importe
 Every import is relative: installed as an extension the package is ``bl_ext.<repository>.modal_deform``.
 """
 import contextlib
+import ctypes
 import importlib
 import importlib.util
 import os
@@ -33,10 +34,20 @@ def _passive_openmp_wait():
         yield
         return
     os.environ["OMP_WAIT_POLICY"] = "passive"
+    _set_core_c_environment("OMP_WAIT_POLICY=passive")
     try:
         yield
     finally:
         del os.environ["OMP_WAIT_POLICY"]
+        _set_core_c_environment("OMP_WAIT_POLICY=")
+
+
+def _set_core_c_environment(assignment):
+    """The Windows core's C runtime is msvcrt.dll (MinGW-w64's), which keeps a copy of the
+    environment of its own: os.environ changes the process's and the UCRT's, and libgomp reads
+    msvcrt's ("NAME=" removes NAME)."""
+    if sys.platform == "win32":
+        ctypes.cdll.msvcrt._putenv(assignment.encode())
 
 
 def _find_native():

@@ -94,8 +94,12 @@ def test_sliver_stiffness_is_bounded_and_sound_elements_keep_theirs():
 
 #: AddressSanitizer reserves terabytes of address space for its shadow memory: under `make sanitize`
 #: (libasan preloaded) any limit on the address space leaves it none, and it aborts.
-limits_address_space = pytest.mark.skipif("libasan" in os.environ.get("LD_PRELOAD", ""),
-                                          reason="AddressSanitizer cannot run under an address-space limit")
+def limits_address_space(test):
+    test = pytest.mark.skipif("libasan" in os.environ.get("LD_PRELOAD", ""),
+                              reason="AddressSanitizer cannot run under an address-space limit")(test)
+    return pytest.mark.skipif(sys.platform == "win32", reason="Windows has no RLIMIT_AS: the memory check "
+                              "reads GlobalMemoryStatusEx there, and this test would need a job object's "
+                              "memory limit, on Windows as under Wine")(test)
 
 
 def run_limited(code, address_space, setup=""):

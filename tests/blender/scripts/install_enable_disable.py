@@ -33,7 +33,8 @@ def enable_and_bake():
     # The compiled core of this Blender's own Python, from where Blender installed it.
     native = sys.modules[f"{module_name}._native"].__file__
     assert os.path.realpath(native).startswith(os.path.realpath(user_folder)), native
-    assert os.path.basename(native).startswith(f"_native.cpython-{sys.version_info[0]}{sys.version_info[1]}-"), native
+    python = f"{sys.version_info[0]}{sys.version_info[1]}"
+    assert os.path.basename(native).startswith((f"_native.cpython-{python}-", f"_native.cp{python}-win_amd64")), native
     assert hasattr(bpy.types.Object, "modal_deform") and hasattr(bpy.types, "VIEW3D_PT_modal_deform")
     obj = support.suzanne(0)
     obj.modal_deform.modes, obj.modal_deform.derivatives, obj.modal_deform.ghost = 10, 5, 100
