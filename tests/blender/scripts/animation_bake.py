@@ -1,7 +1,8 @@
 """Bake animation into the per-frame cache over 10 frames with a keyframed controller: it plays back
 what the per-frame solve gives, scrubbing reads it without solving, a changed keyframe cuts it where
-the motion changed, Esc or a failure leaves it as it was; exported to shape keys and to PC2 and MDD
-files that Blender's Mesh Cache modifier plays; then saved with the shape keys."""
+the motion changed, Esc or a failure leaves it as it was; exported to PC2 and MDD files that
+Blender's Mesh Cache modifier plays and to shape keys (a cancelled export changes nothing); then
+saved with the shape keys."""
 import os
 import sys
 
@@ -10,8 +11,8 @@ import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 import support  # noqa: E402
 
-frame_cache, ops_dynamics, playback, posing = support.enable_addon("frame_cache", "ops_dynamics", "playback",
-                                                                   "posing")
+frame_cache, jobs, ops_dynamics, playback, posing = support.enable_addon("frame_cache", "jobs", "ops_dynamics",
+                                                                         "playback", "posing")
 obj, V = support.baked_suzanne(1, 15, 20, 400)
 controller = support.top_and_bottom_handles(obj, V).controller
 controller.keyframe_insert("location", frame=1)
@@ -131,7 +132,15 @@ for fmt in ("PC2", "MDD"):
     bpy.data.objects.remove(copy)
 print("POINT_CACHE_OK")
 
-# Shape keys: one per frame in place of the cache, and the file saved for a Blender without the add-on.
+# Shape keys: one per frame in place of the cache (the export cancelled after two frames changes
+# nothing), and the file saved for a Blender without the add-on.
+before = support.mesh_state(obj)
+job = jobs.AnimationJob(bpy.context, obj, ops_dynamics.cached_frames(obj),
+                        positions=ops_dynamics.cached_positions(obj, scene))
+assert job.tick() and job.tick() and len(obj.data.shape_keys.key_blocks) == 4
+job.cancel()
+assert job.finish() == ("WARNING", "Shape key export cancelled: nothing changed")
+assert support.mesh_state(obj) == before and frame_cache.get(obj) is not None
 assert bpy.ops.modal_deform.export_shape_keys() == {"FINISHED"}
 assert frame_cache.get(obj) is None
 names = [b.name for b in obj.data.shape_keys.key_blocks]
