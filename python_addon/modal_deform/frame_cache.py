@@ -107,7 +107,7 @@ class Cache:
                 raise ValueError(f"cache: frame {self.end + 1}'s {name} has {row.size} values, earlier frames "
                                  f"{self.block[name + '_width']}")
             self.block[name + "_width"] = row.size
-            self.block[name] = np.concatenate([self.array(name).ravel(), row]) if row.size else np.empty(0)
+            _set_array(self.block, name, np.concatenate([self.array(name).ravel(), row]) if row.size else np.empty(0))
         self.block["frames"] = len(self) + 1
 
     def cut(self, frame):
@@ -117,11 +117,19 @@ class Cache:
             return
         for name in _ARRAYS:
             width = self.block[name + "_width"]
-            self.block[name] = self.array(name)[:keep].ravel().copy() if width else np.empty(0)
+            _set_array(self.block, name, self.array(name)[:keep].ravel().copy() if width else np.empty(0))
         self.block["frames"] = keep
 
     def nbytes(self):
         return sum(self.array(name).nbytes for name in _ARRAYS)
+
+
+def _set_array(block, name, values):
+    """block[name] = values (float64), the old array deleted first: Blender 4.5 corrupts its heap
+    when an ID property array is assigned over one of another length."""
+    if name in block:
+        del block[name]
+    block[name] = values
 
 
 def get(obj):
@@ -146,7 +154,7 @@ def create(obj, scene, start):
     block["keys_digest"] = keys_digest(curves)
     block["frames"] = 0
     for name in _ARRAYS:
-        block[name] = np.empty(0)
+        _set_array(block, name, np.empty(0))
         block[name + "_width"] = 0
     obj.modal_deform.dynamics.cache = block
     return Cache(block)
