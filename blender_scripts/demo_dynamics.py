@@ -14,7 +14,7 @@ from headless import add_handle
 from rendering import render, side_by_side
 
 #: The head's tilt about the camera's axis (degrees) and the frames it starts and stops on.
-TURN, TURN_START, TURN_STOP = 50, 1, 6
+TURN, TURN_START, TURN_STOP = 35, 1, 6
 #: The frames of the strip, from rest through the stop to the settling.
 STRIP = (1, 4, 6, 8, 10, 13, 17, 24, 40)
 #: Ears and chin swing free: the handle holds Suzanne's vertices within this distance of the
@@ -28,7 +28,7 @@ def secondary_motion(addon, output, levels, width):
     frame_cache, playback, posing = addon
     scene = bpy.context.scene
     scene.render.resolution_x, scene.render.resolution_y = width, width * 3 // 4
-    shown = [o for o in bpy.context.scene.objects if not o.hide_render]
+    shown = [o for o in bpy.context.scene.objects if o.type == "MESH" and not o.hide_render]
     for obj in shown:
         obj.hide_render = True
     bpy.ops.mesh.primitive_monkey_add()
