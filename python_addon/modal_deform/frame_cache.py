@@ -28,8 +28,10 @@ import numpy as np
 from . import storage
 
 PREFIX = ".Modal Deform Cache "
-KINDS = ("STATIC", "DYNAMIC")
 _ARRAYS = ("q", "v", "transforms", "curves")
+#: What a cache datablock holds (create() writes them all).
+_FIELDS = ("kind", "start", "signature", "basis_id", "curve_paths", "keys_digest", "frames") + _ARRAYS + tuple(
+    name + "_width" for name in _ARRAYS)
 
 
 def kind(obj):
@@ -62,11 +64,14 @@ class Cache:
     numpy views; append() and cut() write the datablock)."""
 
     def __init__(self, block):
+        """Raises ValueError when the datablock lacks what a cache holds (damaged, or not a cache)."""
+        missing = [name for name in _FIELDS if name not in block]
+        if missing:
+            raise ValueError(f"the cache '{block.name}' is damaged (no '{missing[0]}'): Free it and bake again")
         self.block = block
 
     kind = property(lambda self: self.block["kind"])
     start = property(lambda self: self.block["start"])
-    dimension = property(lambda self: self.block["dimension"])
     signature = property(lambda self: self.block["signature"])
     basis_id = property(lambda self: self.block["basis_id"])
     curve_paths = property(lambda self: json.loads(self.block["curve_paths"]))
@@ -133,7 +138,7 @@ def _set_array(block, name, values):
 
 
 def get(obj):
-    """obj's Cache, or None."""
+    """obj's Cache, or None; raises ValueError when its datablock is damaged."""
     block = obj.modal_deform.dynamics.cache
     return None if block is None else Cache(block)
 
@@ -146,7 +151,6 @@ def create(obj, scene, start):
     block.use_fake_user = False
     block["kind"] = kind(obj)
     block["start"] = start
-    block["dimension"] = obj.modal_deform.status.dimension
     block["signature"] = signature(obj, scene)
     block["basis_id"] = basis_id(obj)
     curves = controller_curves(obj)

@@ -94,7 +94,7 @@ def cache_poll(cls, context):
     """A mesh operator's poll, with a cache to act on."""
     if not mesh_poll(cls, context):
         return False
-    if frame_cache.get(handles.owner(context.object)) is None:
+    if handles.owner(context.object).modal_deform.dynamics.cache is None:
         cls.poll_message_set("No cache: play the timeline with Dynamics on, or Bake")
         return False
     return True

@@ -199,14 +199,18 @@ class VIEW3D_PT_modal_deform_dynamics(_Panel, bpy.types.Panel):
         column.prop(dynamics, "substeps")
         column.prop(dynamics, "frame_start")
         box = layout.box()
-        cache = frame_cache.get(obj)
+        try:
+            cache = frame_cache.get(obj)
+        except ValueError as error:
+            cache, problem = None, str(error)
+        else:
+            problem = playback.problems.get(obj.name)
         if cache is None or not len(cache):
             box.label(text="Cache empty: play or Bake", icon="INFO")
         else:
             what = "Simulation" if cache.kind == "DYNAMIC" else "Animation"
             box.label(text=f"{what}: frames {cache.start}-{cache.end}", icon="FILE_CACHE")
             box.label(text=f"{cache.nbytes() / 1024:.1f} KB in the file")
-        problem = playback.problems.get(obj.name)
         if problem:
             row = box.row()
             row.alert = True

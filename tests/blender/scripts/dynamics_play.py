@@ -2,7 +2,7 @@
 simulates frame after frame into the cache, the mesh overshoots the static pose and settles;
 scrubbing back reads the cache; a jump forward simulates every frame in between and gives the
 same bits as playing; a changed keyframe or setting invalidates what follows; Bake gives the same
-bits again; Free empties the cache."""
+bits again; Free empties the cache; a damaged cache is refused."""
 import os
 import sys
 
@@ -81,4 +81,11 @@ dynamics.damping = 0.3
 assert frame_cache.get(obj) is None
 scene.frame_set(9)
 assert frame_cache.get(obj).end == 9
+# A damaged cache (an array gone) is refused with a message; Free takes it away.
+del dynamics.cache["q"]
+before = key()
+scene.frame_set(12)
+assert "is damaged (no 'q')" in playback.problems.get(obj.name, ""), playback.problems
+assert key().tobytes() == before.tobytes()
+assert bpy.ops.modal_deform.free_cache() == {"FINISHED"} and dynamics.cache is None
 print("DYNAMICS_OK")
