@@ -818,13 +818,69 @@ def section_playback(result):
     return "\n".join(out)
 
 
+def section_dynamics(result):
+    p, f = result["parameters"], result["figures"]
+    d = p["defaults"]
+    bar = f["bar"]
+    out = ["## Secondary motion (issue 40)", "",
+           f"`mdc.Simulation` with its defaults (period {d['period']:g} frames, damping ratio {d['damping']:g}, "
+           f"{d['fps']:g} fps, {d['substeps']} substeps, stiffness {d['stiffness']:g}, BFGS tolerance "
+           f"{d['tolerance']:g}, at most {d['max_iterations']} iterations a substep) unless said otherwise.", "",
+           f"A free bar ({bar['vertices']} vertices, {bar['dimension']} dimensions) released from rest at "
+           f"{p['amplitude']:g} along its lowest flexible mode; period and logarithmic decrement fitted to the mode's "
+           "coordinate frame by frame (a damped sinusoid's recurrence, least squares). Undamped:", ""]
+    out.append(table(["period set (frames)", "fps", "substeps", "period measured", "amplitude after 10 periods"],
+                     [[f"{r['period']:g}", f"{r['fps']:g}", r["substeps"], f"{r['measured_period']:.4f}",
+                       f"{100 * r['amplitude_after_10_periods']:.4f}%"] for r in bar["undamped"]]))
+    out += ["", "Damped (the damped period is the set one over √(1−ζ²)):", ""]
+    out.append(table(["ζ", "decrement 2πζ/√(1−ζ²)", "measured", "error", "period measured"],
+                     [[f"{r['damping']:g}", f"{r['expected_decrement']:.5f}", f"{r['decrement']:.5f}",
+                       f"{100 * (r['decrement'] / r['expected_decrement'] - 1):+.4f}%", f"{r['measured_period']:.3f}"]
+                      for r in bar["damped"]]))
+    rows = []
+    for name, c in list(f["cost"].items()) + [("subdivided twice, on a proxy", f["proxy"])]:
+        rows.append([name, c["vertices"], c.get("proxy_vertices", "-"), c["dimension"], f"{c['bake_s']:.1f}",
+                     f"{c['step_ms']['median']:.2f} / {c['step_ms']['p95']:.2f}",
+                     f"{c['iterations']['median']:g} / {c['iterations']['max']:g}",
+                     f"{c['evaluations']['median']:g}", f"{c['ms_per_evaluation']['median']:.3f}",
+                     f"{c['map_ms']['median']:.2f} / {c['map_ms']['p95']:.2f}", f"{c['map_back_to_back_ms']:.2f}"])
+    out += ["", "Cost per frame: the tail held, the head's controller turning 60° in 12 frames and still after "
+            "(the demo's motion), 60 frames (30 on the proxy). Step: the core's integrator (`stats['ms']`), its "
+            "BFGS iterations and evaluations of the ghost energy a frame and its time per evaluation (what a "
+            "frame costs is evaluations times that); map: `Simulation.positions` into a float32 buffer (what "
+            "Blender's `foreach_set` takes) after each step, and back to back (a busy machine wakes the map's "
+            "threads late after each serial step); median / 95th percentile. Blender's own evaluation "
+            "(foreach_set and the mesh update) is not included.", ""]
+    out.append(table(["mesh", "vertices", "proxy", "dimensions", "bake s", "step ms", "BFGS iterations (median / max)",
+                      "evaluations", "ms per evaluation", "map ms", "map back to back ms"], rows))
+    s = f["stress"]
+    out += ["", f"Stress: the {s['mesh']} ({s['vertices']} vertices), {s['frames']} frames of random controller "
+            f"moves (turns up to 150°, jumps of a third of its length), damping {s['damping']:g}: "
+            f"{s['non_finite_frames']} non-finite frames, farthest vertex {s['farthest_vertex_diagonals']:.2f} "
+            f"diagonals from the centre, step {s['step_ms_median']:.1f} ms median ({s['step_ms_max']:.0f} max), "
+            f"{s['implicit_euler_substeps']} substeps retaken by implicit Euler. Then the controller still for "
+            f"{s['still_frames']} frames: the energy went from {s['energy_at_stop']:.4g} to {s['energy_at_end']:.4g}, "
+            f"its largest increase from one frame to the next {s['largest_energy_increase_still']:.3g}; the mesh "
+            f"ended {s['settled_distance_diagonals']:.2g} diagonals from ReducedSolver's pose "
+            f"({'converged' if s['pose_converged'] else 'NOT converged'}).", ""]
+    t = f["tolerance"]
+    out += [f"BFGS's stopping tolerance on the {t['mesh']} ({t['vertices']} vertices, the demo's motion, {t['frames']} "
+            f"frames) against a solve to {t['reference_tolerance']:g}: the largest distance of a frame, in diagonals "
+            "(the map's own precision is 3e-5), and the iterations a frame.", ""]
+    out.append(table(["tolerance", "largest distance", "iterations (median)", "while turning", "last 24 frames"],
+                     [[f"{r['tolerance']:g}", f"{r['largest_distance_diagonals']:.2g}", f"{r['iterations_median']:g}",
+                       f"{r['iterations_moving']:.1f}", f"{r['iterations_still']:.1f}"] for r in t["rows"]]))
+    out += ["", provenance(result)]
+    return "\n".join(out)
+
+
 SECTIONS = (("table1", section_table1), ("accuracy", section_accuracy), ("renders", section_renders),
             ("convergence", section_convergence), ("taylor", section_taylor), ("blender", section_blender),
             ("bpy_pose", section_bpy_pose), ("viewport_frames", section_viewport_frames), ("native", section_native),
             ("bake_limit", section_bake_limit), ("bake_busy", section_bake_busy),
             ("raw_scan", section_raw_scan), ("multires", section_multires),
             ("strong_poses", section_strong_poses), ("refine", section_refine), ("region", section_region),
-            ("playback", section_playback))
+            ("dynamics", section_dynamics), ("playback", section_playback))
 
 
 def write():

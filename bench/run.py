@@ -29,6 +29,9 @@ Experiments (each writes bench/results/<name>.json: machine, commit, command, pa
   region       the head of the 100k dragon, and of it subdivided to 1.6M (on proxies), baked as a region
                against the whole mesh: time, stages, dimensions, and that nothing outside the region moves
                (bench/region.py)
+  dynamics     secondary motion (issue 40): a free bar's period and decrement against the ones set, the
+               step's cost per frame on the 23k and 100k dragons and the 1.6M one on a proxy, 1000 frames of
+               fast random controllers, BFGS's tolerance (bench/dynamics.py)
   blender      the add-on's pose update in headless Blender and Blender's Laplacian Deform
                (bench/blender_pose.py), in Debian's 3.4.1 app from the source tree
   bpy_pose     the pose update alone at 100k, 400k, 1.6M and 3.2M vertices in bpy 4.5 and 5.3 (.venv/bpy-<version>,
@@ -59,7 +62,7 @@ import common  # noqa: E402
 import report  # noqa: E402
 
 PYTHON_EXPERIMENTS = ("table1", "accuracy", "convergence", "taylor", "bake_limit", "bake_busy", "raw_scan", "multires",
-                      "strong_poses", "refine", "region")
+                      "strong_poses", "refine", "region", "dynamics")
 EXPERIMENTS = ("native",) + PYTHON_EXPERIMENTS + ("blender", "bpy_pose", "viewport_frames", "playback", "renders")
 NATIVE_IN_TABLE1 = "BM_Bake|BM_BfgsIteration|BM_Positions"
 BLENDER = ["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python"]

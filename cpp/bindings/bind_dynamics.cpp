@@ -26,7 +26,8 @@ py::dict to_dict(const SimulationStepStats& stats) {
   return py::dict(py::arg("substeps") = stats.substeps, py::arg("iterations") = stats.iterations,
                   py::arg("evaluations") = stats.evaluations, py::arg("converged") = stats.converged,
                   py::arg("stalled") = stats.stalled, py::arg("line_search_failures") = stats.line_search_failures,
-                  py::arg("implicit_euler") = stats.implicit_euler, py::arg("energy_removed") = stats.energy_removed, py::arg("ms") = stats.milliseconds);
+                  py::arg("implicit_euler") = stats.implicit_euler, py::arg("energy_removed") = stats.energy_removed,
+                  py::arg("ms") = stats.milliseconds);
 }
 
 }  // namespace
@@ -81,8 +82,6 @@ void bind_dynamics(py::module_& m) {
       .def_property_readonly("dimension", &ReducedDynamics::dimension)
       .def_property_readonly("num_handles", &ReducedDynamics::num_handles)
       .def_property_readonly("mass_scale", &ReducedDynamics::mass_scale)
-      .def_property_readonly("rayleigh_stiffness", &ReducedDynamics::rayleigh_stiffness)
-      .def_property_readonly("lowest_eigenvalue", &ReducedDynamics::lowest_eigenvalue)
       .def_property_readonly("lowest_mode", [](const ReducedDynamics& s) { return Eigen::VectorXd(s.lowest_mode()); });
 }
 

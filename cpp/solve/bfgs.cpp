@@ -29,6 +29,12 @@ void Bfgs::start(const Eigen::VectorXd& x, const Eigen::MatrixXd& initial_invers
   for (Eigen::VectorXd* v : {&p_, &x_new_, &gradient_new_, &s_, &y_, &Hy_}) v->resize(n);
 }
 
+void Bfgs::move_to(const Eigen::VectorXd& x) {
+  if (x.size() != x_.size()) throw InputError(message("x: expected ", x_.size(), " values, got ", x.size()));
+  x_ = x;
+  evaluated_ = converged_ = false;
+}
+
 void Bfgs::objective_changed(double value_change, const VectorRef& gradient_change) {
   converged_ = false;
   if (!evaluated_) return;

@@ -41,6 +41,11 @@ class Bfgs {
   // kept for restarts; f and ∇f are evaluated by the next minimize.
   void start(const Eigen::VectorXd& x, const Eigen::MatrixXd& initial_inverse_hessian);
 
+  // Moves to x (n) keeping the inverse Hessian, for an objective that changed by a linear term
+  // (same curvature, e.g. the next time step's incremental potential); f and ∇f are evaluated by
+  // the next minimize.
+  void move_to(const Eigen::VectorXd& x);
+
   // The objective changed by `value_change` and `gradient_change` (n) at the current x.
   void objective_changed(double value_change, const VectorRef& gradient_change);
   // The objective changed in an unknown way: f and ∇f are evaluated again by the next minimize.

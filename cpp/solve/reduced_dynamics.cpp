@@ -93,7 +93,7 @@ ReducedDynamics::ReducedDynamics(const Basis& basis, const Handles& handles, con
   if (lowest == r || !(largest > 0))
     throw InputError("basis: no flexible mode (every direction of the basis is a rigid motion or a mechanism); "
                      "the period is that of the lowest flexible mode");
-  lowest_eigenvalue_ = eigen.eigenvalues()[lowest];
+  const double lowest_eigenvalue = eigen.eigenvalues()[lowest];
   lowest_mode_ = eigen.eigenvectors().col(lowest);
 
   // The poles the artist asks for, and the model's that the midpoint rule maps onto them.
@@ -107,7 +107,7 @@ ReducedDynamics::ReducedDynamics(const Basis& basis, const Handles& handles, con
     product *= model_pole;
     sum += model_pole;
   }
-  mass_scale_ = lowest_eigenvalue_ / product.real();
+  mass_scale_ = lowest_eigenvalue / product.real();
   rayleigh_ = -sum.real() / product.real();
   midpoint_weight_ = h_ * h_ / (4 * mass_scale_);
   euler_weight_ = h_ * h_ / mass_scale_;
@@ -123,8 +123,8 @@ ReducedDynamics::ReducedDynamics(const Basis& basis, const Handles& handles, con
 }
 
 Eigen::MatrixXd ReducedDynamics::inverse_rest_hessian(const Eigen::MatrixXd& K, double potential_weight,
-                                                      double elastic_weight) const {
-  Eigen::MatrixXd H = potential_weight * (elastic_weight * K + handle_term_.hessian());
+                                                      double damping_weight) const {
+  Eigen::MatrixXd H = (potential_weight * damping_weight) * (K + handle_term_.hessian());
   H.diagonal().array() += 1;
   H = 0.5 * (H + H.transpose()).eval();
   const Eigen::LLT<Eigen::MatrixXd> llt(H);
@@ -172,8 +172,8 @@ double ReducedDynamics::incremental_potential(const Eigen::VectorXd& x, Eigen::V
   const double handles = handle_term_.value_and_gradient(x, handle_gradient_);
   gradient = x - prediction_;
   const double inertia = 0.5 * gradient.squaredNorm();
-  gradient += potential_weight_ * (elastic_weight_ * work_gradient_ - damping_pull_ + handle_gradient_);
-  return inertia + potential_weight_ * (elastic_weight_ * elastic_energy - damping_pull_.dot(x) + handles);
+  gradient += potential_weight_ * (damping_weight_ * (work_gradient_ + handle_gradient_) - damping_pull_);
+  return inertia + potential_weight_ * (damping_weight_ * (elastic_energy + handles) - damping_pull_.dot(x));
 }
 
 Transforms ReducedDynamics::interpolated(const Transforms& target, double a) const {
@@ -200,6 +200,7 @@ SimulationStepStats ReducedDynamics::step(const Transforms& transforms) {
   SimulationStepStats stats;
   const int substeps = options_.substeps;
   Transforms substep_start = transforms_;
+  midpoint_started_ = euler_started_ = false;
   for (int k = 0; k < substeps; ++k) {
     const Transforms middle = interpolated(transforms, (k + 0.5) / substeps);
     const Transforms end = interpolated(transforms, static_cast<double>(k + 1) / substeps);
@@ -212,9 +213,16 @@ SimulationStepStats ReducedDynamics::step(const Transforms& transforms) {
   return stats;
 }
 
-BfgsResult ReducedDynamics::minimize(Bfgs& bfgs, const Eigen::MatrixXd& initial_inverse_hessian,
-                                     const Eigen::VectorXd& start, SimulationStepStats& stats) {
-  bfgs.start(start, initial_inverse_hessian);
+void ReducedDynamics::minimize(Bfgs& bfgs, bool& started, const Eigen::MatrixXd& initial_inverse_hessian,
+                               const Eigen::VectorXd& start, SimulationStepStats& stats) {
+  // Φ changes from substep to substep by linear terms only: BFGS keeps what it learnt of its
+  // curvature within a frame, and starts each frame afresh, so that a frame depends on nothing
+  // but the state it starts from (a cached state continues as the run did).
+  if (started)
+    bfgs.move_to(start);
+  else
+    bfgs.start(start, initial_inverse_hessian);
+  started = true;
   const BfgsResult result = bfgs.minimize(
       [this](const Eigen::VectorXd& x, Eigen::VectorXd& gradient) { return incremental_potential(x, gradient); },
       options_.max_iterations, options_.tolerance);
@@ -223,7 +231,6 @@ BfgsResult ReducedDynamics::minimize(Bfgs& bfgs, const Eigen::MatrixXd& initial_
   stats.converged = stats.converged && result.converged;
   stats.stalled = stats.stalled || result.stalled;
   stats.line_search_failures += result.line_search_failures;
-  return result;
 }
 
 void ReducedDynamics::substep(const Transforms& start, const Transforms& middle, const Transforms& end,
@@ -233,13 +240,15 @@ void ReducedDynamics::substep(const Transforms& start, const Transforms& middle,
   // The midpoint rule: Φ over the middle state, from the inertial prediction (from q_n, inside
   // the energies' range, when the prediction leaves it).
   prediction_ = q_ + (h_ / 2) * v_;
-  damping_pull_ = (2 * rayleigh_ / h_) * elastic_gradient_;
-  elastic_weight_ = 1 + 2 * rayleigh_ / h_;
+  handle_term_.value_and_gradient(q_, handle_gradient_);
+  damping_pull_ = (2 * rayleigh_ / h_) * (elastic_gradient_ + handle_gradient_);
+  damping_weight_ = 1 + 2 * rayleigh_ / h_;
   potential_weight_ = midpoint_weight_;
   handle_term_.set_transforms(middle);
   ghost_x_.noalias() = ghost_vectors_ * prediction_;
   ghost_x_ += ghost_rest_;
-  minimize(midpoint_bfgs_, midpoint_inverse_hessian_, positions_in_range(ghost_x_) ? prediction_ : q_, stats);
+  const Eigen::VectorXd& start_state = positions_in_range(ghost_x_) ? prediction_ : q_;
+  minimize(midpoint_bfgs_, midpoint_started_, midpoint_inverse_hessian_, start_state, stats);
   const Eigen::VectorXd& middle_state = midpoint_bfgs_.x();
   Eigen::VectorXd q_next = 2 * middle_state - q_;
   Eigen::VectorXd v_next = (4 / h_) * (middle_state - q_) - v_;
@@ -259,9 +268,9 @@ void ReducedDynamics::substep(const Transforms& start, const Transforms& middle,
     ++stats.implicit_euler;
     prediction_ = q_ + h_ * v_;
     damping_pull_.setZero();
-    elastic_weight_ = 1;
+    damping_weight_ = 1;
     potential_weight_ = euler_weight_;
-    minimize(euler_bfgs_, euler_inverse_hessian_, q_, stats);
+    minimize(euler_bfgs_, euler_started_, euler_inverse_hessian_, q_, stats);
     q_next = euler_bfgs_.x();
     v_next = (q_next - q_) / h_;
     handle_term_.set_transforms(start);

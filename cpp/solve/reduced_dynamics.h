@@ -16,13 +16,14 @@
 // for the lowest mode by the mass scale (below). As a minimisation over the middle state x = q_m
 // (an incremental potential, h the substep):
 //
-//   Φ(x) = ½‖x − q_n − (h/2) v_n‖² + κ [(1 + 2β/h) E(x) − (2β/h) ∇E(q_n)ᵀx + E_C(x, t_m)],
-//   κ = h²/(4ρ),
+//   Φ(x) = ½‖x − q_n − (h/2) v_n‖² + κ [(1 + 2β/h) V(x, t_m) − (2β/h) ∇V(q_n, t_n)ᵀx],
+//   κ = h²/(4ρ),  V = E + E_C,
 //
-// whose stationarity is the scheme with the Rayleigh damping force D v_m = β (2/h)(∇E(q_m) −
-// ∇E(q_n)) ≈ β ∇²E(x) v_m: stiffness-proportional damping with the current tangent stiffness, so
-// a rigid motion is not damped. E_C at the substep's middle time, the controllers' transforms
-// interpolated between frames (rotation by slerp, each handle's centre on a straight line). Then
+// whose stationarity is the scheme with the Rayleigh damping force D v_m = β (2/h)(∇V(q_m, t_m) −
+// ∇V(q_n, t_n)) ≈ β d(∇V)/dt: stiffness-proportional damping with the tangent stiffness of the energy
+// and of the handles' springs, relative to the controllers' motion, so neither a rigid motion nor
+// following the controllers is damped. E_C at the substep's middle time, the controllers'
+// transforms interpolated between frames (rotation by slerp, each handle's centre on a line). Then
 // q_{n+1} = 2x − q_n, v_{n+1} = 4(x − q_n)/h − v_n. Φ is minimised by Bfgs, started from the
 // inertial prediction q_n + (h/2) v_n with the inverse of Φ's Hessian at rest, computed once.
 //
@@ -63,10 +64,11 @@ struct SimulationOptions {
   double damping = 0.05;     // ζ of the lowest flexible mode, in [0, 1]
   double fps = 24.0;         // frames per second
   int substeps = 2;          // midpoint steps per frame
-  // BFGS per substep: at most this many iterations, stopping tolerance (bfgs.h). Small enough that
-  // a step converges to working precision in the linear regime within two iterations.
+  // BFGS per substep: at most this many iterations, and the stopping tolerance (bfgs.h), which
+  // keeps the frames within the map's precision (ReducedSolver::kMapTolerance) of a tight solve's
+  // (bench/results/dynamics.json, "tolerance").
   int max_iterations = 20;
-  double tolerance = 1e-12;
+  double tolerance = 1e-8;
 };
 
 // The shortest period accepted: a vibration faster than this is not seen as one at the frame rate,
@@ -121,22 +123,21 @@ class ReducedDynamics {
 
   int dimension() const { return static_cast<int>(ghost_vectors_.cols()); }
   int num_handles() const { return static_cast<int>(centres_.size()); }
-  double mass_scale() const { return mass_scale_; }          // ρ
-  double rayleigh_stiffness() const { return rayleigh_; }    // β, seconds
-  double lowest_eigenvalue() const { return lowest_eigenvalue_; }  // λ₁ of K
-  const Eigen::VectorXd& lowest_mode() const { return lowest_mode_; }  // its unit eigenvector of K
-  const SimulationOptions& options() const { return options_; }
+  double mass_scale() const { return mass_scale_; }                   // ρ
+  const Eigen::VectorXd& lowest_mode() const { return lowest_mode_; }  // λ₁'s unit eigenvector of K
 
  private:
   // E(q) with ∇E(q) in `gradient` (r): +inf where the ghost leaves the coordinate range.
   double elastic(const Eigen::VectorXd& q, Eigen::VectorXd& gradient);
-  // Φ (above) for the current substep and scheme: ½‖x − prediction‖² + potential_weight (elastic_weight
-  // E(x) − damping_pullᵀx + E_C(x)).
+  // Φ (above) for the current substep and scheme: ½‖x − prediction‖² + potential_weight
+  // (damping_weight V(x) − damping_pullᵀx), V = E + E_C.
   double incremental_potential(const Eigen::VectorXd& x, Eigen::VectorXd& gradient);
-  // The inverse of I + potential_weight (elastic_weight K + 2A): Φ's Hessian at rest.
-  Eigen::MatrixXd inverse_rest_hessian(const Eigen::MatrixXd& K, double potential_weight, double elastic_weight) const;
-  BfgsResult minimize(Bfgs& bfgs, const Eigen::MatrixXd& initial_inverse_hessian, const Eigen::VectorXd& start,
-                      SimulationStepStats& stats);
+  // The inverse of I + potential_weight damping_weight (K + 2A): Φ's Hessian at rest.
+  Eigen::MatrixXd inverse_rest_hessian(const Eigen::MatrixXd& K, double potential_weight, double damping_weight) const;
+  // Minimises the current Φ with `bfgs` from `start`, adding to `stats`; `started`: bfgs has
+  // minimised this scheme's Φ earlier in the frame.
+  void minimize(Bfgs& bfgs, bool& started, const Eigen::MatrixXd& initial_inverse_hessian,
+                const Eigen::VectorXd& start, SimulationStepStats& stats);
   // Transforms at fraction a of the way from start_ to target (per handle).
   Transforms interpolated(const Transforms& target, double a) const;
   void substep(const Transforms& start, const Transforms& middle, const Transforms& end,
@@ -153,13 +154,14 @@ class ReducedDynamics {
   QuantizedVectors quantized_vectors_;
   double map_tolerance_;
 
-  double lowest_eigenvalue_ = 0, mass_scale_ = 0, rayleigh_ = 0, h_ = 0;
+  double mass_scale_ = 0, rayleigh_ = 0, h_ = 0;  // ρ, β (seconds), the substep (seconds)
   Eigen::VectorXd lowest_mode_;
   // The midpoint rule's Φ (κ = h²/(4ρ)) and implicit Euler's (h²/ρ): weight, inverse Hessian at
   // rest, minimiser.
   double midpoint_weight_ = 0, euler_weight_ = 0;
   Eigen::MatrixXd midpoint_inverse_hessian_, euler_inverse_hessian_;
   Bfgs midpoint_bfgs_, euler_bfgs_;
+  bool midpoint_started_ = false, euler_started_ = false;
 
   // State: q, v, E(q) + E_C(q), ∇E(q).
   Eigen::VectorXd q_, v_, elastic_gradient_;
@@ -167,9 +169,9 @@ class ReducedDynamics {
   Eigen::VectorXf q_float_;
   mutable Eigen::VectorXf proxy_displacement_;
   // The current Φ's terms: the prediction (q_n + (h/2) v_n for the midpoint rule), the damping
-  // term's pull ((2β/h) ∇E(q_n)) and the weights.
+  // term's pull ((2β/h) ∇V(q_n, t_n)) and the weights (κ, 1 + 2β/h).
   Eigen::VectorXd prediction_, damping_pull_;
-  double elastic_weight_ = 1, potential_weight_ = 0;
+  double damping_weight_ = 1, potential_weight_ = 0;
   // Work space, sized once.
   Eigen::VectorXd ghost_x_, ghost_gradient_, work_gradient_, handle_gradient_;
 };

@@ -271,6 +271,25 @@ TEST(Bfgs, AKnownChangeOfTheObjectiveEqualsReevaluation) {
   EXPECT_LE((told.x() - reevaluated.x()).norm(), 1e-10);
 }
 
+TEST(Bfgs, MoveToKeepsTheCurvatureLearnt) {
+  // A quadratic learnt from the identity, then the same curvature with another linear term (the
+  // next time step's incremental potential): from the same start, move_to keeps what BFGS learnt.
+  Quadratic f(8);
+  const Eigen::VectorXd start = Eigen::VectorXd::Zero(8);
+  Bfgs kept, fresh;
+  kept.start(start, Eigen::MatrixXd::Identity(8, 8));
+  ASSERT_TRUE(kept.minimize(f, 100, 1e-12).converged);
+  f.b = Eigen::VectorXd::LinSpaced(8, -1.0, 1.0);
+  kept.move_to(start);
+  fresh.start(start, Eigen::MatrixXd::Identity(8, 8));
+  const BfgsResult with_curvature = kept.minimize(f, 100, 1e-12);
+  const BfgsResult without = fresh.minimize(f, 100, 1e-12);
+  ASSERT_TRUE(with_curvature.converged && without.converged);
+  EXPECT_LT(with_curvature.iterations, without.iterations);
+  EXPECT_LE((kept.x() - f.A.llt().solve(f.b)).norm(), 1e-6);
+  EXPECT_THROW(kept.move_to(Eigen::VectorXd::Zero(7)), InputError);
+}
+
 // An objective whose gradient points the wrong way (as a jump in f can make it): no step lowers
 // f, from H or from H0, and the call says it stalled instead of passing for convergence.
 TEST(Bfgs, ReportsAStallWhenNoStepDecreases) {

@@ -77,6 +77,38 @@ def test_damping_ratio_gives_the_logarithmic_decrement(bar, damping):
     assert abs(period - 12.0 / np.sqrt(1 - damping**2)) <= 0.02 * 12
 
 
+@pytest.fixture(scope="module")
+def tube_bases():
+    """The tube baked as a whole, with a painted stiffness, on a proxy, and as a region (its upper
+    half)."""
+    V, F = mdc.cylinder(25, 40, radius=1.0, length=4.0)
+    sizes = dict(modes=16, derivatives=30, ghost=400)
+    upper = np.flatnonzero(V[:, 2] > 2.0)
+    bases = {"whole": mdc.bake(V, F, **sizes),
+             "painted": mdc.bake(V, F, **sizes, stiffness_weights=np.clip(V[:, 2] / 4, 0, 1), max_stiffness=20.0),
+             "proxy": mdc.bake(V, F, **sizes, proxy=400, proxy_above=500),
+             "region": mdc.bake(V, F, **sizes, region=upper)}
+    return V, F, upper, bases
+
+
+@pytest.mark.parametrize("kind", ["whole", "painted", "proxy", "region"])
+def test_every_kind_of_basis_keeps_the_period_and_follows_a_controller(tube_bases, kind):
+    V, F, upper, bases = tube_bases
+    basis = bases[kind]
+    assert basis.on_proxy == (kind == "proxy")
+    period, _ = damped_oscillation(released(basis, 25, damping=0.0))
+    assert abs(period - 12.0) <= 0.02 * 12.0
+    top = np.flatnonzero(V[:, 2] > 4 - 1e-9)
+    sim = mdc.Simulation(basis, [top])
+    for frame in range(1, 13):
+        X = sim.step([rigid([1, 0, 0], np.radians(5 * frame), V[top].mean(axis=0))])
+        assert np.isfinite(X).all() and X.shape == V.shape
+    assert np.abs(X[top] - V[top]).max() > 0.1  # it followed
+    if kind == "region":
+        outside = np.setdiff1d(np.arange(len(V)), upper)
+        assert np.array_equal(X[outside], V[outside].astype(np.float32))
+
+
 def random_controller(rng, centre):
     """A random rigid move of the controller: turns up to 150° about a random axis, jumps up to about
     a bar's length."""
@@ -171,3 +203,33 @@ def test_parameters_are_defined_once_and_checked(bar):
         sim.set_state(np.zeros(r), np.full(r, np.nan))
     with pytest.raises(ValueError, match="q"):
         sim.set_state(np.full(r, 1e300), np.zeros(r))
+
+
+def test_an_unconverged_step_says_so_and_stays_finite(tube):
+    V, F, handles, basis = tube
+    sim = mdc.Simulation(basis, handles, max_iterations=1)
+    rng = np.random.default_rng(5)
+    centre = V[handles[1]].mean(axis=0)
+    stats = []
+    for _ in range(10):
+        X = sim.step([np.eye(4), random_controller(rng, centre)])
+        assert np.isfinite(X).all() and np.isfinite(sim.energy())
+        stats.append(sim.stats)
+    assert not all(s["converged"] for s in stats)
+    assert all(s["substeps"] == 2 and s["iterations"] <= 2 * (1 + s["implicit_euler"]) for s in stats)
+    # Unconverged steps cannot create energy either: with the controllers still it never grows.
+    still = [np.eye(4), random_controller(rng, centre)]
+    sim.step(still)
+    energies = [sim.energy()]
+    for _ in range(40):
+        sim.step(still)
+        energies.append(sim.energy())
+    assert (np.diff(energies) <= 1e-12 * energies[0]).all() and energies[-1] < energies[0]
+
+
+def test_the_motion_in_frames_does_not_depend_on_the_frame_rate(bar):
+    """Period and damping are in frames: at another fps the frames are the same (velocities, per
+    second, scale with it)."""
+    *_, basis = bar
+    traces = [released(basis, 30, fps=fps) for fps in (24.0, 30.0)]
+    assert np.allclose(traces[0], traces[1], rtol=0, atol=1e-9 * np.abs(traces[0]).max())
