@@ -38,6 +38,11 @@ Experiments (each writes bench/results/<name>.json: machine, commit, command, pa
                made by `make bench`) with the add-on installed from its extension zip (`make addon`)
   viewport_frames  the frame while posing in a real viewport: Debian's 3.4.1 app under Xvfb (software
                OpenGL), the dragon at 100k and 1.6M vertices (bench/viewport_frames.py)
+  playback     the per-frame cache and secondary motion (issue 40) in bpy 4.5 and 5.3 on the extension zips:
+               per frame, a cached frame read back and a live simulation step with Blender's evaluation,
+               at 100k vertices (and 1.6M on a proxy unless --quick); the cache's and the .blend's sizes
+               for 250 frames of the 100k dragon against a shape key per frame and a PC2 file
+               (bench/playback.py)
   renders      Cycles renders of the accuracy experiment's bar and cylinder poses
                (blender_scripts/render_figures.py; needs accuracy's meshes from the same run)
 --quick runs tiny sizes (the smoke test): results go to bench/results/tmp/, the report is not
@@ -58,7 +63,7 @@ import report  # noqa: E402
 
 PYTHON_EXPERIMENTS = ("table1", "accuracy", "convergence", "taylor", "bake_limit", "bake_busy", "raw_scan", "multires",
                       "strong_poses", "refine", "region", "dynamics")
-EXPERIMENTS = ("native",) + PYTHON_EXPERIMENTS + ("blender", "bpy_pose", "viewport_frames", "renders")
+EXPERIMENTS = ("native",) + PYTHON_EXPERIMENTS + ("blender", "bpy_pose", "viewport_frames", "playback", "renders")
 NATIVE_IN_TABLE1 = "BM_Bake|BM_BfgsIteration|BM_Positions"
 BLENDER = ["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python"]
 
@@ -135,6 +140,21 @@ def viewport_frames(quick):
                 raise RuntimeError("\n".join(run["log"]))
             runs.append(run)
     return {"sizes": sizes, "updates": 2 if quick else 3}, {"runs": runs}
+
+
+def playback(quick):
+    """bench/playback.py in each of common.BPY_VERSIONS: the 100k dragon with the sizes, then (not
+    quick) the dragon subdivided twice (1.6M vertices, on a proxy) for the per-frame figures."""
+    runs = []
+    sizes = [[]] if quick else [[], ["--subdivide", "2", "--no-sizes"]]
+    with tempfile.TemporaryDirectory() as folder:
+        for version in common.BPY_VERSIONS:
+            for i, size in enumerate(sizes):
+                out = pathlib.Path(folder) / f"playback-{version}-{i}.json"
+                common.in_bpy(version, common.ROOT / "bench" / "playback.py",
+                              ["--output", str(out), *size, *(["--quick"] if quick else [])], folder)
+                runs.append(json.loads(out.read_text()))
+    return {"blenders": common.BPY_VERSIONS, "sizes": sizes}, {"runs": runs}
 
 
 def renders(quick):

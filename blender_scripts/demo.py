@@ -10,6 +10,9 @@ knuckles (a Stiffness Group) curled by its tip against the same tube of uniform 
 Suzanne's left ear baked as a Region Group and pulled up while every other vertex stays exactly
 where it was.
 
+Then secondary motion (issue 40, demo_dynamics.py): a Suzanne whose head tilts fast and stops, her
+ears overshooting and settling, as a strip of frames, OUTPUT/demo_dynamics.png.
+
 Writes OUTPUT/demo.png (Cycles on the CPU: rest, Modal Deform, Laplacian Deform side by side; below
 them the uniform and the painted finger and the ear) and OUTPUT/demo.blend (Suzanne alone), ready to
 pose: select the mesh, Sidebar > Modal Deform > Pose, then move the
@@ -28,6 +31,7 @@ import numpy as np
 from mathutils import Matrix, Vector
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import demo_dynamics  # noqa: E402
 from headless import add_handle, bind_laplacian_deform, enable_addon, evaluated_positions  # noqa: E402
 from rendering import render, side_by_side, stage  # noqa: E402
 
@@ -47,6 +51,8 @@ def arguments():
     parser.add_argument("--turn", type=float, default=TURN, help="the top of the head turned about the vertical, degrees")
     parser.add_argument("--bend", type=float, default=BEND, help="then bent sideways, degrees")
     parser.add_argument("--width", type=int, default=800, help="width of each of the three pictures, pixels")
+    parser.add_argument("--dynamics-subdivisions", type=int, default=2,
+                        help="Catmull-Clark levels of the secondary motion's Suzanne (2: ~8k vertices)")
     return parser.parse_args(argv)
 
 
@@ -256,6 +262,11 @@ def main():
         obj.select_set(obj == suzanne)
     bpy.ops.wm.save_as_mainfile(filepath=str(output / "demo.blend"))
     print(f"wrote {output / 'demo.blend'}")
+
+    start = time.perf_counter()
+    modules = (importlib.import_module(f"{addon}.{name}") for name in ("frame_cache", "playback", "posing"))
+    strip = demo_dynamics.secondary_motion(tuple(modules), output, args.dynamics_subdivisions, args.width // 2)
+    print(f"rendered {strip} (secondary motion) in {time.perf_counter() - start:.1f} s")
 
 
 main()

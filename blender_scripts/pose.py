@@ -3,8 +3,9 @@
     blender -b scene.blend --python blender_scripts/pose.py -- --object Suzanne
     blender -b scene.blend --python blender_scripts/pose.py -- --object Suzanne --frames 1 48
 
-With --frames the controllers' animation is solved frame by frame into shape keys (Bake
-Animation); without, the current frame into the "Modal Deform" shape key (Solve).
+With --frames the controllers' animation is solved frame by frame into the per-frame cache kept in
+the file (Bake Animation; with Dynamics on, simulated); without, the current frame into the
+"Modal Deform" shape key (Solve).
 """
 import pathlib
 import sys

@@ -8,10 +8,10 @@ tick_seconds), False once the job has ended; overall (the fraction done); cancel
 it at once, for execute); finish() on the main thread, returning (level, message) for the report and
 setting `written` when it changed the object.
 
-Bake animation writes one shape key per frame, keyed to show on its frame only, so the result plays
-back and renders without the add-on: frame f shows shape key "Modal Deform f" (value 1 at f, 0 at
-f - 1 and f + 1, constant interpolation). Each frame starts from the previous frame's solution (the
-solver keeps q and its inverse Hessian); refined, from the previous frame's refined answer.
+The refined animation bake, and the export of the per-frame cache (frame_cache.py), write one shape
+key per frame, keyed to show on its frame only, so the result plays back and renders without the
+add-on: frame f shows shape key "Modal Deform f" (value 1 at f, 0 at f - 1 and f + 1, constant
+interpolation). Refined, each frame starts from the previous frame's refined answer.
 """
 import re
 import threading
@@ -193,15 +193,18 @@ def frame_key_name(frame):
 
 
 class AnimationJob:
-    """Solves the frames one per tick() into new shape keys; finish() keys them, cancel() (or a
-    failure) takes them away."""
+    """Writes the frames one per tick() into new shape keys: each frame's pose refined on the full
+    mesh (Newton's method from the reduced pose, then from the previous frame's answer), or with
+    `positions` (frame -> #V by 3 float32) what it gives (the cache's frames); finish() keys them,
+    cancel() (or a failure) takes them away."""
 
     tick_seconds = 0.01
 
-    def __init__(self, context, obj, frames, refine=False):
-        self.pose = posing.Pose(context, obj)
-        # Refine: each frame's pose polished on the full mesh, from the previous frame's answer.
-        self.triangles = mesh_io.triangles(obj.data) if refine else None
+    def __init__(self, context, obj, frames, positions=None):
+        self.positions = positions
+        self.action = "Animation bake" if positions is None else "Shape key export"
+        self.pose = posing.Pose(context, obj) if positions is None else None
+        self.triangles = mesh_io.triangles(obj.data) if positions is None else None
         self.refined = None
         self.obj, self.scene, self.frames = obj, context.scene, list(frames)
         self.frame_before = self.scene.frame_current
@@ -238,30 +241,29 @@ class AnimationJob:
             pass
 
     def _solve_frame(self, frame):
-        self.scene.frame_set(frame)
-        self.pose.follow_controllers()
-        converged = self.pose.converge()["converged"]
-        if self.triangles is not None:
+        if self.positions is None:
+            self.scene.frame_set(frame)
+            self.pose.follow_controllers()
+            self.pose.converge()
             self.refined, stats = self.pose.solver.refine(self.triangles, initial=self.refined)
-            converged = stats["converged"]
-        if not converged:
-            self.unconverged += 1
+            if not stats["converged"]:
+                self.unconverged += 1
+            co = self.refined.astype(np.float32)
+        else:
+            co = self.positions(frame)
         mesh_io.ensure_reference_key(self.obj)
         block = self.obj.shape_key_add(name=frame_key_name(frame), from_mix=False)
         block.value = 0.0
         self.created.append((frame, block.name))
-        if self.refined is None:
-            self.pose.write(mesh_io.shape_key_co(self.obj.data, block))
-        else:
-            mesh_io.write_shape_key(self.obj.data, block, self.refined.astype(np.float32))
+        mesh_io.write_shape_key(self.obj.data, block, co)
 
     def finish(self):
         """Replace the keys of an earlier animation bake with the new ones and key their values.
         Returns (level, message) for a report."""
         if self.cancelling:
-            return "WARNING", "Animation bake cancelled: nothing changed"
+            return "WARNING", f"{self.action} cancelled: nothing changed"
         if self.error is not None:
-            return "ERROR", f"Animation bake failed: {self.error}"
+            return "ERROR", f"{self.action} failed: {self.error}"
         obj = self.obj
         blocks = obj.data.shape_keys.key_blocks
         new_names = {name for _, name in self.created}
@@ -281,7 +283,7 @@ class AnimationJob:
                 point.interpolation = "CONSTANT"
         self.scene.frame_set(self.frame_before)
         self.written = True
-        message = f"Baked {len(self.frames)} frames into shape keys"
+        message = f"{'Exported' if self.positions else 'Baked'} {len(self.frames)} frames into shape keys"
         if self.unconverged:
             return "WARNING", f"{message}; {self.unconverged} did not converge"
         return "INFO", message

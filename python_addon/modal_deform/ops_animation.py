@@ -1,15 +1,18 @@
-"""Bake animation: solve every frame of a range into its own shape key, keyed to show on its frame only
-(jobs.AnimationJob does the work, a frame per timer tick)."""
+"""Bake animation: every frame of a range into the per-frame cache (ops_dynamics.CacheJob: the pose
+of each frame, or the simulation with dynamics on), or refined on the full mesh into a shape key per
+frame (jobs.AnimationJob), a frame per timer tick."""
 import bpy
 
 from . import handles
 from .jobs import AnimationJob
 from .ops_common import JobOperator, mesh_poll
+from .ops_dynamics import CacheJob
 
 
 class MODAL_DEFORM_OT_bake_animation(JobOperator, bpy.types.Operator):
-    """Solve every frame of the range with the controllers' animation into shape keys that play back and \
-render without the add-on. Esc cancels"""
+    """Solve every frame of the range with the controllers' animation (with Dynamics on: simulate from its \
+start) into the cache kept in the file, which plays back at the cost of a pose update; refined: into shape \
+keys. Esc cancels"""
     bl_idname = "modal_deform.bake_animation"
     bl_label = "Bake Animation"
     bl_options = {"REGISTER", "UNDO"}
@@ -18,7 +21,8 @@ render without the add-on. Esc cancels"""
     frame_end: bpy.props.IntProperty(name="End", description="Last frame to solve (default: the scene's)")
     refine: bpy.props.BoolProperty(name="Refine", default=False,
                                    description="Polish every frame on the full mesh (Newton's method, from the "
-                                               "previous frame's answer): exact shapes, seconds per frame")
+                                               "previous frame's answer) into a shape key per frame: exact shapes, "
+                                               "seconds per frame")
 
     poll = classmethod(mesh_poll)
 
@@ -28,7 +32,10 @@ render without the add-on. Esc cancels"""
         end = self.frame_end if self.properties.is_property_set("frame_end") else scene.frame_end
         if end < start:
             raise ValueError(f"frame range: the end ({end}) is before the start ({start})")
-        return AnimationJob(context, handles.owner(context.object), range(start, end + 1), refine=self.refine)
+        obj = handles.owner(context.object)
+        if self.refine:
+            return AnimationJob(context, obj, range(start, end + 1))
+        return CacheJob(context, obj, start, end)
 
     def _status(self):
         job = self.job

@@ -4,7 +4,7 @@ The baked arrays are not here: they live in a separate datablock (storage.py) th
 points to, so the object itself stays small for Blender's copy-on-write.
 """
 import bpy
-from bpy.props import (CollectionProperty, EnumProperty, FloatProperty, FloatVectorProperty,
+from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, FloatVectorProperty,
                        IntProperty, PointerProperty, StringProperty)
 
 from . import core as mdc
@@ -73,6 +73,43 @@ class ModalDeformBakeStatus(bpy.types.PropertyGroup):
     region_group: StringProperty(name="Region Group", description="The region vertex group of the bake")
     region_group_hash: StringProperty(
         name="Region Hash", description="Weights of the region vertex group at the bake (empty: the whole mesh)")
+
+
+# Secondary motion and the per-frame cache (issue 40): frame_cache.py, playback.py, ops_dynamics.py.
+def _dynamics_changed(dynamics, context):
+    from . import frame_cache
+    frame_cache.settings_changed(dynamics.id_data)
+
+
+class ModalDeformDynamics(bpy.types.PropertyGroup):
+    """Secondary motion: the mesh follows its controllers with inertia, and the per-frame cache of
+    its reduced state (static animation or simulation) that plays back."""
+
+    enabled: BoolProperty(
+        name="Dynamics", default=False, update=_dynamics_changed,
+        description="The mesh follows its controllers with inertia: parts away from the handles overshoot and "
+                    "settle when the controllers stop, played live on the timeline and cached per frame")
+    period: FloatProperty(
+        name="Period", default=mdc.SIMULATION_DEFAULTS["period"], min=mdc.MIN_PERIOD_FRAMES, soft_max=100.0,
+        update=_dynamics_changed,
+        description="Frames one swing of the softest part takes (the slowest wobble): more frames make the "
+                    "mesh heavier and lazier, fewer make it snappier")
+    damping: FloatProperty(
+        name="Damping", default=mdc.SIMULATION_DEFAULTS["damping"], min=0.0, max=1.0, update=_dynamics_changed,
+        description="How quickly the swinging dies down: 0 swings on forever, 0.05 settles in a few swings, "
+                    "1 settles without overshooting")
+    substeps: IntProperty(
+        name="Substeps", default=mdc.SIMULATION_DEFAULTS["substeps"], min=1, max=mdc.MAX_SUBSTEPS,
+        update=_dynamics_changed,
+        description="Simulation steps per frame: more follow fast controllers more closely and cost more per "
+                    "frame")
+    frame_start: IntProperty(
+        name="Start", default=1, update=_dynamics_changed,
+        description="Frame the simulation starts on, at rest in the pose of the controllers there; before it "
+                    "the mesh holds that pose")
+    cache: PointerProperty(
+        type=bpy.types.Palette, name="Cache",
+        description="Datablock holding the cached frames (hidden: its name starts with a dot)")
 
 
 class ModalDeformSettings(bpy.types.PropertyGroup):
@@ -147,12 +184,14 @@ class ModalDeformSettings(bpy.types.PropertyGroup):
         name="Vector", default=6, min=0, update=_preview_changed,
         description="Which of the baked shapes the preview shows: moves and turns first, then the natural "
                     "bends from the softest up (vibration modes), then the modal derivatives")
+    dynamics: PointerProperty(type=ModalDeformDynamics, name="Dynamics",
+                              description="Secondary motion and the per-frame cache of the pose")
     preview_amplitude: FloatProperty(
         name="Amplitude", default=0.1, soft_min=-0.5, soft_max=0.5, update=_preview_changed,
         description="How far the preview moves the mesh, as a fraction of its longest side")
 
 
-CLASSES = (ModalDeformHandle, ModalDeformBakeStatus, ModalDeformSettings)
+CLASSES = (ModalDeformHandle, ModalDeformBakeStatus, ModalDeformDynamics, ModalDeformSettings)
 
 
 _register_classes, _unregister_classes = bpy.utils.register_classes_factory(CLASSES)

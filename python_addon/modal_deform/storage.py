@@ -29,7 +29,7 @@ from . import mesh_io
 
 PREFIX = ".Modal Deform "
 _SHAPES = "shapes"
-_BAKE_ID = "bake_id"
+BAKE_ID = "bake_id"
 
 # Loaded bases by bake id, most recent last: a pose, a solve and the preview share one load.
 _bases = collections.OrderedDict()
@@ -138,7 +138,7 @@ def store(obj, basis, mesh_fingerprint, vertex_groups, seconds, energy):
             shapes[name] = list(a.shape)
     block[_SHAPES] = shapes
     bake_id = uuid.uuid4().hex
-    block[_BAKE_ID] = bake_id
+    block[BAKE_ID] = bake_id
 
     settings = obj.modal_deform
     _release(settings)
@@ -187,7 +187,7 @@ def load(obj):
     block = obj.modal_deform.basis
     if block is None:
         raise NotReady(f"'{obj.name}' has no baked basis: bake it first")
-    bake_id = block.get(_BAKE_ID)
+    bake_id = block.get(BAKE_ID)
     if bake_id in _bases:
         _bases.move_to_end(bake_id)
         return _bases[bake_id]
@@ -195,7 +195,7 @@ def load(obj):
         shapes = block[_SHAPES].to_dict()
         arrays = {}
         for name in block.keys():
-            if name in (_SHAPES, _BAKE_ID):
+            if name in (_SHAPES, BAKE_ID):
                 continue
             value = block[name]
             if name in shapes:

@@ -1,4 +1,5 @@
-"""The sidebar (View3D > N > Modal Deform): bake settings and status, handles, pose, animation, preview.
+"""The sidebar (View3D > N > Modal Deform): bake settings and status, handles, pose, animation, dynamics,
+preview.
 
 Every label fits the sidebar at its default width: short property labels beside their fields
 (use_property_split), and sentences wrapped to the sidebar's width (wrapped_label)."""
@@ -6,7 +7,7 @@ import textwrap
 
 import bpy
 
-from . import handles, ops_preview, posing, storage
+from . import frame_cache, handles, ops_preview, playback, posing, storage
 
 
 # Width of a character of the interface font at scale 1, in pixels, for wrapping text (a little above
@@ -197,8 +198,54 @@ class VIEW3D_PT_modal_deform_preview(_Panel, bpy.types.Panel):
                         icon="HIDE_OFF" if showing else "HIDE_ON", depress=showing)
 
 
+# Dynamics and the per-frame cache (issue 40).
+class VIEW3D_PT_modal_deform_dynamics(_Panel, bpy.types.Panel):
+    bl_label = "Dynamics"
+    bl_parent_id = "VIEW3D_PT_modal_deform"
+
+    def draw_header(self, context):
+        self.layout.prop(handles.owner(context.object).modal_deform.dynamics, "enabled", text="")
+
+    def draw(self, context):
+        obj = handles.owner(context.object)
+        dynamics = obj.modal_deform.dynamics
+        layout = self.layout
+        column = layout.column()
+        column.use_property_split = True
+        column.use_property_decorate = False
+        column.active = dynamics.enabled
+        column.prop(dynamics, "period")
+        column.prop(dynamics, "damping")
+        column.prop(dynamics, "substeps")
+        column.prop(dynamics, "frame_start")
+        box = layout.box()
+        try:
+            cache = frame_cache.get(obj)
+        except ValueError as error:
+            cache, problem = None, str(error)
+        else:
+            problem = playback.problems.get(obj.name)
+        if cache is None or not len(cache):
+            box.label(text="Cache empty: play or Bake", icon="INFO")
+        else:
+            what = "Simulation" if cache.kind == "DYNAMIC" else "Animation"
+            box.label(text=f"{what}: frames {cache.start}-{cache.end}", icon="FILE_CACHE")
+            box.label(text=f"{cache.nbytes() / 1024:.1f} KB in the file")
+        if problem:
+            row = box.row()
+            row.alert = True
+            row.label(text=problem, icon="ERROR")
+        row = layout.row(align=True)
+        row.operator("modal_deform.bake_animation", text="Bake", icon="RENDER_ANIMATION")
+        row.operator("modal_deform.free_cache", text="Free", icon="TRASH")
+        row = layout.row(align=True)
+        row.operator("modal_deform.export_shape_keys", text="Shape Keys", icon="SHAPEKEY_DATA")
+        row.operator("modal_deform.export_mesh_cache", text="Mesh Cache", icon="EXPORT")
+
+
 CLASSES = (MODAL_DEFORM_UL_handles, VIEW3D_PT_modal_deform, VIEW3D_PT_modal_deform_bake,
-           VIEW3D_PT_modal_deform_handles, VIEW3D_PT_modal_deform_pose, VIEW3D_PT_modal_deform_preview)
+           VIEW3D_PT_modal_deform_handles, VIEW3D_PT_modal_deform_pose, VIEW3D_PT_modal_deform_dynamics,
+           VIEW3D_PT_modal_deform_preview)
 
 
 register, unregister = bpy.utils.register_classes_factory(CLASSES)

@@ -1,4 +1,5 @@
-"""The add-on in headless Blender: bake, store, reload, solve, stale data, animation, cancel."""
+"""The add-on in headless Blender: bake, store, reload, solve, stale data, cancel (the animation cache:
+test_dynamics.py)."""
 import pathlib
 
 import pytest
@@ -41,11 +42,6 @@ def test_pose_shown_in_positions_or_key_and_repaired_after_undo_or_load(run_blen
 
 def test_stale_mesh_and_bad_handles_are_refused(run_blender):
     assert "STALE_OK" in run_blender("stale_and_bad_handles.py").stdout
-
-
-def test_bake_animation_plays_back_without_the_addon(run_blender, tmp_path):
-    run_blender("animation_bake.py")
-    assert "PLAYBACK_OK" in run_blender("animation_playback.py", blend=tmp_path / "animated.blend", addon=False).stdout
 
 
 def test_quads_ngons_and_mode_preview(run_blender):

@@ -119,7 +119,8 @@ def test_manifest_fields_and_version_match_bl_info(blenders):
     assert manifest["maintainer"]
     assert manifest["license"] == ["SPDX:GPL-3.0-or-later"]
     assert manifest["platforms"] == ["linux-x64"]
-    assert "permissions" not in manifest, "the add-on reads no files, uses no network, clipboard, camera or microphone"
+    # Files only, for Export Mesh Cache: no network, clipboard, camera or microphone.
+    assert manifest["permissions"] == {"files": "Export the cached animation to a PC2 or MDD file"}
     assert set(manifest) <= {"schema_version", "id", "version", "name", "tagline", "maintainer", "type", "tags",
                              "blender_version_min", "blender_version_max", "license", "platforms", "permissions",
                              "website", "copyright", "wheels"}

@@ -1,4 +1,8 @@
-"""Bake animation over 10 frames with a keyframed controller, then save."""
+"""Bake animation into the per-frame cache over 10 frames with a keyframed controller: it plays back
+what the per-frame solve gives, scrubbing reads it without solving, a changed keyframe cuts it where
+the motion changed, Esc or a failure leaves it as it was; exported to PC2 and MDD files that
+Blender's Mesh Cache modifier plays and to shape keys (a cancelled export changes nothing); then
+saved with the shape keys."""
 import os
 import sys
 
@@ -7,7 +11,8 @@ import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 import support  # noqa: E402
 
-jobs = support.enable_addon("jobs")
+frame_cache, jobs, ops_dynamics, playback, posing = support.enable_addon("frame_cache", "jobs", "ops_dynamics",
+                                                                         "playback", "posing")
 obj, V = support.baked_suzanne(1, 15, 20, 400)
 controller = support.top_and_bottom_handles(obj, V).controller
 controller.keyframe_insert("location", frame=1)
@@ -15,36 +20,135 @@ controller.location.y += 0.5
 controller.keyframe_insert("location", frame=10)
 scene = bpy.context.scene
 scene.frame_set(3)
+size = np.ptp(V, axis=0).max()
+
+
+def evaluated(o):
+    """The positions Blender shows for `o` at the current frame (modifiers and shape keys applied)."""
+    e = o.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    mesh = e.to_mesh()
+    co = np.empty(3 * len(mesh.vertices), np.float32)
+    mesh.vertices.foreach_get("co", co)
+    e.to_mesh_clear()
+    return co.reshape(-1, 3)
+
+
+# Without a cache nor dynamics, the frame handler leaves the mesh alone.
+before = support.mesh_state(obj)
+scene.frame_set(4)
+assert support.mesh_state(obj) == before and frame_cache.get(obj) is None
 
 # The job the operator ticks on its timer: cancelled (Esc) after three frames, or failing on the
-# third, it takes away what it added and says so; the mesh and the frame are as they were.
-before = support.mesh_state(obj)
-job = jobs.AnimationJob(bpy.context, obj, range(1, 11))
+# third, it leaves the cache (none here) and the mesh as they were, and the frame where it was.
+job = ops_dynamics.CacheJob(bpy.context, obj, 1, 10)
 job.start()
-assert job.tick() and job.tick() and job.tick() and job.overall == 0.3
-assert len(obj.data.shape_keys.key_blocks) == 4  # the reference key and three frames
+assert job.tick() and job.tick() and job.tick() and job.overall == 0.3 and len(frame_cache.get(obj)) == 3
 job.cancel()
 assert not job.tick()
-assert job.finish() == ("WARNING", "Animation bake cancelled: nothing changed") and not job.written
-assert support.mesh_state(obj) == before and scene.frame_current == 3
-
-job = jobs.AnimationJob(bpy.context, obj, range(1, 11))
-converge = job.pose.converge
-job.pose.converge = lambda: converge() if job.frames_done < 2 else 1 / 0
+assert job.finish() == ("WARNING", "Cache bake cancelled: the cache is as it was") and not job.written
+assert support.mesh_state(obj) == before and scene.frame_current == 4 and frame_cache.get(obj) is None
+job = ops_dynamics.CacheJob(bpy.context, obj, 1, 10)
+job.player.next = lambda cache, frame, transforms: 1 / 0  # frame 2, after frame 1's first()
 job.run()
 level, message = job.finish()
-assert level == "ERROR" and message == "Animation bake failed: division by zero" and not job.written, message
-assert support.mesh_state(obj) == before and scene.frame_current == 3
+assert level == "ERROR" and message == "Cache bake failed: division by zero" and not job.written, message
+assert support.mesh_state(obj) == before and scene.frame_current == 4 and frame_cache.get(obj) is None
+del job.player.next  # the player is kept for the object's next frames
+
 assert bpy.ops.modal_deform.bake_animation(frame_start=1, frame_end=10) == {"FINISHED"}
-assert scene.frame_current == 3
+cache = frame_cache.get(obj)
+assert cache.kind == "STATIC" and (cache.start, cache.end) == (1, 10) and scene.frame_current == 4
+assert cache.nbytes() < 20000, cache.nbytes()  # a shape key per frame would take 12 bytes a vertex
+names = [b.name for b in obj.data.shape_keys.key_blocks]
+assert names == ["Basis", playback.PLAYBACK_KEY], names
+assert np.array_equal(support.positions(obj), V), "the artist's mesh changed"
+
+# Against the solve per frame as Bake Animation did it before the cache (a pose, converged frame
+# after frame from the previous one, mapped by the solver): the same poses within the solver's
+# tolerance (the cache's solver warm-started through other frames: the jobs above).
+pose = posing.Pose(bpy.context, obj)
+shown = {}
+for frame in range(1, 11):
+    scene.frame_set(frame)
+    pose.follow_controllers()
+    pose.converge()
+    shown[frame] = support.key_positions(obj, playback.PLAYBACK_KEY)
+    error = np.abs(shown[frame] - pose.solver.positions()).max() / size
+    assert error < 1e-4, f"frame {frame}: the cache plays {error:.2e} of the size away from the solve"
+    assert np.abs(evaluated(obj) - shown[frame]).max() < 1e-6, f"frame {frame}: Blender does not show the key"
+moved = np.abs(shown[10] - V).max()
+assert moved > 0.3, f"the animated handle did not move the mesh ({moved})"
+
+# Scrubbing back reads the cache: nothing is solved.
+player = playback.player(obj, scene)
+player.first = player.next = None
+for frame in (7, 2, 9):
+    scene.frame_set(frame)
+    assert support.key_positions(obj, playback.PLAYBACK_KEY).tobytes() == shown[frame].tobytes()
+del player.first, player.next
+# Before the first frame the mesh holds it.
+scene.frame_set(-3)
+assert support.key_positions(obj, playback.PLAYBACK_KEY).tobytes() == shown[1].tobytes()
+
+# A changed keyframe cuts the cache at the first frame its motion changed (2: the curve from frame
+# 1 to 10 bends anew), and the frames played after it are solved again.
+kept = cache.array("q")[:1].tobytes()
+scene.frame_set(10)
+controller.location.y += 0.5
+controller.keyframe_insert("location", frame=10)
+scene.frame_set(6)
+assert (cache.start, cache.end) == (1, 6), (cache.start, cache.end)
+assert cache.array("q")[:1].tobytes() == kept
+assert np.abs(support.key_positions(obj, playback.PLAYBACK_KEY) - shown[6]).max() > 0.05, "frame 6 kept the old motion"
+# A jump forward solves every frame up to it.
+scene.frame_set(10)
+assert cache.end == 10 and np.abs(support.key_positions(obj, playback.PLAYBACK_KEY) - shown[10]).max() > 0.3
+# A stiffness change empties it; the static cache keeps the range baked from.
+obj.modal_deform.stiffness *= 2
+scene.frame_set(3)
+assert (frame_cache.get(obj).start, frame_cache.get(obj).end) == (1, 3)
+obj.modal_deform.stiffness /= 2
+assert bpy.ops.modal_deform.bake_animation(frame_start=1, frame_end=10) == {"FINISHED"}
+scene.frame_set(10)
+final = {f: None for f in (1, 5, 10)}
+for frame in final:
+    scene.frame_set(frame)
+    final[frame] = support.key_positions(obj, playback.PLAYBACK_KEY).copy()
+
+# Point-cache files, played by Blender's own Mesh Cache modifier on a copy of the mesh without keys.
+for fmt in ("PC2", "MDD"):
+    path = support.tmp(f"suzanne.{fmt.lower()}")
+    assert bpy.ops.modal_deform.export_mesh_cache(filepath=path, file_format=fmt) == {"FINISHED"}
+    assert os.path.getsize(path) == {"PC2": 32, "MDD": 8 + 4 * 10}[fmt] + 10 * 12 * len(V)
+    copy = bpy.data.objects.new(f"Played {fmt}", obj.data.copy())
+    scene.collection.objects.link(copy)
+    copy.shape_key_clear()
+    modifier = copy.modifiers.new("Mesh Cache", "MESH_CACHE")
+    modifier.cache_format, modifier.filepath, modifier.frame_start = fmt, path, 1
+    for frame, expected in final.items():
+        scene.frame_set(frame)
+        error = np.abs(evaluated(copy) - expected).max()
+        assert error < 1e-6, f"{fmt} frame {frame}: the Mesh Cache modifier plays {error} away"
+    bpy.data.objects.remove(copy)
+print("POINT_CACHE_OK")
+
+# Shape keys: one per frame in place of the cache (the export cancelled after two frames changes
+# nothing), and the file saved for a Blender without the add-on.
+before = support.mesh_state(obj)
+job = jobs.AnimationJob(bpy.context, obj, ops_dynamics.cached_frames(obj),
+                        positions=ops_dynamics.cached_positions(obj, scene))
+assert job.tick() and job.tick() and len(obj.data.shape_keys.key_blocks) == 4
+job.cancel()
+assert job.finish() == ("WARNING", "Shape key export cancelled: nothing changed")
+assert support.mesh_state(obj) == before and frame_cache.get(obj) is not None
+assert bpy.ops.modal_deform.export_shape_keys() == {"FINISHED"}
+assert frame_cache.get(obj) is None
 names = [b.name for b in obj.data.shape_keys.key_blocks]
 assert names == ["Basis"] + [f"Modal Deform {f:04d}" for f in range(1, 11)], names
-# Again: the keys of the first run are replaced, not added to.
-assert bpy.ops.modal_deform.bake_animation(frame_start=1, frame_end=10) == {"FINISHED"}
-assert [b.name for b in obj.data.shape_keys.key_blocks] == names
-assert len(jobs.action_fcurves(obj.data.shape_keys.animation_data)) == 10
-for f in (1, 5, 10):
-    np.save(support.tmp(f"frame{f}.npy"), support.key_positions(obj, f"Modal Deform {f:04d}"))
+for frame, expected in final.items():
+    np.save(support.tmp(f"frame{frame}.npy"), expected)
+    assert support.key_positions(obj, f"Modal Deform {frame:04d}").tobytes() == expected.tobytes()
 np.save(support.tmp("rest.npy"), V)
+scene.frame_set(1)
 bpy.ops.wm.save_as_mainfile(filepath=support.tmp("animated.blend"))
 print("ANIMATED")

@@ -5,7 +5,8 @@ with a simulated G + mouse motion + click, let the timer solve, check the mesh f
 its vertex positions: Suzanne has no shape keys); Esc restores the mesh; saving mid-pose writes
 the rest mesh and the pose in its shape key; entering Edit Mode mid-pose keeps the pose in the key
 and edits the rest mesh; the converged pose equals the Solve operator's; undo takes a bake back; Esc
-takes an animation bake's frames back; disabling the add-on mid-pose restores as Esc does (from the
+takes an animation bake's frames back; the timeline plays with Dynamics on (simulated into the cache,
+scrubbing reads it); disabling the add-on mid-pose restores as Esc does (from the
 shape key and from the positions).
 Each step runs from bpy.app.timers so Blender handles the simulated events in between (window.run).
 Writes OUTPUT/result.json ({"ok": bool, "log": [...]}) and screenshots, then quits.
@@ -274,19 +275,63 @@ def steps():
     assert undone == solved.tobytes(), "Ctrl+Z did not take the applied pose back to the solved one"
     say("saving while posing wrote a consistent file; Enter applied and Ctrl+Z took it back")
 
-    # Bake Animation as the button does: a frame per timer tick with progress; Esc takes every frame
-    # key back.
+    # Bake Animation as the button does: a frame per timer tick into the cache, with progress; Esc
+    # puts the cache back as it was (none).
     keys = [(b.name, b.mute) for b in obj.data.shape_keys.key_blocks]
     with override():
         assert bpy.ops.modal_deform.bake_animation("INVOKE_DEFAULT", frame_start=1, frame_end=1000) == {"RUNNING_MODAL"}
     yield 0.5
-    assert len(obj.data.shape_keys.key_blocks) > len(keys), "the animation bake made no frame"
+    cache = obj.modal_deform.dynamics.cache
+    assert cache is not None and cache["frames"] > 0, "the animation bake cached no frame"
     window.event_simulate(type="ESC", value="PRESS", x=x, y=y)
     window.event_simulate(type="ESC", value="RELEASE", x=x, y=y)
     yield 0.3
-    assert [(b.name, b.mute) for b in obj.data.shape_keys.key_blocks] == keys, "Esc left frame keys behind"
+    assert obj.modal_deform.dynamics.cache is None, "Esc left the cache behind"
+    assert [(b.name, b.mute) for b in obj.data.shape_keys.key_blocks] == keys, "Esc changed the shape keys"
     assert base_positions(obj).tobytes() == rest.tobytes()
-    say("animation bake cancelled with Esc: its frame keys went")
+    say("animation bake cancelled with Esc: its cached frames went")
+
+    # Secondary motion played in the window: Dynamics on, the controller keyed to slide and stop, the
+    # timeline played: every frame shown is simulated into the cache (frames Blender drops to keep
+    # time are simulated on the way); stopped, scrubbing back reads the cache.
+    from modal_deform import frame_cache, playback
+    scene = bpy.context.scene
+    scene.frame_start, scene.frame_end = 1, 48
+    scene.frame_set(1)
+    controller.keyframe_insert("location", frame=1)
+    controller.location.x += 0.4
+    controller.keyframe_insert("location", frame=4)
+    dynamics = obj.modal_deform.dynamics  # obj was read again after the undo above
+    dynamics.enabled = True
+    with override():
+        bpy.ops.screen.animation_play()
+    yield from wait_until(lambda: scene.frame_current >= 16, 60)
+    with override():
+        bpy.ops.screen.animation_cancel(restore_frame=False)
+    yield 0.3
+    cache = frame_cache.get(obj)
+    assert playback.problems.get(obj.name) is None, playback.problems
+    assert cache is not None and cache.kind == "DYNAMIC", "playing made no cache"
+    assert cache.end >= 16, f"playing simulated frames {cache.start} to {cache.end} of {scene.frame_current}"
+    screenshot("dynamics.png")
+    shown = key_positions(obj, playback.PLAYBACK_KEY)
+    assert np.abs(shown - rest).max() > 0.1, "the played mesh did not follow the controller"
+    expected = np.empty_like(shown)
+    playback.player(obj, scene).positions(cache.state(8)[0], expected)
+    with override():
+        scene.frame_set(8)
+    assert key_positions(obj, playback.PLAYBACK_KEY).tobytes() == expected.tobytes(), "scrubbing did not read the cache"
+    assert base_positions(obj).tobytes() == rest.tobytes()
+    played = cache.end
+    with override():
+        assert bpy.ops.modal_deform.free_cache() == {"FINISHED"}
+    dynamics.enabled = False
+    controller.animation_data_clear()
+    controller.location.x -= 0.4
+    obj.data.shape_keys.key_blocks[posing.POSE_KEY].mute = False
+    scene.frame_set(1)
+    yield 0.3
+    say(f"timeline played with Dynamics on: {played} frames simulated and cached, scrubbing reads them")
 
     # Disabling the add-on while posing ends the pose as Esc does. Solve's key was there before, the
     # only key that moves the mesh: posed in a stand-in, and the artist's mesh is put back.

@@ -1,0 +1,145 @@
+"""The per-frame cache in headless Blender (issue 40): per frame, what playback costs (a cached frame
+read back, x = x̄ + U q into the playback shape key; one simulation step live) and Blender's
+evaluation after it; and for FRAMES frames of the dragon (100k vertices), the cache's size and the
+.blend's against the same animation exported as a shape key per frame and as a PC2 file.
+
+    blender -b --factory-startup --python bench/playback.py -- --output out.json [--quick] [--subdivide 2]
+
+In bpy, with the add-on installed from the extension zip (what `make bench` runs, bench/run.py):
+
+    BLENDER_USER_RESOURCES=$(mktemp -d) .venv/bpy-4.5/bin/python tests/blender/bpy_session.py \
+        --extension dist/modal_deform-0.1.0-blender_4.2_to_5.0-linux_x64.zip bench/playback.py -- --output out.json
+
+Per frame: "handler" is the frame handler's work for the object (playback.show: checks, the cache
+read or the step, the mapping into the key), timed alone at the frame the scene is on; "evaluate"
+is Blender's evaluation of the mesh after it (view_layer.update()). Medians over the frames.
+"""
+import argparse
+import json
+import math
+import os
+import pathlib
+import sys
+import tempfile
+import time
+
+import bpy
+import numpy as np
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "bench"))
+import blender_pose  # noqa: E402 (found through the line above; its meshes and handles)
+from headless import enable_addon  # noqa: E402 (blender_pose put blender_scripts/ on the path)
+
+
+def arguments():
+    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--output", required=True)
+    parser.add_argument("--frames", type=int, default=250, help="frames of the animation cached and exported")
+    parser.add_argument("--timed", type=int, default=40, help="frames timed for each per-frame figure")
+    parser.add_argument("--subdivide", type=int, default=0, help="midpoint subdivisions of the 100k dragon "
+                                                                 "(2: 1.6M vertices, baked on a proxy)")
+    parser.add_argument("--no-sizes", action="store_true", help="skip the .blend sizes (dense meshes)")
+    parser.add_argument("--quick", action="store_true", help="dragon_vrip_res4 and a small basis (smoke test)")
+    return parser.parse_args(argv)
+
+
+def animate(controller, frames):
+    """The controller turns by 90 degrees and back about the vertical and slides, a cycle every 48
+    frames, keyed every 6 frames."""
+    start = controller.matrix_world.copy()
+    for frame in range(1, frames + 1, 6):
+        phase = 2 * math.pi * (frame - 1) / 48
+        controller.rotation_euler.z = math.radians(45) * (1 - math.cos(phase))
+        controller.location.x = start.translation.x + 0.05 * math.sin(phase)
+        controller.keyframe_insert("rotation_euler", frame=frame)
+        controller.keyframe_insert("location", frame=frame)
+
+
+def timed_frames(obj, scene, playback, frames, stepping=False):
+    """Median handler and evaluation milliseconds over `frames`, each reached with the handler off
+    (playback.set_frame) and then shown by the handler's function; `stepping`: also the simulation
+    step's own milliseconds and BFGS iterations (Simulation.stats, timed natively)."""
+    handler, evaluate, step, iterations = [], [], [], []
+    for frame in frames:
+        playback.set_frame(scene, frame)
+        start = time.perf_counter()
+        playback.show(obj, scene)
+        handler.append(1e3 * (time.perf_counter() - start))
+        start = time.perf_counter()
+        bpy.context.view_layer.update()
+        evaluate.append(1e3 * (time.perf_counter() - start))
+        if stepping:
+            stats = playback.player(obj, scene).simulation.stats
+            step.append(stats["ms"])
+            iterations.append(stats["iterations"])
+    result = {"handler_ms": float(np.median(handler)), "evaluate_ms": float(np.median(evaluate)),
+              "frames": len(handler)}
+    if stepping:
+        result.update(step_ms=float(np.median(step)), iterations=float(np.median(iterations)))
+    return result
+
+
+def saved_size(folder, name):
+    path = os.path.join(folder, name)
+    bpy.ops.wm.save_as_mainfile(filepath=path, copy=True)
+    return os.path.getsize(path)
+
+
+def main():
+    args = arguments()
+    blender_pose.ADDON = enable_addon().__name__
+    blender_pose.clear_scene()
+    frame_cache, playback = blender_pose.addon("frame_cache", "playback")
+    name = "dragon_vrip_res4" if args.quick else "dragon_vrip_res2"
+    obj, vertices, moving = blender_pose.posed_dragon(name, args.subdivide)
+    settings = obj.modal_deform
+    # The paper's 67 dimensions, as the pose benchmarks (blender_pose.py) bake them.
+    settings.modes, settings.derivatives, settings.ghost = (12, 12, 300) if args.quick else (15, 52, 1000)
+    start = time.perf_counter()
+    assert bpy.ops.modal_deform.bake() == {"FINISHED"}
+    bake_seconds = time.perf_counter() - start
+    scene = bpy.context.scene
+    frames = 20 if args.quick else args.frames
+    timed = range(2, 2 + min(args.timed, frames - 1))
+    scene.frame_start, scene.frame_end = 1, frames
+    animate(moving.controller, frames)
+    results = {"blender": bpy.app.version_string, "mesh": name, "subdivide": args.subdivide, "vertices": vertices,
+               "dimension": settings.status.dimension, "proxy_vertices": settings.status.proxy_vertices,
+               "bake_seconds": bake_seconds, "frames": frames}
+
+    # The static animation: baked into the cache, then read back frame by frame.
+    start = time.perf_counter()
+    assert bpy.ops.modal_deform.bake_animation(frame_start=1, frame_end=frames) == {"FINISHED"}
+    results["static_bake_seconds"] = time.perf_counter() - start
+    results["static_cache_bytes"] = frame_cache.get(obj).nbytes()
+    results["static_read"] = timed_frames(obj, scene, playback, timed)
+    with tempfile.TemporaryDirectory() as folder:
+        if not args.no_sizes:
+            results["blend_with_cache_bytes"] = saved_size(folder, "cache.blend")
+            pc2 = os.path.join(folder, "dragon.pc2")
+            assert bpy.ops.modal_deform.export_mesh_cache(filepath=pc2, file_format="PC2") == {"FINISHED"}
+            results["pc2_bytes"] = os.path.getsize(pc2)
+
+        # Secondary motion: each frame simulated live from the one before, then read back.
+        settings.dynamics.enabled = True
+        playback.set_frame(scene, 1)
+        playback.show(obj, scene)
+        results["dynamic_step"] = timed_frames(obj, scene, playback, timed, stepping=True)
+        results["dynamic_read"] = timed_frames(obj, scene, playback, timed)
+        results["dynamic_cache_bytes_per_frame"] = frame_cache.get(obj).nbytes() / len(frame_cache.get(obj))
+
+        if not args.no_sizes:
+            # The static animation as a shape key per frame, as Bake Animation wrote it before the cache.
+            settings.dynamics.enabled = False
+            assert bpy.ops.modal_deform.bake_animation(frame_start=1, frame_end=frames) == {"FINISHED"}
+            start = time.perf_counter()
+            assert bpy.ops.modal_deform.export_shape_keys() == {"FINISHED"}
+            results["shape_keys_export_seconds"] = time.perf_counter() - start
+            results["blend_with_shape_keys_bytes"] = saved_size(folder, "keys.blend")
+    pathlib.Path(args.output).write_text(json.dumps(results, indent=1))
+    print(json.dumps(results, indent=1))
+
+
+main()

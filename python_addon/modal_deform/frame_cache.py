@@ -1,0 +1,258 @@
+"""The per-frame cache of an object's reduced state, in the .blend file: what a static animation
+bake or the simulation computed for each frame, played back as x = x̄ + U q (playback.py).
+
+What: from the cache's first frame on, one row per frame of q (r,) (the coordinates of the basis
+vectors) and, for a simulation, of its velocity; a few hundred bytes a frame where a shape key per
+frame costs 12 bytes a vertex. Beside them, what each frame was computed from, to tell when it no
+longer holds: the controllers' transforms at that frame (the handles' 4x4 matrices) and the values
+of the controllers' animation curves there; and, for the whole cache, its kind ("STATIC": the
+pose of each frame; "DYNAMIC": the simulation), the bake id of the basis and a signature of the
+settings (dynamics parameters, stiffness, handles).
+
+Where: like the basis (storage.py), a Palette datablock named with a leading "." that
+``Object.modal_deform.dynamics.cache`` points to, each array one flat float64 ID property (Blender
+keeps the bytes: the cache reloads bit for bit), read back by ``np.frombuffer``.
+
+Invalidation, as Blender's point caches: a change of a setting or of the basis empties the cache
+(the next frame shown starts it again); a changed keyframe of a controller cuts the cache before the
+first frame whose curve values changed (``keyframes_changed``, when the keyframes' digest changed,
+checked at every frame shown); and a frame whose controllers stand elsewhere than when it was cached (a
+constraint, a driver, a moved parent) cuts the cache there when it is shown.
+"""
+import hashlib
+import json
+
+import bpy
+import numpy as np
+
+from . import storage
+
+PREFIX = ".Modal Deform Cache "
+_ARRAYS = ("q", "v", "transforms", "curves")
+#: What a cache datablock holds (create() writes them all).
+_FIELDS = ("kind", "start", "signature", "basis_id", "curve_paths", "keys_digest", "frames") + _ARRAYS + tuple(
+    name + "_width" for name in _ARRAYS)
+
+
+def kind(obj):
+    """The kind of cache obj's settings call for: "DYNAMIC" with dynamics enabled, else "STATIC"."""
+    return "DYNAMIC" if obj.modal_deform.dynamics.enabled else "STATIC"
+
+
+def signature(obj, scene):
+    """What the cached frames depend on besides the controllers' motion, as a string: the settings
+    of the kind of cache obj's settings call for, the handles and the scene's frame rate."""
+    settings = obj.modal_deform
+    dynamics = settings.dynamics
+    fields = {"kind": kind(obj), "stiffness": settings.stiffness,
+              "handles": [(h.vertex_group, h.weight, h.controller.name if h.controller else "",
+                           [list(row) for row in h.bind_matrix]) for h in settings.handles]}
+    if dynamics.enabled:
+        fields.update(period=dynamics.period, damping=dynamics.damping, substeps=dynamics.substeps,
+                      start=dynamics.frame_start, fps=scene.render.fps / scene.render.fps_base)
+    return json.dumps(fields, sort_keys=True)
+
+
+def basis_id(obj):
+    """The bake id of obj's stored basis ("" when there is none)."""
+    block = obj.modal_deform.basis
+    return "" if block is None else str(block.get(storage.BAKE_ID, ""))
+
+
+class Cache:
+    """A view of an object's cache datablock: its kind, first frame, frames and arrays (read-only
+    numpy views; append() and cut() write the datablock)."""
+
+    def __init__(self, block):
+        """Raises ValueError when the datablock lacks what a cache holds (damaged, or not a cache)."""
+        missing = [name for name in _FIELDS if name not in block]
+        if missing:
+            raise ValueError(f"the cache '{block.name}' is damaged (no '{missing[0]}'): Free it and bake again")
+        self.block = block
+
+    kind = property(lambda self: self.block["kind"])
+    start = property(lambda self: self.block["start"])
+    signature = property(lambda self: self.block["signature"])
+    basis_id = property(lambda self: self.block["basis_id"])
+    curve_paths = property(lambda self: json.loads(self.block["curve_paths"]))
+
+    def array(self, name):
+        """(frames, width) float64 view of the array `name` ("q", "v", "transforms", "curves")."""
+        value = self.block[name]
+        width = self.block[name + "_width"]
+        flat = np.frombuffer(value, dtype=np.float64) if len(value) else np.empty(0)
+        return flat.reshape(-1, width) if width else np.empty((len(self), 0))
+
+    def __len__(self):
+        """The number of frames cached, from start on."""
+        return self.block["frames"]
+
+    @property
+    def end(self):
+        """The last frame cached (start - 1 when empty)."""
+        return self.start + len(self) - 1
+
+    def row(self, frame):
+        """The index of `frame`'s row, or None when it is not cached."""
+        index = frame - self.start
+        return index if 0 <= index < len(self) else None
+
+    def state(self, frame):
+        """(q, v) of a cached frame (v None for a static cache), copies."""
+        index = self.row(frame)
+        v = self.array("v")
+        return self.array("q")[index].copy(), (v[index].copy() if v.shape[1] else None)
+
+    def append(self, q, v, transforms, curves):
+        """Add the frame after the last (end + 1)."""
+        rows = {"q": q, "v": np.empty(0) if v is None else v, "transforms": transforms, "curves": curves}
+        for name, row in rows.items():
+            row = np.asarray(row, np.float64).ravel()
+            if len(self) and row.size != self.block[name + "_width"]:
+                raise ValueError(f"cache: frame {self.end + 1}'s {name} has {row.size} values, earlier frames "
+                                 f"{self.block[name + '_width']}")
+            self.block[name + "_width"] = row.size
+            _set_array(self.block, name, np.concatenate([self.array(name).ravel(), row]) if row.size else np.empty(0))
+        self.block["frames"] = len(self) + 1
+
+    def cut(self, frame):
+        """Forget `frame` and every frame after it."""
+        keep = max(0, min(len(self), frame - self.start))
+        if keep == len(self):
+            return
+        for name in _ARRAYS:
+            width = self.block[name + "_width"]
+            _set_array(self.block, name, self.array(name)[:keep].ravel().copy() if width else np.empty(0))
+        self.block["frames"] = keep
+
+    def nbytes(self):
+        return sum(self.array(name).nbytes for name in _ARRAYS)
+
+
+def _set_array(block, name, values):
+    """block[name] = values (float64), the old array deleted first: Blender 4.5 corrupts its heap
+    when an ID property array is assigned over one of another length."""
+    if name in block:
+        del block[name]
+    block[name] = values
+
+
+def get(obj):
+    """obj's Cache, or None; raises ValueError when its datablock is damaged."""
+    block = obj.modal_deform.dynamics.cache
+    return None if block is None else Cache(block)
+
+
+def create(obj, scene, start):
+    """A new empty cache for obj, starting at frame `start`, for obj's settings and controller
+    curves as they are now, in place of any other."""
+    free(obj)
+    block = bpy.data.palettes.new(PREFIX + obj.name)
+    block.use_fake_user = False
+    block["kind"] = kind(obj)
+    block["start"] = start
+    block["signature"] = signature(obj, scene)
+    block["basis_id"] = basis_id(obj)
+    curves = controller_curves(obj)
+    block["curve_paths"] = json.dumps([path for path, _ in curves])
+    block["keys_digest"] = keys_digest(curves)
+    block["frames"] = 0
+    for name in _ARRAYS:
+        _set_array(block, name, np.empty(0))
+        block[name + "_width"] = 0
+    obj.modal_deform.dynamics.cache = block
+    return Cache(block)
+
+
+def free(obj):
+    """Forget obj's cache (the datablock goes when no other object uses it)."""
+    dynamics = obj.modal_deform.dynamics
+    block = dynamics.cache
+    dynamics.cache = None
+    if block is not None and block.users == 0 and block.library is None:
+        bpy.data.palettes.remove(block)
+
+
+def holds(cache, obj, scene):
+    """Why the cache no longer fits obj ("" when it does): another kind, settings or basis."""
+    if cache.kind != kind(obj):
+        return "dynamics switched " + ("on" if kind(obj) == "DYNAMIC" else "off")
+    if cache.basis_id != basis_id(obj):
+        return "the basis was baked again"
+    if cache.signature != signature(obj, scene):
+        return "a setting changed"
+    return ""
+
+
+def settings_changed(obj):
+    """A dynamics setting changed: the cache no longer holds (a static cache does not depend on them)."""
+    cache = get(obj)
+    if cache is not None and cache.kind == "DYNAMIC" or obj.modal_deform.dynamics.enabled:
+        free(obj)
+
+
+def controller_curves(obj):
+    """The animation curves of obj's controllers, as (path, F-curve): path "controller:data_path[index]"."""
+    from .jobs import action_fcurves
+    found = []
+    for handle in obj.modal_deform.handles:
+        controller = handle.controller
+        if controller is None:
+            continue
+        for curve in action_fcurves(controller.animation_data) or ():
+            found.append((f"{controller.name}:{curve.data_path}[{curve.array_index}]", curve))
+    found.sort(key=lambda item: item[0])
+    return found
+
+
+def curve_values(curves, frame):
+    """The values of the curves (controller_curves) at `frame`."""
+    return np.array([curve.evaluate(frame) for _, curve in curves], np.float64)
+
+
+def keys_digest(curves):
+    """A hash of the curves' keyframes (positions, handles, interpolation) and extrapolation: cheap
+    enough for every frame shown, it tells when keyframes_changed must compare values."""
+    h = hashlib.blake2b(digest_size=16)
+    for path, curve in curves:
+        points = curve.keyframe_points
+        h.update(f"{path}:{curve.extrapolation}:{len(points)}".encode())
+        for attribute, size in (("co", 2), ("handle_left", 2), ("handle_right", 2), ("interpolation", 1)):
+            values = np.empty(size * len(points), np.float64 if size == 2 else np.int32)
+            points.foreach_get(attribute, values)
+            h.update(values.tobytes())
+    return h.hexdigest()
+
+
+def keyframes_changed(obj):
+    """Cut obj's cache at the first frame whose controller curves no longer give the values it was
+    cached with (a key added, moved, deleted or its interpolation changed); the whole cache when
+    the set of curves changed. Only compares values when the keyframes' digest changed. Returns the
+    frame cut from, or None."""
+    cache = get(obj)
+    if cache is None:
+        return None
+    curves = controller_curves(obj)
+    digest_now = keys_digest(curves)
+    if digest_now == cache.block["keys_digest"]:
+        return None
+    cache.block["keys_digest"] = digest_now
+    if [path for path, _ in curves] != cache.curve_paths:
+        cache.block["curve_paths"] = json.dumps([path for path, _ in curves])
+        cache.cut(cache.start)
+        return cache.start
+    recorded = cache.array("curves")
+    for index in range(len(cache)):
+        frame = cache.start + index
+        if not np.array_equal(curve_values(curves, frame), recorded[index]):
+            cache.cut(frame)
+            return frame
+    return None
+
+
+def digest(cache):
+    """A hash of the cached arrays (tests compare a cache before and after a reload by it)."""
+    h = hashlib.blake2b(digest_size=16)
+    for name in _ARRAYS:
+        h.update(cache.array(name).tobytes())
+    return h.hexdigest()

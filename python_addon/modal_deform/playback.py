@@ -1,0 +1,227 @@
+"""Playback of the per-frame cache (frame_cache.py) on the timeline, like Blender's point caches.
+
+At every frame change, for each object with a cache or with dynamics enabled: a cached frame is
+read back (scrubbing costs the pose update's mapping, x = x̄ + U q, and no solve); the frame after
+the last cached one is computed from it (the static pose for the controllers there, or one step of
+the simulation from the previous frame's state) and cached; a frame further on is reached by
+computing every frame in between (a jump forward simulates from the last cached frame). Before
+the cache's first frame the mesh holds that frame's shape.
+
+The result is shown in the "Modal Deform Playback" shape key at value 1 (the artist's mesh stays in
+the reference key; the "Modal Deform" pose key is muted while the cache plays, as it would add on
+top). Frames computed here are checked against what they were computed from each time they are
+shown (frame_cache: settings, basis, keyframes, the controllers' transforms at that frame) and
+computed again from there when that changed.
+"""
+import types
+
+import bpy
+import numpy as np
+
+from . import core as mdc
+from . import frame_cache, handles, mesh_io, posing, storage
+
+PLAYBACK_KEY = "Modal Deform Playback"
+#: Errors that stop an object's playback with a message for the panel (not baked, stale, a bad
+#: handle or setting); the mesh then shows what it showed before.
+FAILURES = (storage.NotReady, handles.HandleError, ValueError, RuntimeError)
+
+# Runtime state, by object name: the Player (solver or simulation kept between frames), and the
+# last problem met (shown in the panel). Forgotten when a file is loaded.
+_players = {}
+problems = {}
+# True while playback changes the frame itself (catching up): the handler then does nothing.
+_busy = False
+
+
+class Player:
+    """What computes and shows an object's frames: its basis, handles, the static pose solver and a
+    simulation (which steps the dynamics and maps any cached q to the mesh: x̄ + U q, natively), for
+    the settings it was made with (frame_cache.signature)."""
+
+    def __init__(self, obj, scene):
+        settings = obj.modal_deform
+        self.signature = frame_cache.signature(obj, scene)
+        self.basis_id = frame_cache.basis_id(obj)
+        self.kind = frame_cache.kind(obj)
+        self.pose = posing.Pose(types.SimpleNamespace(scene=scene), obj)
+        self.basis, self.handles = self.pose.basis, self.pose.handles
+        dynamics = settings.dynamics
+        self.simulation = mdc.Simulation(self.basis, [h.indices for h in self.handles], stiffness=settings.stiffness,
+                                         period=dynamics.period, damping=dynamics.damping,
+                                         fps=scene.render.fps / scene.render.fps_base, substeps=dynamics.substeps,
+                                         weights=[h.weight for h in self.handles],
+                                         energy=settings.status.energy.lower())
+        self.rest = self.basis.rest.astype(np.float32)
+        # The positions of the last state stepped to (a step maps it anyway), and its q.
+        self.stepped = np.empty_like(self.rest)
+        self.stepped_q = None
+
+    def check_mesh(self, obj):
+        """Raise storage.NotReady when obj's vertices are no longer those of the bake (moved or
+        added since): a comparison of the positions, a fraction of a millisecond at 100k vertices,
+        where the full check (storage.stale_reason, faces and vertex groups too) hashes the mesh."""
+        co = mesh_io.vertex_positions(obj.data)
+        if len(co) != len(self.rest) or not np.array_equal(co, self.rest):
+            storage.ready_basis(obj)
+
+    def fits(self, obj, scene):
+        return self.signature == frame_cache.signature(obj, scene) and self.basis_id == frame_cache.basis_id(obj)
+
+    def transforms(self, obj):
+        """The handles' transforms now, (handles, 4, 4) float64."""
+        return np.array(handles.transforms(obj, self.handles)).reshape(-1, 4, 4)
+
+    def first(self, transforms):
+        """The state at the cache's first frame: the static pose for `transforms` (solved from rest,
+        so that the same bake gives the same bits), at rest."""
+        solver = self.pose.solver
+        solver.reset()
+        solver.set_transforms(list(transforms))
+        self.pose.converge()
+        q = solver.q
+        return q, (np.zeros_like(q) if self.kind == "DYNAMIC" else None)
+
+    def next(self, cache, frame, transforms):
+        """The state at `frame` (the one after cache.end), from the cached frame before it."""
+        if self.kind == "STATIC":  # from the pose of the frame before, which the solver holds
+            self.pose.solver.set_transforms(list(transforms))
+            self.pose.converge()
+            return self.pose.solver.q, None
+        # From the cached state and transforms, always: the same bits whether played, jumped to,
+        # baked or undone.
+        q, v = cache.state(frame - 1)
+        self.simulation.set_state(q, v, list(cache.array("transforms")[cache.row(frame - 1)].reshape(-1, 4, 4)))
+        self.simulation.step(list(transforms), out=self.stepped)
+        q, v = self.simulation.state
+        self.stepped_q = q
+        return q, v
+
+    def positions(self, q, out):
+        """x̄ + U q into `out` (#V by 3 float32, C-contiguous)."""
+        if self.stepped_q is not None and np.array_equal(q, self.stepped_q):
+            np.copyto(out, self.stepped)
+            return
+        self.simulation.set_state(q, np.zeros_like(q))
+        self.simulation.positions(out)
+
+
+def player(obj, scene):
+    """obj's Player for its settings now (made anew when they changed)."""
+    found = _players.get(obj.name)
+    if found is None or not found.fits(obj, scene):
+        found = _players[obj.name] = Player(obj, scene)
+    return found
+
+
+def wants_playback(obj):
+    """Whether the frame handler shows obj: a mesh of this file with a cache or dynamics on, in
+    Object Mode (Edit, Sculpt and Paint Modes show the mesh being edited), not being posed."""
+    if obj.type != "MESH" or obj.library is not None or obj.mode != "OBJECT" or posing.is_posing(obj):
+        return False
+    return obj.modal_deform.dynamics.enabled or obj.modal_deform.dynamics.cache is not None
+
+
+def set_frame(scene, frame):
+    """Go to `frame` without playing it (the handler does nothing meanwhile)."""
+    global _busy
+    _busy = True
+    try:
+        scene.frame_set(frame)
+    finally:
+        _busy = False
+
+
+def fill(obj, scene, cache, frame, player_):
+    """Compute and cache every frame from cache.end + 1 to `frame` (each at its own frame, for the
+    controllers there); the scene is back at the frame it was on."""
+    if cache.end >= frame:
+        return
+    here = scene.frame_current
+    try:
+        for f in range(cache.end + 1, frame + 1):
+            if scene.frame_current != f:
+                set_frame(scene, f)
+            transforms = player_.transforms(obj)
+            q, v = player_.first(transforms) if not len(cache) else player_.next(cache, f, transforms)
+            cache.append(q, v, transforms, frame_cache.curve_values(frame_cache.controller_curves(obj), f))
+    finally:
+        if scene.frame_current != here:
+            set_frame(scene, here)
+
+
+def show(obj, scene):
+    """Show obj's state at the scene's frame, computing what the cache lacks up to it."""
+    frame = scene.frame_current
+    cache = frame_cache.get(obj)
+    start = obj.modal_deform.dynamics.frame_start
+    if cache is not None and frame_cache.holds(cache, obj, scene):
+        if cache.kind == frame_cache.kind(obj) == "STATIC":  # keeps the range the artist baked
+            start = cache.start
+        cache = None
+    if cache is None:
+        cache = frame_cache.create(obj, scene, start)
+    player_ = player(obj, scene)
+    player_.check_mesh(obj)
+    frame_cache.keyframes_changed(obj)
+    shown = max(frame, cache.start)
+    index = cache.row(frame)
+    if index is not None and not np.array_equal(player_.transforms(obj).ravel(), cache.array("transforms")[index]):
+        cache.cut(frame)
+    fill(obj, scene, cache, shown, player_)
+    write(obj, player_, cache.state(shown)[0])
+
+
+def write(obj, player_, q):
+    """Show x̄ + U q in the playback shape key (created on first use, the pose key muted)."""
+    block, _ = mesh_io.shape_key(obj, PLAYBACK_KEY)
+    if block.value != 1.0 or block.mute:
+        block.value, block.mute = 1.0, False
+    keys = obj.data.shape_keys.key_blocks
+    pose = keys.get(posing.POSE_KEY)
+    if pose is not None and not pose.mute:
+        pose.mute = True
+    player_.positions(q, mesh_io.shape_key_co(obj.data, block))
+    obj.data.update()
+
+
+def free(obj):
+    """Forget obj's cache and its playback key: the mesh shows what it shows without them."""
+    frame_cache.free(obj)
+    _players.pop(obj.name, None)
+    problems.pop(obj.name, None)
+    mesh_io.remove_shape_keys(obj, [PLAYBACK_KEY])
+    obj.data.update()
+
+
+@bpy.app.handlers.persistent
+def _frame_changed(scene, depsgraph=None):
+    if _busy:
+        return
+    for obj in scene.objects:
+        if not wants_playback(obj):
+            continue
+        try:
+            show(obj, scene)
+            problems.pop(obj.name, None)
+        except FAILURES as error:
+            if problems.get(obj.name) != str(error):
+                print(f"Modal Deform: '{obj.name}' cannot play: {error}")
+            problems[obj.name] = str(error)
+
+
+@bpy.app.handlers.persistent
+def _forget(*args):
+    _players.clear()
+    problems.clear()
+
+
+def register():
+    bpy.app.handlers.frame_change_post.append(_frame_changed)
+    bpy.app.handlers.load_post.append(_forget)
+
+
+def unregister():
+    bpy.app.handlers.frame_change_post.remove(_frame_changed)
+    bpy.app.handlers.load_post.remove(_forget)
+    _forget()

@@ -1,0 +1,36 @@
+"""Open the file cache_save.py wrote: the cache is there bit for bit, plays back what it showed
+before the save without computing anything, and a mesh edited since the bake is refused."""
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(__file__))
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+import support  # noqa: E402
+
+frame_cache, playback = support.enable_addon("frame_cache", "playback")
+obj = bpy.data.objects["Suzanne"]
+scene = bpy.context.scene
+cache = frame_cache.get(obj)
+with open(support.tmp("digest.txt")) as f:
+    assert frame_cache.digest(cache) == f.read(), "the cache did not reload bit for bit"
+assert np.array_equal(support.positions(obj), np.load(support.tmp("rest.npy"))), "the artist's mesh changed"
+shown = np.load(support.tmp("shown.npy"))
+player = playback.player(obj, scene)
+player.first = player.next = None  # nothing is computed: every frame is read back
+for frame in (12, 1, 7, 3):
+    scene.frame_set(frame)
+    assert support.key_positions(obj, playback.PLAYBACK_KEY).tobytes() == shown[frame - 1].tobytes(), frame
+del player.first, player.next
+
+# A mesh edited after the bake (Edit Mode, a vertex moved): playback refuses it and leaves the mesh alone.
+bpy.context.view_layer.objects.active = obj
+bpy.ops.object.mode_set(mode="EDIT")
+bpy.ops.object.mode_set(mode="OBJECT")
+obj.data.vertices[0].co.x += 0.1
+obj.data.shape_keys.reference_key.data[0].co.x += 0.1
+before = support.key_positions(obj, playback.PLAYBACK_KEY)
+scene.frame_set(5)
+assert "edited after the bake" in playback.problems.get(obj.name, ""), playback.problems
+assert support.key_positions(obj, playback.PLAYBACK_KEY).tobytes() == before.tobytes()
+print("CACHE_RELOADED")

@@ -1,0 +1,33 @@
+"""Cache an animation of Suzanne (static, or simulated with `dynamic`), record what it holds and
+shows, and save the file."""
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(__file__))
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+import support  # noqa: E402
+
+frame_cache, playback = support.enable_addon("frame_cache", "playback")
+kind = support.arguments()[0]
+obj, V = support.baked_suzanne(1, 15, 20, 400)
+controller = support.top_and_bottom_handles(obj, V).controller
+controller.keyframe_insert("location", frame=1)
+controller.location.y += 0.5
+controller.keyframe_insert("location", frame=6)
+obj.modal_deform.dynamics.enabled = kind == "dynamic"
+assert bpy.ops.modal_deform.bake_animation(frame_start=1, frame_end=12) == {"FINISHED"}
+cache = frame_cache.get(obj)
+assert cache.kind == kind.upper() and len(cache) == 12
+scene = bpy.context.scene
+shown = []
+for frame in range(1, 13):
+    scene.frame_set(frame)
+    shown.append(support.key_positions(obj, playback.PLAYBACK_KEY))
+np.save(support.tmp("shown.npy"), np.array(shown))
+np.save(support.tmp("rest.npy"), V)
+with open(support.tmp("digest.txt"), "w") as f:
+    f.write(frame_cache.digest(cache))
+scene.frame_set(1)
+bpy.ops.wm.save_as_mainfile(filepath=support.tmp("cached.blend"))
+print("CACHE_SAVED", cache.nbytes())

@@ -1,0 +1,19 @@
+"""The per-frame cache and secondary motion in headless Blender: play, scrub, keyframe changes,
+bake, free, save and reload (issue 40)."""
+import pytest
+
+
+@pytest.mark.parametrize("kind", ["static", "dynamic"])
+def test_cache_reloads_bit_identical_and_refuses_an_edited_mesh(run_blender, tmp_path, kind):
+    assert "CACHE_SAVED" in run_blender("cache_save.py", kind).stdout
+    assert "CACHE_RELOADED" in run_blender("cache_reload.py", blend=tmp_path / "cached.blend").stdout
+
+
+def test_dynamics_play_scrub_bake_free_and_invalidate(run_blender):
+    assert "DYNAMICS_OK" in run_blender("dynamics_play.py").stdout
+
+
+def test_static_cache_plays_the_per_frame_solve_and_exports_to_mesh_cache_and_shape_keys(run_blender, tmp_path):
+    out = run_blender("animation_bake.py").stdout
+    assert "POINT_CACHE_OK" in out and "ANIMATED" in out
+    assert "PLAYBACK_OK" in run_blender("animation_playback.py", blend=tmp_path / "animated.blend", addon=False).stdout
