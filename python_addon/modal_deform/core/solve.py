@@ -15,7 +15,7 @@ import numpy as np
 
 from .. import _native
 from . import _arrays
-from .bake import PROXY_ABOVE, Basis
+from .bake import PROXY_ABOVE, _basis
 
 #: The most vertices ReducedSolver.refine takes: the size bake takes without a proxy.
 REFINE_MAX_VERTICES = PROXY_ABOVE
@@ -109,9 +109,7 @@ class ReducedSolver:
     """
 
     def __init__(self, basis, handles, stiffness=STIFFNESS, weights=None, energy="shells", warm_start=True):
-        if not isinstance(basis, Basis):
-            raise ValueError(f"basis: expected a modal_deform.core.Basis (from bake or Basis.from_arrays), "
-                             f"got {type(basis).__name__}")
+        basis = _basis(basis)
         native_basis = basis._native
         handles = _handles(handles)
         weights = _weights(weights, len(handles))
@@ -240,13 +238,7 @@ class ReducedSolver:
         With ``out`` (a C-contiguous float32 array of shape (n, 3) or (3n,), e.g. the buffer passed
         to Blender's ``foreach_set("co", ...)``) the result is written there and ``out`` returned.
         """
-        n = self.num_vertices
-        if out is None:
-            out = np.empty((n, 3), dtype=np.float32)
-        elif not (isinstance(out, np.ndarray) and out.dtype == np.float32 and out.flags.c_contiguous
-                  and out.flags.writeable and out.shape in ((n, 3), (3 * n,))):
-            raise ValueError(f"out: expected a writeable C-contiguous float32 array of shape ({n}, 3) or ({3 * n},), "
-                             f"got {getattr(out, 'dtype', type(out).__name__)} {getattr(out, 'shape', '')}")
+        out = _arrays.positions_out(out, self.num_vertices)
         self._native.positions(out.reshape(-1))
         return out
 
