@@ -341,7 +341,7 @@ TEST(SolveFull, AFullStepThatBeatsItsModelIsExtended) {
     if (x > 0) folded.row(v) << x * std::cos(fold), mesh.V(v, 1), x * std::sin(fold);
   }
   const FullSolveResult result = solve_full(mesh.V, mesh.F, held_end, Eigen::VectorXd(), {Eigen::Matrix4d::Identity()},
-                                            1e3, FullSolveOptions{EnergyKind::kShells, 1, 1, 1e-10, 100}, &folded);
+                                            1e3, FullSolveOptions{EnergyKind::kShells, Material{}, 1e-10, 100}, &folded);
   EXPECT_TRUE(result.converged);
   int extended = 0;
   for (size_t i = 0; i < result.history.size(); ++i) {
@@ -349,7 +349,7 @@ TEST(SolveFull, AFullStepThatBeatsItsModelIsExtended) {
     if (!(it.step > 1)) continue;
     ++extended;
     EXPECT_GT(it.ratio, 1.5) << "iteration " << i;
-    EXPECT_LT(it.value, i == 0 ? result.initial_energy : result.history[i - 1].value) << "iteration " << i;
+    EXPECT_LT(it.energy, i == 0 ? result.initial_energy : result.history[i - 1].energy) << "iteration " << i;
   }
   EXPECT_GE(extended, 1);
   std::printf("folded strip: %d iterations, %d of them extended\n", result.iterations, extended);
