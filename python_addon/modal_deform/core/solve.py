@@ -97,7 +97,31 @@ def nearest_rigid(matrix, centre):
     return T
 
 
-class ReducedSolver:
+class _InBasis:
+    """What ReducedSolver and Simulation share: a native object (``self._native``) that moves the
+    mesh of ``self._basis`` by the reduced coordinates q."""
+
+    @property
+    def num_vertices(self):
+        return self._basis.num_vertices
+
+    @property
+    def dimension(self):
+        """r, the number of reduced coordinates (basis.vectors' columns)."""
+        return self._native.dimension
+
+    def positions(self, out=None):
+        """x̄ + U q on the fine mesh: (n, 3) float32, mesh units.
+
+        With ``out`` (a C-contiguous float32 array of shape (n, 3) or (3n,), e.g. the buffer passed
+        to Blender's ``foreach_set("co", ...)``) the result is written there and ``out`` returned.
+        """
+        out = _arrays.positions_out(out, self.num_vertices)
+        self._native.positions(out.reshape(-1))
+        return out
+
+
+class ReducedSolver(_InBasis):
     """BFGS in a baked basis: x = x̄ + U q, energy on the ghost, handles exact on the fine mesh.
 
     ``basis``: from ``mdc.bake`` (kept alive by the solver). ``handles``: list of vertex index
@@ -119,15 +143,6 @@ class ReducedSolver:
         # What refine() solves on the full mesh: the same objective.
         self._problem = dict(handles=handles, weights=weights, stiffness=stiffness, energy=str(energy))
         self._transforms = [np.eye(4)] * len(handles)
-
-    @property
-    def num_vertices(self):
-        return self._basis.num_vertices
-
-    @property
-    def dimension(self):
-        """r, the number of reduced coordinates."""
-        return self._native.dimension
 
     @property
     def q(self):
@@ -231,16 +246,6 @@ class ReducedSolver:
     def reset(self):
         """Back to rest (q = 0) and the initial inverse Hessian; the transforms stay."""
         self._native.reset()
-
-    def positions(self, out=None):
-        """x̄ + U q on the fine mesh: (n, 3) float32, mesh units.
-
-        With ``out`` (a C-contiguous float32 array of shape (n, 3) or (3n,), e.g. the buffer passed
-        to Blender's ``foreach_set("co", ...)``) the result is written there and ``out`` returned.
-        """
-        out = _arrays.positions_out(out, self.num_vertices)
-        self._native.positions(out.reshape(-1))
-        return out
 
 
 def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, energy=FULL_SOLVE_OPTIONS["energy"],
