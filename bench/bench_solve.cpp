@@ -140,7 +140,7 @@ void BM_MapBits(benchmark::State& state) {
   const Eigen::VectorXf q = solver.q().cast<float>();
   const QuantizedVectors quantized(basis.vectors);
   const double diagonal = (basis.rest.colwise().maxCoeff() - basis.rest.colwise().minCoeff()).norm();
-  const double tolerance = state.range(0) == 16 ? ReducedSolver::kMapTolerance * diagonal : 0.0;
+  const double tolerance = state.range(0) == 16 ? FinePositions::kTolerance * diagonal : 0.0;
   Eigen::VectorXf out(3 * basis.num_vertices());
   Eigen::Index from_float32 = 0;
   for (auto _ : state) from_float32 = quantized.map(basis.vectors, q, basis.rest.data(), tolerance, out.data());

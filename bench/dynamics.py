@@ -22,22 +22,12 @@ import numpy as np
 
 import modal_deform.core as mdc
 from common import ROOT, median_ms
+from shapes import rigid_transform as rigid
 from subdivision import midpoint_subdivide
 
 MESHES = ROOT.parent / "shared" / "meshes"
 BAR = dict(modes=20, derivatives=30, ghost=300)
 AMPLITUDE = 0.01
-
-
-def rigid(axis, angle, centre, translation=(0, 0, 0)):
-    """4x4: rotation by ``angle`` about ``axis`` through ``centre``, then a translation."""
-    axis = np.asarray(axis, float) / np.linalg.norm(axis)
-    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-    R = np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
-    T = np.eye(4)
-    T[:3, :3] = R
-    T[:3, 3] = np.asarray(centre) + np.asarray(translation) - R @ centre
-    return T
 
 
 def damped_oscillation(trace):
@@ -50,6 +40,8 @@ def damped_oscillation(trace):
 
 
 def released(basis, frames, **parameters):
+    """A free body released at rest from AMPLITUDE along its lowest flexible mode: the mode's
+    coordinate at the end of each frame."""
     sim = mdc.Simulation(basis, [], **parameters)
     mode = sim.lowest_mode
     sim.set_state(AMPLITUDE * mode, np.zeros_like(mode))

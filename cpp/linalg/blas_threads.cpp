@@ -1,11 +1,7 @@
 #include "linalg/blas_threads.h"
 
-#ifdef _WIN32
-#ifndef NOMINMAX
-#define NOMINMAX  // windows.h defines min and max as macros otherwise
-#endif
-#include <windows.h>
-#else
+#include "util/win32.h"
+#ifndef _WIN32
 #include <dlfcn.h>
 #include <sched.h>
 #endif

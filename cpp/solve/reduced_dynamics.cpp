@@ -5,11 +5,8 @@
 #include <chrono>
 #include <cmath>
 #include <complex>
-#include <limits>
 
-#include "mesh/normalization.h"
 #include "reduction/region.h"
-#include "solve/reduced_solver.h"
 #include "util/errors.h"
 #include "util/math_constants.h"
 #include "util/require_positions.h"
@@ -64,15 +61,12 @@ ReducedDynamics::ReducedDynamics(const Basis& basis, const Handles& handles, con
                                  const SimulationOptions& options, EnergyKind energy)
     : basis_(checked(basis)),
       options_(checked(options)),
-      energy_(make_energy(energy, basis.scale * basis.ghost_vertices, basis.ghost_faces, ghost_material(basis))),
-      ghost_rest_(basis.scale * flatten(basis.ghost_vertices)),
-      ghost_vectors_(basis.scale * basis.ghost_vectors),
+      ghost_energy_(basis, energy),
       handle_term_(HandleTerm(basis.rest, basis.mass, handles, checked_weights(handles, weights, basis.num_vertices()),
                               options.stiffness * std::pow(basis.scale, 4)),
                    [&basis](int v) { return basis.vertex_rows(v); }, basis.dimension()),
       transforms_(handles.size(), Eigen::Matrix4d::Identity()),
-      quantized_vectors_(basis.vectors),
-      map_tolerance_(ReducedSolver::kMapTolerance * bounding_box_diagonal(basis.rest)) {
+      fine_positions_(basis) {
   require_handles_in_region(handles, basis.region);
   for (const std::vector<int>& handle : handles) {
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
@@ -81,8 +75,7 @@ ReducedDynamics::ReducedDynamics(const Basis& basis, const Handles& handles, con
   }
   const Eigen::Index r = basis.dimension();
   // K = U_sᵀ ∇²E(x̄_s) U_s and its lowest flexible mode.
-  const SparseMatrix hessian = energy_->hessian(ghost_rest_);
-  Eigen::MatrixXd K = ghost_vectors_.transpose() * (hessian * ghost_vectors_);
+  Eigen::MatrixXd K = ghost_energy_.rest_hessian();
   K = 0.5 * (K + K.transpose()).eval();
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(K);
   if (eigen.info() != Eigen::Success) throw NumericalError("simulation: the reduced rest Hessian has no eigenvalues");
@@ -113,11 +106,8 @@ ReducedDynamics::ReducedDynamics(const Basis& basis, const Handles& handles, con
   midpoint_inverse_hessian_ = inverse_rest_hessian(K, midpoint_weight_, 1 + 2 * rayleigh_ / h_);
   euler_inverse_hessian_ = inverse_rest_hessian(K, euler_weight_, 1);
 
-  ghost_x_.resize(ghost_rest_.size());
-  ghost_gradient_.resize(ghost_rest_.size());
   work_gradient_.resize(r);
   handle_gradient_.resize(r);
-  if (basis.on_proxy()) proxy_displacement_.resize(basis.vectors.rows());
   set_state(Eigen::VectorXd::Zero(r), Eigen::VectorXd::Zero(r));
 }
 
@@ -142,7 +132,7 @@ void ReducedDynamics::set_state(const Eigen::VectorXd& q, const Eigen::VectorXd&
     throw InputError("v: has non-finite entries, or a kinetic energy beyond double precision");
   if (!transforms.empty()) check_transforms(transforms, num_handles());
   Eigen::VectorXd gradient(r);
-  const double elastic_energy = elastic(q, gradient);
+  const double elastic_energy = ghost_energy_.value_and_gradient(q, gradient);
   if (!std::isfinite(elastic_energy))
     throw InputError(message("q: moves the mesh beyond the coordinates the energies take (", kMaxCoordinate, ")"));
   if (!transforms.empty()) {
@@ -153,20 +143,11 @@ void ReducedDynamics::set_state(const Eigen::VectorXd& q, const Eigen::VectorXd&
   v_ = v;
   elastic_gradient_ = std::move(gradient);
   potential_ = elastic_energy + handle_term_.value_and_gradient(q_, handle_gradient_);
-  q_float_ = q_.cast<float>();
-}
-
-double ReducedDynamics::elastic(const Eigen::VectorXd& q, Eigen::VectorXd& gradient) {
-  ghost_x_.noalias() = ghost_vectors_ * q;
-  ghost_x_ += ghost_rest_;
-  if (!positions_in_range(ghost_x_)) return std::numeric_limits<double>::infinity();
-  const double value = energy_->value_and_gradient(ghost_x_, ghost_gradient_);
-  gradient.noalias() = ghost_vectors_.transpose() * ghost_gradient_;
-  return value;
+  fine_positions_.set(q_);
 }
 
 double ReducedDynamics::incremental_potential(const Eigen::VectorXd& x, Eigen::VectorXd& gradient) {
-  const double elastic_energy = elastic(x, work_gradient_);
+  const double elastic_energy = ghost_energy_.value_and_gradient(x, work_gradient_);
   if (!std::isfinite(elastic_energy)) return elastic_energy;
   const double handles = handle_term_.value_and_gradient(x, handle_gradient_);
   gradient = x - prediction_;
@@ -207,7 +188,7 @@ SimulationStepStats ReducedDynamics::step(const Transforms& transforms) {
     substep_start = end;
   }
   transforms_ = transforms;
-  q_float_ = q_.cast<float>();
+  fine_positions_.set(q_);
   stats.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return stats;
 }
@@ -244,9 +225,7 @@ void ReducedDynamics::substep(const Transforms& start, const Transforms& middle,
   damping_weight_ = 1 + 2 * rayleigh_ / h_;
   potential_weight_ = midpoint_weight_;
   handle_term_.set_transforms(middle);
-  ghost_x_.noalias() = ghost_vectors_ * prediction_;
-  ghost_x_ += ghost_rest_;
-  const Eigen::VectorXd& start_state = positions_in_range(ghost_x_) ? prediction_ : q_;
+  const Eigen::VectorXd& start_state = ghost_energy_.in_range(prediction_) ? prediction_ : q_;
   minimize(midpoint_bfgs_, midpoint_started_, midpoint_inverse_hessian_, start_state, stats);
   const Eigen::VectorXd& middle_state = midpoint_bfgs_.x();
   Eigen::VectorXd q_next = 2 * middle_state - q_;
@@ -257,7 +236,8 @@ void ReducedDynamics::substep(const Transforms& start, const Transforms& middle,
   handle_term_.set_transforms(end);
   work += handle_term_.value_and_gradient(middle_state, handle_gradient_);
   Eigen::VectorXd gradient_next(q_.size());
-  double potential_next = elastic(q_next, gradient_next) + handle_term_.value_and_gradient(q_next, handle_gradient_);
+  double potential_next = ghost_energy_.value_and_gradient(q_next, gradient_next) +
+                          handle_term_.value_and_gradient(q_next, handle_gradient_);
   if (!(potential_next <= energy_before + work)) {
     // The end state holds more energy than the step had (a non-quadratic energy's error, amplified by
     // an unconverged minimisation in a violent motion): take the substep by implicit Euler instead,
@@ -276,7 +256,8 @@ void ReducedDynamics::substep(const Transforms& start, const Transforms& middle,
     work = -handle_term_.value_and_gradient(q_, handle_gradient_);
     handle_term_.set_transforms(end);
     work += handle_term_.value_and_gradient(q_, handle_gradient_);
-    potential_next = elastic(q_next, gradient_next) + handle_term_.value_and_gradient(q_next, handle_gradient_);
+    potential_next = ghost_energy_.value_and_gradient(q_next, gradient_next) +
+                     handle_term_.value_and_gradient(q_next, handle_gradient_);
   }
   // The energy check: the excess over the energy the step had and the work done on it comes out of
   // the kinetic energy.
@@ -291,18 +272,6 @@ void ReducedDynamics::substep(const Transforms& start, const Transforms& middle,
   v_ = std::move(v_next);
   elastic_gradient_ = std::move(gradient_next);
   potential_ = potential_next;
-}
-
-void ReducedDynamics::positions(Eigen::Ref<Eigen::VectorXf> out) const {
-  const Eigen::Index fine_rows = 3 * static_cast<Eigen::Index>(basis_.num_vertices());
-  if (out.size() != fine_rows)
-    throw InputError(message("out: expected ", fine_rows, " values (3 per vertex), got ", out.size()));
-  if (!basis_.on_proxy()) {
-    quantized_vectors_.map(basis_.vectors, q_float_, basis_.rest.data(), map_tolerance_, out.data());
-    return;
-  }
-  quantized_vectors_.map(basis_.vectors, q_float_, nullptr, map_tolerance_, proxy_displacement_.data());
-  prolongate_positions(basis_.prolongation, basis_.rest.data(), proxy_displacement_.data(), out.data());
 }
 
 }  // namespace modal_deform

@@ -46,14 +46,12 @@
 // Not thread-safe: one simulation per thread.
 #pragma once
 
-#include <memory>
 
 #include "basis/basis.h"
-#include "energy/energy.h"
 #include "energy/make_energy.h"
 #include "solve/bfgs.h"
 #include "solve/handle_term.h"
-#include "solve/quantized_vectors.h"
+#include "solve/reduced_map.h"
 
 namespace modal_deform {
 
@@ -65,7 +63,7 @@ struct SimulationOptions {
   double fps = 24.0;         // frames per second
   int substeps = 2;          // midpoint steps per frame
   // BFGS per substep: at most this many iterations, and the stopping tolerance (bfgs.h), which
-  // keeps the frames within the map's precision (ReducedSolver::kMapTolerance) of a tight solve's
+  // keeps the frames within the map's precision (FinePositions::kTolerance) of a tight solve's
   // (bench/results/dynamics.json, "tolerance").
   int max_iterations = 20;
   double tolerance = 1e-8;
@@ -145,17 +143,15 @@ class ReducedDynamics {
   double kinetic_energy() const { return 0.5 * mass_scale_ * v_.squaredNorm(); }
   double potential_energy() const { return potential_; }
 
-  // x̄ + U q on the fine mesh, as ReducedSolver::positions.
-  void positions(Eigen::Ref<Eigen::VectorXf> out) const;
+  // x̄ + U q on the fine mesh, written into `out` (FinePositions::write).
+  void positions(Eigen::Ref<Eigen::VectorXf> out) const { fine_positions_.write(out); }
 
-  int dimension() const { return static_cast<int>(ghost_vectors_.cols()); }
+  int dimension() const { return ghost_energy_.dimension(); }
   int num_handles() const { return static_cast<int>(centres_.size()); }
   double mass_scale() const { return mass_scale_; }                   // ρ
   const Eigen::VectorXd& lowest_mode() const { return lowest_mode_; }  // λ₁'s unit eigenvector of K
 
  private:
-  // E(q) with ∇E(q) in `gradient` (r): +inf where the ghost leaves the coordinate range.
-  double elastic(const Eigen::VectorXd& q, Eigen::VectorXd& gradient);
   // Φ (above) for the current substep and scheme: ½‖x − prediction‖² + potential_weight
   // (damping_weight V(x) − damping_pullᵀx), V = E + E_C.
   double incremental_potential(const Eigen::VectorXd& x, Eigen::VectorXd& gradient);
@@ -172,14 +168,11 @@ class ReducedDynamics {
 
   const Basis& basis_;
   SimulationOptions options_;
-  std::unique_ptr<Energy> energy_;  // of the ghost, normalised frame
-  Eigen::VectorXd ghost_rest_;      // s x̄_s
-  Eigen::MatrixXd ghost_vectors_;   // s U_s
+  GhostEnergy ghost_energy_;  // E(q)
   ReducedHandleTerm handle_term_;
   std::vector<Eigen::Vector3d> centres_;  // each handle's rest centre (interpolation)
   Transforms transforms_;                 // the controllers' at the current state
-  QuantizedVectors quantized_vectors_;
-  double map_tolerance_;
+  FinePositions fine_positions_;
 
   double mass_scale_ = 0, rayleigh_ = 0, h_ = 0;  // ρ, β (seconds), the substep (seconds)
   Eigen::VectorXd lowest_mode_;
@@ -193,14 +186,12 @@ class ReducedDynamics {
   // State: q, v, E(q) + E_C(q), ∇E(q).
   Eigen::VectorXd q_, v_, elastic_gradient_;
   double potential_ = 0;
-  Eigen::VectorXf q_float_;
-  mutable Eigen::VectorXf proxy_displacement_;
   // The current Φ's terms: the prediction (q_n + (h/2) v_n for the midpoint rule), the damping
   // term's pull ((2β/h) ∇V(q_n, t_n)) and the weights (κ, 1 + 2β/h).
   Eigen::VectorXd prediction_, damping_pull_;
   double damping_weight_ = 1, potential_weight_ = 0;
   // Work space, sized once.
-  Eigen::VectorXd ghost_x_, ghost_gradient_, work_gradient_, handle_gradient_;
+  Eigen::VectorXd work_gradient_, handle_gradient_;
 };
 
 }  // namespace modal_deform

@@ -21,14 +21,12 @@
 #pragma once
 
 #include <limits>
-#include <memory>
 
-#include "energy/energy.h"
 #include "energy/make_energy.h"
 #include "basis/basis.h"
 #include "solve/bfgs.h"
 #include "solve/handle_term.h"
-#include "solve/quantized_vectors.h"
+#include "solve/reduced_map.h"
 
 namespace modal_deform {
 
@@ -59,10 +57,6 @@ void for_each_reduced_solve_stat(Visit&& visit) {
 
 class ReducedSolver {
  public:
-  // positions() is within this fraction of the rest's bounding-box diagonal of the float32 map: a
-  // third of the 1e-4 the pose may differ by, far below what shows (60 µm on 2 m).
-  static constexpr double kMapTolerance = 3e-5;
-
   // basis: validated here (validate_basis); it must outlive the solver, which keeps a reference
   // to its fine arrays. handles, weights: see checked_handle_weights (fine vertex indices; empty
   // weights mean 1), inside the basis's region if it has one (require_handles_in_region). stiffness: μ > 0. energy: evaluated on the ghost. warm_start false starts
@@ -85,36 +79,27 @@ class ReducedSolver {
   // Back to rest (q = 0) and the initial inverse Hessian; the transforms stay.
   void reset();
 
-  // x̄ + U q on the fine mesh (3#V, interleaved, mesh units) in single precision, written into
-  // `out`; x̄ + P U q for a basis on a proxy (prolongation.h). U q is read from 16-bit vectors
-  // (QuantizedVectors), each coordinate within kMapTolerance of the bounding-box diagonal of the
-  // float32 map's. Rows are split over threads in blocks; throws InputError for a wrong size.
-  void positions(Eigen::Ref<Eigen::VectorXf> out) const;
+  // x̄ + U q on the fine mesh, written into `out` (FinePositions::write).
+  void positions(Eigen::Ref<Eigen::VectorXf> out) const { fine_positions_.write(out); }
 
   // f(q) with ∇f(q) (r) written into `gradient`; +inf where a ghost coordinate leaves the range
   // the energies take (kMaxCoordinate).
   double objective(const Eigen::VectorXd& q, Eigen::VectorXd& gradient);
 
   const Eigen::VectorXd& q() const { return bfgs_.x(); }
-  int dimension() const { return static_cast<int>(ghost_vectors_.cols()); }
+  int dimension() const { return ghost_energy_.dimension(); }
   int num_handles() const { return num_handles_; }
 
  private:
   const Basis& basis_;
   int num_handles_;
-  std::unique_ptr<Energy> energy_;  // of the ghost, normalised frame
-  Eigen::VectorXd ghost_rest_;      // s x̄_s (3g)
-  Eigen::MatrixXd ghost_vectors_;   // s U_s (3g by r)
+  GhostEnergy ghost_energy_;
   ReducedHandleTerm handle_term_;
   Eigen::MatrixXd initial_inverse_hessian_;
   Bfgs bfgs_;
-  QuantizedVectors quantized_vectors_;  // U in 16 bits, for positions()
-  double map_tolerance_;                // kMapTolerance times the rest's bounding-box diagonal
-
-  Eigen::VectorXf q_float_;  // q for positions()
-  mutable Eigen::VectorXf proxy_displacement_;  // U q on a proxy's vertices, for positions()
+  FinePositions fine_positions_;
   // Work space, sized once.
-  Eigen::VectorXd ghost_x_, ghost_gradient_, handle_gradient_, handle_gradient_old_;
+  Eigen::VectorXd handle_gradient_, handle_gradient_old_;
 };
 
 }  // namespace modal_deform

@@ -1,6 +1,6 @@
 """The work the long operators drive, apart from their Blender UI plumbing: a bake of the mesh on a
 thread (BakeJob), Refine on a thread (RefineJob) and an animation bake a frame at a time on the main
-thread (AnimationJob). They read the object when made and change it only in finish() (AnimationJob:
+thread (AnimationJob, on FrameJob). They read the object when made and change it only in finish() (AnimationJob:
 in tick(), taken back by cancel() and by a failure); cancel() leaves it as it was.
 
 Every job offers what ops_common.JobOperator drives: start(); tick() on the operator's timer (every
@@ -192,26 +192,16 @@ def frame_key_name(frame):
     return f"{posing.POSE_KEY} {frame:04d}"
 
 
-class AnimationJob:
-    """Writes the frames one per tick() into new shape keys: each frame's pose refined on the full
-    mesh (Newton's method from the reduced pose, then from the previous frame's answer), or with
-    `positions` (frame -> #V by 3 float32) what it gives (the cache's frames); finish() keys them,
-    cancel() (or a failure) takes them away."""
+class FrameJob:
+    """A job done a frame per tick() on the main thread (it changes the scene and the mesh): a subclass
+    sets `frames` through __init__, does a frame in _frame(frame) and takes away what it added in
+    _take_back(), after a failure (self.error, reported by finish()) or cancel()."""
 
     tick_seconds = 0.01
 
-    def __init__(self, context, obj, frames, positions=None):
-        self.positions = positions
-        self.action = "Animation bake" if positions is None else "Shape key export"
-        self.pose = posing.Pose(context, obj) if positions is None else None
-        self.triangles = mesh_io.triangles(obj.data) if positions is None else None
-        self.refined = None
-        self.obj, self.scene, self.frames = obj, context.scene, list(frames)
-        self.frame_before = self.scene.frame_current
+    def __init__(self, frames):
+        self.frames = list(frames)
         self.frames_done = 0
-        self.created = []  # (frame, key name as created: a new key may get a ".001" suffix)
-        self.basis_created = obj.data.shape_keys is None
-        self.unconverged = 0
         self.cancelling = self.written = False
         self.error = None
 
@@ -220,15 +210,15 @@ class AnimationJob:
         return self.frames_done / len(self.frames) if self.frames else 1.0
 
     def start(self):
-        """Nothing to start: the frames are solved on the main thread, one per tick()."""
+        """Nothing to start: the frames are done on the main thread, one per tick()."""
 
     def tick(self):
-        """Solve the next frame into a new shape key; False once the job has ended (every frame done,
-        cancelled, or failed: self.error, with what it added taken away)."""
+        """Do the next frame; False once the job has ended (every frame done, cancelled, or failed:
+        self.error, with what it added taken away)."""
         if self.cancelling or self.error is not None or self.frames_done == len(self.frames):
             return False
         try:
-            self._solve_frame(self.frames[self.frames_done])
+            self._frame(self.frames[self.frames_done])
         except Exception as error:  # reported by finish(), as the thread jobs' are
             self.error = error
             self._take_back()
@@ -240,7 +230,33 @@ class AnimationJob:
         while self.tick():
             pass
 
-    def _solve_frame(self, frame):
+    def cancel(self):
+        """Take away everything this job added."""
+        self.cancelling = True
+        self._take_back()
+
+
+class AnimationJob(FrameJob):
+    """Writes the frames one per tick() into new shape keys: each frame's pose refined on the full
+    mesh (Newton's method from the reduced pose, then from the previous frame's answer), or with
+    `positions` (frame -> #V by 3 float32) what it gives (the cache's frames); finish() keys them,
+    cancel() (or a failure) takes them away."""
+
+    def __init__(self, context, obj, frames, positions=None):
+        super().__init__(frames)
+        self.positions = positions
+        self.action = "Animation bake" if positions is None else "Shape key export"
+        self.pose = posing.Pose(context, obj) if positions is None else None
+        self.triangles = mesh_io.triangles(obj.data) if positions is None else None
+        self.refined = None
+        self.obj, self.scene = obj, context.scene
+        self.frame_before = self.scene.frame_current
+        self.created = []  # (frame, key name as created: a new key may get a ".001" suffix)
+        self.basis_created = obj.data.shape_keys is None
+        self.unconverged = 0
+
+    def _frame(self, frame):
+        """Solve (or take) the frame's positions into a new shape key."""
         if self.positions is None:
             self.scene.frame_set(frame)
             self.pose.follow_controllers()
@@ -287,11 +303,6 @@ class AnimationJob:
         if self.unconverged:
             return "WARNING", f"{message}; {self.unconverged} did not converge"
         return "INFO", message
-
-    def cancel(self):
-        """Take away everything this job added."""
-        self.cancelling = True
-        self._take_back()
 
     def _take_back(self):
         names = [name for _, name in self.created]

@@ -7,16 +7,14 @@ import bpy
 import numpy as np
 
 from . import frame_cache, handles, playback, point_cache
-from .jobs import AnimationJob
+from .jobs import AnimationJob, FrameJob
 from .ops_common import JobOperator, mesh_poll
 
 
-class CacheJob:
+class CacheJob(FrameJob):
     """Computes the cache of obj from its first frame to `end`, a frame per tick(), in a new
     datablock; finish() keeps it in place of the old cache, cancel() (or a failure) puts the old one
     back. Static (dynamics off): the frames from `start`; dynamics on: from the dynamics' start."""
-
-    tick_seconds = 0.01
 
     def __init__(self, context, obj, start, end):
         self.obj, self.scene = obj, context.scene
@@ -25,40 +23,16 @@ class CacheJob:
             start = dynamics.frame_start
         if end < start:
             raise ValueError(f"frame range: the end ({end}) is before the start ({start})")
-        self.frames = list(range(start, end + 1))
+        super().__init__(range(start, end + 1))
         self.player = playback.player(obj, self.scene)  # raises for the artist before anything changes
         self.frame_before = self.scene.frame_current
         self.old = dynamics.cache
         dynamics.cache = None  # kept (0 users) until finish() or cancel()
         self.cache = frame_cache.create(obj, self.scene, start)
-        self.frames_done = 0
-        self.cancelling = self.written = False
-        self.error = None
 
-    @property
-    def overall(self):
-        return self.frames_done / len(self.frames)
-
-    def start(self):
-        """Nothing to start: the frames are computed on the main thread, one per tick()."""
-
-    def tick(self):
-        if self.cancelling or self.error is not None or self.frames_done == len(self.frames):
-            return False
-        try:
-            frame = self.frames[self.frames_done]
-            playback.set_frame(self.scene, frame)
-            playback.fill(self.obj, self.scene, self.cache, frame, self.player)
-        except Exception as error:  # reported by finish()
-            self.error = error
-            self._take_back()
-            return False
-        self.frames_done += 1
-        return True
-
-    def run(self):
-        while self.tick():
-            pass
+    def _frame(self, frame):
+        playback.set_frame(self.scene, frame)
+        playback.fill(self.obj, self.scene, self.cache, frame, self.player)
 
     def finish(self):
         if self.cancelling:
@@ -72,10 +46,6 @@ class CacheJob:
         what = "simulation" if self.cache.kind == "DYNAMIC" else "animation"
         return "INFO", (f"Cached the {what} of {len(self.frames)} frames ({self.frames[0]} to {self.frames[-1]}) in "
                         f"{self.cache.nbytes() / 1024:.1f} KB")
-
-    def cancel(self):
-        self.cancelling = True
-        self._take_back()
 
     def _take_back(self):
         dynamics = self.obj.modal_deform.dynamics

@@ -180,7 +180,7 @@ TEST(BakeOnProxy, SolverAgreesWithTheDenseProlongatedBasis) {
   on_proxy.positions(x);
   made_dense.positions(y);
   // Each map is within its 16-bit tolerance of the float32 one (reduced_solver.h), which agree.
-  const double map_tolerance = ReducedSolver::kMapTolerance * bounding_box_diagonal(b.mesh.V);
+  const double map_tolerance = FinePositions::kTolerance * bounding_box_diagonal(b.mesh.V);
   EXPECT_LT((x - y).cwiseAbs().maxCoeff(), 2 * map_tolerance + 1e-5);
   EXPECT_GT((x.cast<double>() - flatten(b.mesh.V)).cwiseAbs().maxCoeff(), 0.1);  // it did move
 }

@@ -182,7 +182,7 @@ TEST(ReducedSolver, PositionsAreRestPlusUqInTheCallersBuffer) {
   // Read from 16 bits (QuantizedVectors): within the map's tolerance, beside float32's own rounding.
   const double diagonal = bounding_box_diagonal(basis.rest);
   EXPECT_LE((out.cast<double>() - expected).cwiseAbs().maxCoeff(),
-            ReducedSolver::kMapTolerance * diagonal + 1e-6 * magnitude);
+            FinePositions::kTolerance * diagonal + 1e-6 * magnitude);
   solver.reset();
   solver.positions(out);
   EXPECT_EQ(out.cast<double>(), flatten(basis.rest).cast<float>().cast<double>());

@@ -1,19 +1,15 @@
 """Secondary motion through the Python API: mdc.Simulation (cpp/solve/reduced_dynamics.h)."""
+import pathlib
+import sys
+
 import numpy as np
 import pytest
 
 import modal_deform.core as mdc
 
-
-def rigid(axis, angle, centre, translation=(0, 0, 0)):
-    """4x4: rotation by ``angle`` about ``axis`` through ``centre``, then a translation."""
-    axis = np.asarray(axis, float) / np.linalg.norm(axis)
-    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-    R = np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
-    T = np.eye(4)
-    T[:3, :3] = R
-    T[:3, 3] = np.asarray(centre) + np.asarray(translation) - R @ centre
-    return T
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "bench"))
+from dynamics import damped_oscillation, released  # noqa: E402  (the benchmark's free-body measurement)
+from shapes import rigid_transform as rigid  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -29,29 +25,6 @@ def tube():
     V, F = mdc.cylinder(25, 40, radius=1.0, length=4.0)
     handles = [np.flatnonzero(V[:, 2] < 1e-9), np.flatnonzero(V[:, 2] > 4 - 1e-9)]
     return V, F, handles, mdc.bake(V, F, modes=16, derivatives=30, ghost=400)
-
-
-def released(basis, frames, amplitude=0.01, **parameters):
-    """A free body released at rest from ``amplitude`` along its lowest flexible mode: the mode's
-    coordinate at the end of each frame."""
-    sim = mdc.Simulation(basis, [], **parameters)
-    mode = sim.lowest_mode
-    sim.set_state(amplitude * mode, np.zeros_like(mode))
-    trace = []
-    for _ in range(frames):
-        sim.step([])
-        trace.append(sim.state[0] @ mode)
-    return np.array(trace)
-
-
-def damped_oscillation(trace):
-    """(period in frames, logarithmic decrement a period) of a sampled damped oscillation
-    p_k = A r^k cos(θk + φ), from its recurrence p_{k+1} = 2r cos θ p_k − r² p_{k−1} fitted by least
-    squares."""
-    (a, b), *_ = np.linalg.lstsq(np.column_stack([trace[1:-1], trace[:-2]]), trace[2:], rcond=None)
-    r = np.sqrt(-b)
-    theta = np.arccos(a / (2 * r))
-    return 2 * np.pi / theta, -np.log(r) * 2 * np.pi / theta
 
 
 @pytest.mark.parametrize("period, fps, substeps", [(12.0, 24.0, 2), (12.0, 24.0, 1), (6.0, 60.0, 3)])

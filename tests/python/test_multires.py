@@ -46,7 +46,7 @@ def test_positions_are_the_prolongated_basis(plane_on_proxy):
     solver.set_transforms([np.eye(4), lift])
     solver.solve(max_iterations=30)
     X = solver.positions()
-    # positions() reads 16-bit vectors: within 1e-4 of the diagonal (ReducedSolver::kMapTolerance, 3e-5)
+    # positions() reads 16-bit vectors: within 1e-4 of the diagonal (FinePositions::kTolerance, 3e-5)
     assert np.abs(X.ravel() - (V.ravel() + U @ solver.q)).max() < 1e-4 * np.linalg.norm(np.ptp(V, axis=0))
     assert X[V[:, 0] > 4, 2].mean() > 1.0  # the lifted end moved
 

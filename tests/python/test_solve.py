@@ -1,19 +1,14 @@
 """Posing through the Python API: mdc.solve_full and mdc.ReducedSolver."""
+import pathlib
+import sys
+
 import numpy as np
 import pytest
 
 import modal_deform.core as mdc
 
-
-def rigid(axis, angle, centre, translation):
-    """4x4: rotation by ``angle`` about ``axis`` through ``centre``, then a translation."""
-    axis = np.asarray(axis, float) / np.linalg.norm(axis)
-    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-    R = np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
-    T = np.eye(4)
-    T[:3, :3] = R
-    T[:3, 3] = np.asarray(centre) + np.asarray(translation) - R @ centre
-    return T
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "bench"))
+from shapes import rigid_transform as rigid  # noqa: E402
 
 
 @pytest.fixture(scope="module")

@@ -47,6 +47,20 @@ def positions(X, num_vertices, name="X"):
     return X.reshape(-1)
 
 
+def positions_out(out, num_vertices):
+    """Where to write x̄ + U q: a new (n, 3) float32 array, or ``out`` once checked to be a writeable
+    C-contiguous float32 array of shape (n, 3) or (3n,) (e.g. the buffer of Blender's
+    ``foreach_set("co", ...)``)."""
+    n = num_vertices
+    if out is None:
+        return np.empty((n, 3), dtype=np.float32)
+    if not (isinstance(out, np.ndarray) and out.dtype == np.float32 and out.flags.c_contiguous
+            and out.flags.writeable and out.shape in ((n, 3), (3 * n,))):
+        raise ValueError(f"out: expected a writeable C-contiguous float32 array of shape ({n}, 3) or ({3 * n},), "
+                         f"got {getattr(out, 'dtype', type(out).__name__)} {getattr(out, 'shape', '')}")
+    return out
+
+
 def values(x, name, length=None):
     """(length,) float64, C order."""
     x = reals(x, name)

@@ -11,8 +11,8 @@ import numpy as np
 
 from .. import _native
 from . import _arrays
-from .bake import Basis
-from .solve import _handles, _transforms, _weights
+from .bake import _basis
+from .solve import _handles, _InBasis, _transforms, _weights
 
 #: The defaults of Simulation's parameters (the native core's SimulationOptions):
 #: stiffness, period (frames), damping (ratio), fps, substeps, max_iterations, tolerance.
@@ -22,7 +22,7 @@ MIN_PERIOD_FRAMES = _native.MIN_PERIOD_FRAMES
 MAX_SUBSTEPS = _native.MAX_SUBSTEPS
 
 
-class Simulation:
+class Simulation(_InBasis):
     """Reduced dynamics of a baked basis driven by handles.
 
     ``basis``: from ``mdc.bake`` (kept alive). ``handles``: a list of vertex index arrays, one per
@@ -40,9 +40,7 @@ class Simulation:
                  fps=SIMULATION_DEFAULTS["fps"], substeps=SIMULATION_DEFAULTS["substeps"], weights=None,
                  energy="shells", max_iterations=SIMULATION_DEFAULTS["max_iterations"],
                  tolerance=SIMULATION_DEFAULTS["tolerance"]):
-        if not isinstance(basis, Basis):
-            raise ValueError(f"basis: expected a modal_deform.core.Basis (from bake or Basis.from_arrays), "
-                             f"got {type(basis).__name__}")
+        basis = _basis(basis)
         handles = [] if _is_empty(handles) else _handles(handles)
         weights = np.zeros(0) if not handles else _weights(weights, len(handles))
         self._native = _native.Simulation(
@@ -53,15 +51,6 @@ class Simulation:
             tolerance=_arrays.number(tolerance, "tolerance"))
         self._basis = basis
         self.stats = None  #: the last step's: see step()
-
-    @property
-    def num_vertices(self):
-        return self._basis.num_vertices
-
-    @property
-    def dimension(self):
-        """r, the number of reduced coordinates (basis.vectors' columns)."""
-        return self._native.dimension
 
     @property
     def num_handles(self):
@@ -117,19 +106,6 @@ class Simulation:
     def mass_scale(self):
         """ρ: the reduced mass matrix is ρ I."""
         return self._native.mass_scale
-
-    def positions(self, out=None):
-        """x̄ + U q on the fine mesh: (n, 3) float32, mesh units; written into ``out`` (a C-contiguous
-        float32 array of shape (n, 3) or (3n,)) when given."""
-        n = self.num_vertices
-        if out is None:
-            out = np.empty((n, 3), dtype=np.float32)
-        elif not (isinstance(out, np.ndarray) and out.dtype == np.float32 and out.flags.c_contiguous
-                  and out.flags.writeable and out.shape in ((n, 3), (3 * n,))):
-            raise ValueError(f"out: expected a writeable C-contiguous float32 array of shape ({n}, 3) or ({3 * n},), "
-                             f"got {getattr(out, 'dtype', type(out).__name__)} {getattr(out, 'shape', '')}")
-        self._native.positions(out.reshape(-1))
-        return out
 
     def _checked_transforms(self, transforms):
         if _is_empty(transforms):

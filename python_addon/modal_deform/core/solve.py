@@ -15,7 +15,7 @@ import numpy as np
 
 from .. import _native
 from . import _arrays
-from .bake import PROXY_ABOVE, Basis
+from .bake import PROXY_ABOVE, _basis
 
 #: The most vertices ReducedSolver.refine takes: the size bake takes without a proxy.
 REFINE_MAX_VERTICES = PROXY_ABOVE
@@ -97,7 +97,31 @@ def nearest_rigid(matrix, centre):
     return T
 
 
-class ReducedSolver:
+class _InBasis:
+    """What ReducedSolver and Simulation share: a native object (``self._native``) that moves the
+    mesh of ``self._basis`` by the reduced coordinates q."""
+
+    @property
+    def num_vertices(self):
+        return self._basis.num_vertices
+
+    @property
+    def dimension(self):
+        """r, the number of reduced coordinates (basis.vectors' columns)."""
+        return self._native.dimension
+
+    def positions(self, out=None):
+        """x̄ + U q on the fine mesh: (n, 3) float32, mesh units.
+
+        With ``out`` (a C-contiguous float32 array of shape (n, 3) or (3n,), e.g. the buffer passed
+        to Blender's ``foreach_set("co", ...)``) the result is written there and ``out`` returned.
+        """
+        out = _arrays.positions_out(out, self.num_vertices)
+        self._native.positions(out.reshape(-1))
+        return out
+
+
+class ReducedSolver(_InBasis):
     """BFGS in a baked basis: x = x̄ + U q, energy on the ghost, handles exact on the fine mesh.
 
     ``basis``: from ``mdc.bake`` (kept alive by the solver). ``handles``: list of vertex index
@@ -109,9 +133,7 @@ class ReducedSolver:
     """
 
     def __init__(self, basis, handles, stiffness=STIFFNESS, weights=None, energy="shells", warm_start=True):
-        if not isinstance(basis, Basis):
-            raise ValueError(f"basis: expected a modal_deform.core.Basis (from bake or Basis.from_arrays), "
-                             f"got {type(basis).__name__}")
+        basis = _basis(basis)
         native_basis = basis._native
         handles = _handles(handles)
         weights = _weights(weights, len(handles))
@@ -121,15 +143,6 @@ class ReducedSolver:
         # What refine() solves on the full mesh: the same objective.
         self._problem = dict(handles=handles, weights=weights, stiffness=stiffness, energy=str(energy))
         self._transforms = [np.eye(4)] * len(handles)
-
-    @property
-    def num_vertices(self):
-        return self._basis.num_vertices
-
-    @property
-    def dimension(self):
-        """r, the number of reduced coordinates."""
-        return self._native.dimension
 
     @property
     def q(self):
@@ -233,22 +246,6 @@ class ReducedSolver:
     def reset(self):
         """Back to rest (q = 0) and the initial inverse Hessian; the transforms stay."""
         self._native.reset()
-
-    def positions(self, out=None):
-        """x̄ + U q on the fine mesh: (n, 3) float32, mesh units.
-
-        With ``out`` (a C-contiguous float32 array of shape (n, 3) or (3n,), e.g. the buffer passed
-        to Blender's ``foreach_set("co", ...)``) the result is written there and ``out`` returned.
-        """
-        n = self.num_vertices
-        if out is None:
-            out = np.empty((n, 3), dtype=np.float32)
-        elif not (isinstance(out, np.ndarray) and out.dtype == np.float32 and out.flags.c_contiguous
-                  and out.flags.writeable and out.shape in ((n, 3), (3 * n,))):
-            raise ValueError(f"out: expected a writeable C-contiguous float32 array of shape ({n}, 3) or ({3 * n},), "
-                             f"got {getattr(out, 'dtype', type(out).__name__)} {getattr(out, 'shape', '')}")
-        self._native.positions(out.reshape(-1))
-        return out
 
 
 def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, energy=FULL_SOLVE_OPTIONS["energy"],

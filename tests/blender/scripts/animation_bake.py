@@ -22,17 +22,6 @@ scene = bpy.context.scene
 scene.frame_set(3)
 size = np.ptp(V, axis=0).max()
 
-
-def evaluated(o):
-    """The positions Blender shows for `o` at the current frame (modifiers and shape keys applied)."""
-    e = o.evaluated_get(bpy.context.evaluated_depsgraph_get())
-    mesh = e.to_mesh()
-    co = np.empty(3 * len(mesh.vertices), np.float32)
-    mesh.vertices.foreach_get("co", co)
-    e.to_mesh_clear()
-    return co.reshape(-1, 3)
-
-
 # Without a cache nor dynamics, the frame handler leaves the mesh alone.
 before = support.mesh_state(obj)
 scene.frame_set(4)
@@ -75,7 +64,8 @@ for frame in range(1, 11):
     shown[frame] = support.key_positions(obj, playback.PLAYBACK_KEY)
     error = np.abs(shown[frame] - pose.solver.positions()).max() / size
     assert error < 1e-4, f"frame {frame}: the cache plays {error:.2e} of the size away from the solve"
-    assert np.abs(evaluated(obj) - shown[frame]).max() < 1e-6, f"frame {frame}: Blender does not show the key"
+    assert np.abs(support.evaluated_positions(obj) - shown[frame]).max() < 1e-6, \
+        f"frame {frame}: Blender does not show the key"
 moved = np.abs(shown[10] - V).max()
 assert moved > 0.3, f"the animated handle did not move the mesh ({moved})"
 
@@ -127,7 +117,7 @@ for fmt in ("PC2", "MDD"):
     modifier.cache_format, modifier.filepath, modifier.frame_start = fmt, path, 1
     for frame, expected in final.items():
         scene.frame_set(frame)
-        error = np.abs(evaluated(copy) - expected).max()
+        error = np.abs(support.evaluated_positions(copy) - expected).max()
         assert error < 1e-6, f"{fmt} frame {frame}: the Mesh Cache modifier plays {error} away"
     bpy.data.objects.remove(copy)
 print("POINT_CACHE_OK")

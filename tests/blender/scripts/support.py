@@ -10,7 +10,7 @@ import numpy as np
 # Handles are made as the demo and the benchmark make them (select, Add Handle).
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "..", "blender_scripts"))
 import headless  # noqa: E402
-from headless import add_handle  # noqa: E402,F401 (the scripts call support.add_handle; no side effect)
+from headless import add_handle, evaluated_positions  # noqa: E402,F401 (the scripts call them from support)
 
 
 def enable_addon(*modules):
