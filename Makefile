@@ -112,7 +112,7 @@ build: build-venv-3.11
 # system's are found.
 wheels: $(WHEEL_PYTHONS:%=wheel-%)
 wheel-%: build-venv-% tools-venv
-	rm -rf build-wheel/dist-$* && mkdir -p dist && rm -f dist/modal_deform_native-*-cp$(subst .,,$*)-*.whl
+	rm -rf build-wheel/dist-$* && mkdir -p dist && rm -f dist/modal_deform_native-*-cp$(subst .,,$*)-*linux*.whl
 	$(VENV)/build-$*/bin/python -m build --wheel --no-isolation --outdir build-wheel/dist-$* .
 	LD_LIBRARY_PATH= PATH=$(CURDIR)/$(TOOLS)/bin:$$PATH $(TOOLS)/bin/auditwheel repair -w dist build-wheel/dist-$*/*.whl
 
@@ -136,7 +136,7 @@ test-python:
 # files from the source tree; its _native*.so is cp311's, which Python 3.13 does not pick up).
 test-wheel: wheel-test-venv-3.13
 	$(VENV)/wheel-test-3.13/bin/pip install -q --disable-pip-version-check --force-reinstall --no-deps \
-		dist/modal_deform_native-*-cp313-*.whl
+		dist/modal_deform_native-*-cp313-*linux*.whl
 	PYTHONPATH=python_addon $(VENV)/wheel-test-3.13/bin/python -m pytest -q -p no:cacheprovider tests/python
 
 # Headless Blender tests in Debian's Blender 3.4.1 app (add-on from the source tree, legacy zip).
