@@ -232,9 +232,9 @@ class VIEW3D_PT_modal_deform_dynamics(_Panel, bpy.types.Panel):
             box.label(text=f"{what}: frames {cache.start}-{cache.end}", icon="FILE_CACHE")
             box.label(text=f"{cache.nbytes() / 1024:.1f} KB in the file")
         if problem:
-            row = box.row()
-            row.alert = True
-            row.label(text=problem, icon="ERROR")
+            column = box.column()
+            column.alert = True
+            wrapped_label(column, context, problem, icon="ERROR")
         row = layout.row(align=True)
         row.operator("modal_deform.bake_animation", text="Bake", icon="RENDER_ANIMATION")
         row.operator("modal_deform.free_cache", text="Free", icon="TRASH")
