@@ -226,7 +226,7 @@ class VIEW3D_PT_modal_deform_dynamics(_Panel, bpy.types.Panel):
         else:
             problem = playback.problems.get(obj.name)
         if cache is None or not len(cache):
-            box.label(text="Cache empty: play or Bake", icon="INFO")
+            wrapped_label(box, context, "Cache empty: play or Bake", icon="INFO")
         else:
             what = "Simulation" if cache.kind == "DYNAMIC" else "Animation"
             box.label(text=f"{what}: frames {cache.start}-{cache.end}", icon="FILE_CACHE")
@@ -238,9 +238,9 @@ class VIEW3D_PT_modal_deform_dynamics(_Panel, bpy.types.Panel):
         row = layout.row(align=True)
         row.operator("modal_deform.bake_animation", text="Bake", icon="RENDER_ANIMATION")
         row.operator("modal_deform.free_cache", text="Free", icon="TRASH")
-        row = layout.row(align=True)
-        row.operator("modal_deform.export_shape_keys", text="Shape Keys", icon="SHAPEKEY_DATA")
-        row.operator("modal_deform.export_mesh_cache", text="Mesh Cache", icon="EXPORT")
+        column = layout.column(align=True)
+        column.operator("modal_deform.export_shape_keys", text="Export Shape Keys", icon="SHAPEKEY_DATA")
+        column.operator("modal_deform.export_mesh_cache", text="Export Mesh Cache", icon="EXPORT")
 
 
 CLASSES = (MODAL_DEFORM_UL_handles, VIEW3D_PT_modal_deform, VIEW3D_PT_modal_deform_bake,
