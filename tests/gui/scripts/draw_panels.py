@@ -14,7 +14,8 @@ import bpy
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from window import click, enable_addon, output, override, run, say, screenshot, show_sidebar_tab, sidebar, view3d  # noqa: E402,E501
+from window import (click, enable_addon, output, override, run, say, screenshot, show_sidebar_tab, sidebar,  # noqa: E402
+                    subdivided_suzanne, view3d)
 
 # Seconds for the sidebar to settle after a change: Blender 4.x animates panels opening and moving.
 SETTLE = 1.0
@@ -97,15 +98,8 @@ def steps():
     check_tooltips()
 
     # Suzanne subdivided once (1,968 vertices) seen from the front, the sidebar open on the tab.
-    for obj in list(bpy.data.objects):
-        bpy.data.objects.remove(obj)
+    obj = subdivided_suzanne(1)
     with override():
-        bpy.ops.mesh.primitive_monkey_add()
-        obj = bpy.context.object
-        modifier = obj.modifiers.new("Subdivision", "SUBSURF")
-        modifier.levels = 1
-        bpy.ops.object.modifier_apply(modifier=modifier.name)
-        bpy.ops.object.shade_smooth()
         bpy.ops.view3d.view_axis(type="FRONT")
         bpy.ops.view3d.view_all()
     yield from show_sidebar_tab()

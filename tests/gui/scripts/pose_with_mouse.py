@@ -23,7 +23,8 @@ import numpy as np
 from mathutils import Vector
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from window import enable_addon, override, output, run, say, screenshot, show_sidebar_tab, view3d  # noqa: E402
+from window import (enable_addon, override, output, run, say, screenshot, show_sidebar_tab,  # noqa: E402
+                    subdivided_suzanne, view3d)
 
 
 def key_positions(obj, name):
@@ -52,15 +53,7 @@ def steps():
     from modal_deform import ops_pose, posing
 
     # Scene: Suzanne (2 subdivision levels, 7,958 vertices) seen from the front, sidebar open.
-    for obj in list(bpy.data.objects):
-        bpy.data.objects.remove(obj)
-    with override():
-        bpy.ops.mesh.primitive_monkey_add()
-        obj = bpy.context.object
-        modifier = obj.modifiers.new("Subdivision", "SUBSURF")
-        modifier.levels = 2
-        bpy.ops.object.modifier_apply(modifier=modifier.name)
-        bpy.ops.object.shade_smooth()
+    obj = subdivided_suzanne(2)
     settings = obj.modal_deform
     settings.ghost = 500
 

@@ -50,6 +50,20 @@ def override():
     return bpy.context.temp_override(window=window, screen=window.screen, area=area, region=region)
 
 
+def subdivided_suzanne(levels):
+    """Empties the scene and adds Suzanne subdivided `levels` times, shaded smooth; returns her."""
+    for obj in list(bpy.data.objects):
+        bpy.data.objects.remove(obj)
+    with override():
+        bpy.ops.mesh.primitive_monkey_add()
+        obj = bpy.context.object
+        modifier = obj.modifiers.new("Subdivision", "SUBSURF")
+        modifier.levels = levels
+        bpy.ops.object.modifier_apply(modifier=modifier.name)
+        bpy.ops.object.shade_smooth()
+    return obj
+
+
 def screenshot(path):
     """The whole window as a PNG at path (relative: in OUTPUT)."""
     path = os.path.join(output, path)
