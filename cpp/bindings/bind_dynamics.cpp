@@ -46,6 +46,8 @@ void bind_dynamics(py::module_& m) {
       .def("set_state", &ReducedDynamics::set_state, py::arg("q"), py::arg("v"), py::arg("transforms"))
       .def("positions", &ReducedDynamics::positions, py::arg("out").noconvert(),
            py::call_guard<py::gil_scoped_release>())
+      .def("positions_of", &ReducedDynamics::positions_of, py::arg("q"), py::arg("out").noconvert(),
+           py::call_guard<py::gil_scoped_release>())
       .def_property_readonly("q", [](const ReducedDynamics& s) { return Eigen::VectorXd(s.q()); })
       .def_property_readonly("v", [](const ReducedDynamics& s) { return Eigen::VectorXd(s.v()); })
       .def("energy", &ReducedDynamics::energy)

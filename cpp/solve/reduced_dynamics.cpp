@@ -123,6 +123,11 @@ Eigen::MatrixXd ReducedDynamics::inverse_rest_hessian(const Eigen::MatrixXd& K, 
   return 0.5 * (inverse + inverse.transpose());
 }
 
+void ReducedDynamics::positions_of(const Eigen::VectorXd& q, Eigen::Ref<Eigen::VectorXf> out) const {
+  if (q.size() != dimension()) throw InputError(message("q: expected ", dimension(), " reduced coordinates, got ", q.size()));
+  fine_positions_.write(q.cast<float>(), out);
+}
+
 void ReducedDynamics::set_state(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Transforms& transforms) {
   const Eigen::Index r = dimension();
   if (q.size() != r) throw InputError(message("q: expected ", r, " reduced coordinates, got ", q.size()));

@@ -145,6 +145,9 @@ class ReducedDynamics {
 
   // x̄ + U q on the fine mesh, written into `out` (FinePositions::write).
   void positions(Eigen::Ref<Eigen::VectorXf> out) const { fine_positions_.write(out); }
+  // x̄ + U q for another q (a cached frame's), the state left alone. Throws InputError for a q of
+  // the wrong size.
+  void positions_of(const Eigen::VectorXd& q, Eigen::Ref<Eigen::VectorXf> out) const;
 
   int dimension() const { return ghost_energy_.dimension(); }
   int num_handles() const { return static_cast<int>(centres_.size()); }

@@ -52,9 +52,11 @@ class FinePositions {
 
   // The q that write() maps (r entries).
   void set(const Eigen::VectorXd& q) { q_ = q.cast<float>(); }
-  // Writes the positions into `out`; rows are split over threads in blocks. Throws InputError
-  // for a wrong size.
-  void write(Eigen::Ref<Eigen::VectorXf> out) const;
+  // Writes the positions of the q set into `out`; rows are split over threads in blocks. Throws
+  // InputError for a wrong size.
+  void write(Eigen::Ref<Eigen::VectorXf> out) const { write(q_, out); }
+  // The same for another q (r entries), leaving the one set alone.
+  void write(const Eigen::VectorXf& q, Eigen::Ref<Eigen::VectorXf> out) const;
 
  private:
   const Basis& basis_;

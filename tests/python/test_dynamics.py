@@ -142,6 +142,12 @@ def test_a_run_is_deterministic_and_its_state_reloads_bit_identical(tube):
     assert reloaded.energy() == cached.energy()
     assert np.array_equal(reloaded.positions(), cached.positions())
     assert all(np.array_equal(x, y) for x, y in zip(run(reloaded, moves[8:]), a[8:]))
+    # A cached frame shown by positions_of: the positions set_state would map, the state untouched.
+    state, energy = reloaded.state, reloaded.energy()
+    assert np.array_equal(reloaded.positions_of(q), cached.positions())
+    assert all(np.array_equal(x, y) for x, y in zip(reloaded.state, state)) and reloaded.energy() == energy
+    with pytest.raises(ValueError, match="q"):
+        reloaded.positions_of(q[:-1])
 
 
 def test_parameters_are_defined_once_and_checked(bar):

@@ -76,6 +76,13 @@ class Simulation(_InBasis):
         coordinates of basis.vectors' columns: what a cache stores."""
         return self._native.q, self._native.v
 
+    def positions_of(self, q, out=None):
+        """x̄ + U q for a q of its own (e.g. a cached frame's), as ``positions(out)`` does for the
+        simulation's; the simulation's state stays as it is."""
+        out = _arrays.positions_out(out, self.num_vertices)
+        self._native.positions_of(_arrays.values(q, "q", self.dimension), out.reshape(-1))
+        return out
+
     def set_state(self, q, v, transforms=None):
         """Puts the simulation at (q, v), e.g. a cached frame's, or a pose's ``ReducedSolver.q``
         with zero velocity. ``transforms``: the controllers' at that state (one 4x4 per handle), the
