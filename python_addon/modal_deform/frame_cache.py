@@ -39,14 +39,24 @@ def kind(obj):
     return "DYNAMIC" if obj.modal_deform.dynamics.enabled else "STATIC"
 
 
+def _pose_fields(obj):
+    """The settings the static pose depends on: the stiffness and the handles."""
+    settings = obj.modal_deform
+    return {"stiffness": settings.stiffness,
+            "handles": [(h.vertex_group, h.weight, h.controller.name if h.controller else "",
+                         [list(row) for row in h.bind_matrix]) for h in settings.handles]}
+
+
+def pose_signature(obj):
+    """What the static pose depends on besides the basis and the controllers' motion, as a string."""
+    return json.dumps(_pose_fields(obj), sort_keys=True)
+
+
 def signature(obj, scene):
     """What the cached frames depend on besides the controllers' motion, as a string: the settings
     of the kind of cache obj's settings call for, the handles and the scene's frame rate."""
-    settings = obj.modal_deform
-    dynamics = settings.dynamics
-    fields = {"kind": kind(obj), "stiffness": settings.stiffness,
-              "handles": [(h.vertex_group, h.weight, h.controller.name if h.controller else "",
-                           [list(row) for row in h.bind_matrix]) for h in settings.handles]}
+    dynamics = obj.modal_deform.dynamics
+    fields = {"kind": kind(obj), **_pose_fields(obj)}
     if dynamics.enabled:
         fields.update(period=dynamics.period, damping=dynamics.damping, substeps=dynamics.substeps,
                       start=dynamics.frame_start, fps=scene.render.fps / scene.render.fps_base)

@@ -37,14 +37,16 @@ _busy = False
 class Player:
     """What computes and shows an object's frames: its basis, handles, the static pose solver and a
     simulation (which steps the dynamics and maps any cached q to the mesh: x̄ + U q, natively), for
-    the settings it was made with (frame_cache.signature)."""
+    the settings it was made with (frame_cache.signature). `pose`: a posing.Pose of the same basis
+    and pose settings (frame_cache.pose_signature) to take over, else one is made."""
 
-    def __init__(self, obj, scene):
+    def __init__(self, obj, scene, pose=None):
         settings = obj.modal_deform
         self.signature = frame_cache.signature(obj, scene)
+        self.pose_signature = frame_cache.pose_signature(obj)
         self.basis_id = frame_cache.basis_id(obj)
         self.kind = frame_cache.kind(obj)
-        self.pose = posing.Pose(types.SimpleNamespace(scene=scene), obj)
+        self.pose = pose or posing.Pose(types.SimpleNamespace(scene=scene), obj)
         self.basis, self.handles = self.pose.basis, self.pose.handles
         dynamics = settings.dynamics
         self.simulation = mdc.Simulation(self.basis, [h.indices for h in self.handles], stiffness=settings.stiffness,
@@ -53,9 +55,9 @@ class Player:
                                          weights=[h.weight for h in self.handles],
                                          energy=settings.status.energy.lower())
         self.rest = self.basis.rest.astype(np.float32)
-        # The positions of the last state stepped to (a step maps it anyway), and its q.
-        self.stepped = np.empty_like(self.rest)
-        self.stepped_q = None
+        # Where a step writes the positions of a frame that is not shown (a step maps them anyway):
+        # frames simulated to catch up with a jump forward, and a bake's.
+        self.scratch = None
 
     def check_mesh(self, obj):
         """Raise storage.NotReady when obj's vertices are no longer those of the bake (moved or
@@ -82,34 +84,37 @@ class Player:
         q = solver.q
         return q, (np.zeros_like(q) if self.kind == "DYNAMIC" else None)
 
-    def next(self, cache, frame, transforms):
-        """The state at `frame` (the one after cache.end), from the cached frame before it."""
+    def next(self, cache, frame, transforms, out=None):
+        """The state at `frame` (the one after cache.end), from the cached frame before it, and
+        whether its positions x̄ + U q are in `out` now: a simulation step maps them (into `out`, a
+        function giving a #V by 3 float32 C-contiguous array, called at once; else into scratch)."""
         if self.kind == "STATIC":  # from the pose of the frame before, which the solver holds
             self.pose.solver.set_transforms(list(transforms))
             self.pose.converge()
-            return self.pose.solver.q, None
+            return self.pose.solver.q, None, False
         # From the cached state and transforms, always: the same bits whether played, jumped to,
         # baked or undone.
         q, v = cache.state(frame - 1)
         self.simulation.set_state(q, v, list(cache.array("transforms")[cache.row(frame - 1)].reshape(-1, 4, 4)))
-        self.simulation.step(list(transforms), out=self.stepped)
+        if out is None and self.scratch is None:
+            self.scratch = np.empty_like(self.rest)
+        self.simulation.step(list(transforms), out=self.scratch if out is None else out())
         q, v = self.simulation.state
-        self.stepped_q = q
-        return q, v
+        return q, v, out is not None
 
     def positions(self, q, out):
         """x̄ + U q into `out` (#V by 3 float32, C-contiguous)."""
-        if self.stepped_q is not None and np.array_equal(q, self.stepped_q):
-            np.copyto(out, self.stepped)
-            return
         self.simulation.positions_of(q, out)
 
 
 def player(obj, scene):
-    """obj's Player for its settings now (made anew when they changed)."""
+    """obj's Player for its settings now (made anew when they changed; a change of the dynamics'
+    settings alone keeps the pose's basis, handles and solver: each first() starts from rest)."""
     found = _players.get(obj.name)
     if found is None or not found.fits(obj, scene):
-        found = _players[obj.name] = Player(obj, scene)
+        same_pose = (found is not None and found.basis_id == frame_cache.basis_id(obj)
+                     and found.pose_signature == frame_cache.pose_signature(obj))
+        found = _players[obj.name] = Player(obj, scene, pose=found.pose if same_pose else None)
     return found
 
 
@@ -131,22 +136,29 @@ def set_frame(scene, frame):
         _busy = False
 
 
-def fill(obj, scene, cache, frame, player_):
+def fill(obj, scene, cache, frame, player_, out=None):
     """Compute and cache every frame from cache.end + 1 to `frame` (each at its own frame, for the
-    controllers there); the scene is back at the frame it was on."""
+    controllers there); the scene is back at the frame it was on. `out`: a function giving the
+    array for the positions of `frame` itself (Player.next). Returns whether they are there."""
     if cache.end >= frame:
-        return
+        return False
     here = scene.frame_current
+    mapped = False
     try:
         for f in range(cache.end + 1, frame + 1):
             if scene.frame_current != f:
                 set_frame(scene, f)
             transforms = player_.transforms(obj)
-            q, v = player_.first(transforms) if not len(cache) else player_.next(cache, f, transforms)
+            if not len(cache):
+                q, v = player_.first(transforms)
+                mapped = False
+            else:
+                q, v, mapped = player_.next(cache, f, transforms, out if f == frame else None)
             cache.append(q, v, transforms, frame_cache.curve_values(frame_cache.controller_curves(obj), f))
     finally:
         if scene.frame_current != here:
             set_frame(scene, here)
+    return mapped
 
 
 def show(obj, scene):
@@ -167,21 +179,22 @@ def show(obj, scene):
     index = cache.row(frame)
     if index is not None and not np.array_equal(player_.transforms(obj).ravel(), cache.array("transforms")[index]):
         cache.cut(frame)
-    fill(obj, scene, cache, shown, player_)
-    write(obj, player_, cache.state(shown)[0])
+    # A frame simulated here is mapped by its step straight into the key (no copy between).
+    if not fill(obj, scene, cache, shown, player_, out=lambda: playback_key_co(obj)):
+        player_.positions(cache.state(shown)[0], playback_key_co(obj))
+    obj.data.update()
 
 
-def write(obj, player_, q):
-    """Show x̄ + U q in the playback shape key (created on first use, the pose key muted)."""
+def playback_key_co(obj):
+    """The positions of the playback shape key (created on first use, shown at value 1, the pose
+    key muted): mesh_io.shape_key_co's view, to write into at once."""
     block, _ = mesh_io.shape_key(obj, PLAYBACK_KEY)
     if block.value != 1.0 or block.mute:
         block.value, block.mute = 1.0, False
-    keys = obj.data.shape_keys.key_blocks
-    pose = keys.get(posing.POSE_KEY)
+    pose = obj.data.shape_keys.key_blocks.get(posing.POSE_KEY)
     if pose is not None and not pose.mute:
         pose.mute = True
-    player_.positions(q, mesh_io.shape_key_co(obj.data, block))
-    obj.data.update()
+    return mesh_io.shape_key_co(obj.data, block)
 
 
 def free(obj):

@@ -81,10 +81,18 @@ scene.frame_set(8)
 assert frame_cache.get(obj).end == 8
 assert frame_cache.get(obj).array("q")[0].tobytes() == frame_cache.get(obj).state(1)[0].tobytes()
 assert np.abs(key() - played[8]).max() > 0.01 * size, "frame 8 kept the old motion"
+pose = playback.player(obj, scene).pose
 dynamics.damping = 0.3
 assert frame_cache.get(obj) is None
 scene.frame_set(9)
 assert frame_cache.get(obj).end == 9
+# A change of a dynamics setting keeps the pose's solver (it starts from rest at the first frame):
+# the same bits as a player made anew.
+assert playback.player(obj, scene).pose is pose
+kept = key()
+playback.free(obj)
+scene.frame_set(9)
+assert playback.player(obj, scene).pose is not pose and key().tobytes() == kept.tobytes()
 # A damaged cache (an array gone) is refused with a message; Free takes it away.
 del dynamics.cache["q"]
 before = key()
