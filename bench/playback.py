@@ -11,8 +11,13 @@ In bpy, with the add-on installed from the extension zip (what `make bench` runs
         --extension dist/modal_deform-0.1.0-blender_4.2_to_5.0-linux_x64.zip bench/playback.py -- --output out.json
 
 Per frame: "handler" is the frame handler's work for the object (playback.show: checks, the cache
-read or the step, the mapping into the key), timed alone at the frame the scene is on; "evaluate"
-is Blender's evaluation of the mesh after it (view_layer.update()). Medians over the frames.
+read or the step, the mapping into the key), timed alone at the frame the scene is on; "map" is the
+mapping x̄ + U q into the key alone (the frame's q mapped again after the handler), the part of
+"handler" that grows with the mesh; "evaluate" is Blender's evaluation of the mesh after it
+(view_layer.update()). Medians over the frames. A jump forward simulates every frame in between:
+its handler's time per frame simulated. For reference, Blender's evaluation of the same mesh
+without shape keys, its vertex positions written (a copy of the mesh on another object): what the
+shape key's blend costs. The load average (1, 5, 15 min) before and after the run.
 """
 import argparse
 import json
@@ -57,28 +62,71 @@ def animate(controller, frames):
         controller.keyframe_insert("location", frame=frame)
 
 
-def timed_frames(obj, scene, playback, frames, stepping=False):
-    """Median handler and evaluation milliseconds over `frames`, each reached with the handler off
-    (playback.set_frame) and then shown by the handler's function; `stepping`: also the simulation
-    step's own milliseconds and BFGS iterations (Simulation.stats, timed natively)."""
-    handler, evaluate, step, iterations = [], [], [], []
+def timed_frames(obj, scene, playback, frame_cache, frames, stepping=False):
+    """Median handler, map and evaluation milliseconds over `frames`, each reached with the handler
+    off (playback.set_frame) and then shown by the handler's function; `stepping`: also the
+    simulation step's own milliseconds and BFGS iterations (Simulation.stats, timed natively)."""
+    handler, mapping, evaluate, step, iterations = [], [], [], [], []
     for frame in frames:
         playback.set_frame(scene, frame)
         start = time.perf_counter()
         playback.show(obj, scene)
         handler.append(1e3 * (time.perf_counter() - start))
-        start = time.perf_counter()
-        bpy.context.view_layer.update()
-        evaluate.append(1e3 * (time.perf_counter() - start))
         if stepping:
             stats = playback.player(obj, scene).simulation.stats
             step.append(stats["ms"])
             iterations.append(stats["iterations"])
-    result = {"handler_ms": float(np.median(handler)), "evaluate_ms": float(np.median(evaluate)),
-              "frames": len(handler)}
+        q = frame_cache.get(obj).state(frame)[0]
+        start = time.perf_counter()
+        playback.player(obj, scene).positions(q, playback.playback_key_co(obj))
+        mapping.append(1e3 * (time.perf_counter() - start))
+        start = time.perf_counter()
+        bpy.context.view_layer.update()
+        evaluate.append(1e3 * (time.perf_counter() - start))
+    result = {"handler_ms": float(np.median(handler)), "map_ms": float(np.median(mapping)),
+              "evaluate_ms": float(np.median(evaluate)), "frames": len(handler)}
     if stepping:
         result.update(step_ms=float(np.median(step)), iterations=float(np.median(iterations)))
     return result
+
+
+def jump_forward(obj, scene, playback, frame_cache, frames):
+    """Milliseconds per frame of a jump forward over `frames` frames simulated (the cache cut after
+    its first frame, then the frame `frames` + 1 shown): each frame stepped from the one before at
+    its own frame (set_frame), the last one mapped into the key."""
+    cache = frame_cache.get(obj)
+    cache.cut(cache.start + 1)
+    playback.set_frame(scene, cache.start + frames)
+    start = time.perf_counter()
+    playback.show(obj, scene)
+    return {"ms_per_frame": 1e3 * (time.perf_counter() - start) / frames, "frames": frames}
+
+
+def without_shape_keys(obj, playback, frame_cache, frames):
+    """Blender's evaluation of a copy of obj's mesh without shape keys on another object (obj
+    hidden), its vertex positions written from the cached frames: median milliseconds."""
+    mesh_io = blender_pose.addon("mesh_io")
+    mesh = obj.data.copy()
+    copied_keys = mesh.shape_keys.name
+    copy = bpy.data.objects.new("Without shape keys", mesh)
+    bpy.context.scene.collection.objects.link(copy)
+    copy.shape_key_clear()
+    left = bpy.data.shape_keys.get(copied_keys)
+    if left is not None:  # Blender 4.5 counts the copy's Key twice and keeps it (then refuses to save)
+        bpy.data.batch_remove([left])
+    obj.hide_set(True)
+    player, cache = playback.player(obj, bpy.context.scene), frame_cache.get(obj)
+    evaluate = []
+    for frame in frames:
+        player.positions(cache.state(frame)[0], mesh_io.vertex_positions(mesh))
+        mesh.update()
+        start = time.perf_counter()
+        bpy.context.view_layer.update()
+        evaluate.append(1e3 * (time.perf_counter() - start))
+    bpy.data.objects.remove(copy)
+    bpy.data.meshes.remove(mesh)
+    obj.hide_set(False)
+    return {"evaluate_ms": float(np.median(evaluate)), "frames": len(evaluate)}
 
 
 def saved_size(folder, name):
@@ -105,6 +153,7 @@ def main():
     timed = range(2, 2 + min(args.timed, frames - 1))
     scene.frame_start, scene.frame_end = 1, frames
     animate(moving.controller, frames)
+    load_before = os.getloadavg()
     results = {"blender": bpy.app.version_string, "mesh": name, "subdivide": args.subdivide, "vertices": vertices,
                "dimension": settings.status.dimension, "proxy_vertices": settings.status.proxy_vertices,
                "bake_seconds": bake_seconds, "frames": frames}
@@ -114,7 +163,7 @@ def main():
     assert bpy.ops.modal_deform.bake_animation(frame_start=1, frame_end=frames) == {"FINISHED"}
     results["static_bake_seconds"] = time.perf_counter() - start
     results["static_cache_bytes"] = frame_cache.get(obj).nbytes()
-    results["static_read"] = timed_frames(obj, scene, playback, timed)
+    results["static_read"] = timed_frames(obj, scene, playback, frame_cache, timed)
     with tempfile.TemporaryDirectory() as folder:
         if not args.no_sizes:
             results["blend_with_cache_bytes"] = saved_size(folder, "cache.blend")
@@ -126,9 +175,11 @@ def main():
         settings.dynamics.enabled = True
         playback.set_frame(scene, 1)
         playback.show(obj, scene)
-        results["dynamic_step"] = timed_frames(obj, scene, playback, timed, stepping=True)
-        results["dynamic_read"] = timed_frames(obj, scene, playback, timed)
+        results["dynamic_step"] = timed_frames(obj, scene, playback, frame_cache, timed, stepping=True)
+        results["dynamic_read"] = timed_frames(obj, scene, playback, frame_cache, timed)
         results["dynamic_cache_bytes_per_frame"] = frame_cache.get(obj).nbytes() / len(frame_cache.get(obj))
+        results["dynamic_jump"] = jump_forward(obj, scene, playback, frame_cache, len(timed))
+        results["without_shape_keys"] = without_shape_keys(obj, playback, frame_cache, timed)
 
         if not args.no_sizes:
             # The static animation as a shape key per frame, as Bake Animation wrote it before the cache.
@@ -138,6 +189,7 @@ def main():
             assert bpy.ops.modal_deform.export_shape_keys() == {"FINISHED"}
             results["shape_keys_export_seconds"] = time.perf_counter() - start
             results["blend_with_shape_keys_bytes"] = saved_size(folder, "keys.blend")
+    results["load_average"] = {"before": load_before, "after": os.getloadavg()}
     pathlib.Path(args.output).write_text(json.dumps(results, indent=1))
     print(json.dumps(results, indent=1))
 

@@ -781,19 +781,35 @@ def section_playback(result):
            "dragon (100k vertices; subdivided twice, 1.6M, on a proxy) with a controller turning and sliding, "
            "keyed every 6 frames. Per frame, medians: \"handler\" is the frame handler's work for the object "
            "(playback.show: the checks, the cache read or the simulation step, x̄ + U q into the playback shape key), "
+           "of it in brackets \"map\", x̄ + U q into the key alone (the part that grows with the mesh), "
            "\"evaluate\" Blender's evaluation of the mesh after it (view_layer.update()).", ""]
-    rows = [[run["blender"], f"{run['vertices']:,}", run["dimension"],
-             f"{run['static_read']['handler_ms']:.2f} + {run['static_read']['evaluate_ms']:.2f}",
-             f"{run['dynamic_read']['handler_ms']:.2f} + {run['dynamic_read']['evaluate_ms']:.2f}",
-             f"{run['dynamic_step']['handler_ms']:.2f} + {run['dynamic_step']['evaluate_ms']:.2f}"] for run in runs]
-    out.append(table(["Blender", "vertices", "dims", "static cache read: handler + evaluate ms",
-                      "simulation cache read ms", "live simulation step ms"], rows))
+
+    def split(figures):
+        mapped = f" ({figures['map_ms']:.2f})" if "map_ms" in figures else ""
+        return f"{figures['handler_ms']:.2f}{mapped} + {figures['evaluate_ms']:.2f}"
+
+    rows = [[run["blender"], f"{run['vertices']:,}", run["dimension"], split(run["static_read"]),
+             split(run["dynamic_read"]), split(run["dynamic_step"]),
+             "{:.1f} / {:.1f}".format(*loads) if (loads := load_range(run)) else ""] for run in runs]
+    out.append(table(["Blender", "vertices", "dims", "static cache read: handler (map) + evaluate ms",
+                      "simulation cache read ms", "live simulation step ms", "load before / after"], rows))
     stepped = [f"{run['blender']}, {run['vertices']:,} vertices: {run['dynamic_step']['step_ms']:.1f} ms, "
                f"{run['dynamic_step']['iterations']:.0f} BFGS iterations" for run in runs
                if "step_ms" in run["dynamic_step"]]
     if stepped:
         out += ["", "Of the live step, the simulation's own step (Simulation.stats, both substeps): "
                 + "; ".join(stepped) + "."]
+    jumps = [f"{run['blender']}, {run['vertices']:,} vertices: {run['dynamic_jump']['ms_per_frame']:.1f} ms a frame "
+             f"over {run['dynamic_jump']['frames']} frames" for run in runs if "dynamic_jump" in run]
+    if jumps:
+        out += ["", "A jump forward (every frame in between simulated at its own frame, the last one mapped): "
+                + "; ".join(jumps) + "."]
+    bare = [f"{run['blender']}, {run['vertices']:,} vertices: {run['without_shape_keys']['evaluate_ms']:.2f} ms "
+            f"against {run['dynamic_read']['evaluate_ms']:.2f} with the playback key" for run in runs
+            if "without_shape_keys" in run]
+    if bare:
+        out += ["", "Blender's evaluation of the same mesh without shape keys, its vertex positions written (a copy on "
+                "another object): what the shape key's blend costs of \"evaluate\": " + "; ".join(bare) + "."]
     targets = {100250: 4.0, 1606964: 16.0}
     checks = [f"{run['blender']}, {run['vertices']:,} vertices: ≤ {targets[run['vertices']]:.0f} ms — "
               f"**{'met' if total <= targets[run['vertices']] else 'NOT met'}** ({total:.1f} ms)"
@@ -816,6 +832,12 @@ def section_playback(result):
                             f"{run['shape_keys_export_seconds']:.1f}"] for run in sized])]
     out += ["", provenance(result)]
     return "\n".join(out)
+
+
+def load_range(run):
+    """(1-minute load average before, after) of a playback run, None for runs that did not record it."""
+    loads = run.get("load_average")
+    return (loads["before"][0], loads["after"][0]) if loads else None
 
 
 def section_dynamics(result):
