@@ -55,9 +55,6 @@ class Player:
                                          weights=[h.weight for h in self.handles],
                                          energy=settings.status.energy.lower())
         self.rest = self.basis.rest.astype(np.float32)
-        # Where a step writes the positions of a frame that is not shown (a step maps them anyway):
-        # frames simulated to catch up with a jump forward, and a bake's.
-        self.scratch = None
 
     def check_mesh(self, obj):
         """Raise storage.NotReady when obj's vertices are no longer those of the bake (moved or
@@ -86,8 +83,9 @@ class Player:
 
     def next(self, cache, frame, transforms, out=None):
         """The state at `frame` (the one after cache.end), from the cached frame before it, and
-        whether its positions x̄ + U q are in `out` now: a simulation step maps them (into `out`, a
-        function giving a #V by 3 float32 C-contiguous array, called at once; else into scratch)."""
+        whether its positions x̄ + U q are in `out` now: a simulation step maps them into `out` (a
+        function giving a #V by 3 float32 C-contiguous array, called at once) when given; a frame
+        not shown (a jump forward's frames in between, a bake's) is not mapped."""
         if self.kind == "STATIC":  # from the pose of the frame before, which the solver holds
             self.pose.solver.set_transforms(list(transforms))
             self.pose.converge()
@@ -96,9 +94,10 @@ class Player:
         # baked or undone.
         q, v = cache.state(frame - 1)
         self.simulation.set_state(q, v, list(cache.array("transforms")[cache.row(frame - 1)].reshape(-1, 4, 4)))
-        if out is None and self.scratch is None:
-            self.scratch = np.empty_like(self.rest)
-        self.simulation.step(list(transforms), out=self.scratch if out is None else out())
+        if out is None:
+            self.simulation.advance(list(transforms))
+        else:
+            self.simulation.step(list(transforms), out=out())
         q, v = self.simulation.state
         return q, v, out is not None
 
@@ -151,7 +150,6 @@ def fill(obj, scene, cache, frame, player_, out=None):
             transforms = player_.transforms(obj)
             if not len(cache):
                 q, v = player_.first(transforms)
-                mapped = False
             else:
                 q, v, mapped = player_.next(cache, f, transforms, out if f == frame else None)
             cache.append(q, v, transforms, frame_cache.curve_values(frame_cache.controller_curves(obj), f))
