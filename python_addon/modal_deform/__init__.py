@@ -70,8 +70,8 @@ def _find_native():
 _find_native()
 
 # The Blender modules in registration order (properties before what refers to them).
-_MODULES = ("properties", "storage", "playback", "ops_bake", "ops_handles", "ops_pose", "ops_dynamics",
-            "ops_animation", "ops_preview", "ui")
+_MODULES = ("properties", "storage", "playback", "ops_bake", "ops_handles", "ops_pose", "pose_recovery",
+            "ops_dynamics", "ops_animation", "ops_preview", "ui")
 
 
 def _modules():

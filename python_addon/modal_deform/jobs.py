@@ -8,12 +8,9 @@ tick_seconds), False once the job has ended; overall (the fraction done); cancel
 it at once, for execute); finish() on the main thread, returning (level, message) for the report and
 setting `written` when it changed the object.
 
-The refined animation bake, and the export of the per-frame cache (frame_cache.py), write one shape
-key per frame, keyed to show on its frame only, so the result plays back and renders without the
-add-on: frame f shows shape key "Modal Deform f" (value 1 at f, 0 at f - 1 and f + 1, constant
-interpolation). Refined, each frame starts from the previous frame's refined answer.
+AnimationJob writes its frames as frame keys (frame_keys.py); refined, each frame starts from the
+previous frame's refined answer.
 """
-import re
 import threading
 import time
 
@@ -21,7 +18,8 @@ import bpy
 import numpy as np
 
 from . import core as mdc
-from . import mesh_io, posing, storage
+from . import frame_keys, mesh_io, posing, storage
+
 
 class _ThreadJob:
     """Native work run by run() here or on a thread by start(); the native call releases the GIL, so
@@ -185,13 +183,6 @@ class RefineJob(_ThreadJob):
         return ("INFO" if stats["converged"] else "WARNING"), message
 
 
-_FRAME_KEY = re.compile(re.escape(posing.POSE_KEY) + r" -?\d{4,}")
-
-
-def frame_key_name(frame):
-    return f"{posing.POSE_KEY} {frame:04d}"
-
-
 class FrameJob:
     """A job done a frame per tick() on the main thread (it changes the scene and the mesh): a subclass
     sets `frames` through __init__, does a frame in _frame(frame) and takes away what it added in
@@ -268,7 +259,7 @@ class AnimationJob(FrameJob):
         else:
             co = self.positions(frame)
         mesh_io.ensure_reference_key(self.obj)
-        block = self.obj.shape_key_add(name=frame_key_name(frame), from_mix=False)
+        block = self.obj.shape_key_add(name=frame_keys.frame_key_name(frame), from_mix=False)
         block.value = 0.0
         self.created.append((frame, block.name))
         mesh_io.write_shape_key(self.obj.data, block, co)
@@ -283,20 +274,15 @@ class AnimationJob(FrameJob):
         obj = self.obj
         blocks = obj.data.shape_keys.key_blocks
         new_names = {name for _, name in self.created}
-        old = [b.name for b in blocks if _FRAME_KEY.fullmatch(b.name) and b.name not in new_names]
-        _remove_keys(obj, old)
+        old = [b.name for b in blocks if frame_keys.is_frame_key(b.name) and b.name not in new_names]
+        frame_keys.remove_keys(obj, old)
         pose_block = blocks.get(posing.POSE_KEY)
         if pose_block is not None:
             pose_block.mute = True  # the frame keys take its place; it would add on top
         for frame, name in self.created:
             block = blocks[name]
-            block.name = frame_key_name(frame)
-            for f, value in ((frame - 1, 0.0), (frame, 1.0), (frame + 1, 0.0)):
-                block.value = value
-                block.keyframe_insert("value", frame=f)
-            curve = action_fcurves(obj.data.shape_keys.animation_data).find(block.path_from_id("value"))
-            for point in curve.keyframe_points:
-                point.interpolation = "CONSTANT"
+            block.name = frame_keys.frame_key_name(frame)
+            frame_keys.show_on_its_frame(obj, block, frame)
         self.scene.frame_set(self.frame_before)
         self.written = True
         message = f"{'Exported' if self.positions else 'Baked'} {len(self.frames)} frames into shape keys"
@@ -312,26 +298,3 @@ class AnimationJob(FrameJob):
         self.created = []
         self.scene.frame_set(self.frame_before)
 
-
-def action_fcurves(animation_data):
-    """The F-curves of an animation's action, None without one: on the action up to Blender 4.5, in
-    the channel bag of the assigned slot from 5.0 (layered actions; Action.fcurves is gone)."""
-    if animation_data is None or animation_data.action is None:
-        return None
-    if hasattr(animation_data.action, "fcurves"):
-        return animation_data.action.fcurves
-    from bpy_extras import anim_utils
-    channelbag = anim_utils.animdata_get_channelbag_for_assigned_slot(animation_data)
-    return None if channelbag is None else channelbag.fcurves
-
-
-def _remove_keys(obj, names):
-    """Remove shape keys and the curves that animate them."""
-    keys = obj.data.shape_keys
-    fcurves = action_fcurves(keys.animation_data)
-    for name in names:
-        if fcurves is not None:
-            curve = fcurves.find(keys.key_blocks[name].path_from_id("value"))
-            if curve is not None:
-                fcurves.remove(curve)
-    mesh_io.remove_shape_keys(obj, names)

@@ -5,7 +5,7 @@ import time
 import bpy
 
 from . import core as mdc
-from . import handles, mesh_io, posing
+from . import handles, mesh_io, pose_displays, posing
 from .jobs import RefineJob
 from .ops_common import FAILURES, JobOperator, mesh_poll
 
@@ -28,7 +28,7 @@ keeps the pose, Esc restores the mesh as it was"""
             return {"CANCELLED"}
         for warning in self.pose.warnings:
             self.report({"WARNING"}, warning)
-        self.shown = posing.display(obj)
+        self.shown = pose_displays.display(obj)
         self.area = context.area
         self.request = None
         self.tick_ms = 0.0
@@ -49,14 +49,14 @@ keeps the pose, Esc restores the mesh as it was"""
 
     def modal(self, context, event):
         if self.request is not None:
-            return self._end(context, self.request)
+            return self.end(context, self.request)
         if event.type == "TIMER":  # ours or another's: a tick either way (3.x events do not say whose)
             return self._tick(context)
         if event.value == "PRESS":
             if event.type == "ESC":
-                return self._end(context, "CANCEL")
+                return self.end(context, "CANCEL")
             if event.type in {"RET", "NUMPAD_ENTER"}:
-                return self._end(context, "APPLY")
+                return self.end(context, "APPLY")
             if event.type == "RIGHTMOUSE":
                 bpy.ops.wm.call_menu(name=MODAL_DEFORM_MT_pose.bl_idname)
                 return {"RUNNING_MODAL"}
@@ -77,15 +77,15 @@ keeps the pose, Esc restores the mesh as it was"""
         try:
             obj.mode
         except ReferenceError:  # deleted while posing
-            return self._end(context, "CANCEL")
+            return self.end(context, "CANCEL")
         if obj.mode != "OBJECT":
             self.report({"WARNING"}, "Left Object Mode: the pose so far is kept")
-            return self._end(context, "APPLY")
+            return self.end(context, "APPLY")
         start = time.perf_counter()
         try:
             moved = self.pose.follow_controllers()
             if not self.shown.shows_pose():  # shape keys added mid-pose: the pose goes on in the key
-                self.shown = self.shown.keep(self.pose)
+                self.keep_in_shape_key()
             if moved or not self.pose.stats["converged"]:
                 solve_ms = self.pose.step(self.budget.ms)["ms"]
                 self.pose.write(self.shown.array())
@@ -94,12 +94,23 @@ keeps the pose, Esc restores the mesh as it was"""
                 self.rest_ms = self.tick_ms - solve_ms
         except FAILURES as error:  # e.g. a controller deleted while posing
             self.report({"ERROR"}, str(error))
-            return self._end(context, "CANCEL")
+            return self.end(context, "CANCEL")
         if self.area is not None:
             self.area.header_text_set(posing.header_text(self.pose.stats, self.tick_ms))
         return {"PASS_THROUGH"}
 
-    def _end(self, context, how):
+    def keep_in_shape_key(self):
+        """The pose so far into the "Modal Deform" shape key, where it goes on (a file saved mid-pose,
+        shape keys added mid-pose)."""
+        self.shown = self.shown.keep(self.pose)
+
+    def request_end(self, how):
+        """End at the next event: "APPLY" keeps the pose, "CANCEL" restores the mesh."""
+        self.request = how
+
+    def end(self, context, how):
+        """End now: the timer, draw handler and texts go, and the pose is kept ("APPLY") or the mesh
+        restored ("CANCEL"). Returns the operator's result."""
         posing.running = None
         context.window_manager.event_timer_remove(self.timer)
         bpy.types.SpaceView3D.draw_handler_remove(self.draw_handler, "WINDOW")
@@ -111,14 +122,14 @@ keeps the pose, Esc restores the mesh as it was"""
             if how == "CANCEL":
                 self.shown.restore()
             else:
-                self.shown = self.shown.keep(self.pose)
+                self.keep_in_shape_key()
         except ReferenceError:  # the object (or the screen) went away while posing: nothing to restore
             return {"CANCELLED"}
         return {"CANCELLED"} if how == "CANCEL" else {"FINISHED"}
 
     def cancel(self, context):
         """Blender ends the operator (file loaded, window closed): put the mesh back."""
-        self._end(context, "CANCEL")
+        self.end(context, "CANCEL")
 
 
 class MODAL_DEFORM_OT_pose_end(bpy.types.Operator):
@@ -136,7 +147,7 @@ class MODAL_DEFORM_OT_pose_end(bpy.types.Operator):
         return posing.running is not None
 
     def execute(self, context):
-        posing.running.request = self.how
+        posing.running.request_end(self.how)
         return {"FINISHED"}
 
 
@@ -236,38 +247,7 @@ CLASSES = (MODAL_DEFORM_OT_pose, MODAL_DEFORM_OT_pose_end, MODAL_DEFORM_MT_pose,
            MODAL_DEFORM_OT_reset)
 
 
-_register_classes, _unregister_classes = bpy.utils.register_classes_factory(CLASSES)
-
-
-@bpy.app.handlers.persistent
-def _keep_before_save(*args):
-    """A file saved mid-pose holds the rest mesh and the pose in its shape key: a pose shown in the
-    vertex positions moves into the key first, and the pose goes on there."""
-    if posing.running is not None:
-        try:
-            posing.running.shown = posing.running.shown.keep(posing.running.pose)
-        except ReferenceError:  # its object went away: the pose ends at its next event
-            pass
-
-
-@bpy.app.handlers.persistent
-def _recover_after_undo_or_load(*args):
-    """Undo, redo or a file loaded replaced the data: a pose under way ends (its next event) and
-    meshes written mid-pose are repaired (posing.recover)."""
-    if posing.running is not None:
-        posing.running.request = "CANCEL"
-    posing.recover()
-
-
-_HANDLERS = ((bpy.app.handlers.save_pre, _keep_before_save), (bpy.app.handlers.undo_post, _recover_after_undo_or_load),
-             (bpy.app.handlers.redo_post, _recover_after_undo_or_load),
-             (bpy.app.handlers.load_post, _recover_after_undo_or_load))
-
-
-def register():
-    _register_classes()
-    for handlers, handler in _HANDLERS:
-        handlers.append(handler)
+register, _unregister_classes = bpy.utils.register_classes_factory(CLASSES)
 
 
 def unregister():
@@ -275,7 +255,5 @@ def unregister():
     an unregistered operator without calling it, which would leave its timer, header text and
     half-made shape key (or posed vertex positions) behind."""
     if posing.running is not None:
-        posing.running._end(bpy.context, "CANCEL")
-    for handlers, handler in _HANDLERS:
-        handlers.remove(handler)
+        posing.running.end(bpy.context, "CANCEL")
     _unregister_classes()

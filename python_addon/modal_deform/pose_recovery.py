@@ -1,0 +1,76 @@
+"""Crash and undo recovery of the interactive pose. A file saved mid-pose first moves the pose into
+the "Modal Deform" shape key (save_pre); after undo, redo or a file loaded, the pose under way ends
+and meshes written mid-pose (they carry a display's marks, pose_displays) are repaired (recover).
+"""
+import bpy
+
+from . import mesh_io, pose_displays, posing, storage
+
+
+def recover():
+    """Meshes written mid-pose by a PositionsDisplay or a StandInDisplay (an undo step of a
+    controller's move, autosave, a crash file, a file saved by a path without save handlers) hold
+    the pose in their positions: their rest comes back (from the stored basis, or the artist's mesh
+    in place of the stand-in) and the pose goes into the "Modal Deform" shape key, as if the pose
+    had been kept. Meshes without a usable basis keep the flag and are reported."""
+    for obj in bpy.data.objects:
+        mesh = obj.data
+        if obj.type != "MESH" or mesh.library is not None or posing.is_posing(obj):
+            continue
+        if mesh.get(pose_displays.STAND_IN_OF) is not None:
+            pose = mesh_io.vertex_positions(mesh).copy()
+            pose_displays.put_mesh_back(obj, mesh)
+            mesh_io.write_shape_key(obj.data, posing.pose_key(obj)[0], pose)
+        elif mesh.get(pose_displays.POSING_FLAG) is not None:
+            _recover_positions(obj)
+
+
+def _recover_positions(obj):
+    """recover() for a mesh posed by a PositionsDisplay."""
+    mesh = obj.data
+    try:
+        rest = storage.load(obj).rest
+    except storage.NotReady as error:
+        print(f"Modal Deform: '{obj.name}' was saved while posing and cannot be repaired: {error}")
+        return
+    if len(rest) != len(mesh.vertices):
+        print(f"Modal Deform: '{obj.name}' was saved while posing and its mesh no longer fits its basis")
+        return
+    pose = mesh_io.vertex_positions(mesh).copy()
+    pose_displays.put_rest_back(mesh, rest)
+    mesh_io.write_shape_key(mesh, posing.pose_key(obj)[0], pose)
+
+
+@bpy.app.handlers.persistent
+def _keep_before_save(*args):
+    """A file saved mid-pose holds the rest mesh and the pose in its shape key: a pose shown in the
+    vertex positions moves into the key first, and the pose goes on there."""
+    if posing.running is not None:
+        try:
+            posing.running.keep_in_shape_key()
+        except ReferenceError:  # its object went away: the pose ends at its next event
+            pass
+
+
+@bpy.app.handlers.persistent
+def _recover_after_undo_or_load(*args):
+    """Undo, redo or a file loaded replaced the data: a pose under way ends (its next event) and
+    meshes written mid-pose are repaired (recover)."""
+    if posing.running is not None:
+        posing.running.request_end("CANCEL")
+    recover()
+
+
+_HANDLERS = ((bpy.app.handlers.save_pre, _keep_before_save), (bpy.app.handlers.undo_post, _recover_after_undo_or_load),
+             (bpy.app.handlers.redo_post, _recover_after_undo_or_load),
+             (bpy.app.handlers.load_post, _recover_after_undo_or_load))
+
+
+def register():
+    for handlers, handler in _HANDLERS:
+        handlers.append(handler)
+
+
+def unregister():
+    for handlers, handler in _HANDLERS:
+        handlers.remove(handler)
