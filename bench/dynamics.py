@@ -12,7 +12,7 @@
   third of its length), then the controller still in a moderate pose: non-finite frames, energy
   increases once it is still, the distance to ReducedSolver's pose at the end.
 - proxy: the 100k dragon midpoint-subdivided twice (1.6M vertices) baked on a proxy: the cost of
-  the demo's motion there.
+  the demo's motion there, and the stress run on it.
 - tolerance: BFGS's stopping tolerance against the frames of a tight solve (the 5k dragon, the
   demo's motion): why SIMULATION_DEFAULTS["tolerance"] is what it is.
 """
@@ -120,19 +120,18 @@ def cost(quick):
     return runs
 
 
-def stress(quick):
-    name = "dragon_vrip_res4" if quick else "dragon_vrip_res3"
-    frames, still = (100, 150) if quick else (1000, 300)
-    V, F = mdc.read_mesh(MESHES / f"{name}.ply.gz")
-    basis = mdc.bake(V, F)
-    handles = tail_and_head(V)
+def stress_run(basis, V, handles, frames, still):
+    """`frames` frames of fast random controllers (turns up to 150°, jumps of about a third of the
+    mesh's length) on the head, the tail held, then `still` frames with the controller still in a
+    moderate pose: non-finite frames, energy increases once it is still, the distance to
+    ReducedSolver's pose at the end."""
     diagonal = np.linalg.norm(np.ptp(V, axis=0))
     length = np.ptp(V[:, 0])
     damping = 0.3
     sim = mdc.Simulation(basis, handles, damping=damping)
     rng = np.random.default_rng(1)
     centre = V[handles[1]].mean(axis=0)
-    non_finite, farthest, step_ms, euler, removed = 0, 0.0, [], 0, 0.0
+    non_finite, farthest, step_ms, euler, removed, evaluations = 0, 0.0, [], 0, 0.0, []
     start = time.perf_counter()
     for _ in range(frames):
         T = rigid(rng.normal(size=3), rng.uniform(0, np.radians(150)), centre, rng.normal(scale=length / 3, size=3))
@@ -140,6 +139,7 @@ def stress(quick):
         non_finite += int(not (np.isfinite(X).all() and np.isfinite(sim.energy())))
         farthest = max(farthest, float(np.abs(X - V.mean(axis=0)).max() / diagonal))
         step_ms.append(sim.stats["ms"])
+        evaluations.append(sim.stats["evaluations"])
         euler += sim.stats["implicit_euler"]
         removed += sim.stats["energy_removed"]
     moving_s = time.perf_counter() - start
@@ -153,9 +153,10 @@ def stress(quick):
     solver = mdc.ReducedSolver(basis, handles, stiffness=mdc.SIMULATION_DEFAULTS["stiffness"])
     solver.set_transforms([np.eye(4), T])
     solved = solver.solve(max_iterations=1000, tolerance=1e-12)
-    return {"mesh": name, "vertices": len(V), "frames": frames, "still_frames": still, "damping": damping,
+    return {"vertices": len(V), "frames": frames, "still_frames": still, "damping": damping,
             "non_finite_frames": non_finite, "farthest_vertex_diagonals": farthest,
             "moving_s": moving_s, "step_ms_median": float(np.median(step_ms)), "step_ms_max": float(max(step_ms)),
+            "evaluations_median": float(np.median(evaluations)), "evaluations_max": int(max(evaluations)),
             "implicit_euler_substeps": euler, "energy_removed": removed,
             "energy_at_stop": energies[0], "energy_at_end": energies[-1],
             "largest_energy_increase_still": float(increases.max()),
@@ -163,7 +164,15 @@ def stress(quick):
             "settled_distance_diagonals": float(np.abs(X - solver.positions()).max() / diagonal)}
 
 
+def stress(quick):
+    name = "dragon_vrip_res4" if quick else "dragon_vrip_res3"
+    V, F = mdc.read_mesh(MESHES / f"{name}.ply.gz")
+    basis = mdc.bake(V, F)
+    return {"mesh": name, **stress_run(basis, V, tail_and_head(V), *((100, 150) if quick else (1000, 300)))}
+
+
 def proxy(quick):
+    """The demo's motion and the stress run on the 1.6M proxy bake."""
     V, F = mdc.read_mesh(MESHES / f"{'dragon_vrip_res4' if quick else 'dragon_vrip_res2'}.ply.gz")
     for _ in range(2):
         V, F = midpoint_subdivide(V, F)
@@ -173,7 +182,8 @@ def proxy(quick):
     bake_s = time.perf_counter() - start
     handles = tail_and_head(V)
     return {"vertices": len(V), "proxy_vertices": basis.num_basis_vertices, "dimension": basis.dimension,
-            "bake_s": bake_s, **per_frame_cost(basis, V, handles, demo_motion(V, handles, 30))}
+            "bake_s": bake_s, **per_frame_cost(basis, V, handles, demo_motion(V, handles, 30)),
+            "stress": stress_run(basis, V, handles, *((100, 150) if quick else (1000, 300)))}
 
 
 def tolerance(quick):

@@ -24,8 +24,14 @@ double GhostEnergy::value_and_gradient(const Eigen::VectorXd& q, Eigen::VectorXd
 }
 
 bool GhostEnergy::in_range(const Eigen::VectorXd& q) {
-  x_.noalias() = vectors_ * q;
-  x_ += rest_;
+  // x = x̄ + U q four columns at a time: one pass over x per four columns, where Eigen's
+  // column-major matrix-vector product (SSE, the wheel's baseline) makes one per column.
+  const Eigen::Index r = vectors_.cols(), panels = r - r % 4;
+  x_ = rest_;
+  for (Eigen::Index j = 0; j < panels; j += 4)
+    x_ += vectors_.col(j) * q[j] + vectors_.col(j + 1) * q[j + 1] + vectors_.col(j + 2) * q[j + 2] +
+          vectors_.col(j + 3) * q[j + 3];
+  for (Eigen::Index j = panels; j < r; ++j) x_ += vectors_.col(j) * q[j];
   return positions_in_range(x_);
 }
 
