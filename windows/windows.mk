@@ -33,9 +33,9 @@ OPENBLAS_DLL    := modal_deform_openblas.dll
 PYTHON_EMBED    := 3.11.0 3.13.0
 # The test environments, each named by its Python (X.Y) and what sets it apart: NumPy 1.26 as
 # Blender 4.2 to 5.0 bring it under 3.11; NumPy 2.5 as bpy 5.3 pins it under 3.13 (5.1 and later);
-# NumPy 2 under 3.11 as pip gives it (2.4, the last for 3.11), on the test files where NumPy's
-# versions differ. NumPy 2 and SciPy call the UCRT's C99 complex functions, which Wine 8.0's
-# ucrtbase.dll only stubs: tests/windows/wine_ucrt_complex.c fills them in, under Wine only.
+# NumPy 2 under 3.11 as pip gives it (2.4, the last for 3.11). NumPy 2 and SciPy call the UCRT's
+# C99 complex functions, which Wine 8.0's ucrtbase.dll only stubs: tests/windows/wine_ucrt_complex.c
+# fills them in, under Wine only.
 WIN_ENVS        := 3.11 3.13 3.11-numpy2
 WIN_TEST_COMMON := pytest==9.2.0 iniconfig==2.3.1 pluggy==1.7.0 packaging==26.4 Pygments==2.21.0 colorama==0.4.6
 WIN_TEST_3.11   := numpy==1.26.4 scipy==1.15.3 $(WIN_TEST_COMMON)
@@ -51,7 +51,7 @@ WIN_TEST_3.11-numpy2 := numpy==2.4.6 scipy==1.17.1 $(WIN_TEST_COMMON)
 WIN_DESELECT    := --deselect tests/python/test_solve.py::test_refine_of_a_strong_turn_is_not_held_back_by_crushed_triangles
 WIN_SUITE_3.11  := tests/python
 WIN_SUITE_3.13  := tests/python
-WIN_SUITE_3.11-numpy2 := $(addprefix tests/python/test_,numpy_versions.py named_options.py mesh.py)
+WIN_SUITE_3.11-numpy2 := tests/python
 WINE        := /usr/lib/wine/wine64
 WINE_ENV    := WINEPREFIX=$(CURDIR)/$(WIN)/wine WINEDEBUG=-all WINEDLLOVERRIDES="mscoree,mshtml="
 # $(call wine_python,X.Y,ARGUMENTS): Windows CPython X.Y under Wine; its exit status is the
