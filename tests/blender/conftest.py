@@ -9,6 +9,9 @@ the Blender app on PATH (Debian's 3.4.1; `make test-blender`).
   with Blender's installer, in a session that sees neither the source tree's add-on nor the build
   machine's libraries: no ADDON_PATH, PYTHONPATH unset, LD_LIBRARY_PATH empty, user folders in the
   test's temporary folder.
+- Windows bpy under Wine (`make test-windows-bpy-5.3`): BLENDER_PYTHON is
+  tests/windows/wine_python.py and WINDOWS_PYTHON the python.exe of the Windows bpy environment;
+  the Windows zips are installed.
 A script signals failure by raising (exit code 1).
 """
 import os
@@ -21,6 +24,7 @@ import pytest
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SCRIPTS = pathlib.Path(__file__).resolve().parent / "scripts"
 BLENDER_PYTHON = os.environ.get("BLENDER_PYTHON")
+WINDOWS_PYTHON = os.environ.get("WINDOWS_PYTHON")
 DIST = pathlib.Path(os.environ.get("MODAL_DEFORM_DIST", ROOT / "dist"))
 sys.path.insert(0, str(ROOT / "python_addon"))
 import package  # noqa: E402
@@ -40,6 +44,19 @@ def blender_python_version():
                           capture_output=True, text=True, check=True).stdout.strip()
 
 
+def blender_platform():
+    """The platform of the extension zips this Blender takes (package.PLATFORMS)."""
+    return package.WINDOWS if WINDOWS_PYTHON else package.PLATFORM
+
+
+def bpy_site_packages():
+    """The bpy environment's site-packages: the embeddable Windows CPython's, or the venv's."""
+    if WINDOWS_PYTHON:
+        return pathlib.Path(WINDOWS_PYTHON).parent / "Lib" / "site-packages"
+    (found,) = pathlib.Path(BLENDER_PYTHON).parents[1].glob("lib/python3.*/site-packages")
+    return found
+
+
 @pytest.fixture(scope="session")
 def extension_zip():
     """The extension zip whose wheel is for this Blender's Python (package.EXTENSIONS)."""
@@ -49,7 +66,7 @@ def extension_zip():
     extension = next((e for e in package.EXTENSIONS if e.python == python), None)
     if extension is None:
         pytest.fail(f"{BLENDER_PYTHON} runs Python {python}: no extension zip is made for it (package.EXTENSIONS)")
-    return built(package.extension_zip_name(extension))
+    return built(package.extension_zip_name(extension, blender_platform()))
 
 
 @pytest.fixture

@@ -41,7 +41,13 @@ def test_a_wait_policy_the_user_chose_is_kept():
 
 
 def loaded_openblas():
-    """The OpenBLAS library loaded in this process (NumPy's, here shared with the core), or None."""
+    """The OpenBLAS library loaded in this process that CHOLMOD calls, or None: on Linux NumPy's,
+    here shared with the core; on Windows the one the core bundles (its wheel, windows/windows.mk)."""
+    if sys.platform == "win32":
+        module_handle = ctypes.windll.kernel32.GetModuleHandleW
+        module_handle.restype = ctypes.c_void_p
+        handle = module_handle("modal_deform_openblas.dll")
+        return ctypes.CDLL("modal_deform_openblas.dll", handle=handle) if handle else None
     with open("/proc/self/maps") as maps:
         paths = {line.split()[-1] for line in maps if "openblas" in line.rsplit("/", 1)[-1]}
     for path in sorted(paths):
