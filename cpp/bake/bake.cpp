@@ -36,13 +36,18 @@ namespace {
 // columns.
 constexpr int kPairsPerPass = 64;
 
+// The fewest vertices of a mesh simplified by edge collapse (the ghost, a proxy): a tetrahedron's.
+constexpr int kFewestSimplifiedVertices = 4;
+
 void check_options(const BakeOptions& o, Eigen::Index num_vertices) {
   if (o.modes < 1) throw InputError(message("modes: expected at least 1, got ", o.modes));
   if (o.derivatives < 0) throw InputError(message("derivatives: expected 0 or more, got ", o.derivatives));
-  if (o.ghost < 4) throw InputError(message("ghost: a ghost needs at least 4 vertices, got ", o.ghost));
+  if (o.ghost < kFewestSimplifiedVertices)
+    throw InputError(message("ghost: a ghost needs at least ", kFewestSimplifiedVertices, " vertices, got ", o.ghost));
   if (o.proxy_above < 0) throw InputError(message("proxy_above: expected 0 (never) or more, got ", o.proxy_above));
-  if (o.proxy_above > 0 && (o.proxy < 4 || o.proxy > o.proxy_above))
-    throw InputError(message("proxy: expected between 4 and proxy_above's ", o.proxy_above, " vertices, got ", o.proxy));
+  if (o.proxy_above > 0 && (o.proxy < kFewestSimplifiedVertices || o.proxy > o.proxy_above))
+    throw InputError(message("proxy: expected between ", kFewestSimplifiedVertices, " and proxy_above's ",
+                             o.proxy_above, " vertices, got ", o.proxy));
   if (o.energy == EnergyKind::kArap && o.derivatives > 0)
     throw InputError(message("derivatives: the ARAP energy has no third derivative, so it has no modal derivatives; ",
                              "bake it with derivatives = 0, or use the shells energy (asked for ", o.derivatives, ")"));
