@@ -30,14 +30,15 @@
 // A region (options.region) changes steps 2 to 4: the simulated vertices are the region's, the
 // energy is that of the faces touching it with the vertices outside clamped, K and M are the
 // blocks of the simulated vertices, there are no rigid motions (a free part of the region has
-// them as zero modes), and the rows of the vertices outside are zero (region.h).
+// them as zero modes), and the rows of the vertices outside are zero (region.h; the part of the
+// mesh that moves: region_bake.h).
 //
 // A mesh of more than options.proxy_above vertices goes through steps 2 to 8 as a proxy: the fine
 // mesh simplified by the same edge collapse to about options.proxy vertices ("proxy"), baked in the
 // fine mesh's normalised frame; then each fine vertex gets its barycentric weights on the nearest
 // proxy triangle ("prolongation"). The Basis keeps the fine rest positions and masses, the
-// proxy's vectors and the prolongation: memory and storage grow with the fine mesh only by
-// those weights. A region of more than options.proxy_above free vertices is baked so too: the proxy
+// proxy's vectors and the prolongation (proxy_bake.h): memory and storage grow with the fine
+// mesh only by those weights. A region of more than options.proxy_above free vertices is baked so too: the proxy
 // is its submesh's, simplified with the free and clamped vertices kept apart (so the line between
 // them stays), baked as a region, and every fine vertex outside the region gets zero weights.
 //

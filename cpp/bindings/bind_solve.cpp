@@ -12,6 +12,7 @@
 #include "bindings/named_fields.h"
 #include "bindings/python_progress.h"
 #include "solve/full_solver.h"
+#include "solve/refine.h"
 #include "solve/reduced_solver.h"
 #include "util/errors.h"
 
@@ -71,29 +72,56 @@ void bind_solve(py::module_& m) {
       .def_property_readonly("dimension", &ReducedSolver::dimension)
       .def_property_readonly("num_handles", &ReducedSolver::num_handles);
 
+  // solve_full and refine: the same arguments and options; (positions, stats) with the stats of their
+  // tables and "history", one dict per Newton iteration.
+  const auto options_of = [full_solve_options](const py::kwargs& keywords, const py::object& progress,
+                                                const char* function) {
+    FullSolveOptions options = from_keywords<FullSolveOptions>(keywords, full_solve_options, function);
+    options.progress = python_progress(progress);
+    return options;
+  };
+  const auto positions_and_stats = [](auto& result, auto stats_table) {
+    py::dict stats = to_dict(result, stats_table);
+    py::list history;
+    for (const NewtonIteration& it : result.history)
+      history.append(to_dict(it, [](auto visit) { for_each_newton_iteration_field(visit); }));
+    stats["history"] = history;
+    return py::make_tuple(std::move(result.positions), stats);
+  };
   m.def(
       "solve_full",
-      [full_solve_options](const VerticesRef& V, const FacesRef& F, const std::vector<Eigen::VectorXi>& handles,
-                           const Transforms& transforms, const VectorRef& weights, double stiffness,
-                           const std::optional<RowMatrixX3d>& initial, const py::object& progress,
-                           const py::kwargs& keywords) {
-        FullSolveOptions options = from_keywords<FullSolveOptions>(keywords, full_solve_options, "solve_full");
-        options.progress = python_progress(progress);
+      [options_of, positions_and_stats](const VerticesRef& V, const FacesRef& F,
+                                        const std::vector<Eigen::VectorXi>& handles, const Transforms& transforms,
+                                        const VectorRef& weights, double stiffness,
+                                        const std::optional<RowMatrixX3d>& initial, const py::object& progress,
+                                        const py::kwargs& keywords) {
+        const FullSolveOptions options = options_of(keywords, progress, "solve_full");
         FullSolveResult result;
         {
           py::gil_scoped_release release;
           result = solve_full(V, F, to_handles(handles), weights, transforms, stiffness, options,
                               initial ? &*initial : nullptr);
         }
-        py::dict stats = to_dict(result, [](auto visit) { for_each_full_solve_stat(visit); });
-        py::list history;
-        for (const NewtonIteration& it : result.history)
-          history.append(to_dict(it, [](auto visit) { for_each_newton_iteration_field(visit); }));
-        stats["history"] = history;
-        return py::make_tuple(std::move(result.positions), stats);
+        return positions_and_stats(result, [](auto visit) { for_each_full_solve_stat(visit); });
       },
       py::arg("V"), py::arg("F"), py::arg("handles"), py::arg("transforms"), py::arg("weights"), py::arg("stiffness"),
       py::kw_only(), py::arg("initial") = py::none(), py::arg("progress") = py::none());
+  m.def(
+      "refine",
+      [options_of, positions_and_stats](const VerticesRef& V, const FacesRef& F,
+                                        const std::vector<Eigen::VectorXi>& handles, const Transforms& transforms,
+                                        const VectorRef& weights, double stiffness, const RowMatrixX3d& initial,
+                                        const py::object& progress, const py::kwargs& keywords) {
+        const FullSolveOptions options = options_of(keywords, progress, "refine");
+        RefineResult result;
+        {
+          py::gil_scoped_release release;
+          result = refine(V, F, to_handles(handles), weights, transforms, stiffness, options, initial);
+        }
+        return positions_and_stats(result, [](auto visit) { for_each_refine_stat(visit); });
+      },
+      py::arg("V"), py::arg("F"), py::arg("handles"), py::arg("transforms"), py::arg("weights"), py::arg("stiffness"),
+      py::kw_only(), py::arg("initial"), py::arg("progress") = py::none());
 }
 
 }  // namespace modal_deform

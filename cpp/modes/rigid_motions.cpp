@@ -69,15 +69,15 @@ Eigen::MatrixXd rigid_motions(const VerticesRef& V, const Eigen::Ref<const Eigen
     scaled_axes[k] = principal.eigenvectors() * moments.cwiseSqrt().cwiseInverse().asDiagonal();
   }
 
-  Eigen::MatrixXd Z = Eigen::MatrixXd::Zero(3 * n, 6 * c);
+  Eigen::MatrixXd Z = Eigen::MatrixXd::Zero(3 * n, kRigidMotions * c);
   for (Eigen::Index i = 0; i < n; ++i) {
     if (component[i] < 0) continue;
     const auto k = static_cast<size_t>(component[i]);
     const Eigen::Vector3d r = V.row(i).transpose() - centroid[k];
-    const Eigen::Index column = 6 * static_cast<Eigen::Index>(k);
+    const Eigen::Index column = kRigidMotions * static_cast<Eigen::Index>(k);
     Z.block<3, 3>(3 * i, column) = Eigen::Matrix3d::Identity() / std::sqrt(total[k]);
     // a × r = −[r]× a for each scaled axis a.
-    Z.block<3, 3>(3 * i, column + 3) = -cross_matrix(r) * scaled_axes[k];
+    Z.block<3, 3>(3 * i, column + kTranslations) = -cross_matrix(r) * scaled_axes[k];
   }
   return Z;
 }

@@ -6,6 +6,11 @@
 
 namespace modal_deform {
 
+// The rigid motions of a component: its translations, then its rotations.
+constexpr int kTranslations = 3;
+constexpr int kRotations = 3;
+constexpr int kRigidMotions = kTranslations + kRotations;
+
 // For each component k of (V, component): its 3 translations and its 3 rotations linearised about
 // its mass-weighted centroid (the rotations about its principal axes of inertia), M-orthonormal.
 // V: #V by 3; component: #V labels in [-1, c), -1 for a vertex outside every component, whose

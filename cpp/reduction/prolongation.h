@@ -1,4 +1,4 @@
-// The prolongation of a multiresolution bake (issue 15): from a proxy mesh, on which the modes
+// The prolongation of a multiresolution bake: from a proxy mesh, on which the modes
 // and derivatives are computed, to every vertex of the dense fine mesh.
 //
 // Each fine vertex i is tied to the proxy triangle nearest to it (among those around the proxy

@@ -1,4 +1,4 @@
-// A region bake (issue 24): only the region's vertices move, every other vertex stays exactly where
+// A region bake: only the region's vertices move, every other vertex stays exactly where
 // it is, and the whole basis is spent inside the region.
 //
 // The energy is that of the faces around the region (those with a vertex in it or next to it: every

@@ -57,13 +57,16 @@ void extrapolate(const PoseObjective& objective, double ratio, const Eigen::Vect
   if (guess.value < point.value) std::swap(point, guess);
 }
 
+// The share of the progress bar that the load path takes, when there is one.
+constexpr double kLoadPathShare = 0.5;
+
 // Fraction of the work done for the progress bar: the load path first (when there is one), then
 // the final load's gradient decrease on a log scale.
 double fraction_done(double load, bool stepping, double gradient_norm, double scale, double tolerance) {
-  const double path = stepping ? 0.5 * load : 0;
+  const double path = stepping ? kLoadPathShare * load : 0;
   if (load < 1) return path;
   const double decrease = std::log(std::max(gradient_norm / scale, tolerance)) / std::log(tolerance);
-  return path + (stepping ? 0.5 : 1.0) * std::clamp(decrease, 0.0, 1.0);
+  return path + (stepping ? 1 - kLoadPathShare : 1.0) * std::clamp(decrease, 0.0, 1.0);
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
-// The reference solve and Refine: Newton's method on the full mesh for the reduced solver's
-// objective, to measure how far the reduced answer is from the true minimiser and to polish a
-// pose on the full mesh.
+// The reference solve: Newton's method on the full mesh for the reduced solver's objective, to
+// measure how far the reduced answer is from the true minimiser and to polish a pose on the full
+// mesh (Refine, refine.h).
 //
 // In the normalised frame y = s x (s = normalizing_scale(V)):
 //
@@ -14,7 +14,7 @@
 // analysis for the whole solve and backtracking along its step (shifted_newton.h: what makes it
 // converge on scans with floppy flaps and fins); the load steps from rest (load_steps.h). Each
 // load step starts from the previous answer moved on along the path the last step took (a secant
-// predictor) when F is lower there; intermediate loads are solved to a loose tolerance (1e-3).
+// predictor) when F is lower there; intermediate loads are solved to a loose tolerance.
 //
 // Where F has a kink rather than a minimum (a sliver triangle collapsed: its bending terms'
 // angle flips as its normal does), F stops decreasing while ‖∇F‖ stays large; the solve then

@@ -23,19 +23,8 @@ namespace {
 
 using testing::dense_modal_basis;
 using testing::rigid_transform;
+using testing::SmallTube;
 using testing::vertices_where;
-
-// A tube of length 3 held at both ends (6 around and 5 along unless told), the far end moved.
-struct SmallTube {
-  TriangleMesh mesh;
-  Handles handles;
-  Transforms transforms;
-  explicit SmallTube(int around = 6, int along = 5) : mesh(cylinder(around, along, 1.0, 3.0)) {
-    handles = {vertices_where(mesh.V, [](const Eigen::Vector3d& x) { return x.z() < 1e-9; }),
-               vertices_where(mesh.V, [](const Eigen::Vector3d& x) { return x.z() > 3 - 1e-9; })};
-    transforms = {Eigen::Matrix4d::Identity(), rigid_transform({1, 1, 1}, 1.0, {0, 0, 3}, {0.8, 0.2, -0.5})};
-  }
-};
 
 double rms(const RowMatrixX3d& a, const RowMatrixX3d& b) { return std::sqrt((a - b).rowwise().squaredNorm().mean()); }
 

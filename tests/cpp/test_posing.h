@@ -10,6 +10,7 @@
 #include "energy/discrete_shells.h"
 #include "mesh/mass.h"
 #include "mesh/normalization.h"
+#include "mesh/primitives.h"
 #include "mesh/triangle_mesh.h"
 #include "basis/basis.h"
 #include "solve/handle_term.h"
@@ -34,6 +35,18 @@ inline std::vector<int> vertices_where(const RowMatrixX3d& V,
     if (inside(V.row(v).transpose())) selected.push_back(v);
   return selected;
 }
+
+// A tube of length 3 held at both ends (6 around and 5 along unless told), the far end moved.
+struct SmallTube {
+  TriangleMesh mesh;
+  Handles handles;
+  Transforms transforms;
+  explicit SmallTube(int around = 6, int along = 5) : mesh(cylinder(around, along, 1.0, 3.0)) {
+    handles = {vertices_where(mesh.V, [](const Eigen::Vector3d& x) { return x.z() < 1e-9; }),
+               vertices_where(mesh.V, [](const Eigen::Vector3d& x) { return x.z() > 3 - 1e-9; })};
+    transforms = {Eigen::Matrix4d::Identity(), rigid_transform({1, 1, 1}, 1.0, {0, 0, 3}, {0.8, 0.2, -0.5})};
+  }
+};
 
 // A basis of the r lowest vibration modes of the shells energy at rest, from a dense generalised
 // eigensolver (r = 3#V spans everything); the ghost is the mesh with the identity map. Modes are

@@ -191,7 +191,7 @@ class ReducedSolver(_InBasis):
         start does not converge (it stalled at a kink, or spent ``max_iterations``), the solve from
         rest (in load steps) is run as well and its answer returned if it converged or is lower
         (stats["from_rest"] says so); iterations, factorisations, seconds and the history then
-        count both solves, whichever answer is returned.
+        count both solves, whichever answer is returned (the core's policy, cpp/solve/refine.h).
 
         The solve runs on the fine mesh, not on the proxy of a basis baked on one: the proxy's rest
         mesh is not kept, and a refined proxy pose carried back by the prolongation would lose the
@@ -209,34 +209,14 @@ class ReducedSolver(_InBasis):
         if start.shape != (n, 3):
             raise ValueError(f"initial: expected shape ({n}, 3), got {start.shape}")
         basis, problem = self._basis, self._problem
-        F = _arrays.faces(F)
         # A region bake's outside stays exactly at rest (where the reduced pose left it).
         held = np.setdiff1d(np.arange(n), basis.region) if len(basis.region) else None
-        if progress is not None and not callable(progress):
-            raise ValueError(f"progress: expected a callable or None, got {type(progress).__name__}")
-
-        def solve(initial, iterations, share):
-            report = progress and (lambda stage, fraction: progress(stage, share[0] + share[1] * fraction))
-            return solve_full(basis.rest, F, problem["handles"], self._transforms, stiffness=problem["stiffness"],
-                              weights=problem["weights"], energy=problem["energy"], bending=basis.bending,
-                              membrane=basis.membrane, stiffness_weights=basis.stiffness_weights,
-                              max_stiffness=basis.max_stiffness, tolerance=tolerance, max_iterations=iterations,
-                              initial=initial, progress=report, held=held)
-
-        X, stats = solve(start, max_iterations, (0.0, 0.5))
-        stats["from_rest"] = False
-        if stats["converged"] and progress:
-            progress("solve", 1.0)
-        if not stats["converged"]:
-            # A start far from the minimum (a small basis, a strong pose) can lead Newton's first
-            # steps to collapse triangles; the solve from rest, in load steps, does not start there.
-            X_rest, stats_rest = solve(None, max_iterations, (0.5, 0.5))
-            spent = {key: stats[key] + stats_rest[key] for key in ("iterations", "factorizations", "seconds", "history")}
-            if stats_rest["converged"] or stats_rest["energy"] < stats["energy"]:
-                stats_rest.update(from_rest=True, initial_energy=stats["initial_energy"])
-                X, stats = X_rest, stats_rest
-            stats.update(spent)
-        return X, stats
+        return _on_full_mesh(_native.refine, basis.rest, F, problem["handles"], self._transforms,
+                             stiffness=problem["stiffness"], weights=problem["weights"], energy=problem["energy"],
+                             bending=basis.bending, membrane=basis.membrane,
+                             stiffness_weights=basis.stiffness_weights, max_stiffness=basis.max_stiffness,
+                             tolerance=tolerance, max_iterations=max_iterations, initial=start, progress=progress,
+                             held=held)
 
     def objective(self, q):
         """The objective f(q) (ghost energy plus handle term, normalised frame) and its gradient
@@ -280,17 +260,26 @@ def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, ene
     turned a triangle over), "ratio" (the decrease over the model's, at α ≤ 1), "cg_iterations" (conjugate gradient iterations of the step; 0: a new
     factorisation solved it), "progress", "energy" and "gradient_norm" after it.
     """
+    return _on_full_mesh(_native.solve_full, V, F, handles, transforms, stiffness=stiffness, weights=weights,
+                         energy=energy, bending=bending, membrane=membrane, tolerance=tolerance,
+                         max_iterations=max_iterations, initial=initial, progress=progress,
+                         stiffness_weights=stiffness_weights, max_stiffness=max_stiffness, held=held)
+
+
+def _on_full_mesh(native, V, F, handles, transforms, *, stiffness, weights, energy, bending, membrane, tolerance,
+                  max_iterations, initial, progress, stiffness_weights, max_stiffness, held):
+    """``native`` (the core's solve_full or refine) called with solve_full's arguments checked."""
     V, F = _arrays.vertices(V), _arrays.faces(F)
     handles = _handles(handles)
     max_iterations = _arrays.integer(max_iterations, "max_iterations")
     if progress is not None and not callable(progress):
         raise ValueError(f"progress: expected a callable or None, got {type(progress).__name__}")
-    return _native.solve_full(V, F, handles, _transforms(transforms, len(handles)), _weights(weights, len(handles)),
-                              _arrays.number(stiffness, "stiffness"),
-                              initial=None if initial is None else _arrays.vertices(initial, "initial"),
-                              progress=progress, energy=str(energy), bending=_arrays.number(bending, "bending"),
-                              membrane=_arrays.number(membrane, "membrane"),
-                              stiffness_weights=_arrays.stiffness_weights(stiffness_weights, len(V)),
-                              max_stiffness=_arrays.number(max_stiffness, "max_stiffness"),
-                              tolerance=_arrays.number(tolerance, "tolerance"), max_iterations=max_iterations,
-                              held=[] if held is None else _arrays.indices(held, "held"))
+    return native(V, F, handles, _transforms(transforms, len(handles)), _weights(weights, len(handles)),
+              _arrays.number(stiffness, "stiffness"),
+              initial=None if initial is None else _arrays.vertices(initial, "initial"),
+              progress=progress, energy=str(energy), bending=_arrays.number(bending, "bending"),
+              membrane=_arrays.number(membrane, "membrane"),
+              stiffness_weights=_arrays.stiffness_weights(stiffness_weights, len(V)),
+              max_stiffness=_arrays.number(max_stiffness, "max_stiffness"),
+              tolerance=_arrays.number(tolerance, "tolerance"), max_iterations=max_iterations,
+              held=[] if held is None else _arrays.indices(held, "held"))
