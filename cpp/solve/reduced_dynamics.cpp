@@ -136,6 +136,9 @@ void ReducedDynamics::set_state(const Eigen::VectorXd& q, const Eigen::VectorXd&
   if (!v.allFinite() || !std::isfinite(0.5 * mass_scale_ * v.squaredNorm()))
     throw InputError("v: has non-finite entries, or a kinetic energy beyond double precision");
   if (!transforms.empty()) check_transforms(transforms, num_handles());
+  // The simulation's own state (playback sets each frame's cached state before stepping from it)
+  // is kept: its energy and gradient were evaluated there, at these transforms, by the last step.
+  if (q_.size() == r && q == q_ && v == v_ && (transforms.empty() || transforms == transforms_)) return;
   Eigen::VectorXd gradient(r);
   const double elastic_energy = ghost_energy_.value_and_gradient(q, gradient);
   if (!std::isfinite(elastic_energy))

@@ -148,6 +148,11 @@ def test_a_run_is_deterministic_and_its_state_reloads_bit_identical(tube):
     assert all(np.array_equal(x, y) for x, y in zip(reloaded.state, state)) and reloaded.energy() == energy
     with pytest.raises(ValueError, match="q"):
         reloaded.positions_of(q[:-1])
+    # Its own state set again, as playback does before each step, continues the same.
+    energy = cached.energy()
+    cached.set_state(q, v, moves[7])
+    assert cached.energy() == energy
+    assert all(np.array_equal(x, y) for x, y in zip(run(cached, moves[8:]), a[8:]))
 
 
 def test_parameters_are_defined_once_and_checked(bar):
