@@ -183,7 +183,7 @@ def free(obj):
         bpy.data.palettes.remove(block)
 
 
-def holds(cache, obj, scene):
+def outdated(cache, obj, scene):
     """Why the cache no longer fits obj ("" when it does): another kind, settings or basis."""
     if cache.kind != kind(obj):
         return "dynamics switched " + ("on" if kind(obj) == "DYNAMIC" else "off")

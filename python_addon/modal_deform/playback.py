@@ -166,7 +166,7 @@ def show(obj, scene):
     frame = scene.frame_current
     cache = frame_cache.get(obj)
     start = obj.modal_deform.dynamics.frame_start
-    if cache is not None and frame_cache.holds(cache, obj, scene):
+    if cache is not None and frame_cache.outdated(cache, obj, scene):
         if cache.kind == frame_cache.kind(obj) == "STATIC":  # keeps the range the artist baked
             start = cache.start
         cache = None
