@@ -57,6 +57,15 @@ def save_figure(fig, name):
     plt.close(fig)
 
 
+def measured_apart(runs):
+    """The paragraph naming the runs measured apart from the rest and merged into the JSON, each
+    with its own provenance (none: no paragraph)."""
+    apart = [f"{run['blender']}, {run['vertices']:,} vertices: {run['measured']['date']}, commit "
+             f"`{run['measured']['commit'][:12]}`, load average at the end {run['measured']['load_average'][0]:.1f}"
+             for run in runs if "measured" in run]
+    return ["", "Measured apart and merged: " + "; ".join(apart) + "."] if apart else []
+
+
 def section_table1(result):
     rows = result["figures"]["rows"]
     paper = result["parameters"]["paper"]
@@ -471,12 +480,7 @@ def section_bpy_pose(result):
     peaks = [f"{run['blender']}, {run['vertices']:,} vertices: {run['peak_gb']:.1f} GB" for run in runs if "peak_gb" in run]
     if peaks:
         out += ["", "Peak resident memory of the Blender process (the bake's): " + "; ".join(peaks) + "."]
-    # Runs measured apart from the rest and merged into the JSON carry their own provenance.
-    apart = [f"{run['blender']}, {run['vertices']:,} vertices: {run['measured']['date']}, commit "
-             f"`{run['measured']['commit'][:12]}`, load average at the end {run['measured']['load_average'][0]:.1f}"
-             for run in runs if "measured" in run]
-    if apart:
-        out += ["", "Measured apart and merged: " + "; ".join(apart) + "."]
+    out += measured_apart(runs)
     plot_update_time(runs)
     out += ["", "![update time against vertex count](figures/update_time.png)", "", provenance(result)]
     return "\n".join(out)
@@ -843,11 +847,7 @@ def section_playback(result):
               for total in [run["dynamic_step"]["handler_ms"] + run["dynamic_step"]["evaluate_ms"]]]
     if checks:
         out += ["", "Target (issue 40, a live step with Blender's evaluation): " + "; ".join(checks) + "."]
-    apart = [f"{run['blender']}, {run['vertices']:,} vertices: {run['measured']['date']}, commit "
-             f"`{run['measured']['commit'][:12]}`, load average at the end {run['measured']['load_average'][0]:.1f}"
-             for run in runs if "measured" in run]
-    if apart:
-        out += ["", "Measured apart and merged: " + "; ".join(apart) + "."]
+    out += measured_apart(runs)
     sized = [run for run in runs if "blend_with_shape_keys_bytes" in run]
     if sized:
         out += ["", table(["Blender", "frames", "cache KB", ".blend with the cache MB", ".blend with a shape key per "
