@@ -18,9 +18,11 @@ import numpy as np
 
 from . import mesh_io
 
-#: The modifier on an object that plays a cache, and its node group (one per file, shared).
+#: The modifier on an object that plays a cache, and its node group (one per file, shared), which
+#: carries the ID property MARK: the modifier is the one whose node group has it, whatever their names.
 MODIFIER = "Modal Deform Playback"
 NODE_GROUP = "Modal Deform Playback"
+MARK = "modal_deform_playback"
 #: The FLOAT_VECTOR point attribute holding the frame's positions (object space).
 ATTRIBUTE = "modal_deform_playback"
 #: Blender 3.4's selection (see the module's comment): True on every point where ATTRIBUTE holds a frame.
@@ -36,12 +38,13 @@ def _named_attribute(tree, data_type, name):
 
 
 def node_group():
-    """The file's node group "Modal Deform Playback" (made on first use): Geometry → Set Position
-    (Position: ATTRIBUTE, Selection: where it exists) → Geometry."""
-    tree = bpy.data.node_groups.get(NODE_GROUP)
-    if tree is not None and tree.bl_idname == "GeometryNodeTree" and tree.library is None:
+    """The file's node group (made on first use): Geometry → Set Position (Position: ATTRIBUTE,
+    Selection: where it exists) → Geometry."""
+    tree = next((g for g in bpy.data.node_groups if g.library is None and g.get(MARK)), None)
+    if tree is not None:
         return tree
     tree = bpy.data.node_groups.new(NODE_GROUP, "GeometryNodeTree")
+    tree[MARK] = True
     if hasattr(tree, "interface"):  # Blender 4.0+
         tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
         tree.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
@@ -77,15 +80,16 @@ def _add_modifier(obj):
     return modifier
 
 
+def modifier_of(obj):
+    """obj's display modifier, or None."""
+    return next((m for m in obj.modifiers if m.type == "NODES" and m.node_group is not None and m.node_group.get(MARK)),
+                None)
+
+
 def positions(obj):
     """Where the frame shown on obj goes: ATTRIBUTE's #V by 3 float32 view (mesh_io.attribute_co),
-    with the modifier that shows it (made if needed, on again if the artist turned it off in the
-    viewport). Use at once, then tag the mesh (mesh.update())."""
-    modifier = obj.modifiers.get(MODIFIER)
-    if modifier is None or modifier.type != "NODES":
-        modifier = _add_modifier(obj)
-    if modifier.node_group is None or modifier.node_group.name != NODE_GROUP:
-        modifier.node_group = node_group()
+    with the modifier that shows it (made if needed). Use at once, then tag the mesh (mesh.update())."""
+    modifier = modifier_of(obj) or _add_modifier(obj)
     mesh = obj.data
     attributes = mesh.attributes
     if attributes.get(ATTRIBUTE) is None:
@@ -99,19 +103,19 @@ def positions(obj):
 def _reads_shown(tree):
     """Whether the node group takes its selection from SHOWN (made in Blender 3.4)."""
     return any(node.bl_idname == "GeometryNodeInputNamedAttribute" and node.inputs["Name"].default_value == SHOWN
-                   for node in tree.nodes)
+               for node in tree.nodes)
 
 
 def shows(obj):
     """Whether obj carries the display (its modifier or attribute)."""
-    return obj.type == "MESH" and (MODIFIER in obj.modifiers or ATTRIBUTE in obj.data.attributes)
+    return obj.type == "MESH" and (ATTRIBUTE in obj.data.attributes or modifier_of(obj) is not None)
 
 
 def remove(obj):
     """Take the display off obj (its modifier and attributes): the mesh shows what it shows without it."""
     if not shows(obj):
         return
-    modifier = obj.modifiers.get(MODIFIER)
+    modifier = modifier_of(obj)
     if modifier is not None:
         obj.modifiers.remove(modifier)
     mesh = obj.data
@@ -127,6 +131,5 @@ def remove_all():
     for obj in bpy.data.objects:
         if obj.library is None:
             remove(obj)
-    tree = bpy.data.node_groups.get(NODE_GROUP)
-    if tree is not None and tree.users == 0 and tree.library is None:
+    for tree in [g for g in bpy.data.node_groups if g.library is None and g.get(MARK) and g.users == 0]:
         bpy.data.node_groups.remove(tree)

@@ -55,6 +55,10 @@ playback_display.positions(other)[...] = V
 assert other.modifiers[0].node_group == modifier.node_group and len(
     [g for g in bpy.data.node_groups if g.name.startswith(playback_display.NODE_GROUP)]) == 1
 bpy.data.objects.remove(other)
+# Renamed by the artist, the modifier and its group are still the display's (no second one).
+modifier.name, modifier.node_group.name = "Renamed", "Renamed too"
+scene.frame_set(5)
+assert len(obj.modifiers) == 2 and shown().tobytes() == frame(5).tobytes()
 
 # A copy of the mesh (Blender 4+ shares the attribute's array with it until written) keeps its values
 # when the original's are written.
@@ -117,7 +121,7 @@ obj.modal_deform.dynamics.enabled = True
 scene.frame_set(4)
 assert playback_display.shows(obj)
 addon_utils.disable(package.__name__, default_set=True)
-assert playback_display.MODIFIER not in obj.modifiers and playback_display.ATTRIBUTE not in obj.data.attributes
-assert playback_display.NODE_GROUP not in bpy.data.node_groups
+assert [m.name for m in obj.modifiers] == [artist.name] and playback_display.ATTRIBUTE not in obj.data.attributes
+assert not [g for g in bpy.data.node_groups if g.get(playback_display.MARK)]
 assert np.abs(shown() - support.key_positions(obj, posing.POSE_KEY)).max() < 1e-6
 print("DISPLAY_OK")
