@@ -122,6 +122,8 @@ def remove(obj):
     if modifier is not None:
         obj.modifiers.remove(modifier)
     mesh = obj.data
+    if mesh.library is not None:  # a linked mesh's attribute is the library's: the modifier alone goes
+        return
     for name in (ATTRIBUTE, SHOWN):
         attribute = mesh.attributes.get(name)
         if attribute is not None:
