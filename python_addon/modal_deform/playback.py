@@ -199,9 +199,10 @@ def free(obj):
 def _frame_changed(scene, depsgraph=None):
     if _busy:
         return
+    displayed = playback_display.in_use()
     for obj in scene.objects:
         if not wants_playback(obj):
-            if obj.type == "MESH" and obj.library is None and not plays(obj):  # freed, or dynamics turned off
+            if displayed and obj.type == "MESH" and obj.library is None and not plays(obj):  # freed, dynamics off
                 playback_display.remove(obj)
             continue
         try:

@@ -109,6 +109,12 @@ def _reads_shown(tree):
                for node in tree.nodes)
 
 
+def in_use():
+    """Whether an object of the file may show the display (a node group of it has users): when not,
+    the frame handler looks at no object for a display to take away."""
+    return any(tree.users and tree.get(MARK) for tree in bpy.data.node_groups)
+
+
 def shows(obj):
     """Whether obj carries the display (its modifier or attribute)."""
     return obj.type == "MESH" and (ATTRIBUTE in obj.data.attributes or modifier_of(obj) is not None)
