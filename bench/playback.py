@@ -1,6 +1,6 @@
 """The per-frame cache in headless Blender (issue 40): per frame, what playback costs (a cached frame
-read back, x = x̄ + U q into the playback shape key; one simulation step live) and Blender's
-evaluation after it; and for FRAMES frames of the dragon (100k vertices), the cache's size and the
+read back, x = x̄ + U q into the display's attribute, playback_display.py; one simulation step live)
+and Blender's evaluation after it (the display's Geometry Nodes modifier); and for FRAMES frames of the dragon (100k vertices), the cache's size and the
 .blend's against the same animation exported as a shape key per frame and as a PC2 file.
 
     blender -b --factory-startup --python bench/playback.py -- --output out.json [--quick] [--subdivide 2]
@@ -11,13 +11,13 @@ In bpy, with the add-on installed from the extension zip (what `make bench` runs
         --extension dist/modal_deform-0.1.0-blender_4.2_to_5.0-linux_x64.zip bench/playback.py -- --output out.json
 
 Per frame: "handler" is the frame handler's work for the object (playback.show: checks, the cache
-read or the step, the mapping into the key), timed alone at the frame the scene is on; "map" is the
-mapping x̄ + U q into the key alone (the frame's q mapped again after the handler), the part of
+read or the step, the mapping into the display), timed alone at the frame the scene is on; "map" is
+the mapping x̄ + U q into the display's attribute alone (the frame's q mapped again after the handler), the part of
 "handler" that grows with the mesh; "evaluate" is Blender's evaluation of the mesh after it
 (view_layer.update()). Medians over the frames. A jump forward simulates every frame in between:
 its handler's time per frame simulated. For reference, Blender's evaluation of the same mesh
-without shape keys, its vertex positions written (a copy of the mesh on another object): what the
-shape key's blend costs. The load average (1, 5, 15 min) before and after the run.
+without the display, its vertex positions written (a copy of the mesh on another object): what the
+display's modifier costs over a mesh that shows its own positions (a stand-in mesh's display). The load average (1, 5, 15 min) before and after the run.
 """
 import argparse
 import json
@@ -66,6 +66,7 @@ def timed_frames(obj, scene, playback, frame_cache, frames, stepping=False):
     """Median handler, map and evaluation milliseconds over `frames`, each reached with the handler
     off (playback.set_frame) and then shown by the handler's function; `stepping`: also the
     simulation step's own milliseconds and BFGS iterations (Simulation.stats, timed natively)."""
+    shown_positions = blender_pose.addon("playback_display").positions
     handler, mapping, evaluate, step, iterations = [], [], [], [], []
     for frame in frames:
         playback.set_frame(scene, frame)
@@ -78,7 +79,7 @@ def timed_frames(obj, scene, playback, frame_cache, frames, stepping=False):
             iterations.append(stats["iterations"])
         q = frame_cache.get(obj).state(frame)[0]
         start = time.perf_counter()
-        playback.player(obj, scene).positions(q, playback.playback_key_co(obj))
+        playback.player(obj, scene).positions(q, shown_positions(obj))
         mapping.append(1e3 * (time.perf_counter() - start))
         start = time.perf_counter()
         bpy.context.view_layer.update()
@@ -93,7 +94,7 @@ def timed_frames(obj, scene, playback, frame_cache, frames, stepping=False):
 def jump_forward(obj, scene, playback, frame_cache, frames):
     """Milliseconds per frame of a jump forward over `frames` frames simulated (the cache cut after
     its first frame, then the frame `frames` + 1 shown): each frame stepped from the one before at
-    its own frame (set_frame), the last one mapped into the key."""
+    its own frame (set_frame), the last one mapped into the display."""
     cache = frame_cache.get(obj)
     cache.cut(cache.start + 1)
     playback.set_frame(scene, cache.start + frames)
@@ -103,17 +104,14 @@ def jump_forward(obj, scene, playback, frame_cache, frames):
 
 
 def without_shape_keys(obj, playback, frame_cache, frames):
-    """Blender's evaluation of a copy of obj's mesh without shape keys on another object (obj
-    hidden), its vertex positions written from the cached frames: median milliseconds."""
+    """Blender's evaluation of a copy of obj's mesh (which has no shape keys) on another object
+    without the display's modifier (obj hidden), its vertex positions written from the cached
+    frames: median milliseconds."""
     mesh_io = blender_pose.addon("mesh_io")
+    assert obj.data.shape_keys is None
     mesh = obj.data.copy()
-    copied_keys = mesh.shape_keys.name
     copy = bpy.data.objects.new("Without shape keys", mesh)
     bpy.context.scene.collection.objects.link(copy)
-    copy.shape_key_clear()
-    left = bpy.data.shape_keys.get(copied_keys)
-    if left is not None:  # Blender 4.5 counts the copy's Key twice and keeps it (then refuses to save)
-        bpy.data.batch_remove([left])
     obj.hide_set(True)
     player, cache = playback.player(obj, bpy.context.scene), frame_cache.get(obj)
     evaluate = []

@@ -810,9 +810,10 @@ def section_playback(result):
            "`bench/playback.py` in bpy from the package index, the add-on installed from its extension zip: the "
            "dragon (100k vertices; subdivided twice, 1.6M, on a proxy) with a controller turning and sliding, "
            "keyed every 6 frames. Per frame, medians: \"handler\" is the frame handler's work for the object "
-           "(playback.show: the checks, the cache read or the simulation step, x̄ + U q into the playback shape key), "
-           "of it in brackets \"map\", x̄ + U q into the key alone (the part that grows with the mesh), "
-           "\"evaluate\" Blender's evaluation of the mesh after it (view_layer.update()).", ""]
+           "(playback.show: the checks, the cache read or the simulation step, x̄ + U q into the display's point "
+           "attribute, playback_display.py), of it in brackets \"map\", x̄ + U q into the attribute alone (the part "
+           "that grows with the mesh), \"evaluate\" Blender's evaluation of the mesh after it (view_layer.update(): "
+           "the display's Geometry Nodes modifier sets the positions from the attribute).", ""]
 
     def split(figures):
         mapped = f" ({figures['map_ms']:.2f})" if "map_ms" in figures else ""
@@ -835,11 +836,12 @@ def section_playback(result):
         out += ["", "A jump forward (every frame in between simulated at its own frame, the last one mapped): "
                 + "; ".join(jumps) + "."]
     bare = [f"{run['blender']}, {run['vertices']:,} vertices: {run['without_shape_keys']['evaluate_ms']:.2f} ms "
-            f"against {run['dynamic_read']['evaluate_ms']:.2f} with the playback key" for run in runs
+            f"against {run['dynamic_read']['evaluate_ms']:.2f} with the display" for run in runs
             if "without_shape_keys" in run]
     if bare:
-        out += ["", "Blender's evaluation of the same mesh without shape keys, its vertex positions written (a copy on "
-                "another object): what the shape key's blend costs of \"evaluate\": " + "; ".join(bare) + "."]
+        out += ["", "Blender's evaluation of the same mesh without the display, its vertex positions written (a copy "
+                "on another object, as a stand-in mesh would show the frame): what the display's modifier costs of "
+                "\"evaluate\": " + "; ".join(bare) + "."]
     targets = common.FRAME_TARGETS_MS
     checks = [f"{run['blender']}, {run['vertices']:,} vertices: ≤ {targets[run['vertices']]:.0f} ms — "
               f"**{'met' if total <= targets[run['vertices']] else 'NOT met'}** ({total:.1f} ms)"

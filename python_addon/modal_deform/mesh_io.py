@@ -108,9 +108,9 @@ def remove_shape_keys(obj, names):
 
 def _float3_view(items):
     """A writeable #items by 3 float32 view of the Blender array behind the RNA collection `items`
-    (a shape key's points, a mesh's vertices), each item starting with its float[3] position. The
-    stride is the distance between the first two items: 12 bytes for a float[3] array, 16 for
-    Blender 3.4's MVert."""
+    (a shape key's points, a mesh's vertices, a vector attribute's values), each item starting with
+    its float[3] position. The stride is the distance between the first two items: 12 bytes for a
+    float[3] array, 16 for Blender 3.4's MVert."""
     count = len(items)
     if not count:
         return np.empty((0, 3), np.float32)
@@ -136,6 +136,17 @@ def shape_key_co(mesh, block):
         raise ValueError(f"shape key '{block.name}' has {count} points for {len(mesh.vertices)} vertices: "
                          f"the mesh changed")
     return _float3_view(block.data)
+
+
+def attribute_co(mesh, attribute):
+    """The values of the FLOAT_VECTOR point attribute `attribute` of `mesh`: a writeable #V by 3
+    float32 view of Blender's own array, as shape_key_co gives a key's (checked against the mesh and
+    read anew each time: use at once, never keep it)."""
+    count = len(attribute.data)
+    if attribute.data_type != "FLOAT_VECTOR" or attribute.domain != "POINT" or count != len(mesh.vertices):
+        raise ValueError(f"attribute '{attribute.name}' is {attribute.data_type} on {count} "
+                         f"{attribute.domain.lower()}s, not a vector on each of the {len(mesh.vertices)} vertices")
+    return _float3_view(attribute.data)
 
 
 def vertex_positions(mesh):

@@ -7,13 +7,11 @@ the simulation from the previous frame's state) and cached; a frame further on i
 computing every frame in between (a jump forward simulates from the last cached frame and maps
 only the frame it shows). Before the cache's first frame the mesh holds that frame's shape.
 
-The result is shown in the "Modal Deform Playback" shape key at value 1 (the artist's mesh stays in
-the reference key; the "Modal Deform" pose key is muted while the cache plays, as it would add on
-top). Blender blends shape keys over every vertex at each evaluation: at 1.6M vertices that, not the
-map, is most of a frame (docs/benchmarks.md, "Animation cache and secondary motion": tens of ms
-against 0.3 for the same mesh without shape keys). Frames computed here are checked against what
-they were computed from each time they are shown (frame_cache: settings, basis, keyframes, the
-controllers' transforms at that frame) and computed again from there when that changed.
+The result is shown by playback_display.py: mapped straight into a point attribute that a Geometry
+Nodes modifier sets the positions from (the artist's positions and shape keys are not written).
+Frames computed here are checked against what they were computed from each time they are shown
+(frame_cache: settings, basis, keyframes, the controllers' transforms at that frame) and computed
+again from there when that changed.
 """
 import types
 
@@ -21,11 +19,10 @@ import bpy
 import numpy as np
 
 from . import core as mdc
-from . import frame_cache, handles, mesh_io, posing, storage
+from . import frame_cache, handles, mesh_io, playback_display, posing, storage
 
-PLAYBACK_KEY = "Modal Deform Playback"
 #: Errors that stop an object's playback with a message for the panel (not baked, stale, a bad
-#: handle or setting); the mesh then shows what it showed before.
+#: handle or setting); the display goes, and the mesh shows what it shows without it.
 FAILURES = (storage.NotReady, handles.HandleError, ValueError, RuntimeError)
 
 # Runtime state, by object name: the Player (solver or simulation kept between frames), and the
@@ -124,6 +121,11 @@ def wants_playback(obj):
     Object Mode (Edit, Sculpt and Paint Modes show the mesh being edited), not being posed."""
     if obj.type != "MESH" or obj.library is not None or obj.mode != "OBJECT" or posing.is_posing(obj):
         return False
+    return plays(obj)
+
+
+def plays(obj):
+    """Whether obj has a cache or dynamics on (a mesh)."""
     return obj.modal_deform.dynamics.enabled or obj.modal_deform.dynamics.cache is not None
 
 
@@ -179,39 +181,29 @@ def show(obj, scene):
     index = cache.row(frame)
     if index is not None and not np.array_equal(player_.transforms(obj).ravel(), cache.array("transforms")[index]):
         cache.cut(frame)
-    # A frame simulated here is mapped by its step straight into the key (no copy between).
-    if not fill(obj, scene, cache, shown, player_, out=lambda: playback_key_co(obj)):
-        player_.positions(cache.state(shown)[0], playback_key_co(obj))
+    # A frame simulated here is mapped by its step straight into the display (no copy between).
+    if not fill(obj, scene, cache, shown, player_, out=lambda: playback_display.positions(obj)):
+        player_.positions(cache.state(shown)[0], playback_display.positions(obj))
     obj.data.update()
-
-
-def playback_key_co(obj):
-    """The positions of the playback shape key (created on first use, shown at value 1, the pose
-    key muted): mesh_io.shape_key_co's view, to write into at once."""
-    block, _ = mesh_io.shape_key(obj, PLAYBACK_KEY)
-    if block.value != 1.0 or block.mute:
-        block.value, block.mute = 1.0, False
-    pose = obj.data.shape_keys.key_blocks.get(posing.POSE_KEY)
-    if pose is not None and not pose.mute:
-        pose.mute = True
-    return mesh_io.shape_key_co(obj.data, block)
 
 
 def free(obj):
-    """Forget obj's cache and its playback key: the mesh shows what it shows without them."""
+    """Forget obj's cache and its display: the mesh shows what it shows without them."""
     frame_cache.free(obj)
     _players.pop(obj.name, None)
     problems.pop(obj.name, None)
-    mesh_io.remove_shape_keys(obj, [PLAYBACK_KEY])
-    obj.data.update()
+    playback_display.remove(obj)
 
 
 @bpy.app.handlers.persistent
 def _frame_changed(scene, depsgraph=None):
     if _busy:
         return
+    displayed = playback_display.in_use()
     for obj in scene.objects:
         if not wants_playback(obj):
+            if displayed and obj.type == "MESH" and obj.library is None and not plays(obj):  # freed, dynamics off
+                playback_display.remove(obj)
             continue
         try:
             show(obj, scene)
@@ -220,6 +212,7 @@ def _frame_changed(scene, depsgraph=None):
             if problems.get(obj.name) != str(error):
                 print(f"Modal Deform: '{obj.name}' cannot play: {error}")
             problems[obj.name] = str(error)
+            playback_display.remove(obj)
 
 
 @bpy.app.handlers.persistent
@@ -237,3 +230,4 @@ def unregister():
     bpy.app.handlers.frame_change_post.remove(_frame_changed)
     bpy.app.handlers.load_post.remove(_forget)
     _forget()
+    playback_display.remove_all()

@@ -10,7 +10,7 @@ leaves on a mesh (POSING_FLAG, STAND_IN_OF) let pose_recovery.py repair a mesh w
 import bpy
 import numpy as np
 
-from . import mesh_io, posing
+from . import mesh_io, playback_display, posing
 
 #: A mesh ID property: while it is set, the mesh's positions hold a pose and its rest is the
 #: stored basis's. A file or undo step written mid-pose carries it, and pose_recovery repairs them.
@@ -57,7 +57,9 @@ class ShapeKeyState:
 
 def display(obj):
     """Where the interactive pose shows the pose of obj: the vertex positions of a mesh without
-    shape keys, a stand-in's when only the "Modal Deform" key moves the mesh, else that key."""
+    shape keys, a stand-in's when only the "Modal Deform" key moves the mesh, else that key. A frame
+    playback shows goes first (it would hide the pose)."""
+    playback_display.remove(obj)
     if obj.data.shape_keys is None:
         return PositionsDisplay(obj)
     return StandInDisplay(obj) if only_pose_key_moves(obj, obj.data) else ShapeKeyDisplay(obj)

@@ -12,7 +12,7 @@ piece of posing state, is `running` here.
 import numpy as np
 
 from . import core as mdc
-from . import handles, mesh_io, storage
+from . import handles, mesh_io, playback_display, storage
 
 POSE_KEY = "Modal Deform"
 #: The interactive pose under way, or None: ops_pose's operator, set while it runs. Besides .pose
@@ -97,9 +97,11 @@ def header_text(stats, tick_ms):
 
 def pose_key(obj):
     """The "Modal Deform" shape key, created if needed (after a Basis key when the mesh has none),
-    shown at value 1; returns (key block, names of the keys created here)."""
+    shown at value 1 (a frame playback shows goes: it would hide the key); returns (key block,
+    names of the keys created here)."""
     block, created = mesh_io.shape_key(obj, POSE_KEY)
     block.value, block.mute = 1.0, False
+    playback_display.remove(obj)
     return block, created
 
 

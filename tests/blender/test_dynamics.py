@@ -17,3 +17,7 @@ def test_static_cache_plays_the_per_frame_solve_and_exports_to_mesh_cache_and_sh
     out = run_blender("animation_bake.py").stdout
     assert "POINT_CACHE_OK" in out and "ANIMATED" in out
     assert "PLAYBACK_OK" in run_blender("animation_playback.py", blend=tmp_path / "animated.blend", addon=False).stdout
+
+
+def test_playback_shows_frames_through_its_modifier_and_takes_it_away(run_blender):
+    assert "DISPLAY_OK" in run_blender("playback_display.py").stdout

@@ -10,11 +10,7 @@ import support  # noqa: E402
 
 frame_cache, playback = support.enable_addon("frame_cache", "playback")
 kind = support.arguments()[0]
-obj, V = support.baked_suzanne(1, 15, 20, 400)
-controller = support.top_and_bottom_handles(obj, V).controller
-controller.keyframe_insert("location", frame=1)
-controller.location.y += 0.5
-controller.keyframe_insert("location", frame=6)
+obj, V, _ = support.keyed_suzanne(6, 15, 20, 400)
 obj.modal_deform.dynamics.enabled = kind == "dynamic"
 assert bpy.ops.modal_deform.bake_animation(frame_start=1, frame_end=12) == {"FINISHED"}
 cache = frame_cache.get(obj)
@@ -23,7 +19,7 @@ scene = bpy.context.scene
 shown = []
 for frame in range(1, 13):
     scene.frame_set(frame)
-    shown.append(support.key_positions(obj, playback.PLAYBACK_KEY))
+    shown.append(support.evaluated_positions(obj))
 np.save(support.tmp("shown.npy"), np.array(shown))
 np.save(support.tmp("rest.npy"), V)
 with open(support.tmp("digest.txt"), "w") as f:

@@ -58,6 +58,17 @@ def top_and_bottom_handles(obj, rest):
     return top
 
 
+def keyed_suzanne(last_frame, modes, derivatives, ghost):
+    """baked_suzanne(1, ...) with top_and_bottom_handles, the top's controller keyed to slide by 0.5
+    along y from frame 1 to `last_frame`; (obj, rest positions, controller)."""
+    obj, rest = baked_suzanne(1, modes, derivatives, ghost)
+    controller = top_and_bottom_handles(obj, rest).controller
+    controller.keyframe_insert("location", frame=1)
+    controller.location.y += 0.5
+    controller.keyframe_insert("location", frame=last_frame)
+    return obj, rest, controller
+
+
 def positions(obj):
     co = np.empty(3 * len(obj.data.vertices), np.float32)
     obj.data.vertices.foreach_get("co", co)

@@ -1,0 +1,146 @@
+"""Where playback shows a frame: a point attribute of the mesh that a Geometry Nodes modifier, first in
+the object's stack, sets the positions from (Set Position from a Named Attribute).
+
+The artist's positions and shape keys are never written: Edit Mode (the modifier is hidden there)
+shows the rest, and a file written mid-playback (a crash's autosave) holds the mesh as it was plus
+the frame in the attribute. Where the attribute is missing the modifier leaves the positions alone
+(the Named Attribute node's "Exists" is Set Position's selection; Blender 3.4 has no such output:
+there a BOOLEAN point attribute, SHOWN, written True with the attribute, is the selection, and goes
+with it), so taking the attribute away shows the mesh as before, and a mesh joined to one that
+plays keeps its own positions. Blender evaluates the modifier in 4.8 to 9.0 ms at 1.6M vertices
+where it blended the playback shape key this replaces in 11.4 to 20.0 (bench/results/playback.json,
+"evaluate_ms", against its record at 246d346); Blender 4+ copies the attribute's array once a frame
+when it is written (positions(): 1.7 ms at 1.6M), as the evaluated mesh shares it until then.
+
+Taken away (remove) when the cache is freed or no longer plays, when a pose shows (the interactive
+pose, or a result in the "Modal Deform" shape key: pose_displays.display, posing.pose_key) and when
+the add-on is disabled.
+"""
+import bpy
+import numpy as np
+
+from . import mesh_io
+
+#: The modifier on an object that plays a cache, and its node group (one per file, shared), which
+#: carries the ID property MARK: the modifier is the one whose node group has it, whatever their names.
+MODIFIER = "Modal Deform Playback"
+NODE_GROUP = "Modal Deform Playback"
+MARK = "modal_deform_playback"
+#: The FLOAT_VECTOR point attribute holding the frame's positions (object space).
+ATTRIBUTE = "modal_deform_playback"
+#: Blender 3.4's selection (see the module's comment): True on every point where ATTRIBUTE holds a frame.
+SHOWN = "modal_deform_playback_shown"
+
+
+def _named_attribute(tree, data_type, name):
+    node = tree.nodes.new("GeometryNodeInputNamedAttribute")
+    node.data_type = data_type
+    node.inputs["Name"].default_value = name
+    # Before Blender 4.0 the node has an "Attribute" output per data type, data_type's enabled.
+    return node, next(o for o in node.outputs if o.name == "Attribute" and o.enabled)
+
+
+def node_group():
+    """The file's node group (made on first use): Geometry → Set Position (Position: ATTRIBUTE,
+    Selection: where it exists) → Geometry."""
+    tree = next((g for g in bpy.data.node_groups if g.library is None and g.get(MARK)), None)
+    if tree is not None:
+        return tree
+    tree = bpy.data.node_groups.new(NODE_GROUP, "GeometryNodeTree")
+    tree[MARK] = True
+    if hasattr(tree, "interface"):  # Blender 4.0+
+        tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+        tree.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    else:
+        tree.inputs.new("NodeSocketGeometry", "Geometry")
+        tree.outputs.new("NodeSocketGeometry", "Geometry")
+    group_in, group_out = tree.nodes.new("NodeGroupInput"), tree.nodes.new("NodeGroupOutput")
+    set_position = tree.nodes.new("GeometryNodeSetPosition")
+    positions, position_output = _named_attribute(tree, "FLOAT_VECTOR", ATTRIBUTE)
+    if "Exists" in positions.outputs:
+        selection = positions.outputs["Exists"]
+    else:
+        selection = _named_attribute(tree, "BOOLEAN", SHOWN)[1]
+    tree.links.new(group_in.outputs[0], set_position.inputs["Geometry"])
+    tree.links.new(position_output, set_position.inputs["Position"])
+    tree.links.new(selection, set_position.inputs["Selection"])
+    tree.links.new(set_position.outputs[0], group_out.inputs[0])
+    return tree
+
+
+def _add_modifier(obj):
+    """The modifier, new, first in obj's stack (before the artist's modifiers: they act on the frame),
+    hidden in Edit Mode (which shows the mesh being edited)."""
+    modifier = obj.modifiers.new(MODIFIER, "NODES")
+    modifier.node_group = node_group()
+    modifier.show_in_editmode = modifier.show_on_cage = False
+    if len(obj.modifiers) > 1:
+        if hasattr(obj.modifiers, "move"):  # Blender 4.0+
+            obj.modifiers.move(len(obj.modifiers) - 1, 0)
+        else:
+            with bpy.context.temp_override(object=obj):
+                bpy.ops.object.modifier_move_to_index(modifier=modifier.name, index=0)
+    return modifier
+
+
+def modifier_of(obj):
+    """obj's display modifier, or None."""
+    return next((m for m in obj.modifiers if m.type == "NODES" and m.node_group is not None and m.node_group.get(MARK)),
+                None)
+
+
+def positions(obj):
+    """Where the frame shown on obj goes: ATTRIBUTE's #V by 3 float32 view (mesh_io.attribute_co),
+    with the modifier that shows it (made if needed). Use at once, then tag the mesh (mesh.update())."""
+    modifier = modifier_of(obj) or _add_modifier(obj)
+    mesh = obj.data
+    attributes = mesh.attributes
+    if attributes.get(ATTRIBUTE) is None:
+        attributes.new(ATTRIBUTE, "FLOAT_VECTOR", "POINT")
+        if _reads_shown(modifier.node_group):
+            shown = attributes.get(SHOWN) or attributes.new(SHOWN, "BOOLEAN", "POINT")
+            shown.data.foreach_set("value", np.ones(len(mesh.vertices), bool))
+    return mesh_io.attribute_co(mesh, attributes[ATTRIBUTE])
+
+
+def _reads_shown(tree):
+    """Whether the node group takes its selection from SHOWN (made in Blender 3.4)."""
+    return any(node.bl_idname == "GeometryNodeInputNamedAttribute" and node.inputs["Name"].default_value == SHOWN
+               for node in tree.nodes)
+
+
+def in_use():
+    """Whether an object of the file may show the display (a node group of it has users): when not,
+    the frame handler looks at no object for a display to take away."""
+    return any(tree.users and tree.get(MARK) for tree in bpy.data.node_groups)
+
+
+def shows(obj):
+    """Whether obj carries the display (its modifier or attribute)."""
+    return obj.type == "MESH" and (ATTRIBUTE in obj.data.attributes or modifier_of(obj) is not None)
+
+
+def remove(obj):
+    """Take the display off obj (its modifier and attributes): the mesh shows what it shows without it."""
+    if not shows(obj):
+        return
+    modifier = modifier_of(obj)
+    if modifier is not None:
+        obj.modifiers.remove(modifier)
+    mesh = obj.data
+    if mesh.library is not None:  # a linked mesh's attribute is the library's: the modifier alone goes
+        return
+    for name in (ATTRIBUTE, SHOWN):
+        attribute = mesh.attributes.get(name)
+        if attribute is not None:
+            mesh.attributes.remove(attribute)
+    mesh.update()
+
+
+def remove_all():
+    """Take the display off every object of the file, and its node group (disabling the add-on)."""
+    for obj in bpy.data.objects:
+        if obj.library is None:
+            remove(obj)
+    for tree in [g for g in bpy.data.node_groups if g.library is None and g.get(MARK) and g.users == 0]:
+        bpy.data.node_groups.remove(tree)
