@@ -116,7 +116,8 @@ class Simulation(_InBasis):
     def set_state(self, q, v, transforms=None):
         """Puts the simulation at (q, v), e.g. a cached frame's, or a pose's ``ReducedSolver.q``
         with zero velocity. ``transforms``: the controllers' at that state (one 4x4 per handle), the
-        start of the next step; None keeps the current ones."""
+        start of the next step; None keeps the current ones. BFGS's memory (step()) is forgotten
+        unless this is the simulation's own state, bit for bit."""
         r = self.dimension
         q = _arrays.values(q, "q", r)
         v = _arrays.values(v, "v", r)
