@@ -77,8 +77,8 @@ BfgsResult Bfgs::minimize(const Objective& objective, int max_iterations, double
       break;
     }
     p_.noalias() = -H_ * gradient_;
-    const double scale = 1 + std::abs(value_), predicted_decrease = -gradient_.dot(p_);
-    if (finish == Finish::kPredicted && predicted_decrease >= 0 && predicted_decrease < tolerance * scale &&
+    const double scale = 1 + std::abs(value_), model_decrease = -0.5 * gradient_.dot(p_);
+    if (finish == Finish::kPredicted && model_decrease >= 0 && model_decrease < tolerance * scale &&
         p_.norm() < sqrt_tolerance * (1 + x_.norm()) && gradient_.norm() <= cbrt_tolerance * scale) {
       x_ += p_;
       evaluated_ = false;

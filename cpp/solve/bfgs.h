@@ -18,8 +18,8 @@
 // until the objective changes.
 //
 // With Finish::kPredicted the test is also taken before each step on the step BFGS predicts,
-// p = −H∇f: when ½|∇fᵀp| (the model's decrease, counted twice) and ‖p‖ pass the first two bounds
-// and ‖∇f‖ the third, x + p is taken unevaluated and the call ends converged. Near a minimum the
+// p = −H∇f: when the decrease its quadratic model predicts, ½|∇fᵀp|, and ‖p‖ pass the first two
+// bounds and ‖∇f‖ the third, x + p is taken unevaluated and the call ends converged. Near a minimum the
 // quasi-Newton step is accepted whole, so x + p is the point the last step would reach, without
 // the evaluation that only confirms it: for a caller that needs x alone, not f and ∇f there.
 #pragma once
