@@ -44,6 +44,9 @@ void bind_dynamics(py::module_& m) {
           },
           py::arg("transforms"))
       .def("set_state", &ReducedDynamics::set_state, py::arg("q"), py::arg("v"), py::arg("transforms"))
+      .def("forget", &ReducedDynamics::forget)
+      .def_property_readonly("remembered_frames", &ReducedDynamics::remembered_frames)
+      .def_property_readonly("memory_frames", &ReducedDynamics::memory_frames)
       .def("positions", &ReducedDynamics::positions, py::arg("out").noconvert(),
            py::call_guard<py::gil_scoped_release>())
       .def("positions_of", &ReducedDynamics::positions_of, py::arg("q"), py::arg("out").noconvert(),

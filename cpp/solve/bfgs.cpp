@@ -34,6 +34,15 @@ void Bfgs::move_to(const Eigen::VectorXd& x) {
   evaluated_ = converged_ = false;
 }
 
+void Bfgs::set_value_and_gradient(double value, const VectorRef& gradient) {
+  if (gradient.size() != x_.size())
+    throw InputError(message("gradient: expected ", x_.size(), " values, got ", gradient.size()));
+  value_ = value;
+  gradient_ = gradient;
+  evaluated_ = true;
+  converged_ = false;
+}
+
 void Bfgs::objective_changed(double value_change, const VectorRef& gradient_change) {
   converged_ = false;
   if (!evaluated_) return;
@@ -43,7 +52,8 @@ void Bfgs::objective_changed(double value_change, const VectorRef& gradient_chan
 
 void Bfgs::objective_changed() { evaluated_ = converged_ = false; }
 
-BfgsResult Bfgs::minimize(const Objective& objective, int max_iterations, double tolerance, double budget_ms) {
+BfgsResult Bfgs::minimize(const Objective& objective, int max_iterations, double tolerance, double budget_ms,
+                          Finish finish) {
   using Clock = std::chrono::steady_clock;
   const Clock::time_point start = Clock::now();
   if (max_iterations < 0) throw InputError(message("max_iterations: expected at least 0, got ", max_iterations));
@@ -67,6 +77,15 @@ BfgsResult Bfgs::minimize(const Objective& objective, int max_iterations, double
       break;
     }
     p_.noalias() = -H_ * gradient_;
+    const double scale = 1 + std::abs(value_), model_decrease = -0.5 * gradient_.dot(p_);
+    if (finish == Finish::kPredicted && model_decrease >= 0 && model_decrease < tolerance * scale &&
+        p_.norm() < sqrt_tolerance * (1 + x_.norm()) && gradient_.norm() <= cbrt_tolerance * scale) {
+      x_ += p_;
+      evaluated_ = false;
+      converged_ = true;
+      ++result.iterations;
+      break;
+    }
     LineSearchResult search;
     if (gradient_.dot(p_) < 0) {
       search = wolfe_line_search(objective, x_, value_, gradient_, p_, x_new_, value_new_, gradient_new_);

@@ -16,6 +16,12 @@
 // predicted decrease −∇fᵀp is below 1e-12 (1 + |f|), which f cannot resolve (a minimum at working
 // precision: a small ε can ask for more than that). Once converged, further calls return at once
 // until the objective changes.
+//
+// With Finish::kPredicted the test is also taken before each step on the step BFGS predicts,
+// p = −H∇f: when the decrease its quadratic model predicts, ½|∇fᵀp|, and ‖p‖ pass the first two
+// bounds and ‖∇f‖ the third, x + p is taken unevaluated and the call ends converged. Near a minimum the
+// quasi-Newton step is accepted whole, so x + p is the point the last step would reach, without
+// the evaluation that only confirms it: for a caller that needs x alone, not f and ∇f there.
 #pragma once
 
 #include <limits>
@@ -24,6 +30,12 @@
 #include "util/types.h"
 
 namespace modal_deform {
+
+// How a converging call ends (the stopping tests above).
+enum class Finish {
+  kEvaluated,  // at a point whose f and ∇f are evaluated
+  kPredicted,  // possibly at the unevaluated x + p of a predicted step within the tolerance
+};
 
 struct BfgsResult {
   int iterations = 0;   // steps taken by this call
@@ -46,6 +58,10 @@ class Bfgs {
   // the next minimize.
   void move_to(const Eigen::VectorXd& x);
 
+  // f and ∇f at the current x are `value` and `gradient` (n), known to the caller (e.g. from the
+  // terms of a state it holds): the next minimize starts from them without evaluating f there.
+  void set_value_and_gradient(double value, const VectorRef& gradient);
+
   // The objective changed by `value_change` and `gradient_change` (n) at the current x.
   void objective_changed(double value_change, const VectorRef& gradient_change);
   // The objective changed in an unknown way: f and ∇f are evaluated again by the next minimize.
@@ -61,11 +77,12 @@ class Bfgs {
   // call unconverged and stalled (the objective cannot be decreased at this precision). Throws
   // NumericalError when f is not finite at the current x.
   BfgsResult minimize(const Objective& objective, int max_iterations, double tolerance,
-                      double budget_ms = std::numeric_limits<double>::infinity());
+                      double budget_ms = std::numeric_limits<double>::infinity(),
+                      Finish finish = Finish::kEvaluated);
 
   const Eigen::VectorXd& x() const { return x_; }
   const Eigen::MatrixXd& inverse_hessian() const { return H_; }
-  // f and ∇f at x; valid after a minimize.
+  // f and ∇f at x; valid after a minimize, unless it ended on a predicted step (Finish::kPredicted).
   double value() const { return value_; }
   const Eigen::VectorXd& gradient() const { return gradient_; }
 

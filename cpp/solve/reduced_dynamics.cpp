@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <complex>
+#include <limits>
 
 #include "reduction/region.h"
 #include "util/errors.h"
@@ -51,6 +52,8 @@ void check_simulation_options(const SimulationOptions& options) {
     throw InputError(message("damping: expected a damping ratio in [0, 1], got ", options.damping));
   if (options.substeps < 1 || options.substeps > kMaxSubsteps)
     throw InputError(message("substeps: expected an integer in [1, ", kMaxSubsteps, "], got ", options.substeps));
+  if (options.memory_frames < 1)
+    throw InputError(message("memory_frames: expected at least 1, got ", options.memory_frames));
   if (options.max_iterations < 1)
     throw InputError(message("max_iterations: expected at least 1, got ", options.max_iterations));
   if (!(options.tolerance > 0 && options.tolerance < 1))
@@ -137,7 +140,8 @@ void ReducedDynamics::set_state(const Eigen::VectorXd& q, const Eigen::VectorXd&
     throw InputError("v: has non-finite entries, or a kinetic energy beyond double precision");
   if (!transforms.empty()) check_transforms(transforms, num_handles());
   // The simulation's own state (playback sets each frame's cached state before stepping from it)
-  // is kept: its energy and gradient were evaluated there, at these transforms, by the last step.
+  // is kept: its energy and gradient were evaluated there, at these transforms, by the last step,
+  // and BFGS's memory is the one that step left.
   if (q_.size() == r && q == q_ && v == v_ && (transforms.empty() || transforms == transforms_)) return;
   Eigen::VectorXd gradient(r);
   const double elastic_energy = ghost_energy_.value_and_gradient(q, gradient);
@@ -147,8 +151,10 @@ void ReducedDynamics::set_state(const Eigen::VectorXd& q, const Eigen::VectorXd&
     transforms_ = transforms;
     handle_term_.set_transforms(transforms_);
   }
+  forget();
   q_ = q;
   v_ = v;
+  elastic_energy_ = elastic_energy;
   elastic_gradient_ = std::move(gradient);
   potential_ = elastic_energy + handle_term_.value_and_gradient(q_, handle_gradient_);
   fine_positions_.set(q_);
@@ -157,10 +163,15 @@ void ReducedDynamics::set_state(const Eigen::VectorXd& q, const Eigen::VectorXd&
 double ReducedDynamics::incremental_potential(const Eigen::VectorXd& x, Eigen::VectorXd& gradient) {
   const double elastic_energy = ghost_energy_.value_and_gradient(x, work_gradient_);
   if (!std::isfinite(elastic_energy)) return elastic_energy;
+  return incremental_potential(x, elastic_energy, work_gradient_, gradient);
+}
+
+double ReducedDynamics::incremental_potential(const Eigen::VectorXd& x, double elastic_energy,
+                                              const Eigen::VectorXd& elastic_gradient, Eigen::VectorXd& gradient) {
   const double handles = handle_term_.value_and_gradient(x, handle_gradient_);
   gradient = x - prediction_;
   const double inertia = 0.5 * gradient.squaredNorm();
-  gradient += potential_weight_ * (damping_weight_ * (work_gradient_ + handle_gradient_) - damping_pull_);
+  gradient += potential_weight_ * (damping_weight_ * (elastic_gradient + handle_gradient_) - damping_pull_);
   return inertia + potential_weight_ * (damping_weight_ * (elastic_energy + handles) - damping_pull_.dot(x));
 }
 
@@ -188,7 +199,7 @@ SimulationStepStats ReducedDynamics::step(const Transforms& transforms) {
   SimulationStepStats stats;
   const int substeps = options_.substeps;
   Transforms substep_start = transforms_;
-  midpoint_started_ = euler_started_ = false;
+  if (remembered_frames_ == options_.memory_frames) forget();
   for (int k = 0; k < substeps; ++k) {
     const Transforms middle = interpolated(transforms, (k + 0.5) / substeps);
     const Transforms end = interpolated(transforms, static_cast<double>(k + 1) / substeps);
@@ -197,23 +208,33 @@ SimulationStepStats ReducedDynamics::step(const Transforms& transforms) {
   }
   transforms_ = transforms;
   fine_positions_.set(q_);
+  ++remembered_frames_;
   stats.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return stats;
 }
 
+void ReducedDynamics::forget() {
+  midpoint_started_ = euler_started_ = false;
+  remembered_frames_ = 0;
+}
+
 void ReducedDynamics::minimize(Bfgs& bfgs, bool& started, const Eigen::MatrixXd& initial_inverse_hessian,
-                               const Eigen::VectorXd& start, SimulationStepStats& stats) {
+                               Finish finish, SimulationStepStats& stats) {
   // Φ changes from substep to substep by linear terms only: BFGS keeps what it learnt of its
-  // curvature within a frame, and starts each frame afresh, so that a frame depends on nothing
-  // but the state it starts from (a cached state continues as the run did).
+  // curvature (the step's header comment says for how long).
   if (started)
-    bfgs.move_to(start);
+    bfgs.move_to(q_);
   else
-    bfgs.start(start, initial_inverse_hessian);
+    bfgs.start(q_, initial_inverse_hessian);
   started = true;
+  // From q_n, where the state holds E and ∇E: the first trial is the quasi-Newton step −H∇Φ(q_n),
+  // for a quadratic energy the minimiser itself, at no evaluation of the ghost energy.
+  Eigen::VectorXd gradient(q_.size());
+  const double value = incremental_potential(q_, elastic_energy_, elastic_gradient_, gradient);
+  bfgs.set_value_and_gradient(value, gradient);
   const BfgsResult result = bfgs.minimize(
       [this](const Eigen::VectorXd& x, Eigen::VectorXd& gradient) { return incremental_potential(x, gradient); },
-      options_.max_iterations, options_.tolerance);
+      options_.max_iterations, options_.tolerance, std::numeric_limits<double>::infinity(), finish);
   stats.iterations += result.iterations;
   stats.evaluations += result.evaluations;
   stats.converged = stats.converged && result.converged;
@@ -225,16 +246,15 @@ void ReducedDynamics::substep(const Transforms& start, const Transforms& middle,
                               SimulationStepStats& stats) {
   ++stats.substeps;
   const double energy_before = energy();
-  // The midpoint rule: Φ over the middle state, from the inertial prediction (from q_n, inside
-  // the energies' range, when the prediction leaves it).
+  // The midpoint rule: Φ over the middle state.
   prediction_ = q_ + (h_ / 2) * v_;
   handle_term_.value_and_gradient(q_, handle_gradient_);
   damping_pull_ = (2 * rayleigh_ / h_) * (elastic_gradient_ + handle_gradient_);
   damping_weight_ = 1 + 2 * rayleigh_ / h_;
   potential_weight_ = midpoint_weight_;
   handle_term_.set_transforms(middle);
-  const Eigen::VectorXd& start_state = ghost_energy_.in_range(prediction_) ? prediction_ : q_;
-  minimize(midpoint_bfgs_, midpoint_started_, midpoint_inverse_hessian_, start_state, stats);
+  // Its result is checked below: it may end on BFGS's predicted step, unevaluated (bfgs.h).
+  minimize(midpoint_bfgs_, midpoint_started_, midpoint_inverse_hessian_, Finish::kPredicted, stats);
   const Eigen::VectorXd& middle_state = midpoint_bfgs_.x();
   Eigen::VectorXd q_next = 2 * middle_state - q_;
   Eigen::VectorXd v_next = (4 / h_) * (middle_state - q_) - v_;
@@ -244,28 +264,29 @@ void ReducedDynamics::substep(const Transforms& start, const Transforms& middle,
   handle_term_.set_transforms(end);
   work += handle_term_.value_and_gradient(middle_state, handle_gradient_);
   Eigen::VectorXd gradient_next(q_.size());
-  double potential_next = ghost_energy_.value_and_gradient(q_next, gradient_next) +
-                          handle_term_.value_and_gradient(q_next, handle_gradient_);
+  double elastic_next = ghost_energy_.value_and_gradient(q_next, gradient_next);
+  double potential_next = elastic_next + handle_term_.value_and_gradient(q_next, handle_gradient_);
   if (!(potential_next <= energy_before + work)) {
     // The end state holds more energy than the step had (a non-quadratic energy's error, amplified by
     // an unconverged minimisation in a violent motion): take the substep by implicit Euler instead,
-    // Φ_E(x) = ½‖x − q_n − h v_n‖² + (h²/ρ) V(x, t_{n+1}), undamped, from q_n. BFGS only decreases Φ_E,
-    // so V(q_{n+1}, t_{n+1}) ≤ Φ_E(q_n) ρ/h² = ½ρ‖v_n‖² + V(q_n, t_{n+1}): within the energy the
-    // step had plus the handles' work at q_n, and the velocity check below holds the total there.
+    // Φ_E(x) = ½‖x − q_n − h v_n‖² + (h²/ρ) V(x, t_{n+1}), undamped, from q_n. BFGS only decreases Φ_E
+    // (it ends at an evaluated point), so V(q_{n+1}, t_{n+1}) ≤ Φ_E(q_n) ρ/h² = ½ρ‖v_n‖² + V(q_n, t_{n+1}):
+    // within the energy the step had plus the handles' work at q_n, and the velocity check below
+    // holds the total there.
     ++stats.implicit_euler;
     prediction_ = q_ + h_ * v_;
     damping_pull_.setZero();
     damping_weight_ = 1;
     potential_weight_ = euler_weight_;
-    minimize(euler_bfgs_, euler_started_, euler_inverse_hessian_, q_, stats);
+    minimize(euler_bfgs_, euler_started_, euler_inverse_hessian_, Finish::kEvaluated, stats);
     q_next = euler_bfgs_.x();
     v_next = (q_next - q_) / h_;
     handle_term_.set_transforms(start);
     work = -handle_term_.value_and_gradient(q_, handle_gradient_);
     handle_term_.set_transforms(end);
     work += handle_term_.value_and_gradient(q_, handle_gradient_);
-    potential_next = ghost_energy_.value_and_gradient(q_next, gradient_next) +
-                     handle_term_.value_and_gradient(q_next, handle_gradient_);
+    elastic_next = ghost_energy_.value_and_gradient(q_next, gradient_next);
+    potential_next = elastic_next + handle_term_.value_and_gradient(q_next, handle_gradient_);
   }
   // The energy check: the excess over the energy the step had and the work done on it comes out of
   // the kinetic energy.
@@ -278,6 +299,7 @@ void ReducedDynamics::substep(const Transforms& start, const Transforms& middle,
   }
   q_ = std::move(q_next);
   v_ = std::move(v_next);
+  elastic_energy_ = elastic_next;
   elastic_gradient_ = std::move(gradient_next);
   potential_ = potential_next;
 }

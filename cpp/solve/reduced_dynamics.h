@@ -24,8 +24,11 @@
 // and of the handles' springs, relative to the controllers' motion, so neither a rigid motion nor
 // following the controllers is damped. E_C at the substep's middle time, the controllers'
 // transforms interpolated between frames (rotation by slerp, each handle's centre on a line). Then
-// q_{n+1} = 2x − q_n, v_{n+1} = 4(x − q_n)/h − v_n. Φ is minimised by Bfgs, started from the
-// inertial prediction q_n + (h/2) v_n with the inverse of Φ's Hessian at rest, computed once.
+// q_{n+1} = 2x − q_n, v_{n+1} = 4(x − q_n)/h − v_n. Φ is minimised by Bfgs with the inverse of Φ's
+// Hessian at rest, computed once, started at q_n, where the state holds E and ∇E (the energy check
+// evaluates them at each substep's end): its first trial, the quasi-Newton step from there, is the
+// inertial prediction q_n + (h/2) v_n corrected by the forces at q_n, and costs the evaluation a
+// start at the prediction would spend on the prediction alone.
 //
 // Parameters from the artist's (exact for the lowest flexible mode of the linearised system): the
 // target poles s = ω(−ζ ± i√(1 − ζ²)), ω = 2π fps/period, are reached in discrete time when the
@@ -67,6 +70,9 @@ struct SimulationOptions {
   // (bench/results/dynamics.json, "tolerance").
   int max_iterations = 20;
   double tolerance = 1e-8;
+  // BFGS keeps what it learnt of Φ's curvature over at most this many frames (step()); 1: each
+  // frame learns afresh.
+  int memory_frames = 8;
 };
 
 // The fields of SimulationOptions by name (the Python API's keywords and SIMULATION_DEFAULTS):
@@ -80,6 +86,7 @@ void for_each_simulation_option(Visit&& visit) {
   visit("substeps", [](auto& o) -> auto& { return o.substeps; });
   visit("max_iterations", [](auto& o) -> auto& { return o.max_iterations; });
   visit("tolerance", [](auto& o) -> auto& { return o.tolerance; });
+  visit("memory_frames", [](auto& o) -> auto& { return o.memory_frames; });
 }
 
 // The shortest period accepted: a vibration faster than this is not seen as one at the frame rate,
@@ -129,11 +136,26 @@ class ReducedDynamics {
 
   // Advances one frame, the controllers reaching `transforms` (one rigid 4 by 4 per handle,
   // check_transforms) at its end.
+  //
+  // BFGS's memory: Φ changes from substep to substep and from frame to frame by linear terms
+  // and by the ghost energy's curvature along the motion, so what BFGS learnt of the curvature
+  // (its inverse Hessian) serves the next minimisations better than the rest Hessian it starts
+  // from. A step uses what the steps since the memory was last forgotten learnt, and forgets it
+  // first when it holds memory_frames frames: a frame is a function of the state it starts from
+  // and of the frames its memory holds, which a caller reproduces bit for bit by forgetting at
+  // fixed blocks of memory_frames frames and, to reach a frame in the middle of a block, stepping
+  // again from the block's first state (playback.Player.next).
   SimulationStepStats step(const Transforms& transforms);
+  // Forgets BFGS's memory: the next step learns from the rest Hessian.
+  void forget();
+  // The frames stepped since the memory was last forgotten (at most memory_frames).
+  int remembered_frames() const { return remembered_frames_; }
+  int memory_frames() const { return options_.memory_frames; }
 
   // The state: q (r) and v = dq/dt (r, per second); transforms: the controllers' at this state
   // (one per handle; empty keeps the current ones). Throws InputError for a wrong size, a
-  // non-finite entry or a q whose ghost leaves the coordinates the energies take.
+  // non-finite entry or a q whose ghost leaves the coordinates the energies take. Forgets BFGS's
+  // memory unless the state is the simulation's own (the same q, v and transforms).
   void set_state(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Transforms& transforms = {});
   const Eigen::VectorXd& q() const { return q_; }
   const Eigen::VectorXd& v() const { return v_; }
@@ -158,12 +180,15 @@ class ReducedDynamics {
   // Φ (above) for the current substep and scheme: ½‖x − prediction‖² + potential_weight
   // (damping_weight V(x) − damping_pullᵀx), V = E + E_C.
   double incremental_potential(const Eigen::VectorXd& x, Eigen::VectorXd& gradient);
+  // The same with E(x) and ∇E(x) given.
+  double incremental_potential(const Eigen::VectorXd& x, double elastic_energy, const Eigen::VectorXd& elastic_gradient,
+                               Eigen::VectorXd& gradient);
   // The inverse of I + potential_weight damping_weight (K + 2A): Φ's Hessian at rest.
   Eigen::MatrixXd inverse_rest_hessian(const Eigen::MatrixXd& K, double potential_weight, double damping_weight) const;
-  // Minimises the current Φ with `bfgs` from `start`, adding to `stats`; `started`: bfgs has
-  // minimised this scheme's Φ earlier in the frame.
-  void minimize(Bfgs& bfgs, bool& started, const Eigen::MatrixXd& initial_inverse_hessian,
-                const Eigen::VectorXd& start, SimulationStepStats& stats);
+  // Minimises the current Φ with `bfgs` from q_n, ending as `finish` says (bfgs.h), adding to
+  // `stats`; `started`: bfgs has minimised this scheme's Φ since the memory was last forgotten.
+  void minimize(Bfgs& bfgs, bool& started, const Eigen::MatrixXd& initial_inverse_hessian, Finish finish,
+                SimulationStepStats& stats);
   // Transforms at fraction a of the way from start_ to target (per handle).
   Transforms interpolated(const Transforms& target, double a) const;
   void substep(const Transforms& start, const Transforms& middle, const Transforms& end,
@@ -185,10 +210,11 @@ class ReducedDynamics {
   Eigen::MatrixXd midpoint_inverse_hessian_, euler_inverse_hessian_;
   Bfgs midpoint_bfgs_, euler_bfgs_;
   bool midpoint_started_ = false, euler_started_ = false;
+  int remembered_frames_ = 0;
 
-  // State: q, v, E(q) + E_C(q), ∇E(q).
+  // State: q, v, E(q) + E_C(q), E(q), ∇E(q).
   Eigen::VectorXd q_, v_, elastic_gradient_;
-  double potential_ = 0;
+  double potential_ = 0, elastic_energy_ = 0;
   // The current Φ's terms: the prediction (q_n + (h/2) v_n for the midpoint rule), the damping
   // term's pull ((2β/h) ∇V(q_n, t_n)) and the weights (κ, 1 + 2β/h).
   Eigen::VectorXd prediction_, damping_pull_;

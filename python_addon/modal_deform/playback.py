@@ -89,15 +89,32 @@ class Player:
             self.pose.solver.set_transforms(list(transforms))
             self.pose.converge()
             return self.pose.solver.q, None, False
-        # From the cached state and transforms, always: the same bits whether played, jumped to,
-        # baked or undone.
-        q, v = cache.state(frame - 1)
-        self.simulation.set_state(q, v, list(cache.array("transforms")[cache.row(frame - 1)].reshape(-1, 4, 4)))
+        # From the cached state and transforms, always, with BFGS's memory of the frames since the
+        # start of the frame's block (memory_frames frames from the cache's start): the same bits
+        # whether played, jumped to, baked or undone. A simulation that does not hold that memory
+        # steps again from the block's first state (at most memory_frames - 1 frames, reached from
+        # the cache alone).
+        simulation = self.simulation
+
+        def cached_transforms(f):
+            return list(cache.array("transforms")[cache.row(f)].reshape(-1, 4, 4))
+
+        def set_cached_state(f):  # BFGS's memory kept when it is the simulation's own state
+            simulation.set_state(*cache.state(f), cached_transforms(f))
+
+        block_start = frame - (frame - cache.start - 1) % simulation.memory_frames - 1
+        set_cached_state(frame - 1)
+        if simulation.remembered_frames != frame - 1 - block_start:
+            set_cached_state(block_start)
+            simulation.forget()
+            for f in range(block_start + 1, frame):
+                simulation.advance(cached_transforms(f))
+            set_cached_state(frame - 1)
         if out is None:
-            self.simulation.advance(list(transforms))
+            simulation.advance(list(transforms))
         else:
-            self.simulation.step(list(transforms), out=out())
-        q, v = self.simulation.state
+            simulation.step(list(transforms), out=out())
+        q, v = simulation.state
         return q, v, out is not None
 
     def positions(self, q, out):

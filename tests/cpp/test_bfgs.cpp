@@ -271,6 +271,40 @@ TEST(Bfgs, AKnownChangeOfTheObjectiveEqualsReevaluation) {
   EXPECT_LE((told.x() - reevaluated.x()).norm(), 1e-10);
 }
 
+TEST(Bfgs, AKnownValueAndGradientAtTheStartSaveItsEvaluation) {
+  Bfgs told, evaluated;
+  told.start(rosenbrock_start(4), Eigen::MatrixXd::Identity(4, 4));
+  evaluated.start(rosenbrock_start(4), Eigen::MatrixXd::Identity(4, 4));
+  Eigen::VectorXd g(4);
+  told.set_value_and_gradient(rosenbrock(rosenbrock_start(4), g), g);
+  const BfgsResult a = told.minimize(rosenbrock, 8, 1e-12);
+  const BfgsResult b = evaluated.minimize(rosenbrock, 8, 1e-12);
+  EXPECT_EQ(a.evaluations + 1, b.evaluations);
+  EXPECT_EQ(told.x(), evaluated.x());
+  EXPECT_THROW(told.set_value_and_gradient(0, Eigen::VectorXd::Zero(3)), InputError);
+}
+
+// Finish::kPredicted ends a converging call one evaluation early, at the unevaluated point the
+// quasi-Newton step predicts, within the tolerance of the evaluated finish's point.
+TEST(Bfgs, APredictedFinishSavesTheConfirmingEvaluation) {
+  for (double tolerance : {1e-8, 1e-10, 1e-12}) {
+    Bfgs predicted, evaluated;
+    predicted.start(rosenbrock_start(6), Eigen::MatrixXd::Identity(6, 6));
+    evaluated.start(rosenbrock_start(6), Eigen::MatrixXd::Identity(6, 6));
+    const BfgsResult a = predicted.minimize(rosenbrock, 500, tolerance, std::numeric_limits<double>::infinity(),
+                                            Finish::kPredicted);
+    const BfgsResult b = evaluated.minimize(rosenbrock, 500, tolerance);
+    ASSERT_TRUE(a.converged && b.converged) << tolerance;
+    EXPECT_LT(a.evaluations, b.evaluations) << tolerance;
+    EXPECT_LE((predicted.x() - Eigen::VectorXd::Ones(6)).norm(), 10 * std::sqrt(tolerance)) << tolerance;
+    EXPECT_LE((predicted.x() - evaluated.x()).norm(), std::sqrt(tolerance) * (1 + evaluated.x().norm())) << tolerance;
+    // Converged: f and ∇f at the point taken are evaluated by the next call, which returns at once.
+    const BfgsResult again = predicted.minimize(rosenbrock, 10, tolerance);
+    EXPECT_TRUE(again.converged);
+    EXPECT_EQ(again.iterations, 0);
+  }
+}
+
 TEST(Bfgs, MoveToKeepsTheCurvatureLearnt) {
   // A quadratic learnt from the identity, then the same curvature with another linear term (the
   // next time step's incremental potential): from the same start, move_to keeps what BFGS learnt.

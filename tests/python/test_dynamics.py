@@ -132,7 +132,9 @@ def test_a_run_is_deterministic_and_its_state_reloads_bit_identical(tube):
     a, b = run(first, moves), run(second, moves)
     assert all(np.array_equal(x, y) for x, y in zip(a, b))
     assert all(np.array_equal(x, y) for x, y in zip(first.state, second.state))
-    # A cache: the state after frame 8, reloaded into a fresh simulation, continues bit-identical.
+    # A cache: the state after frame 8 (the end of a block of BFGS's memory: memory_frames frames
+    # from the start), reloaded into a fresh simulation, continues bit-identical.
+    assert first.memory_frames == mdc.SIMULATION_DEFAULTS["memory_frames"] == 8
     cached = mdc.Simulation(basis, handles)
     run(cached, moves[:8])
     q, v = cached.state
@@ -153,6 +155,55 @@ def test_a_run_is_deterministic_and_its_state_reloads_bit_identical(tube):
     cached.set_state(q, v, moves[7])
     assert cached.energy() == energy
     assert all(np.array_equal(x, y) for x, y in zip(run(cached, moves[8:]), a[8:]))
+
+
+def test_bfgs_memory_spans_blocks_of_frames_and_a_frame_inside_one_is_reached_again(tube):
+    V, F, handles, basis = tube
+    centre = V[handles[1]].mean(axis=0)
+    moves = [[np.eye(4), rigid([1, 0, 0], np.radians(5) * k, centre)] for k in range(1, 13)]
+    played = mdc.Simulation(basis, handles, memory_frames=4)
+    states, evaluations = [(played.state, [np.eye(4)] * 2)], 0
+    for k, T in enumerate(moves):
+        played.advance(T)
+        evaluations += played.stats["evaluations"]
+        assert played.remembered_frames == k % 4 + 1 and played.stats["converged"]
+        states.append((played.state, T))
+    # Frame 7 from the cached state of frame 6 in a simulation that does not remember frames 5 and 6
+    # (a set_state of a state not its own forgets): a different minimisation, the same motion
+    # within the solver's tolerance.
+    jumped = mdc.Simulation(basis, handles, memory_frames=4)
+    jumped.set_state(*states[6][0], states[6][1])
+    assert jumped.remembered_frames == 0
+    jumped.advance(moves[6])
+    assert jumped.stats["converged"] and not np.array_equal(jumped.state[0], states[7][0][0])
+    assert np.abs(jumped.state[0] - states[7][0][0]).max() < 1e-4 * np.abs(states[7][0][0]).max()
+    # From the block's first state (frame 4), with the memory forgotten, frames 5 and 6 stepped again:
+    # frame 7 is the same bits as played.
+    jumped.set_state(*states[4][0], states[4][1])
+    jumped.forget()
+    for T in moves[4:6]:
+        jumped.advance(T)
+    assert all(np.array_equal(x, y) for x, y in zip(jumped.state, states[6][0]))
+    jumped.set_state(*states[6][0], states[6][1])  # its own state: the memory is kept
+    assert jumped.remembered_frames == 2
+    jumped.advance(moves[6])
+    assert all(np.array_equal(x, y) for x, y in zip(jumped.state, states[7][0]))
+    # memory_frames=1: each frame from the rest Hessian, a function of the state it starts from
+    # alone, at more evaluations.
+    fresh = mdc.Simulation(basis, handles, memory_frames=1)
+    fresh_states, fresh_evaluations = [], 0
+    for T in moves:
+        fresh.advance(T)
+        fresh_evaluations += fresh.stats["evaluations"]
+        assert fresh.remembered_frames == 1
+        fresh_states.append(fresh.state)
+    alone = mdc.Simulation(basis, handles, memory_frames=1)
+    alone.set_state(*fresh_states[5], moves[5])
+    alone.advance(moves[6])
+    assert all(np.array_equal(x, y) for x, y in zip(alone.state, fresh_states[6]))
+    assert evaluations < fresh_evaluations
+    with pytest.raises(ValueError, match="memory_frames"):
+        mdc.Simulation(basis, handles, memory_frames=0)
 
 
 def test_parameters_are_defined_once_and_checked(bar):

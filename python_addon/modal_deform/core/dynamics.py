@@ -15,7 +15,7 @@ from .bake import _basis
 from .solve import _handles, _InBasis, _transforms, _weights
 
 #: The defaults of Simulation's parameters (the native core's SimulationOptions):
-#: stiffness, period (frames), damping (ratio), fps, substeps, max_iterations, tolerance.
+#: stiffness, period (frames), damping (ratio), fps, substeps, max_iterations, tolerance, memory_frames.
 SIMULATION_DEFAULTS = dict(_native.SIMULATION_DEFAULTS)
 #: The shortest period accepted, in frames, and the most substeps a frame.
 MIN_PERIOD_FRAMES = _native.MIN_PERIOD_FRAMES
@@ -31,7 +31,8 @@ class Simulation(_InBasis):
     ``damping``: its damping ratio in [0, 1]. ``fps``: frames per second (velocities are per
     second). ``substeps``: midpoint steps per frame (1 to MAX_SUBSTEPS). ``weights``: one per
     handle (default 1); ``energy``: "shells" or "arap"; ``max_iterations``, ``tolerance``: BFGS's
-    per substep. Starts at rest, at rest velocity, with every controller at the identity.
+    per substep; ``memory_frames``: the most frames BFGS's memory of the curvature spans (see
+    step()). Starts at rest, at rest velocity, with every controller at the identity.
     Raises ValueError naming the argument that is wrong.
     """
 
@@ -39,7 +40,7 @@ class Simulation(_InBasis):
                  period=SIMULATION_DEFAULTS["period"], damping=SIMULATION_DEFAULTS["damping"],
                  fps=SIMULATION_DEFAULTS["fps"], substeps=SIMULATION_DEFAULTS["substeps"], weights=None,
                  energy="shells", max_iterations=SIMULATION_DEFAULTS["max_iterations"],
-                 tolerance=SIMULATION_DEFAULTS["tolerance"]):
+                 tolerance=SIMULATION_DEFAULTS["tolerance"], memory_frames=SIMULATION_DEFAULTS["memory_frames"]):
         basis = _basis(basis)
         handles = [] if _is_empty(handles) else _handles(handles)
         weights = np.zeros(0) if not handles else _weights(weights, len(handles))
@@ -48,7 +49,8 @@ class Simulation(_InBasis):
             period=_arrays.number(period, "period"), damping=_arrays.number(damping, "damping"),
             fps=_arrays.number(fps, "fps"), substeps=_arrays.integer(substeps, "substeps"),
             max_iterations=_arrays.integer(max_iterations, "max_iterations"),
-            tolerance=_arrays.number(tolerance, "tolerance"))
+            tolerance=_arrays.number(tolerance, "tolerance"),
+            memory_frames=_arrays.integer(memory_frames, "memory_frames"))
         self._basis = basis
         self.stats = None  #: the last step's: see step()
 
@@ -66,6 +68,14 @@ class Simulation(_InBasis):
         its objective (its state is taken all the same: the step never fails), "energy_removed"
         the energy the energy check took from the motion (nonzero only where the midpoint rule
         or an unconverged substep would have created energy).
+
+        BFGS keeps what it learnt of the curvature from step to step (far fewer evaluations a
+        frame), and forgets it before a step when it holds ``memory_frames`` frames, at forget()
+        and at set_state() of a state not the simulation's own: a frame is a function of the
+        state it starts from and of the frames since the memory was forgotten
+        (``remembered_frames``). For the same bits however a frame is reached, forget at fixed
+        blocks of frames and reach a frame inside a block by stepping from the block's start
+        (playback.Player.next does).
         """
         self.advance(transforms)
         return self.positions(out)
@@ -76,6 +86,19 @@ class Simulation(_InBasis):
         ``self.stats``."""
         self.stats = self._native.step(self._checked_transforms(transforms))
         return self.stats
+
+    def forget(self):
+        """Forgets BFGS's memory: the next step learns the curvature afresh."""
+        self._native.forget()
+
+    @property
+    def memory_frames(self):
+        return self._native.memory_frames
+
+    @property
+    def remembered_frames(self):
+        """The frames stepped since BFGS's memory was last forgotten (at most memory_frames)."""
+        return self._native.remembered_frames
 
     @property
     def state(self):
@@ -93,7 +116,8 @@ class Simulation(_InBasis):
     def set_state(self, q, v, transforms=None):
         """Puts the simulation at (q, v), e.g. a cached frame's, or a pose's ``ReducedSolver.q``
         with zero velocity. ``transforms``: the controllers' at that state (one 4x4 per handle), the
-        start of the next step; None keeps the current ones."""
+        start of the next step; None keeps the current ones. BFGS's memory (step()) is forgotten
+        unless this is the simulation's own state, bit for bit."""
         r = self.dimension
         q = _arrays.values(q, "q", r)
         v = _arrays.values(v, "v", r)

@@ -1,7 +1,8 @@
 """Secondary motion on Suzanne: the head's controller turns fast and stops; playing the timeline
 simulates frame after frame into the cache, the mesh overshoots the static pose and settles;
 scrubbing back reads the cache; a jump forward simulates every frame in between and gives the
-same bits as playing; a changed keyframe or setting invalidates what follows; Bake gives the same
+same bits as playing, and so do frames simulated again after a cut in the middle of a block of
+BFGS's memory; a changed keyframe or setting invalidates what follows; Bake gives the same
 bits again; Free empties the cache; a damaged cache is refused."""
 import os
 import sys
@@ -65,6 +66,18 @@ assert len(frame_cache.get(obj)) == 40 and scene.frame_current == 30
 for frame in (40, 7, 20):
     scene.frame_set(frame)
     assert key().tobytes() == played[frame].tobytes(), f"the bake differs from playing at frame {frame}"
+
+# A cut in the middle of a block of BFGS's memory (memory_frames frames from the cache's start;
+# the simulation holds frame 40's): the frames after it simulated again, from the block's first
+# frame, the same bits as playing.
+memory_frames = playback.player(obj, scene).simulation.memory_frames
+assert 1 < memory_frames < 11, memory_frames
+frame_cache.get(obj).cut(2 + memory_frames + memory_frames // 2)
+scene.frame_set(30)
+assert frame_cache.get(obj).end == 30
+for frame in (30, 2 + memory_frames + memory_frames // 2, 2 + 2 * memory_frames):
+    scene.frame_set(frame)
+    assert key().tobytes() == played[frame].tobytes(), f"simulated again after a cut, frame {frame} differs"
 
 # Free, then a jump forward: every frame up to it simulated, the same bits as playing.
 assert bpy.ops.modal_deform.free_cache() == {"FINISHED"}
