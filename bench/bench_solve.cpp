@@ -142,8 +142,9 @@ void BM_MapBits(benchmark::State& state) {
   const double diagonal = (basis.rest.colwise().maxCoeff() - basis.rest.colwise().minCoeff()).norm();
   const double tolerance = state.range(0) == 16 ? FinePositions::kTolerance * diagonal : 0.0;
   Eigen::VectorXf out(3 * basis.num_vertices());
+  const Eigen::VectorXf rest = flatten(basis.rest).cast<float>();
   Eigen::Index from_float32 = 0;
-  for (auto _ : state) from_float32 = quantized.map(basis.vectors, q, basis.rest.data(), tolerance, out.data());
+  for (auto _ : state) from_float32 = quantized.map(basis.vectors, q, rest.data(), tolerance, out.data());
   state.counters["blocks_from_float32"] = static_cast<double>(from_float32) / quantized.blocks();
 }
 BENCHMARK(BM_MapBits)->Arg(32)->Arg(16)->Unit(benchmark::kMillisecond);

@@ -56,7 +56,7 @@ Prolongation held_at_rest(Eigen::Index num_vertices) {
   return {RowMatrixX3i::Zero(num_vertices, 3), RowMatrixX3f::Zero(num_vertices, 3)};
 }
 
-void prolongate_positions(const Prolongation& prolongation, const double* rest, const float* proxy_displacement,
+void prolongate_positions(const Prolongation& prolongation, const float* rest, const float* proxy_displacement,
                           float* out) {
   const int* vertices = prolongation.vertices.data();
   const float* weights = prolongation.weights.data();
@@ -67,7 +67,7 @@ void prolongate_positions(const Prolongation& prolongation, const double* rest, 
       const float* d2 = proxy_displacement + 3 * vertices[3 * i + 2];
       const float w0 = weights[3 * i], w1 = weights[3 * i + 1], w2 = weights[3 * i + 2];
       for (int a = 0; a < 3; ++a)
-        out[3 * i + a] = static_cast<float>(rest[3 * i + a] + static_cast<double>(w0 * d0[a] + w1 * d1[a] + w2 * d2[a]));
+        out[3 * i + a] = rest[3 * i + a] + (w0 * d0[a] + w1 * d1[a] + w2 * d2[a]);
     }
   });
 }

@@ -10,7 +10,7 @@ constexpr float kLargest = 32767.0f;  // the largest int16 magnitude, what s_bj 
 // Threads only where they pay (the float32 map's threshold: 4096 vertices).
 constexpr Eigen::Index kParallelRows = 3 * 4096;
 
-// One float32 row's dot product with q; x̄ is added in double and the sum rounded once.
+// One float32 row's dot product with q.
 float row_dot(const float* u, const float* q, Eigen::Index r) {
   float dot = 0;
 #pragma omp simd reduction(+ : dot)
@@ -60,7 +60,7 @@ QuantizedVectors::QuantizedVectors(const RowMatrixXf& U)
   }
 }
 
-Eigen::Index QuantizedVectors::map(const RowMatrixXf& U, const Eigen::VectorXf& q, const double* rest,
+Eigen::Index QuantizedVectors::map(const RowMatrixXf& U, const Eigen::VectorXf& q, const float* rest,
                                    double tolerance, float* out) const {
   const Eigen::Index blocks = scales_.rows();
   const Eigen::VectorXd q_abs = q.cwiseAbs().cast<double>();
@@ -81,7 +81,7 @@ Eigen::Index QuantizedVectors::map(const RowMatrixXf& U, const Eigen::VectorXf& 
         accumulate_columns(values_.data() + begin * cols_, scaled_q.data(), end - begin, cols_, sum);
       }
       for (Eigen::Index k = begin; k < end; ++k)
-        out[k] = rest ? static_cast<float>(rest[k] + static_cast<double>(sum[k - begin])) : sum[k - begin];
+        out[k] = rest ? rest[k] + sum[k - begin] : sum[k - begin];
     }
   }
   return from_float32;

@@ -43,6 +43,7 @@ Eigen::MatrixXd GhostEnergy::rest_hessian() const {
 
 FinePositions::FinePositions(const Basis& basis)
     : basis_(basis),
+      rest_(flatten(basis.rest).cast<float>()),
       quantized_vectors_(basis.vectors),
       tolerance_(kTolerance * bounding_box_diagonal(basis.rest)),
       q_(Eigen::VectorXf::Zero(basis.dimension())) {
@@ -54,13 +55,13 @@ void FinePositions::write(const Eigen::VectorXf& q, Eigen::Ref<Eigen::VectorXf> 
   if (out.size() != fine_rows)
     throw InputError(message("out: expected ", fine_rows, " values (3 per vertex), got ", out.size()));
   if (!basis_.on_proxy()) {
-    quantized_vectors_.map(basis_.vectors, q, basis_.rest.data(), tolerance_, out.data());
+    quantized_vectors_.map(basis_.vectors, q, rest_.data(), tolerance_, out.data());
     return;
   }
   // On a proxy: its displacement U q, then x̄ + P (U q) on the fine vertices (convex weights: the
   // displacement's error bound holds there too).
   quantized_vectors_.map(basis_.vectors, q, nullptr, tolerance_, proxy_displacement_.data());
-  prolongate_positions(basis_.prolongation, basis_.rest.data(), proxy_displacement_.data(), out.data());
+  prolongate_positions(basis_.prolongation, rest_.data(), proxy_displacement_.data(), out.data());
 }
 
 }  // namespace modal_deform

@@ -60,6 +60,9 @@ class FinePositions {
 
  private:
   const Basis& basis_;
+  // x̄ in single precision (3#V, interleaved), what Blender stores: the map reads half the bytes
+  // of the double rest for it, a third of all it reads on a proxy.
+  Eigen::VectorXf rest_;
   QuantizedVectors quantized_vectors_;  // U in 16 bits
   double tolerance_;                    // kTolerance times the rest's bounding-box diagonal
   Eigen::VectorXf q_;

@@ -51,7 +51,7 @@ TEST(Prolongation, PositionsAreRestPlusTheInterpolatedDisplacement) {
   const Eigen::Matrix3d A = (Eigen::Matrix3d() << 0.1, -0.2, 0.0, 0.3, 0.05, 0.0, -0.4, 0.2, 0.0).finished();
   const Eigen::VectorXf d = flatten(RowMatrixX3d(g.proxy.V * A.transpose())).cast<float>();
   Eigen::VectorXf out(3 * g.fine.V.rows());
-  prolongate_positions(P, g.fine.V.data(), d.data(), out.data());
+  prolongate_positions(P, flatten(g.fine.V).cast<float>().eval().data(), d.data(), out.data());
   const RowMatrixX3d expected = g.fine.V + g.fine.V * A.transpose();
   EXPECT_LT((out.cast<double>() - flatten(expected)).cwiseAbs().maxCoeff(), 1e-6);
 }
@@ -62,7 +62,7 @@ TEST(Prolongation, DetailOffTheProxyStaysInTheRestFrame) {
   const Prolongation P = prolongation_to_proxy(g.fine.V, g.proxy.V, g.proxy.F, g.cluster);
   const Eigen::VectorXf d = Eigen::VectorXf::Constant(3 * g.proxy.V.rows(), 0.25f);  // a translation
   Eigen::VectorXf out(3 * g.fine.V.rows());
-  prolongate_positions(P, g.fine.V.data(), d.data(), out.data());
+  prolongate_positions(P, flatten(g.fine.V).cast<float>().eval().data(), d.data(), out.data());
   EXPECT_LT((out.cast<double>() - (flatten(g.fine.V).array() + 0.25).matrix()).cwiseAbs().maxCoeff(), 1e-6);
 }
 

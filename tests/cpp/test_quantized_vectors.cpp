@@ -31,17 +31,18 @@ TEST(QuantizedVectors, EveryCoordinateIsWithinTheToleranceAndTheBoundChoosesFloa
   const QuantizedVectors quantized(U);
   ASSERT_EQ(quantized.blocks(), 71);
   const Eigen::VectorXf q = (10.0 * testing::random_vector(cols, 3)).cast<float>();
-  const Eigen::VectorXd rest = testing::random_vector(rows, 5);
+  const Eigen::VectorXf rest32 = testing::random_vector(rows, 5).cast<float>();
+  const Eigen::VectorXd rest = rest32.cast<double>();
   const Eigen::VectorXd expected = exact_map(U, q, rest);
   const double largest = (expected - rest).cwiseAbs().maxCoeff();
   const double rounding = 1e-6 * (largest + rest.cwiseAbs().maxCoeff());  // float32's own
   Eigen::VectorXf out(rows);
   std::vector<Eigen::Index> from_float32;
   for (double tolerance : {1e3 * largest, 3e-5 * largest, 0.0}) {
-    from_float32.push_back(quantized.map(U, q, rest.data(), tolerance, out.data()));
+    from_float32.push_back(quantized.map(U, q, rest32.data(), tolerance, out.data()));
     EXPECT_LE((out.cast<double>() - expected).cwiseAbs().maxCoeff(), tolerance + rounding) << tolerance;
     for (Eigen::Index k = 2 * QuantizedVectors::kRowsPerBlock; k < 3 * QuantizedVectors::kRowsPerBlock; ++k)
-      ASSERT_EQ(out(k), static_cast<float>(rest(k))) << "a zero row moves";
+      ASSERT_EQ(out(k), rest32(k)) << "a zero row moves";
   }
   EXPECT_EQ(from_float32[0], 0);
   EXPECT_GT(from_float32[1], 0) << "the largest rows' bound exceeds 3e-5 of the largest coordinate";
