@@ -60,14 +60,14 @@ class Player:
 
     def check_mesh(self, obj):
         """Raise storage.NotReady when obj's vertices are no longer those of the bake (moved or
-        added since): a comparison of the positions, a fraction of a millisecond at 100k vertices,
-        where the full check (storage.stale_reason, faces and vertex groups too) hashes the mesh."""
-        co = mesh_io.vertex_positions(obj.data)
-        if len(co) != len(self.rest) or not np.array_equal(co, self.rest):
+        added since): a comparison of the positions (mesh_io.same_positions), where the full check
+        (storage.stale_reason, faces and vertex groups too) hashes the mesh."""
+        if not mesh_io.same_positions(obj.data, self.rest):
             storage.ready_basis(obj)
 
-    def fits(self, obj, scene):
-        return self.signature == frame_cache.signature(obj, scene) and self.basis_id == frame_cache.basis_id(obj)
+    def fits(self, obj, signature):
+        """Whether this Player is for obj's basis and settings (`signature`: frame_cache.signature)."""
+        return self.signature == signature and self.basis_id == frame_cache.basis_id(obj)
 
     def transforms(self, obj):
         """The handles' transforms now, (handles, 4, 4) float64."""
@@ -108,11 +108,12 @@ class Player:
         self.simulation.positions_of(q, out)
 
 
-def player(obj, scene):
+def player(obj, scene, signature=None):
     """obj's Player for its settings now (made anew when they changed; a change of the dynamics'
-    settings alone keeps the pose's basis, handles and solver: each first() starts from rest)."""
+    settings alone keeps the pose's basis, handles and solver: each first() starts from rest).
+    `signature`: frame_cache.signature(obj, scene) when the caller has it."""
     found = _players.get(obj.name)
-    if found is None or not found.fits(obj, scene):
+    if found is None or not found.fits(obj, signature or frame_cache.signature(obj, scene)):
         same_pose = (found is not None and found.basis_id == frame_cache.basis_id(obj)
                      and found.pose_signature == frame_cache.pose_signature(obj))
         found = _players[obj.name] = Player(obj, scene, pose=found.pose if same_pose else None)
@@ -137,12 +138,15 @@ def set_frame(scene, frame):
         _busy = False
 
 
-def fill(obj, scene, cache, frame, player_, out=None):
+def fill(obj, scene, cache, frame, player_, out=None, curves=None):
     """Compute and cache every frame from cache.end + 1 to `frame` (each at its own frame, for the
     controllers there); the scene is back at the frame it was on. `out`: a function giving the
-    array for the positions of `frame` itself (Player.next). Returns whether they are there."""
+    array for the positions of `frame` itself (Player.next); `curves`: the controllers' curves
+    (frame_cache.controller_curves) when the caller has them. Returns whether the positions are there."""
     if cache.end >= frame:
         return False
+    if curves is None:
+        curves = frame_cache.controller_curves(obj)
     here = scene.frame_current
     mapped = False
     try:
@@ -154,7 +158,7 @@ def fill(obj, scene, cache, frame, player_, out=None):
                 q, v = player_.first(transforms)
             else:
                 q, v, mapped = player_.next(cache, f, transforms, out if f == frame else None)
-            cache.append(q, v, transforms, frame_cache.curve_values(frame_cache.controller_curves(obj), f))
+            cache.append(q, v, transforms, frame_cache.curve_values(curves, f))
     finally:
         if scene.frame_current != here:
             set_frame(scene, here)
@@ -165,23 +169,25 @@ def show(obj, scene):
     """Show obj's state at the scene's frame, computing what the cache lacks up to it."""
     frame = scene.frame_current
     cache = frame_cache.get(obj)
+    signature = frame_cache.signature(obj, scene)
     start = obj.modal_deform.dynamics.frame_start
-    if cache is not None and frame_cache.outdated(cache, obj, scene):
+    if cache is not None and frame_cache.outdated(cache, obj, signature):
         if cache.kind == frame_cache.kind(obj) == "STATIC":  # keeps the range the artist baked
             start = cache.start
         cache = None
     if cache is None:
         cache = frame_cache.create(obj, scene, start)
-    player_ = player(obj, scene)
+    player_ = player(obj, scene, signature)
     player_.check_mesh(obj)
-    frame_cache.keyframes_changed(obj)
+    curves = frame_cache.controller_curves(obj)
+    frame_cache.keyframes_changed(cache, curves)
     shown = max(frame, cache.start)
     index = cache.row(frame)
     if index is not None and not np.array_equal(player_.transforms(obj).ravel(), cache.array("transforms")[index]):
         cache.cut(frame)
     # A frame simulated here is mapped by its step straight into the key (no copy between).
-    if not fill(obj, scene, cache, shown, player_, out=lambda: playback_key_co(obj)):
-        player_.positions(cache.state(shown)[0], playback_key_co(obj))
+    if not fill(obj, scene, cache, shown, player_, out=lambda: playback_key_co(obj), curves=curves):
+        player_.positions(cache.array("q")[cache.row(shown)], playback_key_co(obj))
     obj.data.update()
 
 
