@@ -93,6 +93,36 @@ kept = key()
 playback.free(obj)
 scene.frame_set(9)
 assert playback.player(obj, scene).pose is not pose and key().tobytes() == kept.tobytes()
+
+# Playing compares the mesh's positions with the bake's only when Blender reported an update of the
+# mesh (after an edit, or in the next frame's evaluation; never for playback's own writes): an edit
+# between frames is refused either way, and undoing it plays again.
+compared = []
+same_positions = playback.mesh_io.same_positions
+playback.mesh_io.same_positions = lambda mesh, co: compared.append(mesh.name) or same_positions(mesh, co)
+for frame in (10, 11, 12):
+    scene.frame_set(frame)
+    bpy.context.view_layer.update()
+assert compared == [] and obj.name not in playback.problems, (compared, playback.problems)
+
+
+def move_vertex(x):
+    """Vertex 0 to x, in the mesh and its reference key (read anew: Blender 4 moves the positions
+    of a mesh when they are written while its evaluated copy shares them)."""
+    obj.data.vertices[0].co.x = obj.data.shape_keys.reference_key.data[0].co.x = x
+
+
+x = obj.data.vertices[0].co.x
+for frame, reported in ((13, bpy.context.view_layer.update), (15, lambda: None)):
+    move_vertex(x + 0.1)
+    reported()
+    scene.frame_set(frame)
+    assert "edited after the bake" in playback.problems.get(obj.name, ""), (frame, playback.problems)
+    move_vertex(x)
+    scene.frame_set(frame + 1)
+    assert obj.name not in playback.problems, (frame, playback.problems)
+assert len(compared) == 4, compared
+playback.mesh_io.same_positions = same_positions
 # A damaged cache (an array gone) is refused with a message; Free takes it away.
 del dynamics.cache["q"]
 before = key()
