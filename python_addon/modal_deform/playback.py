@@ -32,11 +32,6 @@ FAILURES = (storage.NotReady, handles.HandleError, ValueError, RuntimeError)
 # last problem met (shown in the panel). Forgotten when a file is loaded.
 _players = {}
 problems = {}
-# The meshes (as_pointer()) Blender reported a geometry update of since their positions were last
-# compared (Player.check_mesh): an edit between frames is reported after it (depsgraph_update_post)
-# or in the next frame's evaluation (its depsgraph's updates). Playback's own writes are evaluated
-# within the frame change and never reported.
-_edited_meshes = set()
 # True while playback changes the frame itself (catching up): the handler then does nothing.
 _busy = False
 
@@ -62,24 +57,27 @@ class Player:
                                          weights=[h.weight for h in self.handles],
                                          energy=settings.status.energy.lower())
         self.rest = self.basis.rest.astype(np.float32)
-        self.compared = None  # the mesh (address, vertex count) last found equal to rest
+        # The mesh (address, vertex count) last found equal to rest; None again when Blender reports
+        # a geometry update of it (_edits_reported) or after an undo.
+        self.compared = None
 
-    def check_mesh(self, obj, edited_meshes=None):
+    def check_mesh(self, obj, edits_reported=False):
         """Raise storage.NotReady when obj's vertices are no longer those of the bake (moved or
         added since): a comparison of the positions (mesh_io.same_positions), where the full check
-        (storage.stale_reason, faces and vertex groups too) hashes the mesh. `edited_meshes`: the
-        meshes Blender reported a geometry update of (_edited_meshes); the comparison is skipped when
-        obj's mesh is the one compared last and not among them. None: compared. (The comparison
-        costs more than reading 12 bytes a vertex: from Blender 4 on, reading the positions through
-        RNA copies them when the evaluated mesh shares them.)"""
+        (storage.stale_reason, faces and vertex groups too) hashes the mesh. `edits_reported`: the
+        caller is the frame handler, which forgets the comparisons of the meshes Blender reports
+        a geometry update of: an edit between frames is reported after it (depsgraph_update_post)
+        or in the frame's evaluation (frame_change_post's depsgraph), never playback's own writes
+        (evaluated within the frame change). The comparison is then skipped while it holds; it
+        costs more than reading 12 bytes a vertex (from Blender 4 on, reading the positions
+        through RNA copies them when the evaluated mesh shares them)."""
         mesh = obj.data
         compared = (mesh.as_pointer(), len(mesh.vertices))
-        if edited_meshes is not None and compared == self.compared and compared[0] not in edited_meshes:
+        if edits_reported and compared == self.compared:
             return
         if not mesh_io.same_positions(mesh, self.rest):
             storage.ready_basis(obj)
         self.compared = compared
-        _edited_meshes.discard(compared[0])
 
     def fits(self, obj, signature):
         """Whether this Player is for obj's basis and settings (`signature`: frame_cache.signature)."""
@@ -181,9 +179,9 @@ def fill(obj, scene, cache, frame, player_, out=None, curves=None):
     return mapped
 
 
-def show(obj, scene, edited_meshes=None):
+def show(obj, scene, edits_reported=False):
     """Show obj's state at the scene's frame, computing what the cache lacks up to it.
-    `edited_meshes`: as Player.check_mesh takes it (the frame handler's)."""
+    `edits_reported`: as Player.check_mesh takes it."""
     frame = scene.frame_current
     cache = frame_cache.get(obj)
     signature = frame_cache.signature(obj, scene)
@@ -195,7 +193,7 @@ def show(obj, scene, edited_meshes=None):
     if cache is None:
         cache = frame_cache.create(obj, scene, start)
     player_ = player(obj, scene, signature)
-    player_.check_mesh(obj, edited_meshes)
+    player_.check_mesh(obj, edits_reported)
     curves = frame_cache.controller_curves(obj)
     frame_cache.keyframes_changed(cache, curves)
     shown = max(frame, cache.start)
@@ -229,9 +227,13 @@ def free(obj):
     obj.data.update()
 
 
-def _note_edited_meshes(depsgraph):
-    _edited_meshes.update(update.id.original.as_pointer() for update in depsgraph.updates
-                          if update.is_updated_geometry and isinstance(update.id, bpy.types.Mesh))
+def _edits_reported(depsgraph):
+    """Forget the comparisons (Player.check_mesh) of the meshes depsgraph reports a geometry update of."""
+    edited = {update.id.original.as_pointer() for update in depsgraph.updates
+              if update.is_updated_geometry and isinstance(update.id, bpy.types.Mesh)}
+    for found in _players.values():
+        if found.compared is not None and found.compared[0] in edited:
+            found.compared = None
 
 
 @bpy.app.handlers.persistent
@@ -239,12 +241,12 @@ def _frame_changed(scene, depsgraph=None):
     if _busy:
         return
     if depsgraph is not None:
-        _note_edited_meshes(depsgraph)
+        _edits_reported(depsgraph)
     for obj in scene.objects:
         if not wants_playback(obj):
             continue
         try:
-            show(obj, scene, None if depsgraph is None else _edited_meshes)
+            show(obj, scene, edits_reported=depsgraph is not None)
             problems.pop(obj.name, None)
         except FAILURES as error:
             if problems.get(obj.name) != str(error):
@@ -254,7 +256,7 @@ def _frame_changed(scene, depsgraph=None):
 
 @bpy.app.handlers.persistent
 def _geometry_updated(scene, depsgraph):
-    _note_edited_meshes(depsgraph)
+    _edits_reported(depsgraph)
 
 
 @bpy.app.handlers.persistent
@@ -268,7 +270,6 @@ def _compare_again(*args):
 def _forget(*args):
     _players.clear()
     problems.clear()
-    _edited_meshes.clear()
 
 
 def register():

@@ -2,7 +2,7 @@
 simulates frame after frame into the cache, the mesh overshoots the static pose and settles;
 scrubbing back reads the cache; a jump forward simulates every frame in between and gives the
 same bits as playing; a changed keyframe or setting invalidates what follows; Bake gives the same
-bits again; Free empties the cache; a damaged cache is refused."""
+bits again; Free empties the cache; a mesh edited between frames and a damaged cache are refused."""
 import os
 import sys
 
