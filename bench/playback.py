@@ -10,9 +10,10 @@ In bpy, with the add-on installed from the extension zip (what `make bench` runs
     BLENDER_USER_RESOURCES=$(mktemp -d) .venv/bpy-4.5/bin/python tests/blender/bpy_session.py \
         --extension dist/modal_deform-0.1.0-blender_4.2_to_5.0-linux_x64.zip bench/playback.py -- --output out.json
 
-Per frame: "handler" is the frame handler's work for the object (playback.show: checks, the cache
-read or the step, the mapping into the display), timed alone at the frame the scene is on; "map" is
-the mapping x̄ + U q into the display's attribute alone (the frame's q mapped again after the handler), the part of
+Per frame: "handler" is the frame handler's work for the object (playback.show as the handler calls
+it when Blender reported no edit of the mesh: checks, the cache read or the step, the mapping into
+the display), timed alone at the frame the scene is on; "map" is the mapping x̄ + U q into the
+display's attribute alone (the frame's q mapped again after the handler), the part of
 "handler" that grows with the mesh; "evaluate" is Blender's evaluation of the mesh after it
 (view_layer.update()). Medians over the frames. A jump forward simulates every frame in between:
 its handler's time per frame simulated. For reference, Blender's evaluation of the same mesh
@@ -71,7 +72,7 @@ def timed_frames(obj, scene, playback, frame_cache, frames, stepping=False):
     for frame in frames:
         playback.set_frame(scene, frame)
         start = time.perf_counter()
-        playback.show(obj, scene)
+        playback.show(obj, scene, edits_reported=True)
         handler.append(1e3 * (time.perf_counter() - start))
         if stepping:
             stats = playback.player(obj, scene).simulation.stats

@@ -11,7 +11,8 @@ settings (dynamics parameters, stiffness, handles).
 
 Where: like the basis (storage.py), a Palette datablock named with a leading "." that
 ``Object.modal_deform.dynamics.cache`` points to, each array one flat float64 ID property (Blender
-keeps the bytes: the cache reloads bit for bit), read back by ``np.frombuffer``.
+keeps the bytes: the cache reloads bit for bit), read back by ``np.frombuffer``. An array may hold
+room for more frames after the last one: a frame is cached by writing its row in place (append()).
 
 Invalidation, as Blender's point caches: a change of a setting or of the basis empties the cache
 (the next frame shown starts it again); a changed keyframe of a controller cuts the cache before the
@@ -88,10 +89,10 @@ class Cache:
 
     def array(self, name):
         """(frames, width) float64 view of the array `name` ("q", "v", "transforms", "curves")."""
-        value = self.block[name]
         width = self.block[name + "_width"]
-        flat = np.frombuffer(value, dtype=np.float64) if len(value) else np.empty(0)
-        return flat.reshape(-1, width) if width else np.empty((len(self), 0))
+        if not width:
+            return np.empty((len(self), 0))
+        return _values(self.block, name)[:len(self) * width].reshape(-1, width)
 
     def __len__(self):
         """The number of frames cached, from start on."""
@@ -114,16 +115,24 @@ class Cache:
         return self.array("q")[index].copy(), (v[index].copy() if v.shape[1] else None)
 
     def append(self, q, v, transforms, curves):
-        """Add the frame after the last (end + 1)."""
+        """Add the frame after the last (end + 1): each row written in place into the room its array
+        keeps after the last frame, the array grown to twice the frames when full (so that caching a
+        frame costs the same at any length of cache, where copying every array grew with it)."""
+        frames = len(self)
         rows = {"q": q, "v": np.empty(0) if v is None else v, "transforms": transforms, "curves": curves}
         for name, row in rows.items():
             row = np.asarray(row, np.float64).ravel()
-            if len(self) and row.size != self.block[name + "_width"]:
+            width = self.block[name + "_width"]
+            if frames and row.size != width:
                 raise ValueError(f"cache: frame {self.end + 1}'s {name} has {row.size} values, earlier frames "
-                                 f"{self.block[name + '_width']}")
-            self.block[name + "_width"] = row.size
-            _set_array(self.block, name, np.concatenate([self.array(name).ravel(), row]) if row.size else np.empty(0))
-        self.block["frames"] = len(self) + 1
+                                 f"{width}")
+            if not frames or len(self.block[name]) < (frames + 1) * width:
+                room = np.zeros(max(_FIRST_ROOM, 2 * (frames + 1)) * row.size)
+                room[:frames * width] = self.array(name).ravel()
+                _set_array(self.block, name, room)
+                self.block[name + "_width"] = width = row.size
+            _values(self.block, name)[frames * width:(frames + 1) * width] = row
+        self.block["frames"] = frames + 1
 
     def cut(self, frame):
         """Forget `frame` and every frame after it."""
@@ -137,6 +146,16 @@ class Cache:
 
     def nbytes(self):
         return sum(self.array(name).nbytes for name in _ARRAYS)
+
+
+#: The frames an array has room for when its first frame is cached.
+_FIRST_ROOM = 16
+
+
+def _values(block, name):
+    """The flat float64 array `name` of the datablock, a writeable view of its ID property."""
+    value = block[name]
+    return np.frombuffer(value, dtype=np.float64) if len(value) else np.empty(0)
 
 
 def _set_array(block, name, values):
@@ -183,13 +202,14 @@ def free(obj):
         bpy.data.palettes.remove(block)
 
 
-def outdated(cache, obj, scene):
-    """Why the cache no longer fits obj ("" when it does): another kind, settings or basis."""
+def outdated(cache, obj, signature_now):
+    """Why the cache no longer fits obj ("" when it does): another kind, settings or basis.
+    `signature_now`: signature(obj, scene), which the caller computes once for the frame."""
     if cache.kind != kind(obj):
         return "dynamics switched " + ("on" if kind(obj) == "DYNAMIC" else "off")
     if cache.basis_id != basis_id(obj):
         return "the basis was baked again"
-    if cache.signature != signature(obj, scene):
+    if cache.signature != signature_now:
         return "a setting changed"
     return ""
 
@@ -222,27 +242,28 @@ def curve_values(curves, frame):
 
 def keys_digest(curves):
     """A hash of the curves' keyframes (positions, handles, interpolation) and extrapolation: cheap
-    enough for every frame shown, it tells when keyframes_changed must compare values."""
+    enough for every frame shown, it tells when keyframes_changed must compare values. Read in
+    Blender's own types (float32 points, int interpolation), which foreach_get copies without
+    converting item by item."""
     h = hashlib.blake2b(digest_size=16)
     for path, curve in curves:
         points = curve.keyframe_points
         h.update(f"{path}:{curve.extrapolation}:{len(points)}".encode())
-        for attribute, size in (("co", 2), ("handle_left", 2), ("handle_right", 2), ("interpolation", 1)):
-            values = np.empty(size * len(points), np.float64 if size == 2 else np.int32)
-            points.foreach_get(attribute, values)
-            h.update(values.tobytes())
+        co = np.empty((3, 2 * len(points)), np.float32)
+        for row, attribute in zip(co, ("co", "handle_left", "handle_right")):
+            points.foreach_get(attribute, row)
+        interpolation = np.empty(len(points), np.int32)
+        points.foreach_get("interpolation", interpolation)
+        h.update(co)
+        h.update(interpolation)
     return h.hexdigest()
 
 
-def keyframes_changed(obj):
-    """Cut obj's cache at the first frame whose controller curves no longer give the values it was
-    cached with (a key added, moved, deleted or its interpolation changed); the whole cache when
-    the set of curves changed. Only compares values when the keyframes' digest changed. Returns the
-    frame cut from, or None."""
-    cache = get(obj)
-    if cache is None:
-        return None
-    curves = controller_curves(obj)
+def keyframes_changed(cache, curves):
+    """Cut the cache at the first frame whose controller curves (controller_curves of its object)
+    no longer give the values it was cached with (a key added, moved, deleted or its interpolation
+    changed); the whole cache when the set of curves changed. Only compares values when the
+    keyframes' digest changed. Returns the frame cut from, or None."""
     digest_now = keys_digest(curves)
     if digest_now == cache.block["keys_digest"]:
         return None

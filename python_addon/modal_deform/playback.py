@@ -54,17 +54,31 @@ class Player:
                                          weights=[h.weight for h in self.handles],
                                          energy=settings.status.energy.lower())
         self.rest = self.basis.rest.astype(np.float32)
+        # The mesh (address, vertex count) last found equal to rest; None again when Blender reports
+        # a geometry update of it (_edits_reported) or after an undo.
+        self.compared = None
 
-    def check_mesh(self, obj):
+    def check_mesh(self, obj, edits_reported=False):
         """Raise storage.NotReady when obj's vertices are no longer those of the bake (moved or
-        added since): a comparison of the positions, a fraction of a millisecond at 100k vertices,
-        where the full check (storage.stale_reason, faces and vertex groups too) hashes the mesh."""
-        co = mesh_io.vertex_positions(obj.data)
-        if len(co) != len(self.rest) or not np.array_equal(co, self.rest):
+        added since): a comparison of the positions (mesh_io.same_positions), where the full check
+        (storage.stale_reason, faces and vertex groups too) hashes the mesh. `edits_reported`: the
+        caller is the frame handler, which forgets the comparisons of the meshes Blender reports
+        a geometry update of: an edit between frames is reported after it (depsgraph_update_post)
+        or in the frame's evaluation (frame_change_post's depsgraph), never playback's own writes
+        (evaluated within the frame change). The comparison is then skipped while it holds; it
+        costs more than reading 12 bytes a vertex (from Blender 4 on, reading the positions
+        through RNA copies them when the evaluated mesh shares them)."""
+        mesh = obj.data
+        compared = (mesh.as_pointer(), len(mesh.vertices))
+        if edits_reported and compared == self.compared:
+            return
+        if not mesh_io.same_positions(mesh, self.rest):
             storage.ready_basis(obj)
+        self.compared = compared
 
-    def fits(self, obj, scene):
-        return self.signature == frame_cache.signature(obj, scene) and self.basis_id == frame_cache.basis_id(obj)
+    def fits(self, obj, signature):
+        """Whether this Player is for obj's basis and settings (`signature`: frame_cache.signature)."""
+        return self.signature == signature and self.basis_id == frame_cache.basis_id(obj)
 
     def transforms(self, obj):
         """The handles' transforms now, (handles, 4, 4) float64."""
@@ -122,11 +136,12 @@ class Player:
         self.simulation.positions_of(q, out)
 
 
-def player(obj, scene):
+def player(obj, scene, signature=None):
     """obj's Player for its settings now (made anew when they changed; a change of the dynamics'
-    settings alone keeps the pose's basis, handles and solver: each first() starts from rest)."""
+    settings alone keeps the pose's basis, handles and solver: each first() starts from rest).
+    `signature`: frame_cache.signature(obj, scene) when the caller has it."""
     found = _players.get(obj.name)
-    if found is None or not found.fits(obj, scene):
+    if found is None or not found.fits(obj, signature or frame_cache.signature(obj, scene)):
         same_pose = (found is not None and found.basis_id == frame_cache.basis_id(obj)
                      and found.pose_signature == frame_cache.pose_signature(obj))
         found = _players[obj.name] = Player(obj, scene, pose=found.pose if same_pose else None)
@@ -156,12 +171,15 @@ def set_frame(scene, frame):
         _busy = False
 
 
-def fill(obj, scene, cache, frame, player_, out=None):
+def fill(obj, scene, cache, frame, player_, out=None, curves=None):
     """Compute and cache every frame from cache.end + 1 to `frame` (each at its own frame, for the
     controllers there); the scene is back at the frame it was on. `out`: a function giving the
-    array for the positions of `frame` itself (Player.next). Returns whether they are there."""
+    array for the positions of `frame` itself (Player.next); `curves`: the controllers' curves
+    (frame_cache.controller_curves) when the caller has them. Returns whether the positions are there."""
     if cache.end >= frame:
         return False
+    if curves is None:
+        curves = frame_cache.controller_curves(obj)
     here = scene.frame_current
     mapped = False
     try:
@@ -173,34 +191,37 @@ def fill(obj, scene, cache, frame, player_, out=None):
                 q, v = player_.first(transforms)
             else:
                 q, v, mapped = player_.next(cache, f, transforms, out if f == frame else None)
-            cache.append(q, v, transforms, frame_cache.curve_values(frame_cache.controller_curves(obj), f))
+            cache.append(q, v, transforms, frame_cache.curve_values(curves, f))
     finally:
         if scene.frame_current != here:
             set_frame(scene, here)
     return mapped
 
 
-def show(obj, scene):
-    """Show obj's state at the scene's frame, computing what the cache lacks up to it."""
+def show(obj, scene, edits_reported=False):
+    """Show obj's state at the scene's frame, computing what the cache lacks up to it.
+    `edits_reported`: as Player.check_mesh takes it."""
     frame = scene.frame_current
     cache = frame_cache.get(obj)
+    signature = frame_cache.signature(obj, scene)
     start = obj.modal_deform.dynamics.frame_start
-    if cache is not None and frame_cache.outdated(cache, obj, scene):
+    if cache is not None and frame_cache.outdated(cache, obj, signature):
         if cache.kind == frame_cache.kind(obj) == "STATIC":  # keeps the range the artist baked
             start = cache.start
         cache = None
     if cache is None:
         cache = frame_cache.create(obj, scene, start)
-    player_ = player(obj, scene)
-    player_.check_mesh(obj)
-    frame_cache.keyframes_changed(obj)
+    player_ = player(obj, scene, signature)
+    player_.check_mesh(obj, edits_reported)
+    curves = frame_cache.controller_curves(obj)
+    frame_cache.keyframes_changed(cache, curves)
     shown = max(frame, cache.start)
     index = cache.row(frame)
     if index is not None and not np.array_equal(player_.transforms(obj).ravel(), cache.array("transforms")[index]):
         cache.cut(frame)
     # A frame simulated here is mapped by its step straight into the display (no copy between).
-    if not fill(obj, scene, cache, shown, player_, out=lambda: playback_display.positions(obj)):
-        player_.positions(cache.state(shown)[0], playback_display.positions(obj))
+    if not fill(obj, scene, cache, shown, player_, out=lambda: playback_display.positions(obj), curves=curves):
+        player_.positions(cache.array("q")[cache.row(shown)], playback_display.positions(obj))
     obj.data.update()
 
 
@@ -212,10 +233,21 @@ def free(obj):
     playback_display.remove(obj)
 
 
+def _edits_reported(depsgraph):
+    """Forget the comparisons (Player.check_mesh) of the meshes depsgraph reports a geometry update of."""
+    edited = {update.id.original.as_pointer() for update in depsgraph.updates
+              if update.is_updated_geometry and isinstance(update.id, bpy.types.Mesh)}
+    for found in _players.values():
+        if found.compared is not None and found.compared[0] in edited:
+            found.compared = None
+
+
 @bpy.app.handlers.persistent
 def _frame_changed(scene, depsgraph=None):
     if _busy:
         return
+    if depsgraph is not None:
+        _edits_reported(depsgraph)
     displayed = playback_display.in_use()
     for obj in scene.objects:
         if not wants_playback(obj):
@@ -223,13 +255,25 @@ def _frame_changed(scene, depsgraph=None):
                 playback_display.remove(obj)
             continue
         try:
-            show(obj, scene)
+            show(obj, scene, edits_reported=depsgraph is not None)
             problems.pop(obj.name, None)
         except FAILURES as error:
             if problems.get(obj.name) != str(error):
                 print(f"Modal Deform: '{obj.name}' cannot play: {error}")
             problems[obj.name] = str(error)
             playback_display.remove(obj)
+
+
+@bpy.app.handlers.persistent
+def _geometry_updated(scene, depsgraph):
+    _edits_reported(depsgraph)
+
+
+@bpy.app.handlers.persistent
+def _compare_again(*args):
+    """After an undo or redo, which may read meshes back from memory, every mesh is compared again."""
+    for found in _players.values():
+        found.compared = None
 
 
 @bpy.app.handlers.persistent
@@ -240,11 +284,17 @@ def _forget(*args):
 
 def register():
     bpy.app.handlers.frame_change_post.append(_frame_changed)
+    bpy.app.handlers.depsgraph_update_post.append(_geometry_updated)
+    bpy.app.handlers.undo_post.append(_compare_again)
+    bpy.app.handlers.redo_post.append(_compare_again)
     bpy.app.handlers.load_post.append(_forget)
 
 
 def unregister():
     bpy.app.handlers.frame_change_post.remove(_frame_changed)
+    bpy.app.handlers.depsgraph_update_post.remove(_geometry_updated)
+    bpy.app.handlers.undo_post.remove(_compare_again)
+    bpy.app.handlers.redo_post.remove(_compare_again)
     bpy.app.handlers.load_post.remove(_forget)
     _forget()
     playback_display.remove_all()

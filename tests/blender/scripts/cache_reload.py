@@ -1,5 +1,6 @@
 """Open the file cache_save.py wrote: the cache is there bit for bit, plays back what it showed
-before the save without computing anything, and a mesh edited since the bake is refused."""
+before the save without computing anything, simulates the frame after it as before the save, and
+a mesh edited since the bake is refused."""
 import os
 import sys
 
@@ -23,6 +24,11 @@ for frame in (12, 1, 7, 3):
     scene.frame_set(frame)
     assert support.evaluated_positions(obj).tobytes() == shown[frame - 1].tobytes(), frame
 del player.first, player.next
+if cache.kind == "DYNAMIC":  # simulated from the cached frame before it: the same bits after the reload
+    kept = {name: cache.array(name).copy() for name in ("q", "v", "transforms", "curves")}
+    scene.frame_set(13)
+    assert len(cache) == 13 and all(cache.array(name)[:12].tobytes() == rows.tobytes() for name, rows in kept.items())
+    assert support.evaluated_positions(obj).tobytes() == np.load(support.tmp("next.npy")).tobytes()
 
 # A mesh edited after the bake (Edit Mode, a vertex moved): playback refuses it and shows the mesh as edited.
 bpy.context.view_layer.objects.active = obj

@@ -26,4 +26,7 @@ with open(support.tmp("digest.txt"), "w") as f:
     f.write(frame_cache.digest(cache))
 scene.frame_set(1)
 bpy.ops.wm.save_as_mainfile(filepath=support.tmp("cached.blend"))
+# The frame after the cache, computed after the save: the reloaded file computes it again.
+scene.frame_set(13)
+np.save(support.tmp("next.npy"), support.evaluated_positions(obj))
 print("CACHE_SAVED", cache.nbytes())

@@ -3,7 +3,7 @@ simulates frame after frame into the cache, the mesh overshoots the static pose 
 scrubbing back reads the cache; a jump forward simulates every frame in between and gives the
 same bits as playing, and so do frames simulated again after a cut in the middle of a block of
 BFGS's memory; a changed keyframe or setting invalidates what follows; Bake gives the same
-bits again; Free empties the cache; a damaged cache is refused."""
+bits again; Free empties the cache; a mesh edited between frames and a damaged cache are refused."""
 import os
 import sys
 
@@ -108,6 +108,37 @@ kept = key()
 playback.free(obj)
 scene.frame_set(9)
 assert playback.player(obj, scene).pose is not pose and key().tobytes() == kept.tobytes()
+
+# Playing compares the mesh's positions with the bake's only when Blender reported an update of the
+# mesh (after an edit, or in the next frame's evaluation; never for playback's own writes): an edit
+# between frames is refused either way, and undoing it plays again.
+compared = []
+same_positions = playback.mesh_io.same_positions
+playback.mesh_io.same_positions = lambda mesh, co: compared.append(mesh.name) or same_positions(mesh, co)
+for frame in (10, 11, 12):
+    scene.frame_set(frame)
+    bpy.context.view_layer.update()
+assert compared == [] and obj.name not in playback.problems, (compared, playback.problems)
+
+
+def move_vertex(x):
+    """Vertex 0 to x (the mesh without shape keys: playback writes none; read anew: Blender 4 moves
+    the positions of a mesh when they are written while its evaluated copy shares them)."""
+    assert obj.data.shape_keys is None
+    obj.data.vertices[0].co.x = x
+
+
+x = obj.data.vertices[0].co.x
+for frame, reported in ((13, bpy.context.view_layer.update), (15, lambda: None)):
+    move_vertex(x + 0.1)
+    reported()
+    scene.frame_set(frame)
+    assert "edited after the bake" in playback.problems.get(obj.name, ""), (frame, playback.problems)
+    move_vertex(x)
+    scene.frame_set(frame + 1)
+    assert obj.name not in playback.problems, (frame, playback.problems)
+assert len(compared) == 4, compared
+playback.mesh_io.same_positions = same_positions
 # A damaged cache (an array gone) is refused with a message, and the mesh shows its rest; Free takes it away.
 del dynamics.cache["q"]
 scene.frame_set(12)
