@@ -10,12 +10,12 @@ In bpy, with the add-on installed from the extension zip (what `make bench` runs
     BLENDER_USER_RESOURCES=$(mktemp -d) .venv/bpy-4.5/bin/python tests/blender/bpy_session.py \
         --extension dist/modal_deform-0.1.0-blender_4.2_to_5.0-linux_x64.zip bench/playback.py -- --output out.json
 
-Per frame: "handler" is the frame handler's work for the object (playback.show as the handler calls
-it when Blender reported no edit of the mesh: checks, the cache read or the step, the mapping into
-the display), timed alone at the frame the scene is on; "map" is the mapping x̄ + U q into the
-display's attribute alone (the frame's q mapped again after the handler), the part of
-"handler" that grows with the mesh; "evaluate" is Blender's evaluation of the mesh after it
-(view_layer.update()). Medians over the frames. A jump forward simulates every frame in between:
+Per frame, each frame reached by scene.frame_set as the timeline reaches it: "handler" is the
+add-on's frame handler (playback: checks, the cache read or the step, the mapping into the
+display), timed by handlers run just before and after it; "evaluate" is Blender's evaluation of
+what it changed, from the handler's end to frame_set's return; "map" is the mapping x̄ + U q
+alone (the frame's q mapped again after, into an array of its own), the part of "handler" that
+grows with the mesh. Medians over the frames. A jump forward simulates every frame in between:
 its handler's time per frame simulated. For reference, Blender's evaluation of the same mesh
 without the display, its vertex positions written (a copy of the mesh on another object): what the
 display's modifier costs over a mesh that shows its own positions (a stand-in mesh's display). The load average (1, 5, 15 min) before and after the run.
@@ -64,27 +64,43 @@ def animate(controller, frames):
 
 
 def timed_frames(obj, scene, playback, frame_cache, frames, stepping=False):
-    """Median handler, map and evaluation milliseconds over `frames`, each reached with the handler
-    off (playback.set_frame) and then shown by the handler's function; `stepping`: also the
+    """Median handler, map and evaluation milliseconds over `frames`, each reached by
+    scene.frame_set as the timeline reaches it: "handler" from the start to the end of the add-on's
+    frame handler (clocks read by handlers put before and after it), "evaluate" from its end to the
+    return of frame_set (Blender evaluating what the handler changed); `stepping`: also the
     simulation step's own milliseconds and BFGS iterations (Simulation.stats, timed natively)."""
-    shown_positions = blender_pose.addon("playback_display").positions
+    scratch = np.empty((len(obj.data.vertices), 3), np.float32)
+    handlers = bpy.app.handlers.frame_change_post
+    clock = {}
+
+    def before(*args):
+        clock["before"] = time.perf_counter()
+
+    def after(*args):
+        clock["after"] = time.perf_counter()
+
+    add_on_handler = next(h for h in handlers if h.__module__.endswith(".playback"))
+    handlers.insert(list(handlers).index(add_on_handler), before)
+    handlers.insert(list(handlers).index(add_on_handler) + 1, after)
     handler, mapping, evaluate, step, iterations = [], [], [], [], []
-    for frame in frames:
-        playback.set_frame(scene, frame)
-        start = time.perf_counter()
-        playback.show(obj, scene, edits_reported=True)
-        handler.append(1e3 * (time.perf_counter() - start))
-        if stepping:
-            stats = playback.player(obj, scene).simulation.stats
-            step.append(stats["ms"])
-            iterations.append(stats["iterations"])
-        q = frame_cache.get(obj).state(frame)[0]
-        start = time.perf_counter()
-        playback.player(obj, scene).positions(q, shown_positions(obj))
-        mapping.append(1e3 * (time.perf_counter() - start))
-        start = time.perf_counter()
-        bpy.context.view_layer.update()
-        evaluate.append(1e3 * (time.perf_counter() - start))
+    try:
+        for frame in frames:
+            scene.frame_set(frame)
+            returned = time.perf_counter()
+            assert obj.name not in playback.problems, playback.problems
+            handler.append(1e3 * (clock["after"] - clock["before"]))
+            evaluate.append(1e3 * (returned - clock["after"]))
+            if stepping:
+                stats = playback.player(obj, scene).simulation.stats
+                step.append(stats["ms"])
+                iterations.append(stats["iterations"])
+            q = frame_cache.get(obj).state(frame)[0]
+            start = time.perf_counter()
+            playback.player(obj, scene).positions(q, scratch)
+            mapping.append(1e3 * (time.perf_counter() - start))
+    finally:
+        handlers.remove(before)
+        handlers.remove(after)
     result = {"handler_ms": float(np.median(handler)), "map_ms": float(np.median(mapping)),
               "evaluate_ms": float(np.median(evaluate)), "frames": len(handler)}
     if stepping:
