@@ -265,7 +265,7 @@ def main():
     print(f"wrote {output / 'demo.blend'}")
 
     start = time.perf_counter()
-    modules = (importlib.import_module(f"{addon}.{name}") for name in ("frame_cache", "playback", "posing"))
+    modules = (importlib.import_module(f"{addon}.{name}") for name in ("frame_cache", "posing"))
     strip = demo_dynamics.secondary_motion(tuple(modules), output, args.dynamics_subdivisions, args.width // 2)
     print(f"rendered {strip} (secondary motion) in {time.perf_counter() - start:.1f} s")
 

@@ -10,7 +10,7 @@ import math
 import bpy
 import numpy as np
 
-from headless import add_handle
+from headless import add_handle, evaluated_positions
 from rendering import render, side_by_side
 
 #: The head's tilt about the camera's axis (degrees) and the frames it starts and stops on.
@@ -25,7 +25,7 @@ CORE_RADIUS, CHIN = 0.55, -0.35
 def secondary_motion(addon, output, levels, width):
     """Bake a Suzanne subdivided `levels` times, tilt her head and let the ears follow; render the
     STRIP frames (`width` pixels wide each) into OUTPUT/demo_dynamics.png. Returns the strip's path."""
-    frame_cache, playback, posing = addon
+    frame_cache, posing = addon
     scene = bpy.context.scene
     scene.render.resolution_x, scene.render.resolution_y = width, width * 3 // 4
     shown = [o for o in bpy.context.scene.objects if o.type == "MESH" and not o.hide_render]
@@ -65,9 +65,8 @@ def secondary_motion(addon, output, levels, width):
     pictures, along = [], []
     for frame in range(1, max(STRIP) + 1):
         scene.frame_set(frame)
-        X = np.empty(V.size, np.float32)
-        suzanne.data.shape_keys.key_blocks[playback.PLAYBACK_KEY].data.foreach_get("co", X)
-        along.append(np.dot(X.reshape(-1, 3)[ears].ravel() - V[ears].ravel(), way) / np.dot(way, way))
+        X = evaluated_positions(suzanne)
+        along.append(np.dot(X[ears].ravel() - V[ears].ravel(), way) / np.dot(way, way))
         if frame in STRIP:
             pictures.append(render(output / f"demo_dynamics_{frame:02d}.png"))
     print(f"the ears' way from rest (0) to where they settle (1), frames 1 to {max(STRIP)}: "
