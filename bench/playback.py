@@ -120,14 +120,14 @@ def jump_forward(obj, scene, playback, frame_cache, frames):
     return {"ms_per_frame": 1e3 * (time.perf_counter() - start) / frames, "frames": frames}
 
 
-def without_shape_keys(obj, playback, frame_cache, frames):
+def without_display(obj, playback, frame_cache, frames):
     """Blender's evaluation of a copy of obj's mesh (which has no shape keys) on another object
     without the display's modifier (obj hidden), its vertex positions written from the cached
     frames: median milliseconds."""
     mesh_io = blender_pose.addon("mesh_io")
     assert obj.data.shape_keys is None
     mesh = obj.data.copy()
-    copy = bpy.data.objects.new("Without shape keys", mesh)
+    copy = bpy.data.objects.new("Without the display", mesh)
     bpy.context.scene.collection.objects.link(copy)
     obj.hide_set(True)
     player, cache = playback.player(obj, bpy.context.scene), frame_cache.get(obj)
@@ -194,7 +194,7 @@ def main():
         results["dynamic_read"] = timed_frames(obj, scene, playback, frame_cache, timed)
         results["dynamic_cache_bytes_per_frame"] = frame_cache.get(obj).nbytes() / len(frame_cache.get(obj))
         results["dynamic_jump"] = jump_forward(obj, scene, playback, frame_cache, len(timed))
-        results["without_shape_keys"] = without_shape_keys(obj, playback, frame_cache, timed)
+        results["without_display"] = without_display(obj, playback, frame_cache, timed)
 
         if not args.no_sizes:
             # The static animation as a shape key per frame, as Bake Animation wrote it before the cache.

@@ -835,9 +835,9 @@ def section_playback(result):
     if jumps:
         out += ["", "A jump forward (every frame in between simulated at its own frame, the last one mapped): "
                 + "; ".join(jumps) + "."]
-    bare = [f"{run['blender']}, {run['vertices']:,} vertices: {run['without_shape_keys']['evaluate_ms']:.2f} ms "
+    bare = [f"{run['blender']}, {run['vertices']:,} vertices: {run['without_display']['evaluate_ms']:.2f} ms "
             f"against {run['dynamic_read']['evaluate_ms']:.2f} with the display" for run in runs
-            if "without_shape_keys" in run]
+            if "without_display" in run]
     if bare:
         out += ["", "Blender's evaluation of the same mesh without the display, its vertex positions written (a copy "
                 "on another object, as a stand-in mesh would show the frame): what the display's modifier costs of "
