@@ -71,6 +71,7 @@ void bind_solve(py::module_& m) {
       .def_property_readonly("q", [](const ReducedSolver& solver) { return Eigen::VectorXd(solver.q()); })
       .def_property_readonly("dimension", &ReducedSolver::dimension)
       .def_property_readonly("num_handles", &ReducedSolver::num_handles);
+  m.def("nearest_rigid", &nearest_rigid, py::arg("matrix"), py::arg("centre"));
 
   // solve_full and refine: the same arguments and options; (positions, stats) with the stats of their
   // tables and "history", one dict per Newton iteration.

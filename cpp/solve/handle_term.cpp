@@ -1,5 +1,6 @@
 #include "solve/handle_term.h"
 
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -52,6 +53,19 @@ void check_transforms(const Transforms& transforms, int num_handles) {
       throw InputError(message("transforms[", h, "]: the translation (", T(0, 3), ", ", T(1, 3), ", ", T(2, 3),
                                ") is beyond ", kMaxCoordinate, " in a coordinate"));
   }
+}
+
+Eigen::Matrix4d nearest_rigid(const Eigen::Matrix4d& M, const Eigen::Vector3d& centre) {
+  if (!M.allFinite() || !centre.allFinite()) throw InputError("matrix: has non-finite entries");
+  const Eigen::Matrix3d A = M.topLeftCorner<3, 3>();
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d U = svd.matrixU();
+  if ((U * svd.matrixV().transpose()).determinant() < 0) U.col(2) = -U.col(2);
+  const Eigen::Matrix3d R = U * svd.matrixV().transpose();
+  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+  T.topLeftCorner<3, 3>() = R;
+  T.topRightCorner<3, 1>() = A * centre + M.topRightCorner<3, 1>() - R * centre;
+  return T;
 }
 
 HandleTerm::HandleTerm(const VerticesRef& rest, const VectorRef& mass, const Handles& handles,

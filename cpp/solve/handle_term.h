@@ -46,6 +46,12 @@ Eigen::VectorXd checked_handle_weights(const Handles& handles, const VectorRef& 
 // a translation coordinate beyond kMaxCoordinate; or when there is not one transform per handle.
 void check_transforms(const Transforms& transforms, int num_handles);
 
+// The rigid transform closest to M (4 by 4: a controller's, which may be scaled or sheared) that
+// takes `centre` where M does: the rotation is the orthogonal polar factor of M's 3 by 3 block
+// (U Vᵀ of its SVD, a reflection turned into a rotation), the translation M centre − R centre.
+// Throws InputError when M or centre has a non-finite entry.
+Eigen::Matrix4d nearest_rigid(const Eigen::Matrix4d& M, const Eigen::Vector3d& centre);
+
 // E_C on the fine mesh: the full solve's handle term, and what ReducedHandleTerm restricts.
 class HandleTerm {
  public:

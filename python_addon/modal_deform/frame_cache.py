@@ -20,6 +20,7 @@ first frame whose curve values changed (``keyframes_changed``, when the keyframe
 checked at every frame shown); and a frame whose controllers stand elsewhere than when it was cached (a
 constraint, a driver, a moved parent) cuts the cache there when it is shown.
 """
+import ctypes
 import hashlib
 import json
 
@@ -240,22 +241,27 @@ def curve_values(curves, frame):
     return np.array([curve.evaluate(frame) for _, curve in curves], np.float64)
 
 
+#: The first bytes of each keyframe in Blender's array of them (BezTriple): its point and both
+#: handles, float[3][3].
+_KEYFRAME_POINTS_BYTES = 36
+
+
 def keys_digest(curves):
-    """A hash of the curves' keyframes (positions, handles, interpolation) and extrapolation: cheap
-    enough for every frame shown, it tells when keyframes_changed must compare values. Read in
-    Blender's own types (float32 points, int interpolation), which foreach_get copies without
-    converting item by item."""
+    """A hash of the curves' keyframes and extrapolation: cheap enough for every frame shown, it
+    tells when keyframes_changed must compare values. Each curve's keyframes are hashed as the bytes
+    of Blender's array of them (BezTriple, one after another, read in place): every keyframe whole
+    (point, handles, interpolation, easing and its parameters) but the last, of which only the point
+    and handles shape the curve. A change that moves no value (a selection) leads to a comparison
+    that finds nothing."""
     h = hashlib.blake2b(digest_size=16)
     for path, curve in curves:
         points = curve.keyframe_points
-        h.update(f"{path}:{curve.extrapolation}:{len(points)}".encode())
-        co = np.empty((3, 2 * len(points)), np.float32)
-        for row, attribute in zip(co, ("co", "handle_left", "handle_right")):
-            points.foreach_get(attribute, row)
-        interpolation = np.empty(len(points), np.int32)
-        points.foreach_get("interpolation", interpolation)
-        h.update(co)
-        h.update(interpolation)
+        count = len(points)
+        h.update(f"{path}:{curve.extrapolation}:{count}".encode())
+        if count:
+            address = points[0].as_pointer()
+            stride = points[1].as_pointer() - address if count > 1 else 0
+            h.update(ctypes.string_at(address, stride * (count - 1) + _KEYFRAME_POINTS_BYTES))
     return h.hexdigest()
 
 

@@ -253,6 +253,8 @@ def test_nearest_rigid_names_a_bad_argument():
         mdc.nearest_rigid(np.eye(3), np.zeros(3))
     with pytest.raises(ValueError, match="centre"):
         mdc.nearest_rigid(np.eye(4), np.zeros(2))
+    with pytest.raises(ValueError, match="matrix: has non-finite entries"):
+        mdc.nearest_rigid(np.diag([1.0, np.nan, 1.0, 1.0]), np.zeros(3))
 
 
 def dragon_turn(V, degrees):

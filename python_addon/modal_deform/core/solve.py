@@ -80,21 +80,13 @@ def nearest_rigid(matrix, centre):
     that takes ``centre`` (3,) where ``matrix`` does: what the solvers take for a handle.
 
     Rotation: the orthogonal polar factor of the 3x3 part (U Vᵀ of its SVD, a reflection turned
-    into a rotation); translation: chosen so the handle's centre lands on matrix @ centre.
+    into a rotation); translation: chosen so the handle's centre lands on matrix @ centre. Native:
+    playback computes one per moving handle every frame.
     """
     M = _arrays.reals(matrix, "matrix")
     if M.shape != (4, 4):
         raise ValueError(f"matrix: expected a 4x4 matrix, got shape {M.shape}")
-    centre = _arrays.values(centre, "centre", 3)
-    A = M[:3, :3]
-    U, _, Vt = np.linalg.svd(A)
-    if np.linalg.det(U @ Vt) < 0:
-        U[:, 2] = -U[:, 2]
-    R = U @ Vt
-    T = np.eye(4)
-    T[:3, :3] = R
-    T[:3, 3] = A @ centre + M[:3, 3] - R @ centre
-    return T
+    return _native.nearest_rigid(M, _arrays.values(centre, "centre", 3))
 
 
 class _InBasis:

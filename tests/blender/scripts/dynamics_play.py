@@ -12,8 +12,8 @@ import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 import support  # noqa: E402
 
-frame_cache, playback, playback_display, posing = support.enable_addon("frame_cache", "playback",
-                                                                       "playback_display", "posing")
+frame_cache, frame_keys, playback, playback_display, posing = support.enable_addon(
+    "frame_cache", "frame_keys", "playback", "playback_display", "posing")
 obj, V = support.baked_suzanne(2, 20, 52, 1000)  # the demo's Suzanne and the default basis
 size = np.ptp(V, axis=0).max()
 # The core of the head is held by the controller, tilted fast and stopped (as the demo does); the
@@ -86,6 +86,30 @@ assert support.evaluated_positions(obj).tobytes() == V.tobytes(), "Free left a f
 scene.frame_set(25)
 assert frame_cache.get(obj).end == 25 and scene.frame_current == 25
 assert key().tobytes() == played[25].tobytes(), "a jump forward differs from playing"
+
+# The keyframes' digest sees every change that moves a curve: a key's point, its handles (free
+# handles: auto ones are computed again), its interpolation and easing; the last key's
+# interpolation shapes no segment. On a curve of its own.
+empty = bpy.data.objects.new("Keys", None)
+scene.collection.objects.link(empty)
+for frame, z in ((1, 0.0), (6, 0.6)):
+    empty.location.z = z
+    empty.keyframe_insert("location", index=2, frame=frame)
+curve = frame_keys.action_fcurves(empty.animation_data)[0]
+points = curve.keyframe_points
+for point in points:
+    point.handle_left_type = point.handle_right_type = "FREE"
+curves = [("Keys:location[2]", curve)]
+digests = {frame_cache.keys_digest(curves)}
+for change in (lambda: setattr(points[0], "interpolation", "LINEAR"), lambda: setattr(points[0], "easing", "EASE_IN"),
+               lambda: setattr(points[0].handle_right, "y", 0.3), lambda: setattr(points[1].co, "y", 0.7),
+               lambda: setattr(points[1].handle_left, "x", 4.5)):
+    change()
+    digests.add(frame_cache.keys_digest(curves))
+assert len(digests) == 6, "a change of a keyframe left the digest as it was"
+points[1].interpolation = "CONSTANT"
+assert frame_cache.keys_digest(curves) in digests
+bpy.data.objects.remove(empty)
 
 # A changed keyframe invalidates from the first frame it changes (2: the turn's curve), and a
 # change of a setting everything; what follows is simulated again.
