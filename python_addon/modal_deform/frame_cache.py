@@ -42,27 +42,29 @@ def kind(obj):
 
 
 def _pose_fields(obj):
-    """The settings the static pose depends on: the stiffness and the handles."""
+    """The settings the static pose depends on, (name, value) pairs: the stiffness and the handles."""
     settings = obj.modal_deform
-    return {"stiffness": settings.stiffness,
-            "handles": [(h.vertex_group, h.weight, h.controller.name if h.controller else "",
-                         [list(row) for row in h.bind_matrix]) for h in settings.handles]}
+    return (("stiffness", settings.stiffness),
+            ("handles", tuple((h.vertex_group, h.weight, h.controller.name if h.controller else "",
+                               tuple(value for row in h.bind_matrix for value in row)) for h in settings.handles)))
 
 
 def pose_signature(obj):
-    """What the static pose depends on besides the basis and the controllers' motion, as a string."""
-    return json.dumps(_pose_fields(obj), sort_keys=True)
+    """What the static pose depends on besides the basis and the controllers' motion, as a string
+    (the repr of plain values: every frame shown computes it, where JSON took twice as long)."""
+    return repr(_pose_fields(obj))
 
 
 def signature(obj, scene):
-    """What the cached frames depend on besides the controllers' motion, as a string: the settings
-    of the kind of cache obj's settings call for, the handles and the scene's frame rate."""
+    """What the cached frames depend on besides the controllers' motion, as a string (as
+    pose_signature): the settings of the kind of cache obj's settings call for, the handles and the
+    scene's frame rate."""
     dynamics = obj.modal_deform.dynamics
-    fields = {"kind": kind(obj), **_pose_fields(obj)}
+    fields = (("kind", kind(obj)),) + _pose_fields(obj)
     if dynamics.enabled:
-        fields.update(period=dynamics.period, damping=dynamics.damping, substeps=dynamics.substeps,
-                      start=dynamics.frame_start, fps=scene.render.fps / scene.render.fps_base)
-    return json.dumps(fields, sort_keys=True)
+        fields += (("period", dynamics.period), ("damping", dynamics.damping), ("substeps", dynamics.substeps),
+                   ("start", dynamics.frame_start), ("fps", scene.render.fps / scene.render.fps_base))
+    return repr(fields)
 
 
 def basis_id(obj):

@@ -95,12 +95,14 @@ def positions(obj):
     modifier = modifier_of(obj) or _add_modifier(obj)
     mesh = obj.data
     attributes = mesh.attributes
-    if attributes.get(ATTRIBUTE) is None:
+    attribute = attributes.get(ATTRIBUTE)
+    if attribute is None:
         attributes.new(ATTRIBUTE, "FLOAT_VECTOR", "POINT")
         if _reads_shown(modifier.node_group):
             shown = attributes.get(SHOWN) or attributes.new(SHOWN, "BOOLEAN", "POINT")
             shown.data.foreach_set("value", np.ones(len(mesh.vertices), bool))
-    return mesh_io.attribute_co(mesh, attributes[ATTRIBUTE])
+        attribute = attributes[ATTRIBUTE]  # looked up after SHOWN is added, which can move it
+    return mesh_io.attribute_co(mesh, attribute)
 
 
 def _reads_shown(tree):
