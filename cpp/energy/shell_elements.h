@@ -7,7 +7,7 @@
 // and ∂s/∂x0 = −Σ_m ∂s/∂r_m. A quantity provides
 //   Frame<T> frame(r)              the intermediate vectors shared by value and gradient,
 //   gradient(frame, g)             ∇s with respect to r (3(K − 1) values),
-// and a double-only measure of its value. Gradients divide by the element's size (length,
+// and a measure of its value (for a hinge, of cos θ and sin θ: double only). Gradients divide by the element's size (length,
 // normal): callers check the frame first (see discrete_shells.h for what a collapsed element does).
 #pragma once
 
@@ -51,7 +51,10 @@ struct EdgeLength {
     return {a, sqrt(dot(a, a))};
   }
 
-  static double measure(const Frame<double>& f) { return f.length; }
+  template <typename T>
+  static T measure(const Frame<T>& f) {
+    return f.length;
+  }
 
   // ∇ℓ = a / ‖a‖.
   template <typename T>
@@ -79,7 +82,10 @@ struct TriangleArea {
     return {a, b, n, sqrt(dot(n, n))};
   }
 
-  static double measure(const Frame<double>& f) { return 0.5 * f.norm; }
+  template <typename T>
+  static T measure(const Frame<T>& f) {
+    return 0.5 * f.norm;
+  }
 
   // With the unit normal u = n / ‖n‖: ∇_a A = ½ b × u, ∇_b A = ½ u × a.
   template <typename T>
