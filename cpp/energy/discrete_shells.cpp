@@ -103,22 +103,19 @@ bool hinge_faded(const HingeTerm& term, double n1n1, double n2n2) {
 }
 
 // ½ w (2 sin(δ/2))² = ½ w ‖(cos θ, sin θ) − (cos θ̄, sin θ̄)‖², the unfaded bending term, and
-// w sin δ, its derivative in θ, from the frame (any scalar T) and the rest's cos θ̄, sin θ̄ and w
-// (doubles, or lanes as T is).
+// w sin δ, its derivative in θ, from cos θ and sin θ (any scalar T) and the rest's cos θ̄, sin θ̄
+// and w (doubles, or lanes as T is).
 template <typename T, typename C>
-std::array<T, 2> bending_and_slope(const C& cos_rest, const C& sin_rest, const C& weight,
-                                   const DihedralAngle::Frame<T>& f) {
-  using std::sqrt;
-  const T inverse = sqrt(f.inverse_product);  // 1 / (‖a‖‖n1‖‖n2‖)
-  const T cos_theta = shells::dot(f.n1, f.n2) * f.length * inverse;
-  const T sin_theta = -(shells::dot(f.n1, f.c) * f.aa * inverse);
+std::array<T, 2> bending_and_slope(const T& cos_theta, const T& sin_theta, const C& cos_rest, const C& sin_rest,
+                                   const C& weight) {
   const T dc = cos_theta - T(cos_rest), ds = sin_theta - T(sin_rest);
   return {(dc * dc + ds * ds) * (0.5 * weight), (sin_theta * cos_rest - cos_theta * sin_rest) * weight};
 }
 
 template <typename T>
 std::array<T, 2> bending_and_slope(const HingeTerm& term, const DihedralAngle::Frame<T>& f) {
-  return bending_and_slope(term.cos_rest, term.sin_rest, term.weight, f);
+  const auto [cos_theta, sin_theta] = DihedralAngle::measure(f);
+  return bending_and_slope(cos_theta, sin_theta, term.cos_rest, term.sin_rest, term.weight);
 }
 
 // The gradient of a faded hinge's whole term b(θ) φ(t1) φ(t2) over r = (a, b, c):
@@ -147,8 +144,8 @@ void faded_hinge_gradient(const HingeTerm& term, const DihedralAngle::Frame<T>& 
 // small δ, exactly 0 at rest. The derivatives in δ use the angle-difference formulas. This is
 // the term where neither triangle is crushed (hinge_faded false).
 Response unfaded_respond(const HingeTerm& term, const DihedralAngle::Frame<double>& frame) {
-  const auto [bending, slope] = bending_and_slope(term, frame);  // w sin δ
   const auto [cos_theta, sin_theta] = DihedralAngle::measure(frame);
+  const auto [bending, slope] = bending_and_slope(cos_theta, sin_theta, term.cos_rest, term.sin_rest, term.weight);
   const double cos_delta = cos_theta * term.cos_rest + sin_theta * term.sin_rest;
   return {bending, slope, term.weight * cos_delta, -slope, true};
 }
@@ -281,8 +278,9 @@ std::array<TermLanes, 2> usual_value_and_slope(const TriangleTerm* terms,
                              lanes_of(terms, &TriangleTerm::weight));
 }
 std::array<TermLanes, 2> usual_value_and_slope(const HingeTerm* terms, const DihedralAngle::Frame<TermLanes>& frame) {
-  return bending_and_slope(lanes_of(terms, &HingeTerm::cos_rest), lanes_of(terms, &HingeTerm::sin_rest),
-                           lanes_of(terms, &HingeTerm::weight), frame);
+  const auto [cos_theta, sin_theta] = DihedralAngle::measure(frame);
+  return bending_and_slope(cos_theta, sin_theta, lanes_of(terms, &HingeTerm::cos_rest),
+                           lanes_of(terms, &HingeTerm::sin_rest), lanes_of(terms, &HingeTerm::weight));
 }
 
 bool in_usual_state(const EdgeTerm& term, const EdgeLength::Frame<TermLanes>& frame, int lane) {
