@@ -293,39 +293,52 @@ bool in_usual_state(const HingeTerm& term, const DihedralAngle::Frame<TermLanes>
   return !hinge_faded(term, frame.n1n1[lane], frame.n2n2[lane]);  // a collapsed hinge is faded too
 }
 
+// Terms per chunk of add_gradients_in_lanes: all are evaluated before any is added to the
+// gradient, so that their evaluations, independent of each other, overlap in the processor.
+constexpr int kChunk = 16 * kLanes;
+
 // add_gradient over all `terms` in order, every vertex owned, their values added to `energy`: the
-// same sums, bit for bit, kLanes terms at a time. The lanes' frames, usual values, slopes and
-// gradients are computed at once (lanes.h), then added to `out` term by term; a term not in its
-// usual state and the last terms go through add_gradient.
+// same sums, bit for bit, chunk by chunk. A chunk's terms are evaluated kLanes at a time, their
+// frames, usual values, slopes and gradients at once (lanes.h), then added to `out` term by term;
+// a term not in its usual state and the last terms go through add_gradient.
 template <typename Term>
 void add_gradients_in_lanes(const std::vector<Term>& terms, const double* x, double* out, double& energy) {
-  constexpr int K = kVerticesOf<Term>, N = kDofsOf<Term>;
+  constexpr int K = kVerticesOf<Term>, N = kDofsOf<Term>, kGroups = kChunk / kLanes;
   const AllVertices all;
   const size_t count = terms.size(), whole = count - count % kLanes;
-  for (size_t start = 0; start < whole; start += kLanes) {
-    const Term* group = terms.data() + start;
-    TermLanes r[N];
-    for (int l = 0; l < kLanes; ++l) {
-      double rl[N];
-      relative(group[l], x, rl);
-      for (int i = 0; i < N; ++i) r[i][l] = rl[i];
+  for (size_t first = 0; first < whole; first += kChunk) {
+    const Term* chunk = terms.data() + first;
+    const int size = static_cast<int>(std::min<size_t>(kChunk, whole - first));
+    TermLanes g[kGroups][N], f[kGroups], df[kGroups];
+    bool usual[kChunk];
+    for (int k = 0; k < size / kLanes; ++k) {
+      const Term* group = chunk + k * kLanes;
+      TermLanes r[N];
+      for (int l = 0; l < kLanes; ++l) {
+        double rl[N];
+        relative(group[l], x, rl);
+        for (int i = 0; i < N; ++i) r[i][l] = rl[i];
+      }
+      const auto frame = Term::Quantity::frame(r);
+      const auto [value, slope] = usual_value_and_slope(group, frame);
+      f[k] = value;
+      df[k] = slope;
+      Term::Quantity::gradient(frame, g[k]);
+      for (TermLanes& gi : g[k]) gi = gi * df[k];
+      for (int l = 0; l < kLanes; ++l) usual[k * kLanes + l] = in_usual_state(group[l], frame, l);
     }
-    const auto frame = Term::Quantity::frame(r);
-    const auto [f, df] = usual_value_and_slope(group, frame);
-    TermLanes g[N];
-    Term::Quantity::gradient(frame, g);
-    for (TermLanes& gi : g) gi = gi * df;
-    for (int l = 0; l < kLanes; ++l) {
-      if (!in_usual_state(group[l], frame, l)) {
-        energy += add_gradient(group[l], x, all, out);
+    for (int e = 0; e < size; ++e) {
+      const int k = e / kLanes, l = e % kLanes;
+      if (!usual[e]) {
+        energy += add_gradient(chunk[e], x, all, out);
         continue;
       }
-      energy += f[l];
-      if (df[l] == 0) continue;
+      energy += f[k][l];
+      if (df[k][l] == 0) continue;
       double gl[N], full[3 * K];
-      for (int i = 0; i < N; ++i) gl[i] = g[i][l];
+      for (int i = 0; i < N; ++i) gl[i] = g[k][i][l];
       to_vertices<K>(gl, full);
-      add_owned(group[l], full, all, out);
+      add_owned(chunk[e], full, all, out);
     }
   }
   for (size_t e = whole; e < count; ++e) energy += add_gradient(terms[e], x, all, out);
