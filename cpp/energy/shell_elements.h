@@ -7,8 +7,9 @@
 // and ∂s/∂x0 = −Σ_m ∂s/∂r_m. A quantity provides
 //   Frame<T> frame(r)              the intermediate vectors shared by value and gradient,
 //   gradient(frame, g)             ∇s with respect to r (3(K − 1) values),
-// and a measure of its value (for a hinge, cos θ and sin θ). Gradients divide by the element's size (length,
-// normal): callers check the frame first (see discrete_shells.h for what a collapsed element does).
+// and a measure of its value (for a hinge, cos θ and sin θ). Gradients divide by the element's
+// size (length, normal): callers check the frame first (see discrete_shells.h for what a collapsed
+// element does).
 #pragma once
 
 #include <array>
