@@ -65,8 +65,9 @@
 // Meshes with at least kParallelElements terms are evaluated in parallel (OpenMP) over vertex
 // ranges (vertex_partition.h), with the same results for any number of threads (but for the
 // order in which value sums); smaller ones, such as the reduced solver's ghost mesh, run on the
-// calling thread without allocating (value, value_and_gradient). All methods are const and safe
-// to call concurrently.
+// calling thread without allocating (value, value_and_gradient), the gradient two terms of a kind
+// at a time in SIMD lanes (lanes.h) with the same sums, bit for bit. All methods are const and
+// safe to call concurrently.
 #pragma once
 
 #include <array>

@@ -7,8 +7,9 @@
 // and ∂s/∂x0 = −Σ_m ∂s/∂r_m. A quantity provides
 //   Frame<T> frame(r)              the intermediate vectors shared by value and gradient,
 //   gradient(frame, g)             ∇s with respect to r (3(K − 1) values),
-// and a double-only measure of its value. Gradients divide by the element's size (length,
-// normal): callers check the frame first (see discrete_shells.h for what a collapsed element does).
+// and a measure of its value (for a hinge, cos θ and sin θ). Gradients divide by the element's
+// size (length, normal): callers check the frame first (see discrete_shells.h for what a collapsed
+// element does).
 #pragma once
 
 #include <array>
@@ -51,7 +52,10 @@ struct EdgeLength {
     return {a, sqrt(dot(a, a))};
   }
 
-  static double measure(const Frame<double>& f) { return f.length; }
+  template <typename T>
+  static T measure(const Frame<T>& f) {
+    return f.length;
+  }
 
   // ∇ℓ = a / ‖a‖.
   template <typename T>
@@ -79,7 +83,10 @@ struct TriangleArea {
     return {a, b, n, sqrt(dot(n, n))};
   }
 
-  static double measure(const Frame<double>& f) { return 0.5 * f.norm; }
+  template <typename T>
+  static T measure(const Frame<T>& f) {
+    return 0.5 * f.norm;
+  }
 
   // With the unit normal u = n / ‖n‖: ∇_a A = ½ b × u, ∇_b A = ½ u × a.
   template <typename T>
@@ -129,15 +136,13 @@ struct DihedralAngle {
     return f;
   }
 
-  struct CosSin {
-    double cos, sin;
-  };
-
-  // cos θ = n1·n2 / (‖n1‖‖n2‖), sin θ = (n1 × n2)·a / (‖n1‖‖n2‖‖a‖) = −(n1·c) ‖a‖ / (‖n1‖‖n2‖),
-  // since n1 × n2 = −((a × b)·c) a.
-  static CosSin measure(const Frame<double>& f) {
-    const double inverse = std::sqrt(f.inverse_product);  // 1 / (‖a‖‖n1‖‖n2‖)
-    return {dot(f.n1, f.n2) * f.length * inverse, -dot(f.n1, f.c) * f.aa * inverse};
+  // (cos θ, sin θ): cos θ = n1·n2 / (‖n1‖‖n2‖), sin θ = (n1 × n2)·a / (‖n1‖‖n2‖‖a‖)
+  // = −(n1·c) ‖a‖ / (‖n1‖‖n2‖), since n1 × n2 = −((a × b)·c) a.
+  template <typename T>
+  static std::array<T, 2> measure(const Frame<T>& f) {
+    using std::sqrt;
+    const T inverse = sqrt(f.inverse_product);  // 1 / (‖a‖‖n1‖‖n2‖)
+    return {dot(f.n1, f.n2) * f.length * inverse, -(dot(f.n1, f.c) * f.aa * inverse)};
   }
 
   // The classic hinge gradient (e.g. Wardetzky et al. 2007, "Discrete quadratic curvature
