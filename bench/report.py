@@ -809,7 +809,10 @@ def section_playback(result):
     out = ["## Animation cache and secondary motion (issue 40)", "",
            "`bench/playback.py` in bpy from the package index, the add-on installed from its extension zip: the "
            "dragon (100k vertices; subdivided twice, 1.6M, on a proxy) with a controller turning and sliding, "
-           "keyed every 6 frames. Per frame, medians: \"handler\" is the frame handler's work for the object "
+           f"keyed every 6 frames. Per frame, the median over the frames of each frame's least over "
+           f"{runs[0]['dynamic_step'].get('rounds', 1)} rounds of the same frames (a live step's frames simulated "
+           "again each round: a neighbour's load on the machine left out): \"handler\" is the frame handler's work "
+           "for the object "
            "(playback.show: the checks, the cache read or the simulation step, x̄ + U q into the display's point "
            "attribute, playback_display.py), of it in brackets \"map\", x̄ + U q into the attribute alone (the part "
            "that grows with the mesh), \"evaluate\" Blender's evaluation of the mesh after it (view_layer.update(): "
