@@ -60,8 +60,11 @@ Eigen::Matrix4d nearest_rigid(const Eigen::Matrix4d& M, const Eigen::Vector3d& c
   const Eigen::Matrix3d A = M.topLeftCorner<3, 3>();
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d U = svd.matrixU();
-  if ((U * svd.matrixV().transpose()).determinant() < 0) U.col(2) = -U.col(2);
-  const Eigen::Matrix3d R = U * svd.matrixV().transpose();
+  Eigen::Matrix3d R = U * svd.matrixV().transpose();
+  if (R.determinant() < 0) {
+    U.col(2) = -U.col(2);
+    R = U * svd.matrixV().transpose();
+  }
   Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
   T.topLeftCorner<3, 3>() = R;
   T.topRightCorner<3, 1>() = A * centre + M.topRightCorner<3, 1>() - R * centre;

@@ -20,14 +20,13 @@ first frame whose curve values changed (``keyframes_changed``, when the keyframe
 checked at every frame shown); and a frame whose controllers stand elsewhere than when it was cached (a
 constraint, a driver, a moved parent) cuts the cache there when it is shown.
 """
-import ctypes
 import hashlib
 import json
 
 import bpy
 import numpy as np
 
-from . import storage
+from . import mesh_io, storage
 
 PREFIX = ".Modal Deform Cache "
 _ARRAYS = ("q", "v", "transforms", "curves")
@@ -261,9 +260,7 @@ def keys_digest(curves):
         count = len(points)
         h.update(f"{path}:{curve.extrapolation}:{count}".encode())
         if count:
-            address = points[0].as_pointer()
-            stride = points[1].as_pointer() - address if count > 1 else 0
-            h.update(ctypes.string_at(address, stride * (count - 1) + _KEYFRAME_POINTS_BYTES))
+            h.update(mesh_io.item_memory(points, _KEYFRAME_POINTS_BYTES)[0])
     return h.hexdigest()
 
 
