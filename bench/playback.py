@@ -1,7 +1,9 @@
 """The per-frame cache in headless Blender (issue 40): per frame, what playback costs (a cached frame
-read back, x = x̄ + U q into the display's attribute, playback_display.py; one simulation step live)
-and Blender's evaluation after it (the display's Geometry Nodes modifier); and for FRAMES frames of the dragon (100k vertices), the cache's size and the
-.blend's against the same animation exported as a shape key per frame and as a PC2 file.
+read back, x = x̄ + U q into the display, playback_display.py; one simulation step live) and Blender's
+evaluation after it, the frames played (the display reading a stand-in) and, for a live step, stepped
+through with the timeline still (the display's attribute); and for FRAMES frames of the dragon (100k
+vertices), the cache's size and the .blend's against the same animation exported as a shape key per
+frame and as a PC2 file.
 
     blender -b --factory-startup --python bench/playback.py -- --output out.json [--quick] [--subdivide 2]
 
@@ -18,8 +20,8 @@ alone (the frame's q mapped again after, into an array of its own), the part of 
 grows with the mesh. Each figure is the median over the frames of a frame's least over ROUNDS
 rounds of the same frames (a live step's frames simulated again each round). A jump forward simulates every frame in between:
 its handler's time per frame simulated. For reference, Blender's evaluation of the same mesh
-without the display, its vertex positions written (a copy of the mesh on another object): what the
-display's modifier costs over a mesh that shows its own positions (a stand-in mesh's display). The load average (1, 5, 15 min) before and after the run.
+without the display, its vertex positions written (a copy of the mesh on another object): the floor
+of what the display costs. The load average (1, 5, 15 min) before and after the run.
 """
 import argparse
 import json
@@ -68,9 +70,17 @@ def animate(controller, frames):
         controller.keyframe_insert("location", frame=frame)
 
 
-def timed_frames(obj, scene, playback, frame_cache, frames, stepping=False, rounds=ROUNDS):
+def playback_handler(name):
+    """The add-on's handler Blender calls when the timeline starts or stops playing (Blender 4+),
+    which headless frame changes do not call."""
+    return next(h for h in getattr(bpy.app.handlers, name) if h.__module__.endswith(".playback"))
+
+
+def timed_frames(obj, scene, playback, frame_cache, frames, stepping=False, rounds=ROUNDS, playing=True):
     """Handler, map and evaluation milliseconds over `frames`, each reached by scene.frame_set as
-    the timeline reaches it: "handler" from the start to the end of the add-on's frame handler
+    the timeline reaches it, played (`playing`: between the calls of the add-on's playback handlers,
+    the display reading a stand-in) or stepped through while still (the display's attribute):
+    "handler" from the start to the end of the add-on's frame handler
     (clocks read by handlers put before and after it), "evaluate" from its end to the return of
     frame_set (Blender evaluating what the handler changed); `stepping`: also the simulation step's
     own milliseconds and BFGS iterations (Simulation.stats, timed natively), each round after the
@@ -93,6 +103,8 @@ def timed_frames(obj, scene, playback, frame_cache, frames, stepping=False, roun
     handlers.insert(list(handlers).index(add_on_handler) + 1, after)
     figures = {name: np.full((rounds, len(frames)), np.inf) for name in ("handler", "map", "evaluate", "step")}
     iterations = []
+    if playing:
+        playback_handler("animation_playback_pre")(scene, None)
     try:
         for round_ in range(rounds):
             if stepping:
@@ -114,6 +126,8 @@ def timed_frames(obj, scene, playback, frame_cache, frames, stepping=False, roun
     finally:
         handlers.remove(before)
         handlers.remove(after)
+        if playing:
+            playback_handler("animation_playback_post")(scene, None)
     least = {name: float(np.median(values.min(axis=0))) for name, values in figures.items()}
     result = {"handler_ms": least["handler"], "map_ms": least["map"], "evaluate_ms": least["evaluate"],
               "frames": len(frames), "rounds": rounds,
@@ -208,6 +222,8 @@ def main():
         playback.set_frame(scene, 1)
         playback.show(obj, scene)
         results["dynamic_step"] = timed_frames(obj, scene, playback, frame_cache, timed, stepping=True)
+        results["dynamic_step_still"] = timed_frames(obj, scene, playback, frame_cache, timed, stepping=True,
+                                                     playing=False)
         results["dynamic_read"] = timed_frames(obj, scene, playback, frame_cache, timed)
         results["dynamic_cache_bytes_per_frame"] = frame_cache.get(obj).nbytes() / len(frame_cache.get(obj))
         results["dynamic_jump"] = jump_forward(obj, scene, playback, frame_cache, len(timed))

@@ -813,10 +813,12 @@ def section_playback(result):
            f"{runs[0]['dynamic_step'].get('rounds', 1)} rounds of the same frames (a live step's frames simulated "
            "again each round: a neighbour's load on the machine left out): \"handler\" is the frame handler's work "
            "for the object "
-           "(playback.show: the checks, the cache read or the simulation step, x̄ + U q into the display's point "
-           "attribute, playback_display.py), of it in brackets \"map\", x̄ + U q into the attribute alone (the part "
-           "that grows with the mesh), \"evaluate\" Blender's evaluation of the mesh after it (view_layer.update(): "
-           "the display's Geometry Nodes modifier sets the positions from the attribute).", ""]
+           "(playback.show: the checks, the cache read or the simulation step, x̄ + U q into the display, "
+           "playback_display.py), of it in brackets \"map\", x̄ + U q alone (the part that grows with the mesh), "
+           "\"evaluate\" Blender's evaluation after it, to the return of frame_set. The frames are played: the "
+           "add-on's playback handlers called around them, the display reads a stand-in mesh whose positions are "
+           "the frame; the last column steps the same frames with the timeline still (scrubbing), where the "
+           "display's Geometry Nodes modifier sets the positions from a point attribute.", ""]
 
     def split(figures):
         mapped = f" ({figures['map_ms']:.2f})" if "map_ms" in figures else ""
@@ -824,9 +826,11 @@ def section_playback(result):
 
     rows = [[run["blender"], f"{run['vertices']:,}", run["dimension"], split(run["static_read"]),
              split(run["dynamic_read"]), split(run["dynamic_step"]),
-             "{:.1f} / {:.1f}".format(*loads) if (loads := load_range(run)) else ""] for run in runs]
+             "{:.1f} / {:.1f}".format(*loads) if (loads := load_range(run)) else "",
+             split(run["dynamic_step_still"]) if "dynamic_step_still" in run else ""] for run in runs]
     out.append(table(["Blender", "vertices", "dims", "static cache read: handler (map) + evaluate ms",
-                      "simulation cache read ms", "live simulation step ms", "load before / after"], rows))
+                      "simulation cache read ms", "live simulation step ms", "load before / after",
+                      "live step, timeline still ms"], rows))
     stepped = [f"{run['blender']}, {run['vertices']:,} vertices: {run['dynamic_step']['step_ms']:.1f} ms, "
                f"{run['dynamic_step']['iterations']:.0f} BFGS iterations" for run in runs
                if "step_ms" in run["dynamic_step"]]
@@ -843,8 +847,8 @@ def section_playback(result):
             if "without_display" in run]
     if bare:
         out += ["", "Blender's evaluation of the same mesh without the display, its vertex positions written (a copy "
-                "on another object, as a stand-in mesh would show the frame): what the display's modifier costs of "
-                "\"evaluate\": " + "; ".join(bare) + "."]
+                "on another object): the floor of \"evaluate\", against the played cache read's: "
+                + "; ".join(bare) + "."]
     targets = common.FRAME_TARGETS_MS
     checks = [f"{run['blender']}, {run['vertices']:,} vertices: ≤ {targets[run['vertices']]:.0f} ms — "
               f"**{'met' if total <= targets[run['vertices']] else 'NOT met'}** ({total:.1f} ms)"

@@ -31,6 +31,8 @@ _players = {}
 problems = {}
 # True while playback changes the frame itself (catching up): the handler then does nothing.
 _busy = False
+# True while the timeline plays (Blender 4+): objects shown then read a stand-in (playback_display).
+_playing = False
 
 
 class Player:
@@ -219,10 +221,12 @@ def show(obj, scene, edits_reported=False):
     index = cache.row(frame)
     if index is not None and not np.array_equal(player_.transforms(obj).ravel(), cache.array("transforms")[index]):
         cache.cut(frame)
+    if _playing:
+        playback_display.use_stand_in(obj)
     # A frame simulated here is mapped by its step straight into the display (no copy between).
     if not fill(obj, scene, cache, shown, player_, out=lambda: playback_display.positions(obj), curves=curves):
         player_.positions(cache.array("q")[cache.row(shown)], playback_display.positions(obj))
-    obj.data.update()
+    playback_display.tag(obj)
 
 
 def free(obj):
@@ -234,12 +238,17 @@ def free(obj):
 
 
 def _edits_reported(depsgraph):
-    """Forget the comparisons (Player.check_mesh) of the meshes depsgraph reports a geometry update of."""
+    """Forget the comparisons (Player.check_mesh) of the meshes depsgraph reports a geometry update of,
+    and end their objects' stand-ins: what the artist changed shows."""
     edited = {update.id.original.as_pointer() for update in depsgraph.updates
               if update.is_updated_geometry and isinstance(update.id, bpy.types.Mesh)}
-    for found in _players.values():
-        if found.compared is not None and found.compared[0] in edited:
+    if not edited:
+        return
+    for name, found in _players.items():
+        obj = bpy.data.objects.get(name)
+        if obj is not None and obj.type == "MESH" and obj.data.as_pointer() in edited:
             found.compared = None
+            playback_display.end_stand_in(obj)
 
 
 @bpy.app.handlers.persistent
@@ -251,8 +260,11 @@ def _frame_changed(scene, depsgraph=None):
     displayed = playback_display.in_use()
     for obj in scene.objects:
         if not wants_playback(obj):
-            if displayed and obj.type == "MESH" and obj.library is None and not plays(obj):  # freed, dynamics off
-                playback_display.remove(obj)
+            if displayed and obj.type == "MESH" and obj.library is None:
+                if not plays(obj):  # freed, dynamics off
+                    playback_display.remove(obj)
+                elif _playing:  # Edit, Sculpt or Paint Mode: the mesh itself shows there
+                    playback_display.end_stand_in(obj)
             continue
         try:
             show(obj, scene, edits_reported=depsgraph is not None)
@@ -271,30 +283,58 @@ def _geometry_updated(scene, depsgraph):
 
 @bpy.app.handlers.persistent
 def _compare_again(*args):
-    """After an undo or redo, which may read meshes back from memory, every mesh is compared again."""
+    """After an undo or redo, which may read meshes back from memory, every mesh is compared again;
+    with the timeline still, the stand-ins it brought back go."""
     for found in _players.values():
         found.compared = None
+    if not _playing:
+        playback_display.end_stand_ins()
 
 
 @bpy.app.handlers.persistent
 def _forget(*args):
+    global _playing
     _players.clear()
     problems.clear()
+    _playing = False
+    playback_display.end_stand_ins()  # a file written mid-playback
+
+
+@bpy.app.handlers.persistent
+def _playback_started(*args):
+    global _playing
+    _playing = True
+
+
+@bpy.app.handlers.persistent
+def _playback_stopped(*args):
+    global _playing
+    _playing = False
+    playback_display.end_stand_ins()
+
+
+@bpy.app.handlers.persistent
+def _before_saving(*args):
+    """The file holds the mesh once: the stand-ins go, and come back at the next frame played."""
+    playback_display.end_stand_ins()
+
+
+# Blender's handlers and ours; the playback handlers are Blender 4's.
+_HANDLERS = [("frame_change_post", _frame_changed), ("depsgraph_update_post", _geometry_updated),
+             ("undo_post", _compare_again), ("redo_post", _compare_again), ("load_post", _forget),
+             ("save_pre", _before_saving), ("animation_playback_pre", _playback_started),
+             ("animation_playback_post", _playback_stopped)]
 
 
 def register():
-    bpy.app.handlers.frame_change_post.append(_frame_changed)
-    bpy.app.handlers.depsgraph_update_post.append(_geometry_updated)
-    bpy.app.handlers.undo_post.append(_compare_again)
-    bpy.app.handlers.redo_post.append(_compare_again)
-    bpy.app.handlers.load_post.append(_forget)
+    for name, handler in _HANDLERS:
+        if hasattr(bpy.app.handlers, name):
+            getattr(bpy.app.handlers, name).append(handler)
 
 
 def unregister():
-    bpy.app.handlers.frame_change_post.remove(_frame_changed)
-    bpy.app.handlers.depsgraph_update_post.remove(_geometry_updated)
-    bpy.app.handlers.undo_post.remove(_compare_again)
-    bpy.app.handlers.redo_post.remove(_compare_again)
-    bpy.app.handlers.load_post.remove(_forget)
+    for name, handler in _HANDLERS:
+        if hasattr(bpy.app.handlers, name):
+            getattr(bpy.app.handlers, name).remove(handler)
     _forget()
     playback_display.remove_all()

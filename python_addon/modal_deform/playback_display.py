@@ -12,6 +12,16 @@ where it blended the playback shape key this replaces in 11.4 to 20.0 (bench/res
 "evaluate_ms", against its record at 246d346); Blender 4+ copies the attribute's array once a frame
 when it is written (positions(): 1.7 ms at 1.6M), as the evaluated mesh shares it until then.
 
+While the timeline plays (from Blender 4 on, whose playback handlers say when), the modifier reads a
+stand-in instead (use_stand_in): a copy of the mesh without shape keys, in no scene, whose positions
+are the frame, passed on whole by an Object Info node. Blender then evaluates a mesh whose positions
+were written rather than a Set Position, in less than half the time (bench/results/playback.json,
+"evaluate_ms" of "dynamic_step" against "dynamic_step_still"). The stand-in goes (end_stand_in) when
+playback stops, before a file is saved, when the artist edits the mesh or leaves Object Mode, and
+after a file is loaded or an undo while the timeline is still: the attribute then holds its frame, so
+the display shows the same. A file written mid-playback without save_pre (a crash's autosave) holds
+the stand-in, which shows the frame as the attribute does.
+
 Taken away (remove) when the cache is freed or no longer plays, when a pose shows (the interactive
 pose, or a result in the "Modal Deform" shape key: pose_displays.display, posing.pose_key) and when
 the add-on is disabled.
@@ -30,6 +40,9 @@ MARK = "modal_deform_playback"
 ATTRIBUTE = "modal_deform_playback"
 #: Blender 3.4's selection (see the module's comment): True on every point where ATTRIBUTE holds a frame.
 SHOWN = "modal_deform_playback_shown"
+#: ID property of a stand-in's object, mesh and node group (one each per object that plays): the name
+#: of the object it stands in for.
+STAND_IN = "modal_deform_stand_in"
 
 
 def _named_attribute(tree, data_type, name):
@@ -40,13 +53,9 @@ def _named_attribute(tree, data_type, name):
     return node, next(o for o in node.outputs if o.name == "Attribute" and o.enabled)
 
 
-def node_group():
-    """The file's node group (made on first use): Geometry → Set Position (Position: ATTRIBUTE,
-    Selection: where it exists) → Geometry."""
-    tree = next((g for g in bpy.data.node_groups if g.library is None and g.get(MARK)), None)
-    if tree is not None:
-        return tree
-    tree = bpy.data.node_groups.new(NODE_GROUP, "GeometryNodeTree")
+def _geometry_group(name):
+    """A new node group of the display (MARK) taking and giving a geometry."""
+    tree = bpy.data.node_groups.new(name, "GeometryNodeTree")
     tree[MARK] = True
     if hasattr(tree, "interface"):  # Blender 4.0+
         tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
@@ -54,6 +63,16 @@ def node_group():
     else:
         tree.inputs.new("NodeSocketGeometry", "Geometry")
         tree.outputs.new("NodeSocketGeometry", "Geometry")
+    return tree
+
+
+def node_group():
+    """The file's node group (made on first use): Geometry → Set Position (Position: ATTRIBUTE,
+    Selection: where it exists) → Geometry."""
+    tree = next((g for g in bpy.data.node_groups if g.library is None and g.get(MARK) and not g.get(STAND_IN)), None)
+    if tree is not None:
+        return tree
+    tree = _geometry_group(NODE_GROUP)
     group_in, group_out = tree.nodes.new("NodeGroupInput"), tree.nodes.new("NodeGroupOutput")
     set_position = tree.nodes.new("GeometryNodeSetPosition")
     positions, position_output = _named_attribute(tree, "FLOAT_VECTOR", ATTRIBUTE)
@@ -90,9 +109,13 @@ def modifier_of(obj):
 
 
 def positions(obj):
-    """Where the frame shown on obj goes: ATTRIBUTE's #V by 3 float32 view (mesh_io.attribute_co),
-    with the modifier that shows it (made if needed). Use at once, then tag the mesh (mesh.update())."""
+    """Where the frame shown on obj goes: its stand-in's positions while it has one, else ATTRIBUTE's
+    (made if needed, with the modifier that shows it): a #V by 3 float32 view of Blender's array
+    (mesh_io). Use at once, then tag(obj)."""
     modifier = modifier_of(obj) or _add_modifier(obj)
+    stand_in = _stand_in(modifier)
+    if stand_in is not None:
+        return mesh_io.vertex_positions(stand_in.data)
     mesh = obj.data
     attributes = mesh.attributes
     attribute = attributes.get(ATTRIBUTE)
@@ -103,6 +126,97 @@ def positions(obj):
             shown.data.foreach_set("value", np.ones(len(mesh.vertices), bool))
         attribute = attributes[ATTRIBUTE]  # looked up after SHOWN is added, which can move it
     return mesh_io.attribute_co(mesh, attribute)
+
+
+def tag(obj):
+    """Tell Blender that obj's frame was written (positions()): the mesh written is evaluated again."""
+    modifier = modifier_of(obj)
+    stand_in = _stand_in(modifier) if modifier is not None else None
+    (stand_in.data if stand_in is not None else obj.data).update()
+
+
+def use_stand_in(obj):
+    """Have obj's modifier (made if needed) read a stand-in of its own, showing the frame shown now."""
+    modifier = modifier_of(obj)
+    if modifier is not None and _stand_in(modifier) is not None:
+        return
+    frame = positions(obj).copy()
+    modifier = modifier_of(obj)
+    mesh = obj.data.copy()
+    for name in (ATTRIBUTE, SHOWN):
+        if name in mesh.attributes:
+            mesh.attributes.remove(mesh.attributes[name])
+    if mesh.shape_keys is not None:  # the copy's own (Object.shape_key_clear leaves it in Blender 4.2 to 4.5)
+        bpy.data.batch_remove([mesh.shape_keys])
+    stand_in = bpy.data.objects.new(f"{obj.name} (Modal Deform playback)", mesh)
+    mesh.name = stand_in.name
+    mesh_io.vertex_positions(mesh)[...] = frame
+    tree = _geometry_group(f"{NODE_GROUP}: {obj.name}")
+    for block in (stand_in, mesh, tree):
+        block[STAND_IN] = obj.name
+    group_out = tree.nodes.new("NodeGroupOutput")
+    info = tree.nodes.new("GeometryNodeObjectInfo")
+    info.transform_space = "ORIGINAL"  # the stand-in's geometry as it is, shared rather than copied
+    info.inputs["Object"].default_value = stand_in
+    tree.links.new(info.outputs["Geometry"], group_out.inputs[0])
+    modifier.node_group = tree
+
+
+def end_stand_in(obj):
+    """Have obj's modifier read ATTRIBUTE again, holding the stand-in's frame, and delete the stand-in."""
+    modifier = modifier_of(obj)
+    stand_in = _stand_in(modifier) if modifier is not None else None
+    if stand_in is None:
+        return
+    frame = mesh_io.vertex_positions(stand_in.data).copy()
+    tree = modifier.node_group
+    modifier.node_group = node_group()
+    _delete_stand_in(tree)
+    # In Edit Mode the mesh's arrays are not the ones edited: the next frame shown writes ATTRIBUTE.
+    mesh = obj.data
+    if mesh.library is None and not mesh.is_editmode and len(frame) == len(mesh.vertices):
+        positions(obj)[...] = frame
+        mesh.update()
+
+
+def end_stand_ins():
+    """end_stand_in for every object of the file, and delete the stand-ins left without one."""
+    for obj in [o for o in bpy.data.objects if o.type == "MESH" and o.library is None and has_stand_in(o)]:
+        end_stand_in(obj)
+    _delete_stand_ins()
+
+
+def has_stand_in(obj):
+    """Whether obj's display reads a stand-in."""
+    modifier = modifier_of(obj)
+    return modifier is not None and _stand_in(modifier) is not None
+
+
+def _stand_in(modifier):
+    """The stand-in object modifier's node group reads, or None (it reads ATTRIBUTE)."""
+    tree = modifier.node_group
+    if not tree.get(STAND_IN):
+        return None
+    info = next((node for node in tree.nodes if node.bl_idname == "GeometryNodeObjectInfo"), None)
+    return info.inputs["Object"].default_value if info is not None else None
+
+
+def _delete_stand_in(tree):
+    """Delete a stand-in's node group `tree` (no modifier reading it), its object and the object's mesh."""
+    stand_in = next(n for n in tree.nodes if n.bl_idname == "GeometryNodeObjectInfo").inputs["Object"].default_value
+    bpy.data.node_groups.remove(tree)
+    if stand_in is not None and stand_in.get(STAND_IN):
+        mesh = stand_in.data
+        bpy.data.objects.remove(stand_in)
+        if mesh.get(STAND_IN) and not mesh.users:
+            bpy.data.meshes.remove(mesh)
+
+
+def _delete_stand_ins():
+    """Delete the stand-ins no modifier reads (node groups, then the objects and meshes they read)."""
+    for collection in (bpy.data.node_groups, bpy.data.objects, bpy.data.meshes):
+        for block in [b for b in collection if b.library is None and b.get(STAND_IN) and not b.users]:
+            collection.remove(block)
 
 
 def _reads_shown(tree):
@@ -128,7 +242,10 @@ def remove(obj):
         return
     modifier = modifier_of(obj)
     if modifier is not None:
+        tree = modifier.node_group
         obj.modifiers.remove(modifier)
+        if tree.get(STAND_IN) and not tree.users:
+            _delete_stand_in(tree)
     mesh = obj.data
     if mesh.library is not None:  # a linked mesh's attribute is the library's: the modifier alone goes
         return
@@ -144,5 +261,6 @@ def remove_all():
     for obj in bpy.data.objects:
         if obj.library is None:
             remove(obj)
+    _delete_stand_ins()
     for tree in [g for g in bpy.data.node_groups if g.library is None and g.get(MARK) and g.users == 0]:
         bpy.data.node_groups.remove(tree)

@@ -288,8 +288,9 @@ def steps():
 
     # Secondary motion played in the window: Dynamics on, the controller keyed to slide and stop, the
     # timeline played: every frame shown is simulated into the cache (frames Blender drops to keep
-    # time are simulated on the way); stopped, scrubbing back reads the cache.
-    from modal_deform import frame_cache, playback
+    # time are simulated on the way), read through a stand-in while playing (Blender 4+); stopped, the
+    # stand-in is gone and scrubbing back reads the cache.
+    from modal_deform import frame_cache, playback, playback_display
     scene = bpy.context.scene
     scene.frame_start, scene.frame_end = 1, 48
     scene.frame_set(1)
@@ -301,9 +302,13 @@ def steps():
     with override():
         bpy.ops.screen.animation_play()
     yield from wait_until(lambda: scene.frame_current >= 16, 60)
+    playing_stand_in = playback_display.has_stand_in(obj)
     with override():
         bpy.ops.screen.animation_cancel(restore_frame=False)
     yield 0.3
+    assert playing_stand_in == hasattr(bpy.app.handlers, "animation_playback_pre"), "no stand-in while playing"
+    assert not playback_display.has_stand_in(obj) and not [
+        o for o in bpy.data.objects if o.get(playback_display.STAND_IN)], "a stand-in after playback stopped"
     cache = frame_cache.get(obj)
     assert playback.problems.get(obj.name) is None, playback.problems
     assert cache is not None and cache.kind == "DYNAMIC", "playing made no cache"
