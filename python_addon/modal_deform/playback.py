@@ -221,11 +221,12 @@ def show(obj, scene, edits_reported=False):
     index = cache.row(frame)
     if index is not None and not np.array_equal(player_.transforms(obj).ravel(), cache.array("transforms")[index]):
         cache.cut(frame)
-    if _playing:
-        playback_display.use_stand_in(obj)
-    # A frame simulated here is mapped by its step straight into the display (no copy between).
-    if not fill(obj, scene, cache, shown, player_, out=lambda: playback_display.positions(obj), curves=curves):
-        player_.positions(cache.array("q")[cache.row(shown)], playback_display.positions(obj))
+
+    def display():  # a frame simulated here is mapped by its step straight into it (no copy between)
+        return playback_display.positions(obj, stand_in=_playing)
+
+    if not fill(obj, scene, cache, shown, player_, out=display, curves=curves):
+        player_.positions(cache.array("q")[cache.row(shown)], display())
     playback_display.tag(obj)
 
 

@@ -13,7 +13,7 @@ where it blended the playback shape key this replaces in 11.4 to 20.0 (bench/res
 when it is written (positions(): 1.7 ms at 1.6M), as the evaluated mesh shares it until then.
 
 While the timeline plays (from Blender 4 on, whose playback handlers say when), the modifier reads a
-stand-in instead (use_stand_in): a copy of the mesh without shape keys, in no scene, whose positions
+stand-in instead (positions(stand_in=True)): a copy of the mesh without shape keys, in no scene, whose positions
 are the frame, passed on whole by an Object Info node. Blender then evaluates a mesh whose positions
 were written rather than a Set Position, in less than half the time (bench/results/playback.json,
 "evaluate_ms" of "dynamic_step" against "dynamic_step_still"). The stand-in goes (end_stand_in) when
@@ -108,14 +108,16 @@ def modifier_of(obj):
                 None)
 
 
-def positions(obj):
-    """Where the frame shown on obj goes: its stand-in's positions while it has one, else ATTRIBUTE's
-    (made if needed, with the modifier that shows it): a #V by 3 float32 view of Blender's array
-    (mesh_io). Use at once, then tag(obj)."""
+def positions(obj, stand_in=False):
+    """Where the frame shown on obj goes: its stand-in's positions while it has one (made first when
+    `stand_in`: the timeline plays), else ATTRIBUTE's (made if needed, with the modifier that shows
+    it): a #V by 3 float32 view of Blender's array (mesh_io). Use at once, then tag(obj)."""
     modifier = modifier_of(obj) or _add_modifier(obj)
-    stand_in = _stand_in(modifier)
-    if stand_in is not None:
-        return mesh_io.vertex_positions(stand_in.data)
+    found = _stand_in(modifier)
+    if found is None and stand_in:
+        found = _make_stand_in(obj, modifier)
+    if found is not None:
+        return mesh_io.vertex_positions(found.data)
     mesh = obj.data
     attributes = mesh.attributes
     attribute = attributes.get(ATTRIBUTE)
@@ -135,13 +137,9 @@ def tag(obj):
     (stand_in.data if stand_in is not None else obj.data).update()
 
 
-def use_stand_in(obj):
-    """Have obj's modifier (made if needed) read a stand-in of its own, showing the frame shown now."""
-    modifier = modifier_of(obj)
-    if modifier is not None and _stand_in(modifier) is not None:
-        return
+def _make_stand_in(obj, modifier):
+    """Have obj's `modifier` read a stand-in of its own, showing the frame shown now; returns it."""
     frame = positions(obj).copy()
-    modifier = modifier_of(obj)
     mesh = obj.data.copy()
     for name in (ATTRIBUTE, SHOWN):
         if name in mesh.attributes:
@@ -160,6 +158,7 @@ def use_stand_in(obj):
     info.inputs["Object"].default_value = stand_in
     tree.links.new(info.outputs["Geometry"], group_out.inputs[0])
     modifier.node_group = tree
+    return stand_in
 
 
 def end_stand_in(obj):
