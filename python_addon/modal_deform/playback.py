@@ -57,7 +57,7 @@ class Player:
                                          energy=settings.status.energy.lower())
         self.rest = self.basis.rest.astype(np.float32)
         # The mesh (address, vertex count) last found equal to rest; None again when Blender reports
-        # a geometry update of it (_edits_reported) or after an undo.
+        # a geometry update of it (_edits_reported). An undo makes every Player again (_undone).
         self.compared = None
 
     def check_mesh(self, obj, edits_reported=False):
@@ -283,11 +283,11 @@ def _geometry_updated(scene, depsgraph):
 
 
 @bpy.app.handlers.persistent
-def _compare_again(*args):
-    """After an undo or redo, which may read meshes back from memory, every mesh is compared again;
-    with the timeline still, the stand-ins it brought back go."""
-    for found in _players.values():
-        found.compared = None
+def _undone(*args):
+    """After an undo or redo, which reads objects and meshes back from memory, the Players (which
+    hold the handles' controllers) are made again, comparing their meshes again; with the timeline
+    still, a stand-in the undo step held goes."""
+    _players.clear()
     if not _playing:
         playback_display.end_stand_ins()
 
@@ -322,7 +322,7 @@ def _before_saving(*args):
 
 # Blender's handlers and ours; the playback handlers are Blender 4's.
 _HANDLERS = [("frame_change_post", _frame_changed), ("depsgraph_update_post", _geometry_updated),
-             ("undo_post", _compare_again), ("redo_post", _compare_again), ("load_post", _forget),
+             ("undo_post", _undone), ("redo_post", _undone), ("load_post", _forget),
              ("save_pre", _before_saving), ("animation_playback_pre", _playback_started),
              ("animation_playback_post", _playback_stopped)]
 

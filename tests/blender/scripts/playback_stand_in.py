@@ -1,7 +1,7 @@
 """While the timeline plays (Blender 4+), playback's display reads a stand-in (playback_display.py):
 the same frames bit for bit, the artist's mesh and shape keys untouched; it goes when playback stops,
 before a file is saved, in Edit Mode and when the artist changes the mesh, and a file written
-mid-playback loads without it, showing the same frame."""
+mid-playback, or an undo step, loads without it, showing the same frame."""
 import os
 import sys
 
@@ -102,6 +102,22 @@ scene.frame_set(8)
 assert not stand_ins(), "a stand-in with the timeline still"
 untouched()
 
+# Undone to a step written mid-playback, with the timeline still: no stand-in, that step's frame
+# shows, and the next frame plays (the objects undo read back are not the ones before it).
+playback_handler("animation_playback_pre")
+scene.frame_set(4)
+bpy.ops.ed.undo_push(message="mid-playback")
+scene.frame_set(5)
+bpy.ops.ed.undo_push(message="later")
+playback_handler("animation_playback_post")
+name = obj.name
+assert bpy.ops.ed.undo() == {"FINISHED"}
+obj, scene = bpy.data.objects[name], bpy.context.scene
+assert scene.frame_current == 4 and not stand_ins(), stand_ins()
+assert support.evaluated_positions(obj).tobytes() == frame(4).tobytes(), "the undo step's frame does not show"
+scene.frame_set(6)
+assert support.evaluated_positions(obj).tobytes() == frame(6).tobytes(), "no frame plays after an undo"
+
 # A file written mid-playback without save_pre (a crash's autosave) holds the stand-in; loaded, it
 # shows the same frame through the attribute, with no stand-in left.
 playback_handler("animation_playback_pre")
@@ -111,7 +127,6 @@ saving = next(h for h in bpy.app.handlers.save_pre if h.__module__.endswith(".pl
 bpy.app.handlers.save_pre.remove(saving)
 bpy.ops.wm.save_as_mainfile(filepath=support.tmp("autosaved.blend"), copy=True)
 bpy.app.handlers.save_pre.append(saving)
-name = obj.name
 bpy.ops.wm.open_mainfile(filepath=support.tmp("autosaved.blend"))
 obj = bpy.data.objects[name]
 assert not stand_ins() and not playback_display.has_stand_in(obj), stand_ins()
