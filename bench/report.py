@@ -817,7 +817,7 @@ def section_playback(result):
            "playback_display.py), of it in brackets \"map\", x̄ + U q alone (the part that grows with the mesh), "
            "\"evaluate\" Blender's evaluation after it, to the return of frame_set. The frames are played: the "
            "add-on's playback handlers called around them, the display reads a stand-in mesh whose positions are "
-           "the frame; the last column steps the same frames with the timeline still (scrubbing), where the "
+           "the frame; \"timeline still\" steps the same frames with the timeline still (scrubbing), where the "
            "display's Geometry Nodes modifier sets the positions from a point attribute.", ""]
 
     def split(figures):
@@ -826,11 +826,11 @@ def section_playback(result):
 
     rows = [[run["blender"], f"{run['vertices']:,}", run["dimension"], split(run["static_read"]),
              split(run["dynamic_read"]), split(run["dynamic_step"]),
-             "{:.1f} / {:.1f}".format(*loads) if (loads := load_range(run)) else "",
-             split(run["dynamic_step_still"]) if "dynamic_step_still" in run else ""] for run in runs]
+             split(run["dynamic_step_still"]) if "dynamic_step_still" in run else "",
+             "{:.1f} / {:.1f}".format(*loads) if (loads := load_range(run)) else ""] for run in runs]
     out.append(table(["Blender", "vertices", "dims", "static cache read: handler (map) + evaluate ms",
-                      "simulation cache read ms", "live simulation step ms", "load before / after",
-                      "live step, timeline still ms"], rows))
+                      "simulation cache read ms", "live simulation step ms", "live step, timeline still ms",
+                      "load before / after"], rows))
     stepped = [f"{run['blender']}, {run['vertices']:,} vertices: {run['dynamic_step']['step_ms']:.1f} ms, "
                f"{run['dynamic_step']['iterations']:.0f} BFGS iterations" for run in runs
                if "step_ms" in run["dynamic_step"]]
