@@ -111,10 +111,16 @@ def modifier_of(obj):
 def positions(obj, stand_in=False):
     """Where the frame shown on obj goes: its stand-in's positions while it has one (made first when
     `stand_in`: the timeline plays), else ATTRIBUTE's (made if needed, with the modifier that shows
-    it): a #V by 3 float32 view of Blender's array (mesh_io). Use at once, then tag(obj)."""
+    it): a #V by 3 float32 view of Blender's array (mesh_io). Use at once, then tag(obj). No stand-in
+    while the artist has put a modifier before the display's."""
     modifier = modifier_of(obj) or _add_modifier(obj)
     found = _stand_in(modifier)
-    if found is None and stand_in:
+    # A stand-in replaces the geometry it is given: only first in the stack does it show what the attribute shows.
+    first = obj.modifiers[0] == modifier
+    if found is not None and not first:
+        end_stand_in(obj)
+        found = None
+    elif found is None and stand_in and first:
         found = _make_stand_in(obj, modifier)
     if found is not None:
         return mesh_io.vertex_positions(found.data)

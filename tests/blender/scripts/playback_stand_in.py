@@ -91,6 +91,17 @@ evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
 assert tuple(evaluated.attributes["paint"].data[0].color) == (1.0, 0.0, 0.0, 1.0)
 assert support.evaluated_positions(obj).tobytes() == frame(6).tobytes()
 
+# A modifier the artist puts before the display's acts on the mesh the frame is set on: no stand-in then
+# (it would replace that modifier's result), and again once the modifier goes.
+solidify = obj.modifiers.new("Artist's Solidify", "SOLIDIFY")
+bpy.ops.object.modifier_move_to_index(modifier=solidify.name, index=0)
+scene.frame_set(7)
+assert not stand_ins() and len(support.evaluated_positions(obj)) == 2 * len(V), "the stand-in hides a modifier"
+obj.modifiers.remove(solidify)
+scene.frame_set(6)
+assert playback_display.has_stand_in(obj)
+assert support.evaluated_positions(obj).tobytes() == frame(6).tobytes()
+
 # Stopping: the stand-in goes (the object renamed meanwhile), the attribute holds the frame last shown.
 scene.frame_set(7)
 assert playback_display.has_stand_in(obj)
