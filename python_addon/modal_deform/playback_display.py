@@ -152,10 +152,11 @@ def _make_stand_in(obj, modifier):
             mesh.attributes.remove(mesh.attributes[name])
     if mesh.shape_keys is not None:  # the copy's own (Object.shape_key_clear leaves it in Blender 4.2 to 4.5)
         bpy.data.batch_remove([mesh.shape_keys])
-    stand_in = bpy.data.objects.new(f"{obj.name} (Modal Deform playback)", mesh)
+    # Named with a leading "." as Blender's hidden datablocks: out of the artist's menus.
+    stand_in = bpy.data.objects.new(f".{obj.name} (Modal Deform playback)", mesh)
     mesh.name = stand_in.name
     mesh_io.vertex_positions(mesh)[...] = frame
-    tree = _geometry_group(f"{NODE_GROUP}: {obj.name}")
+    tree = _geometry_group(f".{NODE_GROUP}: {obj.name}")
     for block in (stand_in, mesh, tree):
         block[STAND_IN] = obj.name
     group_out = tree.nodes.new("NodeGroupOutput")
