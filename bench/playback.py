@@ -18,10 +18,11 @@ display), timed by handlers run just before and after it; "evaluate" is Blender'
 what it changed, from the handler's end to frame_set's return; "map" is the mapping x̄ + U q
 alone (the frame's q mapped again after, into an array of its own), the part of "handler" that
 grows with the mesh. Each figure is the median over the frames of a frame's least over ROUNDS
-rounds of the same frames (a live step's frames simulated again each round). A jump forward simulates every frame in between:
-its handler's time per frame simulated. For reference, Blender's evaluation of the same mesh
-without the display, its vertex positions written (a copy of the mesh on another object): the floor
-of what the display costs. The load average (1, 5, 15 min) before and after the run.
+rounds of the same frames (a live step's frames simulated again each round). A jump forward
+simulates every frame in between: its handler's time per frame simulated. For reference, Blender's
+evaluation of the same mesh without the display, its vertex positions written (a copy of the mesh
+on another object): the floor of what the display costs. The load average (1, 5, 15 min) before and
+after the run.
 """
 import argparse
 import json

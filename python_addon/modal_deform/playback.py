@@ -8,7 +8,8 @@ computing every frame in between (a jump forward simulates from the last cached 
 only the frame it shows). Before the cache's first frame the mesh holds that frame's shape.
 
 The result is shown by playback_display.py: mapped straight into a point attribute that a Geometry
-Nodes modifier sets the positions from (the artist's positions and shape keys are not written).
+Nodes modifier sets the positions from, or while the timeline plays into a stand-in mesh the modifier
+reads (the artist's positions and shape keys are not written).
 Frames computed here are checked against what they were computed from each time they are shown
 (frame_cache: settings, basis, keyframes, the controllers' transforms at that frame) and computed
 again from there when that changed.

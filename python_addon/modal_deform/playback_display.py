@@ -13,14 +13,15 @@ where it blended the playback shape key this replaces in 11.4 to 20.0 (bench/res
 when it is written (positions(): 1.7 ms at 1.6M), as the evaluated mesh shares it until then.
 
 While the timeline plays (from Blender 4 on, whose playback handlers say when), the modifier reads a
-stand-in instead (positions(stand_in=True)): a copy of the mesh without shape keys, in no scene, whose positions
-are the frame, passed on whole by an Object Info node. Blender then evaluates a mesh whose positions
-were written rather than a Set Position, in less than half the time (bench/results/playback.json,
-"evaluate_ms" of "dynamic_step" against "dynamic_step_still"). The stand-in goes (end_stand_in) when
-playback stops, before a file is saved, when the artist edits the mesh or leaves Object Mode, and
-after a file is loaded or an undo while the timeline is still: the attribute then holds its frame, so
-the display shows the same. A file written mid-playback without save_pre (a crash's autosave) holds
-the stand-in, which shows the frame as the attribute does.
+stand-in instead (positions(stand_in=True)): a copy of the mesh without shape keys, in no scene,
+whose positions are the frame, passed on whole by an Object Info node. Blender then evaluates a mesh
+whose positions were written rather than a Set Position, in less than half the time
+(bench/results/playback.json, "evaluate_ms" of "dynamic_step" against "dynamic_step_still"). The
+stand-in goes (end_stand_in) when playback stops, before a file is saved, when the artist edits the
+mesh, leaves Object Mode or puts a modifier before the display's, and after a file is loaded or an
+undo while the timeline is still: the attribute then holds its frame, so the display shows the same.
+A file written mid-playback without save_pre (a crash's autosave) holds the stand-in, which shows
+the frame as the attribute does.
 
 Taken away (remove) when the cache is freed or no longer plays, when a pose shows (the interactive
 pose, or a result in the "Modal Deform" shape key: pose_displays.display, posing.pose_key) and when
@@ -114,7 +115,7 @@ def positions(obj, stand_in=False):
     it): a #V by 3 float32 view of Blender's array (mesh_io). Use at once, then tag(obj). No stand-in
     while the artist has put a modifier before the display's."""
     modifier = modifier_of(obj) or _add_modifier(obj)
-    found = _stand_in(modifier)
+    found = _stand_in(modifier.node_group)
     # A stand-in replaces the geometry it is given: only first in the stack does it show what the attribute shows.
     first = obj.modifiers[0] == modifier
     if found is not None and not first:
@@ -139,7 +140,7 @@ def positions(obj, stand_in=False):
 def tag(obj):
     """Tell Blender that obj's frame was written (positions()): the mesh written is evaluated again."""
     modifier = modifier_of(obj)
-    stand_in = _stand_in(modifier) if modifier is not None else None
+    stand_in = _stand_in(modifier.node_group) if modifier is not None else None
     (stand_in.data if stand_in is not None else obj.data).update()
 
 
@@ -171,7 +172,7 @@ def _make_stand_in(obj, modifier):
 def end_stand_in(obj):
     """Have obj's modifier read ATTRIBUTE again, holding the stand-in's frame, and delete the stand-in."""
     modifier = modifier_of(obj)
-    stand_in = _stand_in(modifier) if modifier is not None else None
+    stand_in = _stand_in(modifier.node_group) if modifier is not None else None
     if stand_in is None:
         return
     frame = mesh_io.vertex_positions(stand_in.data).copy()
@@ -195,12 +196,11 @@ def end_stand_ins():
 def has_stand_in(obj):
     """Whether obj's display reads a stand-in."""
     modifier = modifier_of(obj)
-    return modifier is not None and _stand_in(modifier) is not None
+    return modifier is not None and _stand_in(modifier.node_group) is not None
 
 
-def _stand_in(modifier):
-    """The stand-in object modifier's node group reads, or None (it reads ATTRIBUTE)."""
-    tree = modifier.node_group
+def _stand_in(tree):
+    """The stand-in object the display's node group `tree` reads, or None (it reads ATTRIBUTE)."""
     if not tree.get(STAND_IN):
         return None
     info = next((node for node in tree.nodes if node.bl_idname == "GeometryNodeObjectInfo"), None)
@@ -209,7 +209,7 @@ def _stand_in(modifier):
 
 def _delete_stand_in(tree):
     """Delete a stand-in's node group `tree` (no modifier reading it), its object and the object's mesh."""
-    stand_in = next(n for n in tree.nodes if n.bl_idname == "GeometryNodeObjectInfo").inputs["Object"].default_value
+    stand_in = _stand_in(tree)
     bpy.data.node_groups.remove(tree)
     if stand_in is not None and stand_in.get(STAND_IN):
         mesh = stand_in.data
