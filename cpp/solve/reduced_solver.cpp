@@ -32,8 +32,7 @@ ReducedSolver::ReducedSolver(const Basis& basis, const Handles& handles, const V
       handle_term_(HandleTerm(basis.rest, basis.mass, handles,
                               checked_handle_weights(handles, weights, basis.num_vertices()),
                               checked_stiffness(stiffness) * std::pow(basis.scale, 4)),
-                   [&basis](int v) { return basis.vertex_rows(v); }, basis.dimension()),
-      fine_positions_(basis) {
+                   [&basis](int v) { return basis.vertex_rows(v); }, basis.dimension()) {
   require_handles_in_region(handles, basis.region);
   const Eigen::Index r = basis.dimension();
   if (warm_start) {
@@ -69,7 +68,6 @@ ReducedSolveStats ReducedSolver::solve(int max_iterations, double tolerance, dou
   const BfgsResult result =
       bfgs_.minimize([this](const Eigen::VectorXd& q, Eigen::VectorXd& gradient) { return objective(q, gradient); },
                      max_iterations, tolerance, budget_ms);
-  fine_positions_.set(q());
   ReducedSolveStats stats;
   stats.iterations = result.iterations;
   stats.evaluations = result.evaluations;
@@ -84,7 +82,11 @@ ReducedSolveStats ReducedSolver::solve(int max_iterations, double tolerance, dou
 
 void ReducedSolver::reset() {
   bfgs_.start(Eigen::VectorXd::Zero(dimension()), initial_inverse_hessian_);
-  fine_positions_.set(q());
+}
+
+void ReducedSolver::positions(Eigen::Ref<Eigen::VectorXf> out) const {
+  if (!fine_positions_) fine_positions_ = std::make_unique<FinePositions>(basis_);
+  fine_positions_->write(q().cast<float>(), out);
 }
 
 double ReducedSolver::objective(const Eigen::VectorXd& q, Eigen::VectorXd& gradient) {

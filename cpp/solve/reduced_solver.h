@@ -21,6 +21,7 @@
 #pragma once
 
 #include <limits>
+#include <memory>
 
 #include "energy/make_energy.h"
 #include "basis/basis.h"
@@ -79,8 +80,10 @@ class ReducedSolver {
   // Back to rest (q = 0) and the initial inverse Hessian; the transforms stay.
   void reset();
 
-  // x̄ + U q on the fine mesh, written into `out` (FinePositions::write).
-  void positions(Eigen::Ref<Eigen::VectorXf> out) const { fine_positions_.write(out); }
+  // x̄ + U q on the fine mesh, written into `out` (FinePositions::write). The map's 16-bit vectors
+  // are made at the first call: a solver that only solves (a cache's static poses, played through
+  // a simulation's map) never holds them.
+  void positions(Eigen::Ref<Eigen::VectorXf> out) const;
 
   // f(q) with ∇f(q) (r) written into `gradient`; +inf where a ghost coordinate leaves the range
   // the energies take (kMaxCoordinate).
@@ -97,7 +100,7 @@ class ReducedSolver {
   ReducedHandleTerm handle_term_;
   Eigen::MatrixXd initial_inverse_hessian_;
   Bfgs bfgs_;
-  FinePositions fine_positions_;
+  mutable std::unique_ptr<FinePositions> fine_positions_;  // made by the first positions()
   // Work space, sized once.
   Eigen::VectorXd handle_gradient_, handle_gradient_old_;
 };
