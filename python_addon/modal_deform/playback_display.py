@@ -118,10 +118,10 @@ def positions(obj, stand_in=False):
     found = _stand_in(modifier.node_group)
     # A stand-in replaces the geometry it is given: only first in the stack does it show what the attribute shows.
     first = obj.modifiers[0] == modifier
-    if found is not None and not first:
+    if modifier.node_group.get(STAND_IN) and (found is None or not first):  # its object deleted, or not first
         end_stand_in(obj)
         found = None
-    elif found is None and stand_in and first:
+    if found is None and stand_in and first:
         found = _make_stand_in(obj, modifier)
     if found is not None:
         return mesh_io.vertex_positions(found.data)
@@ -171,17 +171,18 @@ def _make_stand_in(obj, modifier):
 
 def end_stand_in(obj):
     """Have obj's modifier read ATTRIBUTE again, holding the stand-in's frame, and delete the stand-in."""
-    modifier = modifier_of(obj)
-    stand_in = _stand_in(modifier.node_group) if modifier is not None else None
-    if stand_in is None:
+    if not has_stand_in(obj):
         return
-    frame = mesh_io.vertex_positions(stand_in.data).copy()
+    modifier = modifier_of(obj)
     tree = modifier.node_group
+    stand_in = _stand_in(tree)
+    frame = mesh_io.vertex_positions(stand_in.data).copy() if stand_in is not None else None
     modifier.node_group = node_group()
-    _delete_stand_in(tree)
+    bpy.data.node_groups.remove(tree)
+    _delete_stand_ins()
     # In Edit Mode the mesh's arrays are not the ones edited: the next frame shown writes ATTRIBUTE.
     mesh = obj.data
-    if mesh.library is None and not mesh.is_editmode and len(frame) == len(mesh.vertices):
+    if frame is not None and mesh.library is None and not mesh.is_editmode and len(frame) == len(mesh.vertices):
         positions(obj)[...] = frame
         mesh.update()
 
@@ -194,9 +195,9 @@ def end_stand_ins():
 
 
 def has_stand_in(obj):
-    """Whether obj's display reads a stand-in."""
+    """Whether obj's display is made to read a stand-in (its node group one of a stand-in's)."""
     modifier = modifier_of(obj)
-    return modifier is not None and _stand_in(modifier.node_group) is not None
+    return modifier is not None and bool(modifier.node_group.get(STAND_IN))
 
 
 def _stand_in(tree):
@@ -205,17 +206,6 @@ def _stand_in(tree):
         return None
     info = next((node for node in tree.nodes if node.bl_idname == "GeometryNodeObjectInfo"), None)
     return info.inputs["Object"].default_value if info is not None else None
-
-
-def _delete_stand_in(tree):
-    """Delete a stand-in's node group `tree` (no modifier reading it), its object and the object's mesh."""
-    stand_in = _stand_in(tree)
-    bpy.data.node_groups.remove(tree)
-    if stand_in is not None and stand_in.get(STAND_IN):
-        mesh = stand_in.data
-        bpy.data.objects.remove(stand_in)
-        if mesh.get(STAND_IN) and not mesh.users:
-            bpy.data.meshes.remove(mesh)
 
 
 def _delete_stand_ins():
@@ -248,10 +238,10 @@ def remove(obj):
         return
     modifier = modifier_of(obj)
     if modifier is not None:
-        tree = modifier.node_group
+        stand_in = modifier.node_group.get(STAND_IN)
         obj.modifiers.remove(modifier)
-        if tree.get(STAND_IN) and not tree.users:
-            _delete_stand_in(tree)
+        if stand_in:
+            _delete_stand_ins()
     mesh = obj.data
     if mesh.library is not None:  # a linked mesh's attribute is the library's: the modifier alone goes
         return

@@ -64,6 +64,13 @@ stand_in = next(o for o in bpy.data.objects if o.get(playback_display.STAND_IN))
 assert stand_in.data.shape_keys is None and stand_in.users_scene == (), "the stand-in is drawn or has keys"
 untouched()
 
+# The stand-in deleted by the artist (the Outliner's Blender File view shows it): the next frame has a new one.
+bpy.data.objects.remove(stand_in)
+scene.frame_set(2)
+assert playback_display.has_stand_in(obj) and len(stand_ins()) == 3, stand_ins()
+assert support.evaluated_positions(obj).tobytes() == frame(2).tobytes(), "a deleted stand-in hides the frame"
+scene.frame_set(3)
+
 # Saving: the file holds the mesh once; the next frame played has the stand-in again.
 bpy.ops.wm.save_as_mainfile(filepath=support.tmp("saved.blend"), copy=True)
 assert not stand_ins() and not playback_display.has_stand_in(obj)
@@ -128,6 +135,15 @@ assert scene.frame_current == 4 and not stand_ins(), stand_ins()
 assert support.evaluated_positions(obj).tobytes() == frame(4).tobytes(), "the undo step's frame does not show"
 scene.frame_set(6)
 assert support.evaluated_positions(obj).tobytes() == frame(6).tobytes(), "no frame plays after an undo"
+
+# Free mid-playback takes the display away, stand-in and all.
+playback_handler("animation_playback_pre")
+scene.frame_set(5)
+assert playback_display.has_stand_in(obj)
+bpy.context.view_layer.objects.active = obj
+assert bpy.ops.modal_deform.free_cache() == {"FINISHED"}
+assert not stand_ins() and not playback_display.shows(obj), stand_ins()
+playback_handler("animation_playback_post")
 
 # A file written mid-playback without save_pre (a crash's autosave) holds the stand-in; loaded, it
 # shows the same frame through the attribute, with no stand-in left.
