@@ -72,8 +72,9 @@ def animate(controller, frames):
 
 
 def playback_handler(name):
-    """The add-on's handler Blender calls when the timeline starts or stops playing (Blender 4+),
-    which headless frame changes do not call."""
+    """The add-on's playback handler in bpy.app.handlers.`name`: the frame change's, and those Blender
+    calls when the timeline starts or stops playing (Blender 4+), which headless frame changes do not
+    call."""
     return next(h for h in getattr(bpy.app.handlers, name) if h.__module__.endswith(".playback"))
 
 
@@ -99,7 +100,7 @@ def timed_frames(obj, scene, playback, frame_cache, frames, stepping=False, roun
     def after(*args):
         clock["after"] = time.perf_counter()
 
-    add_on_handler = next(h for h in handlers if h.__module__.endswith(".playback"))
+    add_on_handler = playback_handler("frame_change_post")
     handlers.insert(list(handlers).index(add_on_handler), before)
     handlers.insert(list(handlers).index(add_on_handler) + 1, after)
     figures = {name: np.full((rounds, len(frames)), np.inf) for name in ("handler", "map", "evaluate", "step")}

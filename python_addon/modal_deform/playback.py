@@ -222,13 +222,14 @@ def show(obj, scene, edits_reported=False):
     index = cache.row(frame)
     if index is not None and not np.array_equal(player_.transforms(obj).ravel(), cache.array("transforms")[index]):
         cache.cut(frame)
+    mesh = playback_display.frame_mesh(obj, stand_in=_playing)
 
     def display():  # a frame simulated here is mapped by its step straight into it (no copy between)
-        return playback_display.positions(obj, stand_in=_playing)
+        return playback_display.frame_positions(mesh)
 
     if not fill(obj, scene, cache, shown, player_, out=display, curves=curves):
         player_.positions(cache.array("q")[cache.row(shown)], display())
-    playback_display.tag(obj)
+    mesh.update()
 
 
 def free(obj):

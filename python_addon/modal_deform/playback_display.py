@@ -13,7 +13,7 @@ where it blended the playback shape key this replaces in 11.4 to 20.0 (bench/res
 when it is written (positions(): 1.7 ms at 1.6M), as the evaluated mesh shares it until then.
 
 While the timeline plays (from Blender 4 on, whose playback handlers say when), the modifier reads a
-stand-in instead (positions(stand_in=True)): a copy of the mesh without shape keys, in no scene,
+stand-in instead (frame_mesh(stand_in=True)): a copy of the mesh without shape keys, in no scene,
 whose positions are the frame, passed on whole by an Object Info node. Blender then evaluates a mesh
 whose positions were written rather than a Set Position, in less than half the time
 (bench/results/playback.json, "evaluate_ms" of "dynamic_step" against "dynamic_step_still"). The
@@ -110,10 +110,15 @@ def modifier_of(obj):
 
 
 def positions(obj, stand_in=False):
-    """Where the frame shown on obj goes: its stand-in's positions while it has one (made first when
-    `stand_in`: the timeline plays), else ATTRIBUTE's (made if needed, with the modifier that shows
-    it): a #V by 3 float32 view of Blender's array (mesh_io). Use at once, then tag(obj). No stand-in
-    while the artist has put a modifier before the display's."""
+    """Where the frame shown on obj goes: frame_positions(frame_mesh(obj, stand_in)). Use at once,
+    then update the mesh."""
+    return frame_positions(frame_mesh(obj, stand_in))
+
+
+def frame_mesh(obj, stand_in=False):
+    """The mesh obj's frame is written into: its stand-in's while it has one (made first when
+    `stand_in`: the timeline plays), else obj's own, with ATTRIBUTE (made if needed, with the modifier
+    that shows it). No stand-in while the artist has put a modifier before the display's."""
     modifier = modifier_of(obj) or _add_modifier(obj)
     found = _stand_in(modifier.node_group)
     # A stand-in replaces the geometry it is given: only first in the stack does it show what the attribute shows.
@@ -124,24 +129,23 @@ def positions(obj, stand_in=False):
     if found is None and stand_in and first:
         found = _make_stand_in(obj, modifier)
     if found is not None:
-        return mesh_io.vertex_positions(found.data)
+        return found.data
     mesh = obj.data
     attributes = mesh.attributes
-    attribute = attributes.get(ATTRIBUTE)
-    if attribute is None:
+    if attributes.get(ATTRIBUTE) is None:
         attributes.new(ATTRIBUTE, "FLOAT_VECTOR", "POINT")
         if _reads_shown(modifier.node_group):
             shown = attributes.get(SHOWN) or attributes.new(SHOWN, "BOOLEAN", "POINT")
             shown.data.foreach_set("value", np.ones(len(mesh.vertices), bool))
-        attribute = attributes[ATTRIBUTE]  # looked up after SHOWN is added, which can move it
-    return mesh_io.attribute_co(mesh, attribute)
+    return mesh
 
 
-def tag(obj):
-    """Tell Blender that obj's frame was written (positions()): the mesh written is evaluated again."""
-    modifier = modifier_of(obj)
-    stand_in = _stand_in(modifier.node_group) if modifier is not None else None
-    (stand_in.data if stand_in is not None else obj.data).update()
+def frame_positions(mesh):
+    """The frame's #V by 3 float32 view of Blender's array in `mesh` (frame_mesh): a stand-in's
+    positions, else ATTRIBUTE's values (mesh_io). Use at once, then update the mesh."""
+    if mesh.get(STAND_IN):
+        return mesh_io.vertex_positions(mesh)
+    return mesh_io.attribute_co(mesh, mesh.attributes[ATTRIBUTE])
 
 
 def _make_stand_in(obj, modifier):
