@@ -314,10 +314,10 @@ def _before_saving(*args):
 
 
 # Blender's handlers and ours; the playback handlers are Blender 4's.
-_HANDLERS = [("frame_change_post", _frame_changed), ("depsgraph_update_post", _geometry_updated),
+_HANDLERS = (("frame_change_post", _frame_changed), ("depsgraph_update_post", _geometry_updated),
              ("undo_post", _undone), ("redo_post", _undone), ("load_post", _forget),
              ("save_pre", _before_saving), ("animation_playback_pre", _playback_started),
-             ("animation_playback_post", _playback_stopped)]
+             ("animation_playback_post", _playback_stopped))
 
 
 def register():
