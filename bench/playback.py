@@ -1,5 +1,5 @@
 """The per-frame cache in headless Blender (issue 40): per frame, what playback costs (a cached frame
-read back, x = x̄ + U q into the display, playback_display.py; one simulation step live) and Blender's
+read back, x = x̄ + U q into the display, playback/frame_display.py; one simulation step live) and Blender's
 evaluation after it, the frames played (the display reading a stand-in) and, for a live step, stepped
 through with the timeline still (the display's attribute); and for FRAMES frames of the dragon (100k
 vertices), the cache's size and the .blend's against the same animation exported as a shape key per
