@@ -8,7 +8,7 @@ import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 import support  # noqa: E402
 
-frame_cache, playback = support.enable_addon("frame_cache", "playback")
+frame_cache, timeline = support.enable_addon("playback.frame_cache", "playback.timeline")
 kind = support.arguments()[0]
 obj, V, _ = support.keyed_suzanne(6, 15, 20, 400)
 obj.modal_deform.dynamics.enabled = kind == "dynamic"

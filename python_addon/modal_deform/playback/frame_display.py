@@ -24,13 +24,13 @@ A file written mid-playback without save_pre (a crash's autosave) holds the stan
 the frame as the attribute does.
 
 Taken away (remove) when the cache is freed or no longer plays, when a pose shows (the interactive
-pose, or a result in the "Modal Deform" shape key: pose_displays.display, posing.pose_key) and when
+pose, or a result in the "Modal Deform" shape key: pose.displays.display, posing.pose_key) and when
 the add-on is disabled.
 """
 import bpy
 import numpy as np
 
-from . import mesh_io
+from .. import mesh_io
 
 #: The modifier on an object that plays a cache, and its node group (one per file, shared), which
 #: carries the ID property MARK: the modifier is the one whose node group has it, whatever their names.
