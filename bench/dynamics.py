@@ -53,7 +53,7 @@ def released(basis, frames, **parameters):
 
 
 def bar(quick):
-    V, F = mdc.bar(4, 4, 16, 1, 1, 4)
+    V, F = mdc.testing.bar(4, 4, 16, 1, 1, 4)
     basis = mdc.bake(V, F, **BAR)
     undamped = []
     for period, fps, substeps in [(12.0, 24.0, 2), (12.0, 24.0, 1), (24.0, 24.0, 1), (6.0, 60.0, 3), (4.0, 24.0, 2)]:

@@ -98,7 +98,7 @@ def _rod_poses(length, axis, poses):
 def bumpy_plane(n=199):
     """Bumpy plane, 10 by 10 with 12 bumps ((n+1)² vertices, 40k by default): the border held,
     a disc of radius 1 in the middle moved."""
-    V, F = mdc.bumpy_plane(n, 10.0, 12, 1.0)
+    V, F = mdc.testing.bumpy_plane(n, 10.0, 12, 1.0)
     r = np.hypot(V[:, 0], V[:, 1])
     handles = [np.flatnonzero(np.abs(V[:, :2]).max(axis=1) > 5 - 1e-9), np.flatnonzero(r < 1)]
     centre = V[handles[1]].mean(axis=0)
@@ -126,7 +126,7 @@ def _rod_handles(V, length):
 def cylinder(around=64, along=80):
     """Open tube of radius 1.25 and length 10 (around x (along+1) vertices, 5k by default), its
     end rings as handles."""
-    V, F = mdc.cylinder(around, along, 1.25, 10.0)
+    V, F = mdc.testing.cylinder(around, along, 1.25, 10.0)
     deg = np.pi / 180
     poses = _rod_poses(10.0, (0, 0), (
         ("lift", "far ring shifted sideways by 2.5", 0, 0, 2.5, 3),
@@ -140,7 +140,7 @@ def cylinder(around=64, along=80):
 
 def bar(nx=12, nz=120):
     """Closed 1 x 1 x 10 box (about 6k vertices by default), its end faces as handles."""
-    V, F = mdc.bar(nx, nx, nz, 1.0, 1.0, 10.0)
+    V, F = mdc.testing.bar(nx, nx, nz, 1.0, 1.0, 10.0)
     deg = np.pi / 180
     poses = _rod_poses(10.0, (0.5, 0.5), (
         ("lift", "far end shifted sideways by 2", 0, 0, 2.0, 3),

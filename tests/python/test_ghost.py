@@ -41,8 +41,8 @@ def euler_characteristic(V, F):
 
 
 def two_cylinders():
-    Va, Fa = mdc.cylinder(24, 20, 1.0, 4.0)
-    Vb, Fb = mdc.cylinder(16, 30, 0.5, 6.0)
+    Va, Fa = mdc.testing.cylinder(24, 20, 1.0, 4.0)
+    Vb, Fb = mdc.testing.cylinder(16, 30, 0.5, 6.0)
     return np.vstack([Va, Vb + [3.0, 0.0, 0.0]]), np.vstack([Fa, Fb + len(Va)])
 
 
@@ -83,8 +83,8 @@ def assert_valid_ghost(V, F, M, Vg, Fg, ghost_map):
 def test_ghost_is_valid_and_reaches_the_target(shared_mesh, name, target):
     V, F = {
         "bunny": lambda: shared_mesh("bunny.obj.gz"),
-        "grid": lambda: mdc.grid(30, 30, 10.0, 10.0),
-        "cylinder": lambda: mdc.cylinder(32, 30, 1.0, 6.0),
+        "grid": lambda: mdc.testing.grid(30, 30, 10.0, 10.0),
+        "cylinder": lambda: mdc.testing.cylinder(32, 30, 1.0, 6.0),
         "two cylinders": two_cylinders,
     }.get(name, lambda: shared_mesh(name))()
     Vg, Fg, ghost_map = mdc.ghost_mesh(V, F, vertices=target)
@@ -95,8 +95,8 @@ def test_ghost_is_valid_and_reaches_the_target(shared_mesh, name, target):
 
 @pytest.mark.parametrize(
     "make, target",
-    [(lambda V, F: (V, F), 20), (lambda V, F: mdc.grid(30, 30, 10.0, 10.0), 12),
-     (lambda V, F: mdc.cylinder(32, 30, 1.0, 6.0), 12), (lambda V, F: two_cylinders(), 24)],
+    [(lambda V, F: (V, F), 20), (lambda V, F: mdc.testing.grid(30, 30, 10.0, 10.0), 12),
+     (lambda V, F: mdc.testing.cylinder(32, 30, 1.0, 6.0), 12), (lambda V, F: two_cylinders(), 24)],
     ids=["bunny", "grid", "cylinder", "two cylinders"],
 )
 def test_topology_and_boundary_are_kept(shared_mesh, make, target):
@@ -158,7 +158,7 @@ def test_progress_reports_the_ghost_stage_and_false_cancels(shared_mesh):
 
 
 def test_an_error_in_the_progress_callback_reaches_the_caller():
-    V, F = mdc.grid(20, 20)
+    V, F = mdc.testing.grid(20, 20)
 
     def broken(stage, fraction):
         raise KeyError("from the callback")
@@ -167,7 +167,7 @@ def test_an_error_in_the_progress_callback_reaches_the_caller():
         mdc.ghost_mesh(V, F, vertices=50, progress=broken)
 
 
-V_GRID, F_GRID = mdc.grid(4, 4)
+V_GRID, F_GRID = mdc.testing.grid(4, 4)
 
 
 @pytest.mark.parametrize(

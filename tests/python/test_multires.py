@@ -15,7 +15,7 @@ import shapes  # noqa: E402  (end_pull: the benchmark's handles and pose)
 
 @pytest.fixture(scope="module")
 def plane_on_proxy():
-    V, F = mdc.bumpy_plane(100)  # 10,201 vertices
+    V, F = mdc.testing.bumpy_plane(100)  # 10,201 vertices
     return V, F, mdc.bake(V, F, modes=12, derivatives=10, ghost=200, proxy=2000, proxy_above=5000)
 
 
@@ -79,7 +79,7 @@ def test_round_trip_and_damaged_prolongation(plane_on_proxy):
 
 
 def test_a_version_1_basis_still_loads():
-    V, F = mdc.bumpy_plane(20)
+    V, F = mdc.testing.bumpy_plane(20)
     arrays = mdc.bake(V, F, modes=10, derivatives=4, ghost=100).to_arrays()
     old = {name: a for name, a in arrays.items() if not name.startswith("prolongation")}
     old["format_version"] = np.array(1, dtype=np.int32)
@@ -88,7 +88,7 @@ def test_a_version_1_basis_still_loads():
 
 
 def test_proxy_options_and_progress():
-    V, F = mdc.bumpy_plane(40)
+    V, F = mdc.testing.bumpy_plane(40)
     stages = []
     basis = mdc.bake(V, F, modes=10, derivatives=4, ghost=100, proxy=400, proxy_above=1000,
                      progress=lambda stage, fraction: stages.append(stage))

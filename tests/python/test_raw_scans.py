@@ -52,7 +52,7 @@ def test_pairs_of_slivers_bake(seed):
     simulated (shape ratio 1e-3 to 1e-2): those hinges were up to 3e8 times as stiff as an
     equilateral one, which threw the shift of K - sigma M far below the modes (seed 1 failed: "sigma
     ... is too far below the largest eigenvalue given")."""
-    V, F = mdc.grid(25, 25, 10.0, 10.0)
+    V, F = mdc.testing.grid(25, 25, 10.0, 10.0)
     V = V.copy()
     V[:, 2] = 0.3 * np.sin(0.7 * V[:, 0]) * np.cos(0.5 * V[:, 1])
     V, F = raw_scans.damaged(V, F, seed=seed, rates={kind: 0 for kind in raw_scans.RATES} | {"sliver_pairs": 1000})
@@ -79,11 +79,11 @@ def test_sliver_stiffness_is_bounded_and_sound_elements_keep_theirs():
     the sliver thins, and the terms away from the sliver are untouched."""
     largest = []
     for ratio in (1e-1, 1e-2, 1e-3):
-        V, F = _sliver(*mdc.grid(6, 6, 2.0, 2.0), ratio)
+        V, F = _sliver(*mdc.testing.grid(6, 6, 2.0, 2.0), ratio)
         K = mdc.DiscreteShells(V, F).hessian(V)
         largest.append(np.abs(K.diagonal()).max())
     assert largest[2] < 2 * largest[1], largest  # was about 1e3 times larger per tenfold thinning
-    V, F = mdc.grid(6, 6, 2.0, 2.0)
+    V, F = mdc.testing.grid(6, 6, 2.0, 2.0)
     Vs, Fs = _sliver(V, F, 1e-3)
     far = np.flatnonzero(np.linalg.norm(V - V[F[30]].mean(axis=0), axis=1) > 1.2)
     dofs = (3 * far[:, None] + np.arange(3)).ravel()

@@ -14,7 +14,7 @@ from shapes import rigid_transform as rigid  # noqa: E402
 @pytest.fixture(scope="module")
 def tube():
     """A tube along z held at its bottom ring, its top ring turned and pushed."""
-    V, F = mdc.cylinder(16, 12, radius=1.0, length=3.0)
+    V, F = mdc.testing.cylinder(16, 12, radius=1.0, length=3.0)
     handles = [np.flatnonzero(V[:, 2] < 1e-9), np.flatnonzero(V[:, 2] > 3 - 1e-9)]
     transforms = [np.eye(4), rigid([1, 0, 1], 0.8, [0, 0, 3], [0.8, 0, -0.3])]
     return V, F, handles, transforms

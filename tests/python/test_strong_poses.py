@@ -27,7 +27,7 @@ def _bake(V, F, **options):
 
 def _mesh(name):
     if name == "bar":
-        V, F = mdc.bar(12, 12, 120, 1.0, 1.0, 10.0)
+        V, F = mdc.testing.bar(12, 12, 120, 1.0, 1.0, 10.0)
         return V, F, _bake(V, F, derivatives=47, ghost=1000)
     if name == "dragon_23k":
         V, F = mdc.read_mesh(SHARED_MESHES / "dragon_vrip_res3.ply.gz")

@@ -15,7 +15,7 @@ import support  # noqa: E402
 
 mdc, posing, storage = support.enable_addon("core", "posing", "storage")
 
-V, F = mdc.cylinder(10, 30, 0.5, 6.0)
+V, F = mdc.testing.cylinder(10, 30, 0.5, 6.0)
 obj = support.mesh_object("Bar", V, F)
 settings = obj.modal_deform
 settings.modes, settings.derivatives, settings.ghost = 16, 40, 2000
