@@ -17,17 +17,17 @@ A script signals failure by raising (exit code 1).
 import os
 import pathlib
 import subprocess
-import sys
 
 import pytest
+
+import package
+import support
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SCRIPTS = pathlib.Path(__file__).resolve().parent / "scripts"
 BLENDER_PYTHON = os.environ.get("BLENDER_PYTHON")
 WINDOWS_PYTHON = os.environ.get("WINDOWS_PYTHON")
 DIST = pathlib.Path(os.environ.get("MODAL_DEFORM_DIST", ROOT / "dist"))
-sys.path.insert(0, str(ROOT / "python_addon"))
-import package  # noqa: E402
 
 
 def built(pattern):
@@ -88,7 +88,7 @@ def run_blender(tmp_path, extension_zip):
             base.update(LD_LIBRARY_PATH="", BLENDER_USER_RESOURCES=str(tmp_path / "blender_user"))
         else:
             command = ["blender", "-b"] + ([str(blend)] if blend is not None else [])
-            command += ["--factory-startup", "--python-exit-code", "1", "--python", str(script), "--", *map(str, args)]
+            command += ["--factory-startup", "--python-exit-code", "1", *support.in_blender(script), "--", *map(str, args)]
             base = dict(os.environ, ADDON_PATH=str(ROOT / "python_addon"))
         environment = dict(base, TEST_TMP=str(tmp_path), **(env or {}))
         result = subprocess.run(command, capture_output=True, text=True, timeout=timeout, env=environment, cwd=tmp_path)

@@ -11,6 +11,8 @@ import subprocess
 
 import pytest
 
+import support
+
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SCRIPTS = pathlib.Path(__file__).resolve().parent / "scripts"
 XVFB = ["xvfb-run", "-a", "-s", "-screen 0 1280x800x24"]
@@ -65,7 +67,7 @@ def run_script(window, script):
     wrote none, failed a step or printed a Python traceback (a panel's draw() that raises only prints)."""
     prefix, env, artefacts = window
     (artefacts / "result.json").unlink(missing_ok=True)
-    command = prefix + XVFB + ["blender", "--factory-startup", "--enable-event-simulate", "--python", str(script),
+    command = prefix + XVFB + ["blender", "--factory-startup", "--enable-event-simulate", *support.in_blender(script),
                                "--", str(artefacts)]
     run = subprocess.run(command, capture_output=True, text=True, timeout=900, env=env, cwd=artefacts)
     output = f"{run.stdout[-4000:]}\n{run.stderr[-4000:]}"

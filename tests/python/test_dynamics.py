@@ -1,15 +1,12 @@
 """Secondary motion through the Python API: mdc.Simulation (cpp/solve/reduced_dynamics.h)."""
-import pathlib
-import sys
 
 import numpy as np
 import pytest
 
 import modal_deform.core as mdc
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "bench"))
-from dynamics import damped_oscillation, released  # noqa: E402  (the benchmark's free-body measurement)
-from shapes import rigid_transform as rigid  # noqa: E402
+from support.dynamics import damped_oscillation, released  # the benchmark's free-body measurement
+from support.poses import rigid_transform as rigid
 
 
 @pytest.fixture(scope="module")

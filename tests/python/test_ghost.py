@@ -1,6 +1,4 @@
-import pathlib
 import re
-import sys
 
 import numpy as np
 import pytest
@@ -9,10 +7,8 @@ from scipy.sparse.csgraph import connected_components
 
 import modal_deform.core as mdc
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "bench"))
-import raw_scans  # noqa: E402  (midpoint_subdivide)
-
-SHARED_MESHES = pathlib.Path(__file__).resolve().parents[2].parent / "shared" / "meshes"
+from support.meshes import read_shared
+from support.subdivision import midpoint_subdivide
 
 
 def normals(V, F):
@@ -198,9 +194,9 @@ def test_a_subdivided_scan_leaves_no_island_of_fine_triangles(target):
     one fine vertex each, 32 faces below a hundredth of the median area; the 1.6M dragon's ghost had
     891 such faces), which a pose crushes and turns over first: every collapse around them made
     some needle a little thinner (the rule per face), or turned a needle's normal."""
-    V, F = mdc.read_mesh(SHARED_MESHES / "dragon_vrip_res4.ply.gz")
+    V, F = read_shared("dragon_vrip_res4.ply.gz")
     for _ in range(2):
-        V, F = raw_scans.midpoint_subdivide(V, F)
+        V, F = midpoint_subdivide(V, F)
     G, GF, ghost_map = mdc.ghost_mesh(V, F, target)
     assert len(G) <= target
     sizes = np.bincount(ghost_map[ghost_map >= 0])

@@ -1,6 +1,4 @@
 """The multiresolution bake (issue 15): dense meshes baked on a proxy and carried to every vertex."""
-import sys
-import pathlib
 
 import numpy as np
 import pytest
@@ -8,9 +6,8 @@ import pytest
 import modal_deform.core as mdc
 from modal_deform.core.bake import PROXY
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "bench"))
-import subdivision  # noqa: E402  (midpoint_subdivide: the project's own)
-import shapes  # noqa: E402  (end_pull: the benchmark's handles and pose)
+from support import subdivision  # midpoint_subdivide: the project's own
+from support.poses import end_pull  # the benchmark's handles and pose
 
 
 @pytest.fixture(scope="module")
@@ -109,7 +106,7 @@ def test_the_subdivided_dragon_on_a_proxy_poses_like_the_dragon(shared_mesh):
     V_fine, F_fine = subdivision.midpoint_subdivide(V, F)
 
     def posed(basis, V):
-        handles, poses = shapes.end_pull(V)
+        handles, poses = end_pull(V)
         solver = mdc.ReducedSolver(basis, handles)
         solver.set_transforms(poses[0].at(1.0))
         solver.solve(max_iterations=300, tolerance=1e-9)

@@ -1,4 +1,4 @@
-"""Raw scans: meshes with every kind of scan damage (bench/raw_scans.py, made from the shared
+"""Raw scans: meshes with every kind of scan damage (tests/support/raw_scans.py, made from the shared
 dragons) bake and pose; near-degenerate elements have bounded stiffness; a bake that cannot fit
 in memory is refused up front with the sizes, and a lack of memory is never reported as a matrix
 that is not positive definite. The 400k-vertex raw scan is in make bench (bench/raw_scan.py)."""
@@ -14,9 +14,7 @@ import pytest
 
 import modal_deform.core as mdc
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "bench"))
-import raw_scans  # noqa: E402
+from support import SHARED_MESHES, raw_scans
 
 
 @pytest.mark.parametrize("seed", [0, 1])
@@ -111,7 +109,7 @@ def run_limited(code, address_space, setup=""):
         sys.path.insert(0, {str(pathlib.Path(mdc.__file__).parents[2])!r})
         import numpy as np
         import modal_deform.core as mdc
-        V, F = mdc.read_mesh({str(ROOT.parent / "shared" / "meshes" / "dragon_vrip_res3.ply.gz")!r})
+        V, F = mdc.read_mesh({str(SHARED_MESHES / "dragon_vrip_res3.ply.gz")!r})
     """) + textwrap.dedent(setup) + textwrap.dedent(f"""
         pages = int(open("/proc/self/statm").read().split()[0])
         limit = pages * resource.getpagesize() + {address_space}

@@ -1,14 +1,11 @@
 """Posing through the Python API: mdc.solve_full and mdc.ReducedSolver."""
-import pathlib
-import sys
 
 import numpy as np
 import pytest
 
 import modal_deform.core as mdc
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "bench"))
-from shapes import rigid_transform as rigid  # noqa: E402
+from support.poses import rigid_transform as rigid
 
 
 @pytest.fixture(scope="module")
