@@ -1,6 +1,7 @@
 """What the tests share, importable as ``support``: pytest finds it through pyproject.toml's
 ``pythonpath``, a Blender script through the ``--python-expr`` of ``in_blender`` (bpy_session.py
-puts the same folders on sys.path). The benchmarks use it too (bench/shapes.py and bench/common.py put it on sys.path).
+puts the same folders on sys.path). The benchmarks use it too (bench/shapes.py and
+bench/common.py put it on sys.path).
 
 - this module: where the shared meshes are, and Blender's arguments to run a test script;
 - ``meshes``: reading them (imports modal_deform.core);

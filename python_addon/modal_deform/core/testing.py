@@ -1,4 +1,4 @@
-"""Generated test shapes, the Botsch–Sorkine benchmark's meshes (V (n, 3) float64, F (m, 3) int32).
+"""Generated test shapes (the Botsch–Sorkine benchmarks'): V (n, 3) float64, F (m, 3) int32.
 
     import modal_deform.core as mdc
     V, F = mdc.testing.bar(4, 4, 16)
