@@ -41,10 +41,11 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 # source tree's; two modal_deform packages in one Blender would register the core's types twice.
 sys.path.insert(0, str(ROOT / "blender_scripts"))
 sys.path.insert(0, str(ROOT / "bench"))
+sys.path.insert(0, str(ROOT / "tests"))
 from headless import (add_handle, bind_laplacian_deform, enable_addon,  # noqa: E402 (found through the lines above)
                       evaluated_positions)
-import subdivision  # noqa: E402 (the project's midpoint subdivision)
-MESHES = ROOT.parent / "shared" / "meshes"
+from support import SHARED_MESHES as MESHES  # noqa: E402
+from support import subdivision  # noqa: E402 (the project's midpoint subdivision, NumPy only)
 ADDON = "modal_deform"  # the add-on's module: bl_ext.<repository>.modal_deform when installed as an extension
 
 

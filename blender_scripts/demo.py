@@ -113,7 +113,7 @@ def curled_finger(mdc, name, painted, x):
     """A tube along z (a finger 2 long) at `x`, held at its base ring and its tip ring curled by 60°
     about each knuckle (about the y axis, seen from the camera); with `painted`, a Stiffness Group
     makes its three phalanges 100 times stiffer than its two knuckles. Returns the object, posed."""
-    V, F = mdc.cylinder(24, 60, 0.16, 2.0)
+    V, F = mdc.testing.cylinder(24, 60, 0.16, 2.0)
     V[:, 0] += x
     obj = bpy.data.objects.new(name, bpy.data.meshes.new(name))
     obj.data.from_pydata([tuple(v) for v in V], [], [tuple(f) for f in F])

@@ -4,8 +4,9 @@ import pathlib
 
 import pytest
 
+from support import SHARED_MESHES
+
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-SHARED_MESHES = ROOT.parent / "shared" / "meshes"
 BLENDER_SCRIPTS = ROOT / "blender_scripts"
 
 

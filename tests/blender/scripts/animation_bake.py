@@ -4,12 +4,10 @@ the motion changed, Esc or a failure leaves it as it was; exported to PC2 and MD
 Blender's Mesh Cache modifier plays and to shape keys (a cancelled export changes nothing); then
 saved with the shape keys."""
 import os
-import sys
 
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-import support  # noqa: E402
+import bpy
+import numpy as np
+from support import blender as support
 
 frame_cache, jobs, operators, timeline, frame_display, posing = support.enable_addon(
     "playback.frame_cache", "jobs", "playback.operators", "playback.timeline", "playback.frame_display", "posing")

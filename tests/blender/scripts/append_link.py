@@ -1,11 +1,7 @@
 """The stored basis follows an object appended or linked from a saved file (undo: tests/gui)."""
-import os
-import sys
-
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-import support  # noqa: E402
+import bpy
+import numpy as np
+from support import blender as support
 
 storage = support.enable_addon("storage")
 

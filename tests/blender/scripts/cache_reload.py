@@ -1,13 +1,9 @@
 """Open the file cache_save.py wrote: the cache is there bit for bit, plays back what it showed
 before the save without computing anything, simulates the frame after it as before the save, and
 a mesh edited since the bake is refused."""
-import os
-import sys
-
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-import support  # noqa: E402
+import bpy
+import numpy as np
+from support import blender as support
 
 frame_cache, timeline = support.enable_addon("playback.frame_cache", "playback.timeline")
 obj = bpy.data.objects["Suzanne"]

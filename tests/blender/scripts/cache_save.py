@@ -1,12 +1,8 @@
 """Cache an animation of Suzanne (static, or simulated with `dynamic`), record what it holds and
 shows, and save the file."""
-import os
-import sys
-
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-import support  # noqa: E402
+import bpy
+import numpy as np
+from support import blender as support
 
 frame_cache, timeline = support.enable_addon("playback.frame_cache", "playback.timeline")
 kind = support.arguments()[0]

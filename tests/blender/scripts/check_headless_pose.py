@@ -1,12 +1,8 @@
 """Open the file blender_scripts/pose.py saved: the pose is in the "Modal Deform" shape key, the base
 mesh is as bake_and_save.py left it, and with the controllers where they were bound the pose is rest."""
-import os
-import sys
-
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-import support  # noqa: E402
+import bpy
+import numpy as np
+from support import blender as support
 
 posing = support.enable_addon("posing")
 

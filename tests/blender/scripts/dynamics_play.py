@@ -4,13 +4,9 @@ scrubbing back reads the cache; a jump forward simulates every frame in between 
 same bits as playing, and so do frames simulated again after a cut in the middle of a block of
 BFGS's memory; a changed keyframe or setting invalidates what follows; Bake gives the same
 bits again; Free empties the cache; a mesh edited between frames and a damaged cache are refused."""
-import os
-import sys
-
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-import support  # noqa: E402
+import bpy
+import numpy as np
+from support import blender as support
 
 frame_cache, frame_keys, timeline, frame_display, posing = support.enable_addon(
     "playback.frame_cache", "frame_keys", "playback.timeline", "playback.frame_display", "posing")

@@ -1,11 +1,7 @@
 """modal_deform.core imports inside Blender's Python and computes on a Blender mesh."""
-import os
-import sys
-
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-import support  # noqa: E402
+import bpy
+import numpy as np
+from support import blender as support
 
 mdc = support.enable_addon("core")
 bpy.ops.mesh.primitive_monkey_add()

@@ -4,11 +4,9 @@ installed or enabled.
 
 Arguments: ZIP."""
 import os
-import sys
 
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import support  # noqa: E402
+import bpy
+from support import blender as support
 
 (zip_path,) = support.arguments()
 try:

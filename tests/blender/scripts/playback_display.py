@@ -3,15 +3,11 @@ modifier first in the stack (the artist's modifiers act on it), the artist's pos
 untouched, the rest in Edit Mode; a copy of the mesh is not written through; without the attribute
 the mesh shows its rest; a pose (Solve, the interactive pose) takes the display away, as do dynamics
 turned off, a cache that no longer fits and disabling the add-on."""
-import os
-import sys
-
-sys.path.insert(0, os.path.dirname(__file__))
-import addon_utils  # noqa: E402
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-from mathutils import Matrix  # noqa: E402
-import support  # noqa: E402
+import addon_utils
+import bpy
+import numpy as np
+from mathutils import Matrix
+from support import blender as support
 
 package = support.enable_addon()
 frame_cache, mesh_io, timeline, frame_display, displays, posing = support.enable_addon(

@@ -2,13 +2,11 @@
 the same frames bit for bit, the artist's mesh and shape keys untouched; it goes when playback stops,
 before a file is saved, in Edit Mode and when the artist changes the mesh, and a file written
 mid-playback, or an undo step, loads without it, showing the same frame."""
-import os
 import sys
 
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-import support  # noqa: E402
+import bpy
+import numpy as np
+from support import blender as support
 
 if not hasattr(bpy.app.handlers, "animation_playback_pre"):
     print("STAND_IN_UNSUPPORTED")

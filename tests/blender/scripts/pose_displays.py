@@ -5,15 +5,11 @@ added mid-pose (a copy of the posed positions) gets the rest as its reference; a
 the artist's shape keys is posed in the key and gets them back untouched; a mesh written mid-pose
 by a path without save handlers (an undo step of a controller's move, autosave, a crash file) is
 repaired after undo and after loading: rest from the stored basis, pose into the key."""
-import os
-import sys
-
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-from mathutils import Matrix  # noqa: E402
-import support  # noqa: E402
-from headless import evaluated_positions  # noqa: E402
+import bpy
+import numpy as np
+from mathutils import Matrix
+from support import blender as support
+from support.blender import evaluated_positions
 
 posing, displays, storage = support.enable_addon("posing", "pose.displays", "storage")
 

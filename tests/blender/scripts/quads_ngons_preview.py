@@ -1,12 +1,9 @@
 """Quads and n-gons are triangulated for the energy without touching the faces; mode preview."""
 import math
-import os
-import sys
 
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-import support  # noqa: E402
+import bpy
+import numpy as np
+from support import blender as support
 
 ops_preview, storage = support.enable_addon("ops_preview", "storage")
 

@@ -1,13 +1,9 @@
 """Open the file region_bake.py wrote: the region bake is fresh, poses as before, and the ear's
 tip pulled further still leaves every vertex outside the ear exactly where it was, refined too."""
-import os
-import sys
-
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-from mathutils import Matrix  # noqa: E402
-import support  # noqa: E402
+import bpy
+import numpy as np
+from mathutils import Matrix
+from support import blender as support
 
 posing, storage = support.enable_addon("posing", "storage")
 

@@ -1,14 +1,11 @@
 """Open the file bake_and_save.py wrote: the basis must be bit for bit what was baked; then move
 one controller, solve, and check the pose (handles on target, base mesh untouched)."""
 import math
-import os
-import sys
 
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-from mathutils import Matrix  # noqa: E402
-import support  # noqa: E402
+import bpy
+import numpy as np
+from mathutils import Matrix
+from support import blender as support
 
 handles, posing, storage = support.enable_addon("handles", "posing", "storage")
 

@@ -1,12 +1,10 @@
 """A solve that cannot make progress says so (issue 22): with the reduced solver reporting a stall
 (no step lowers the objective), Solve warns with the hint for the artist, and the interactive
 pose's header names the stall; a converged solve says neither."""
-import os
 import sys
 
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import support  # noqa: E402
+import bpy
+from support import blender as support
 
 posing, core = support.enable_addon("posing", "core")
 obj, rest = support.baked_suzanne(0, 10, 20, 300)

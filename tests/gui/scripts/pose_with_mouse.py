@@ -13,7 +13,6 @@ Writes OUTPUT/result.json ({"ok": bool, "log": [...]}) and screenshots, then qui
 """
 import importlib
 import os
-import sys
 import threading
 import time
 
@@ -22,10 +21,8 @@ import bpy
 import numpy as np
 from mathutils import Vector
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "blender_scripts"))
-from headless import evaluated_positions  # noqa: E402
-from window import (enable_addon, override, output, run, say, screenshot, show_sidebar_tab,  # noqa: E402
+from support.blender import evaluated_positions
+from window import (enable_addon, override, output, run, say, screenshot, show_sidebar_tab,
                     subdivided_suzanne, view3d)
 
 
