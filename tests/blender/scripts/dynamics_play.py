@@ -169,4 +169,3 @@ scene.frame_set(12)
 assert "is damaged (no 'q')" in playback.problems.get(obj.name, ""), playback.problems
 assert key().tobytes() == V.tobytes()
 assert bpy.ops.modal_deform.free_cache() == {"FINISHED"} and dynamics.cache is None
-print("DYNAMICS_OK")
