@@ -133,21 +133,24 @@ endif
 check: build
 	$(MAKE) --no-print-directory test-cpp test-python check-format
 
-# The C and C++ sources and the Python files git knows or would add (not those it ignores).
-FORMATTED_CXX = $(shell git ls-files --cached --others --exclude-standard '*.cpp' '*.h' '*.c')
+# The C and C++ files git knows or would add (not those it ignores); ruff finds the Python files
+# itself (pyproject.toml).
+FORMATTED_CXX = $(or $(shell git ls-files --cached --others --exclude-standard '*.cpp' '*.h' '*.c' 2>/dev/null),\
+	$(error no C++ files from git ls-files: make check-format and make format run in a git checkout))
 # Every check runs, so that one report names every file to format (one diagnostic per C++ file).
 check-format: check-venv
 	@status=0; \
 	$(CHECK)/bin/clang-format --dry-run --Werror --ferror-limit=1 $(FORMATTED_CXX) || status=1; \
 	$(CHECK)/bin/ruff format --check --output-format concise . || status=1; \
 	$(CHECK)/bin/ruff check --output-format concise . || status=1; \
-	if [ $$status != 0 ]; then echo "Formatting: make format applies it"; fi; exit $$status
+	if [ $$status != 0 ]; then echo "make format applies the formatting and ruff's safe fixes; the rest is by hand"; fi; \
+	exit $$status
 
 # Applies the formatting in place: ruff's safe lint fixes (import order), ruff format, clang-format.
 format: check-venv
 	$(CHECK)/bin/ruff check --fix-only .
 	$(CHECK)/bin/ruff format .
-	$(CHECK)/bin/clang-format -i $(FORMATTED_CXX)
+	@echo "clang-format -i on the C and C++ files"; $(CHECK)/bin/clang-format -i $(FORMATTED_CXX)
 
 # The core as a wheel for each of WHEEL_PYTHONS (pyproject.toml: scikit-build-core on this
 # CMakeLists.txt, build tree in build-wheel/<tag>/), repaired by auditwheel into dist/: the libraries
