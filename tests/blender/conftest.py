@@ -13,7 +13,8 @@ the Blender app on PATH (Debian's 3.4.1; `make test-blender`).
 - Windows bpy under Wine (`make test-windows-bpy-5.3`): BLENDER_PYTHON is
   tests/windows/wine_python.py and WINDOWS_PYTHON the python.exe of the Windows bpy environment;
   the Windows zips are installed.
-A script signals failure by raising (exit code 1).
+A script fails by raising (exit code 1) and passes by running to its end: the tests read its output
+only for what it reports.
 """
 import os
 import pathlib

@@ -26,4 +26,3 @@ for link in (False, True):
     assert storage.stale_reason(obj) == ""
     loaded = storage.load(obj).to_arrays()
     assert all(baked[k].tobytes() == loaded[k].tobytes() for k in baked), f"link={link}: basis differs"
-print("APPEND_LINK_OK")

@@ -34,4 +34,3 @@ obj.data.vertices[0].co.x += 0.1
 scene.frame_set(5)
 assert "edited after the bake" in timeline.problems.get(obj.name, ""), timeline.problems
 assert support.evaluated_positions(obj).tobytes() == support.positions(obj).tobytes()
-print("CACHE_RELOADED")

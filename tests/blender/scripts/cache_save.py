@@ -25,4 +25,4 @@ bpy.ops.wm.save_as_mainfile(filepath=support.tmp("cached.blend"))
 # The frame after the cache, computed after the save: the reloaded file computes it again.
 scene.frame_set(13)
 np.save(support.tmp("next.npy"), support.evaluated_positions(obj))
-print("CACHE_SAVED", cache.nbytes())
+print("the cache holds", cache.nbytes(), "bytes")

@@ -165,4 +165,3 @@ scene.frame_set(12)
 assert "is damaged (no 'q')" in timeline.problems.get(obj.name, ""), timeline.problems
 assert key().tobytes() == V.tobytes()
 assert bpy.ops.modal_deform.free_cache() == {"FINISHED"} and dynamics.cache is None
-print("DYNAMICS_OK")

@@ -16,4 +16,4 @@ except RuntimeError as error:  # the operator's error report
 assert "bl_ext.user_default.modal_deform" not in bpy.context.preferences.addons, f"installed and enabled: {result}"
 repository = bpy.utils.user_resource('EXTENSIONS', path="user_default")
 assert not os.path.exists(os.path.join(repository, "modal_deform")), f"files left in {repository}: {result}"
-print("REFUSED", result)
+print("the installer returned:", result)

@@ -37,4 +37,3 @@ settings.stiffness_group = ""
 assert bpy.ops.modal_deform.bake() == {"FINISHED"}
 uniform = middle_deviation()
 assert painted < 0.2 * uniform, (painted, uniform)
-print("PAINTED_RELOADED")

@@ -54,4 +54,3 @@ assert bpy.ops.modal_deform.solve() == {"FINISHED"}
 np.save(support.tmp("painted_pose.npy"), support.key_positions(obj, posing.POSE_KEY))
 assert support.positions(obj).tobytes() == V.astype(np.float32).tobytes(), "the base mesh changed"
 bpy.ops.wm.save_as_mainfile(filepath=support.tmp("painted.blend"))
-print("PAINTED_OK")

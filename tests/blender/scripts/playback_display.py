@@ -120,4 +120,3 @@ addon_utils.disable(package.__name__, default_set=True)
 assert [m.name for m in obj.modifiers] == [artist.name] and frame_display.ATTRIBUTE not in obj.data.attributes
 assert not [g for g in bpy.data.node_groups if g.get(frame_display.MARK)]
 assert np.abs(shown() - support.key_positions(obj, posing.POSE_KEY)).max() < 1e-6
-print("DISPLAY_OK")

@@ -158,4 +158,3 @@ obj = bpy.data.objects[name]
 assert not stand_ins() and not frame_display.has_stand_in(obj), stand_ins()
 assert support.evaluated_positions(obj).tobytes() == shown.tobytes(), "the loaded file shows another frame"
 assert np.array_equal(support.positions(obj), V)
-print("STAND_IN_OK")

@@ -99,7 +99,6 @@ shown = shown.keep(pose)
 assert support.positions(obj).tobytes() == rest.tobytes()
 assert support.key_positions(obj, "Basis").tobytes() == rest.tobytes()
 assert support.key_positions(obj, posing.POSE_KEY).tobytes() == posed.tobytes()
-print("POSITIONS_OK")
 
 # The artist's own shape key: posed in the key, the artist's key and the mesh as they were after Esc.
 obj.shape_key_clear()
@@ -113,7 +112,6 @@ assert support.positions(obj).tobytes() == rest.tobytes()
 shown.restore()
 assert support.mesh_state(obj) == before, "the artist's shape keys changed"
 obj.shape_key_clear()
-print("SHAPE_KEYS_OK")
 
 # An undo step taken mid-pose (a controller's move pushes one) holds the pose in the positions:
 # undoing to it after the pose was kept repairs it.
@@ -122,7 +120,6 @@ assert obj.data.get(displays.POSING_FLAG) is None, "undo left a posed mesh"
 assert support.positions(obj).tobytes() == rest.tobytes(), "undo left the pose in the base mesh"
 assert support.key_positions(obj, posing.POSE_KEY).tobytes() == posed.tobytes()
 obj.shape_key_clear()
-print("UNDO_OK")
 
 # A file written mid-pose without save handlers (autosave, a crash file; here a plain save with no
 # interactive pose running to move the pose first): loading it repairs the mesh.
@@ -138,7 +135,6 @@ assert obj.data.get(displays.POSING_FLAG) is None
 assert support.positions(obj).tobytes() == rest.tobytes(), "loading left the pose in the base mesh"
 assert support.key_positions(obj, posing.POSE_KEY).tobytes() == posed.tobytes()
 assert storage.stale_reason(obj) == "", "the repaired mesh does not fit its basis"
-print("LOAD_OK")
 
 # A mesh posed and kept before (here just repaired: "Basis" and "Modal Deform"), with an artist's
 # key at 0: posed in a stand-in without shape keys, the artist's mesh untouched; Esc puts it back.
@@ -196,7 +192,6 @@ expected = np.zeros_like(offset)
 expected[0, 0] = 0.2
 assert np.abs(offset - expected).max() < 1e-5, "the key added mid-pose was not carried over"
 obj.shape_key_remove(obj.data.shape_keys.key_blocks["Frown"])
-print("STAND_IN_OK")
 
 # An undo step and a file written mid-pose hold the stand-in on the object: the artist's mesh comes
 # back on undo and on loading, with the pose in the key.
@@ -215,4 +210,3 @@ assert obj.data.name == "Suzanne" and not [m for m in bpy.data.meshes if m.get(d
 assert support.key_positions(obj, posing.POSE_KEY).tobytes() == posed.tobytes()
 assert support.positions(obj).tobytes() == rest.tobytes()
 assert storage.stale_reason(obj) == "", "the mesh put back does not fit its basis"
-print("STAND_IN_UNDO_LOAD_OK")

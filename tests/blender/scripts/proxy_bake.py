@@ -49,4 +49,4 @@ settings.preview_amplitude = 0.1
 assert bpy.ops.modal_deform.preview_mode() == {"FINISHED"}
 preview = support.key_positions(obj, ops_preview.PREVIEW_KEY)
 assert abs(np.linalg.norm(preview - rest, axis=1).max() - 0.1 * size) < 1e-3 * size
-print("PROXY_OK", n, settings.status.proxy_vertices)
+print(n, "vertices posed through a proxy of", settings.status.proxy_vertices)

@@ -48,4 +48,3 @@ settings.preview_amplitude = -0.2  # the key follows the slider
 assert abs(np.linalg.norm(support.key_positions(obj, ops_preview.PREVIEW_KEY) - rest, axis=1).max() - 0.8) < 1e-4
 assert bpy.ops.modal_deform.preview_mode() == {"FINISHED"}
 assert not ops_preview.showing(obj)
-print("NGONS_OK")

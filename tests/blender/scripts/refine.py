@@ -42,4 +42,3 @@ assert bpy.ops.modal_deform.bake_animation(frame_start=1, frame_end=3, refine=Tr
 names = [b.name for b in obj.data.shape_keys.key_blocks]
 assert [f"Modal Deform {f:04d}" for f in range(1, 4)] == names[-3:], names
 assert np.array_equal(support.positions(obj), rest)
-print("REFINE_OK")

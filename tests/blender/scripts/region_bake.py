@@ -44,4 +44,3 @@ group.remove([int(np.flatnonzero(~ear)[0])])
 assert storage.stale_reason(obj) == ""
 np.save(support.tmp("region_pose.npy"), pose)
 bpy.ops.wm.save_as_mainfile(filepath=support.tmp("region.blend"))
-print("REGION_OK")

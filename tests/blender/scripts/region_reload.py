@@ -27,4 +27,3 @@ assert bpy.ops.modal_deform.refine() == {"FINISHED"}
 refined = support.key_positions(obj, posing.POSE_KEY)
 assert refined[~ear].tobytes() == V[~ear].tobytes(), "Refine moved a vertex outside the region"
 assert np.abs(refined - pose).max() > 1e-4, "Refine left the reduced pose as it was"
-print("REGION_RELOADED")

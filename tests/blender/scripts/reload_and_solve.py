@@ -39,4 +39,4 @@ for handle, T in zip(resolved, handles.transforms(obj, resolved)):
     target = rest[handle.indices] @ T[:3, :3].T + T[:3, 3]
     error = np.linalg.norm(pose[handle.indices] - target, axis=1).mean() / size
     assert error < 0.01, f"handle {handle.name} misses its target by {error:.2%} of the model's size"
-print("SOLVED", obj.name, "moved", np.abs(pose - rest).max() / size)
+print(obj.name, "posed: moved by", np.abs(pose - rest).max() / size, "of its size")

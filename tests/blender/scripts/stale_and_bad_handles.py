@@ -64,5 +64,3 @@ assert bpy.ops.modal_deform.bake() == {"FINISHED"}
 assert storage.stale_reason(obj) == "" and len(support.stored_bases()) == 1
 assert bpy.ops.modal_deform.clear_basis() == {"FINISHED"}
 assert obj.modal_deform.basis is None and len(support.stored_bases()) == 0
-
-print("STALE_OK")

@@ -18,4 +18,3 @@ for pose in strong_poses.POSES:
     worst = max(step["difference_error"] for step in path)
     assert worst < 1e-4, (pose, worst)
     print(pose, sum(step["iterations"] for step in path), "iterations, energy", path[-1]["energy"])
-print("STRONG_POSES_OK")
