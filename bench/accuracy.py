@@ -78,12 +78,12 @@ def objective(energy, mass, shape, transforms, X):
 def pose_reduced(basis, shape, pose):
     """Positions (n, 3) of the reduced solve through every frame of the pose, and whether every
     frame converged."""
-    solver = mdc.ReducedSolver(basis, shape.handles, stiffness=STIFFNESS)
+    solver = mdc.ReducedSolver(basis, shape.handles, pull=STIFFNESS)
     converged = True
     for frame in range(1, pose.frames + 1):
         solver.set_transforms(pose.at(frame / pose.frames))
         for _ in range(50):
-            if solver.solve(20, TOLERANCE)["converged"]:
+            if solver.solve(max_iterations=20, tolerance=TOLERANCE)["converged"]:
                 break
         else:
             converged = False
@@ -101,7 +101,7 @@ def meshes_for_renders(shape, pose, reference):
 def reference(shape, pose, energy, mass, start=None):
     """solve_full's minimum of the pose: (positions, objective, converged, stats); from rest, or
     from `start` (n, 3), a reduced pose, as Refine does."""
-    X, stats = mdc.solve_full(shape.V, shape.F, shape.handles, pose.at(1.0), stiffness=STIFFNESS, initial=start)
+    X, stats = mdc.solve_full(shape.V, shape.F, shape.handles, pose.at(1.0), pull=STIFFNESS, initial=start)
     print(f"  {shape.name} {pose.name}: reference {'converged' if stats['converged'] else 'NOT converged'} "
           f"after {stats['iterations']} Newton iterations", flush=True)
     return X, objective(energy, mass, shape, pose.at(1.0), X), bool(stats["converged"]), stats

@@ -301,16 +301,16 @@ def laplacian_on_shapes(folder):
             laplacian_ms.append(milliseconds(t))
         data["laplacian"] = evaluated_positions(obj).astype(np.float64)
 
-        solver = mdc.ReducedSolver(mdc.bake(V, F, 20, 47, ghost=1000), [data["handle0"], data["handle1"]])
+        solver = mdc.ReducedSolver(mdc.bake(V, F, modes=20, derivatives=47, ghost=1000), [data["handle0"], data["handle1"]])
         out = np.empty(V.shape, np.float32)
         ours_ms = []
         for transforms in steps:
             t = time.perf_counter()
             solver.set_transforms(transforms)
-            solver.solve(10, 1e-6)
+            solver.solve(max_iterations=10, tolerance=1e-6)
             solver.positions(out)
             ours_ms.append(milliseconds(t))
-        while not solver.solve(50, 1e-10)["converged"]:
+        while not solver.solve(max_iterations=50, tolerance=1e-10)["converged"]:
             pass
         ours = solver.positions().astype(np.float64)
         energy = mdc.DiscreteShells(V, F)

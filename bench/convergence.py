@@ -94,7 +94,7 @@ def bfgs(basis, shape, transforms, warm):
     value, gradient = solver.objective(solver.q)
     trace = [value]
     for _ in range(ITERATIONS):
-        stats = solver.solve(1, 1e-15)
+        stats = solver.solve(max_iterations=1, tolerance=1e-15)
         if stats["iterations"] == 0:
             break
         trace.append(stats["energy"])

@@ -14,7 +14,7 @@
 - proxy: the 100k dragon midpoint-subdivided twice (1.6M vertices) baked on a proxy: the cost of
   the demo's motion there, and the stress run on it.
 - tolerance: BFGS's stopping tolerance against the frames of a tight solve (the 5k dragon, the
-  demo's motion): why SIMULATION_DEFAULTS["tolerance"] is what it is.
+  demo's motion): why SIMULATION_OPTIONS["tolerance"] is what it is.
 """
 import time
 
@@ -26,6 +26,9 @@ from shapes import rigid_transform as rigid
 from support.dynamics import AMPLITUDE, damped_oscillation, released  # noqa: F401
 from support import SHARED_MESHES as MESHES
 from support.subdivision import midpoint_subdivide
+
+# The handles' pull the dynamics records were made with.
+PULL = 100.0
 
 BAR = dict(modes=20, derivatives=30, ghost=300)
 
@@ -64,7 +67,7 @@ def per_frame_cost(basis, V, handles, moves, **parameters):
     """Per frame: the core's step, the map after it, BFGS's iterations and evaluations, the step's
     time per evaluation; and the map run back to back (its threads awake), which a busy machine
     otherwise delays by waking them after each serial step."""
-    sim = mdc.Simulation(basis, handles, **parameters)
+    sim = mdc.Simulation(basis, handles, **parameters, pull=PULL)
     out = np.empty((len(V), 3), np.float32)
     step_ms, map_ms, iterations, evaluations = [], [], [], []
     for T in moves:
@@ -106,7 +109,7 @@ def stress_run(basis, V, handles, frames, still):
     diagonal = np.linalg.norm(np.ptp(V, axis=0))
     length = np.ptp(V[:, 0])
     damping = 0.3
-    sim = mdc.Simulation(basis, handles, damping=damping)
+    sim = mdc.Simulation(basis, handles, damping=damping, pull=PULL)
     rng = np.random.default_rng(1)
     centre = V[handles[1]].mean(axis=0)
     non_finite, farthest, step_ms, euler, removed, evaluations = 0, 0.0, [], 0, 0.0, []
@@ -128,7 +131,7 @@ def stress_run(basis, V, handles, frames, still):
         X = sim.step([np.eye(4), T])
         energies.append(sim.energy())
     increases = np.diff(energies)
-    solver = mdc.ReducedSolver(basis, handles, stiffness=mdc.SIMULATION_DEFAULTS["stiffness"])
+    solver = mdc.ReducedSolver(basis, handles, pull=PULL)
     solver.set_transforms([np.eye(4), T])
     solved = solver.solve(max_iterations=1000, tolerance=1e-12)
     return {"vertices": len(V), "frames": frames, "still_frames": still, "damping": damping,
@@ -172,7 +175,7 @@ def tolerance(quick):
     moves = demo_motion(V, handles, 72)
 
     def frames(tol):
-        sim = mdc.Simulation(basis, handles, tolerance=tol, max_iterations=200)
+        sim = mdc.Simulation(basis, handles, tolerance=tol, max_iterations=200, pull=PULL)
         X, iterations = [], []
         for T in moves:
             X.append(sim.step(T).astype(np.float64))
@@ -197,5 +200,5 @@ def run(quick=False):
         start = time.perf_counter()
         figures[name] = part(quick)
         print(f"   {name}: {time.perf_counter() - start:.0f} s", flush=True)
-    parameters = {"defaults": dict(mdc.SIMULATION_DEFAULTS), "bar_bake": BAR, "amplitude": AMPLITUDE}
+    parameters = {"defaults": {name: o.default for name, o in mdc.SIMULATION_OPTIONS.items()}, "bar_bake": BAR, "amplitude": AMPLITUDE}
     return parameters, figures

@@ -25,7 +25,7 @@ def bake_and_pose(model, save):
 
     shape = shapes.make(model)
     start = time.perf_counter()
-    basis = mdc.bake(shape.V, shape.F, 20, 47, ghost=1000)
+    basis = mdc.bake(shape.V, shape.F, modes=20, derivatives=47, ghost=1000)
     bake_s = time.perf_counter() - start
     posing = table1.time_posing(basis, shape)
     if save:

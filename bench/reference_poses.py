@@ -83,9 +83,9 @@ def cases():
         V, F = _mesh("dragon_res4")
         handles, poses = shapes.end_turns(V, turns=(30,), bend=None)
         transforms = poses[0].at(1.0)
-        X, stats = mdc.solve_full(V, F, handles, transforms, stiffness=100.0)
+        X, stats = mdc.solve_full(V, F, handles, transforms, pull=100.0)
         arrays = {"full.positions": X, **_stats_arrays("full", stats)}
-        solver = mdc.ReducedSolver(mdc.bake(V, F, modes=15), handles, stiffness=100.0)
+        solver = mdc.ReducedSolver(mdc.bake(V, F, modes=15), handles, pull=100.0)
         solver.set_transforms(transforms)
         solver.solve(max_iterations=200)
         X, stats = solver.refine(F)

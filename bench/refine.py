@@ -67,14 +67,14 @@ def crushed_faces(rest_areas, X, F):
 
 def from_rest(V, F, rest_areas, handles, transforms):
     start = time.perf_counter()
-    X, stats = mdc.solve_full(V, F, handles, transforms, stiffness=STIFFNESS)
+    X, stats = mdc.solve_full(V, F, handles, transforms, pull=STIFFNESS)
     stats["wall_seconds"] = time.perf_counter() - start
     stats.update(crushed_at_start=0, crushed_at_end=crushed_faces(rest_areas, X, F))
     return stats
 
 
 def refine(basis, F, rest_areas, handles, transforms):
-    solver = mdc.ReducedSolver(basis, handles, stiffness=STIFFNESS)
+    solver = mdc.ReducedSolver(basis, handles, pull=STIFFNESS)
     solver.set_transforms(transforms)
     start = time.perf_counter()
     reduced = solver.solve(max_iterations=2000, tolerance=1e-6)

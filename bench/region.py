@@ -67,7 +67,7 @@ def run(quick=False):
     for _ in range(2):
         V, F = midpoint_subdivide(V, F)
     # The quick run's proxies are scaled down with its mesh (5k vertices subdivided: 80k).
-    proxy = {"proxy": 5000, "proxy_above": 10000} if quick else {"proxy": mdc.PROXY, "proxy_above": mdc.PROXY_ABOVE}
+    proxy = {"proxy": 5000, "proxy_above": 10000} if quick else {"proxy": mdc.BAKE_OPTIONS["proxy"].default, "proxy_above": mdc.BAKE_OPTIONS["proxy_above"].default}
     on_proxy = whole_and_region(V, F, 1 if quick else RUNS["proxy"], proxy)
     parameters = {"mesh": name, "head_fraction": HEAD, **SIZES, **proxy}
     return parameters, {"dense": dense, "on_proxy": on_proxy}

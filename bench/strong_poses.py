@@ -30,7 +30,7 @@ _CHILD = textwrap.dedent("""
 
     def interactive(basis, V, degrees):
         handles, _ = strong_poses.transforms(V, "turn", 0)
-        solver = mdc.ReducedSolver(basis, handles, stiffness=strong_poses.STIFFNESS)
+        solver = mdc.ReducedSolver(basis, handles, pull=strong_poses.STIFFNESS)
         stuck = stalled = 0
         for call in range(1, 201):
             t = min(1.0, call / 60)
@@ -73,7 +73,7 @@ _CHILD = textwrap.dedent("""
         # reports it at its start), then Newton on the 100k dragon from the lower of them (Refine:
         # the own bake's pose carries its slivers' strain, about 1000 times the minimum at 30 degrees).
         handles, T = strong_poses.transforms(coarse.V, "turn", degrees, shift=(3, 1.5))
-        full = dict(stiffness=strong_poses.STIFFNESS)
+        full = dict(pull=strong_poses.STIFFNESS)
         poses = dict(fine=fine_X, own=own_X)
         objective = {{pose: mdc.solve_full(coarse.V, coarse.F, handles, T, initial=X, max_iterations=0,
                                            **full)[1]["initial_energy"] for pose, X in poses.items()}}

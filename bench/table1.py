@@ -44,7 +44,7 @@ def time_posing(basis, shape):
     iterations, solve_ms = 0, 0.0
     for frame in range(1, FRAMES + 1):
         solver.set_transforms(pose.at(frame / FRAMES))
-        stats = solver.solve(10, 1e-6)
+        stats = solver.solve(max_iterations=10, tolerance=1e-6)
         iterations += stats["iterations"]
         solve_ms += stats["ms"]
     out = np.empty((basis.num_vertices, 3), np.float32)
@@ -55,7 +55,7 @@ def time_posing(basis, shape):
     for frame in range(20):
         start = time.perf_counter()
         solver.set_transforms(pose.at(1 - 0.02 * (frame + 1)))
-        update_iterations.append(solver.solve(10, 1e-12)["iterations"])
+        update_iterations.append(solver.solve(max_iterations=10, tolerance=1e-12)["iterations"])
         solver.positions(out)
         update_ms.append(1e3 * (time.perf_counter() - start))
     return {"ms_per_iteration": solve_ms / max(iterations, 1), "iterations_per_frame": iterations / FRAMES,

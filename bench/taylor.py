@@ -43,7 +43,7 @@ def run(quick=False):
     basis = mdc.bake(shape.V, shape.F, *DIMENSION, ghost=len(shape.V))
     solver = mdc.ReducedSolver(basis, shape.handles)
     solver.set_transforms(transforms)
-    while not solver.solve(50, 1e-12)["converged"]:
+    while not solver.solve(max_iterations=50, tolerance=1e-12)["converged"]:
         pass
     direction = solver.q
     objectives = {"fine mesh": objective_along(basis, shape, transforms, direction)}

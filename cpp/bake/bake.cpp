@@ -36,16 +36,9 @@ namespace {
 // columns.
 constexpr int kPairsPerPass = 64;
 
-// The fewest vertices of a mesh simplified by edge collapse (the ghost, a proxy): a tetrahedron's.
-constexpr int kFewestSimplifiedVertices = 4;
-
-void check_options(const BakeOptions& o, Eigen::Index num_vertices) {
-  if (o.modes < 1) throw InputError(message("modes: expected at least 1, got ", o.modes));
-  if (o.derivatives < 0) throw InputError(message("derivatives: expected 0 or more, got ", o.derivatives));
-  if (o.ghost < kFewestSimplifiedVertices)
-    throw InputError(message("ghost: a ghost needs at least ", kFewestSimplifiedVertices, " vertices, got ", o.ghost));
-  if (o.proxy_above < 0) throw InputError(message("proxy_above: expected 0 (never) or more, got ", o.proxy_above));
-  if (o.proxy_above > 0 && (o.proxy < kFewestSimplifiedVertices || o.proxy > o.proxy_above))
+void check_bake_options(const BakeOptions& o, Eigen::Index num_vertices) {
+  check_options(o, [](auto visit) { for_each_bake_option(visit); });
+  if (o.proxy_above > 0 && o.proxy > o.proxy_above)
     throw InputError(message("proxy: expected between ", kFewestSimplifiedVertices, " and proxy_above's ",
                              o.proxy_above, " vertices, got ", o.proxy));
   if (o.energy == EnergyKind::kArap && o.derivatives > 0)
@@ -321,7 +314,7 @@ Basis bake_stages(const VerticesRef& V, const MovingPart& part, const BakeOption
 
 Basis bake(const VerticesRef& V, const FacesRef& F, const BakeOptions& options, Progress& progress) {
   try {
-    check_options(options, V.rows());
+    check_bake_options(options, V.rows());
     validate_mesh(V, F);
     Basis fine = rest_state(V, F, options, normalizing_scale(V));
     const MovingPart part(V, F, fine.mass, options.region);

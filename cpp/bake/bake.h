@@ -58,6 +58,7 @@
 
 #include "energy/make_energy.h"
 #include "basis/basis.h"
+#include "util/option.h"
 #include "util/progress.h"
 #include "util/types.h"
 
@@ -67,6 +68,9 @@ namespace modal_deform {
 // grows with the resolution as rounding in K does) is a zero mode: on the shared scans the zero
 // modes lie orders of magnitude below it and the lowest flexible modes orders of magnitude above.
 constexpr double kZeroEigenvalue = 1e-12;
+
+// The fewest vertices of a mesh simplified by edge collapse (the ghost, a proxy): a tetrahedron's.
+constexpr int kFewestSimplifiedVertices = 4;
 
 struct BakeOptions {
   int modes = 20;                 // vibration modes, rigid motions included
@@ -91,19 +95,46 @@ struct BakeOptions {
   Eigen::VectorXi region = {};
 };
 
-// The options by the names the bindings take them as keywords, with their defaults from
-// BakeOptions{}: visit(name, field) with `field` an accessor o -> o.member.
+// The options as the Python API and the add-on take them (option.h), with their defaults from
+// BakeOptions{}: visit(option, field) with `field` an accessor o -> o.member.
 template <typename Visit>
 void for_each_bake_option(Visit&& visit) {
-  visit("modes", [](auto& o) -> auto& { return o.modes; });
-  visit("derivatives", [](auto& o) -> auto& { return o.derivatives; });
-  visit("ghost", [](auto& o) -> auto& { return o.ghost; });
-  visit("energy", [](auto& o) -> auto& { return o.energy; });
+  visit(Option{"modes",
+               "Vibration modes, the rigid motions of the simulated parts (6 each) included: more let poses "
+               "take more shapes and make the bake and posing slower.",
+               at_least(1)},
+        [](auto& o) -> auto& { return o.modes; });
+  visit(Option{"derivatives",
+               "Modal derivatives of pairs of modes, low eigenvalues first (Discrete Shells only): they let large "
+               "bends and twists keep the mesh's volume; more cost bake and posing time.",
+               at_least(0)},
+        [](auto& o) -> auto& { return o.derivatives; });
+  visit(Option{"ghost",
+               "Vertices of the ghost, the coarse copy of the mesh posing weighs the deformation on (the mesh "
+               "itself when it has fewer): more follow the mesh more closely, fewer pose faster.",
+               at_least(kFewestSimplifiedVertices)},
+        [](auto& o) -> auto& { return o.ghost; });
+  visit(Option{"energy", "The deformation energy: \"shells\" (Discrete Shells) or \"arap\" (as-rigid-as-possible, "
+                         "with derivatives=0: it has no third derivative)."},
+        [](auto& o) -> auto& { return o.energy; });
   for_each_material_option(visit);
-  visit("rotation_pairs", [](auto& o) -> auto& { return o.rotation_pairs; });
-  visit("proxy_above", [](auto& o) -> auto& { return o.proxy_above; });
-  visit("proxy", [](auto& o) -> auto& { return o.proxy; });
-  visit("region", [](auto& o) -> auto& { return o.region; });
+  visit(Option{"rotation_pairs",
+               "Derivatives of pairs with the linearised rotations too (the paper's rule), or of pairs of flexible "
+               "modes only (False: needs more modes for as many derivatives)."},
+        [](auto& o) -> auto& { return o.rotation_pairs; });
+  visit(Option{"proxy_above",
+               "A mesh with more vertices than this is baked on a proxy of about `proxy` vertices (0: never).",
+               at_least(0)},
+        [](auto& o) -> auto& { return o.proxy_above; });
+  visit(Option{"proxy",
+               "Vertices of the proxy a dense mesh is baked on, made by the ghost's edge collapse; every fine vertex "
+               "follows it by barycentric weights on its nearest proxy triangle.",
+               at_least(kFewestSimplifiedVertices)},
+        [](auto& o) -> auto& { return o.proxy; });
+  visit(Option{"region",
+               "The vertices that may move, (k,) indices, or None for the whole mesh: every other vertex stays "
+               "exactly at rest and the faces around the region hold it as a fixed boundary."},
+        [](auto& o) -> auto& { return o.region; });
 }
 
 // The reduced space of (V #V by 3, F #F by 3, any length unit) per the pipeline above: a Basis in

@@ -91,8 +91,7 @@ void bind_bake(py::module_& m) {
   for (size_t i = 0; i < kBakeStages.size(); ++i) stages[i] = kBakeStages[i];
   m.attr("BAKE_STAGES") = stages;
 
-  // The options by keyword, names and defaults from for_each_bake_option.
-  m.attr("BAKE_OPTIONS") = defaults<BakeOptions>([](auto visit) { for_each_bake_option(visit); });
+  m.attr("BAKE_OPTIONS") = option_table<BakeOptions>([](auto visit) { for_each_bake_option(visit); });
   m.def(
       "bake",
       [](const VerticesRef& V, const FacesRef& F, const py::object& progress, const py::kwargs& keywords) {

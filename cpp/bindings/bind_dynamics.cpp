@@ -16,11 +16,8 @@ namespace py = pybind11;
 namespace modal_deform {
 
 void bind_dynamics(py::module_& m) {
-  // The options by keyword, names and defaults from for_each_simulation_option.
   const auto simulation_options = [](auto visit) { for_each_simulation_option(visit); };
-  m.attr("SIMULATION_DEFAULTS") = defaults<SimulationOptions>(simulation_options);
-  m.attr("MIN_PERIOD_FRAMES") = kMinPeriodFrames;
-  m.attr("MAX_SUBSTEPS") = kMaxSubsteps;
+  m.attr("SIMULATION_OPTIONS") = option_table<SimulationOptions>(simulation_options);
   py::class_<ReducedDynamics>(m, "Simulation")
       .def(py::init([simulation_options](const Basis& basis, const std::vector<Eigen::VectorXi>& handles,
                                          const VectorRef& weights, const std::string& energy,

@@ -4,9 +4,11 @@
 #include <pybind11/stl.h>
 
 #include "bindings/bindings.h"
+#include "bindings/named_fields.h"
 #include "energy/arap.h"
 #include "energy/discrete_shells.h"
 #include "energy/energy.h"
+#include "energy/material.h"
 
 namespace py = pybind11;
 
@@ -33,13 +35,15 @@ void bind_energy(py::module_& m) {
 
   py::class_<Arap, Energy>(m, "Arap")
       .def(py::init<const VerticesRef&, const FacesRef&>(), py::arg("V"), py::arg("F"), release);
+  const auto material_options = [](auto visit) { for_each_material_field(visit); };
+  m.attr("MATERIAL_OPTIONS") = option_table<Material>(material_options);
   py::class_<DiscreteShells, Energy>(m, "DiscreteShells")
-      .def(py::init([](const VerticesRef& V, const FacesRef& F, double bending, double membrane,
-                       const Eigen::VectorXd& stiffness_weights, double max_stiffness) {
-             return DiscreteShells(V, F, bending, membrane, {stiffness_weights, max_stiffness});
+      .def(py::init([material_options](const VerticesRef& V, const FacesRef& F, const py::kwargs& keywords) {
+             const Material material = from_keywords<Material>(keywords, material_options, "DiscreteShells");
+             py::gil_scoped_release unlocked;
+             return DiscreteShells(V, F, material.bending, material.membrane, material.paint);
            }),
-           py::arg("V"), py::arg("F"), py::arg("bending"), py::arg("membrane"), py::arg("stiffness_weights"),
-           py::arg("max_stiffness"), release)
+           py::arg("V"), py::arg("F"))
       .def("third_batch", &DiscreteShells::third_batch, py::arg("x"), py::arg("Phi"), py::arg("pairs"), release)
       .def_property_readonly("term_counts", [](const DiscreteShells& energy) {
         const auto counts = energy.term_counts();

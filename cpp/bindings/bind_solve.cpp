@@ -27,31 +27,51 @@ Handles to_handles(const std::vector<Eigen::VectorXi>& arrays) {
   return handles;
 }
 
+namespace {
+
+// solve_full's and refine's keywords: the pull μ (their argument in the core) and the options.
+struct FullSolveKeywords {
+  double pull = kDefaultPull;
+  FullSolveOptions options;
+};
+
+template <typename Visit>
+void for_each_full_solve_keyword(Visit&& visit) {
+  visit(kPull, [](auto& k) -> auto& { return k.pull; });
+  for_each_full_solve_option([&](const Option& option, auto field) {
+    visit(option, [field](auto& k) -> auto& { return field(k.options); });
+  });
+}
+
+}  // namespace
+
 void bind_solve(py::module_& m) {
-  // The options of solve_full by keyword, names and defaults from for_each_full_solve_option.
-  const auto full_solve_options = [](auto visit) { for_each_full_solve_option(visit); };
-  m.attr("FULL_SOLVE_OPTIONS") = defaults<FullSolveOptions>(full_solve_options);
+  const auto solver_options = [](auto visit) { for_each_reduced_solver_option(visit); };
+  const auto solve_options = [](auto visit) { for_each_reduced_solve_option(visit); };
+  const auto full_solve_keywords = [](auto visit) { for_each_full_solve_keyword(visit); };
+  m.attr("REDUCED_SOLVER_OPTIONS") = option_table<ReducedSolverOptions>(solver_options);
+  m.attr("REDUCED_SOLVE_OPTIONS") = option_table<ReducedSolveOptions>(solve_options);
+  m.attr("FULL_SOLVE_OPTIONS") = option_table<FullSolveKeywords>(full_solve_keywords);
   py::class_<ReducedSolver>(m, "ReducedSolver")
-      .def(py::init([](const Basis& basis, const std::vector<Eigen::VectorXi>& handles, const VectorRef& weights,
-                       double stiffness, const std::string& energy, bool warm_start) {
+      .def(py::init([solver_options](const Basis& basis, const std::vector<Eigen::VectorXi>& handles,
+                                     const VectorRef& weights, const py::kwargs& keywords) {
+             const auto options = from_keywords<ReducedSolverOptions>(keywords, solver_options, "ReducedSolver");
              py::gil_scoped_release release;
-             return std::make_unique<ReducedSolver>(basis, to_handles(handles), weights, stiffness,
-                                                    energy_kind(energy), warm_start);
+             return std::make_unique<ReducedSolver>(basis, to_handles(handles), weights, options);
            }),
-           py::arg("basis"), py::arg("handles"), py::arg("weights"), py::arg("stiffness"), py::arg("energy"),
-           py::arg("warm_start"), py::keep_alive<1, 2>())
+           py::arg("basis"), py::arg("handles"), py::arg("weights"), py::keep_alive<1, 2>())
       .def("set_transforms", &ReducedSolver::set_transforms, py::arg("transforms"))
       .def(
           "solve",
-          [](ReducedSolver& solver, int max_iterations, double tolerance, double budget_ms) {
+          [solve_options](ReducedSolver& solver, const py::kwargs& keywords) {
+            const auto options = from_keywords<ReducedSolveOptions>(keywords, solve_options, "solve");
             ReducedSolveStats stats;
             {
               py::gil_scoped_release release;
-              stats = solver.solve(max_iterations, tolerance, budget_ms);
+              stats = solver.solve(options);
             }
             return to_dict(stats, [](auto visit) { for_each_reduced_solve_stat(visit); });
-          },
-          py::arg("max_iterations"), py::arg("tolerance"), py::arg("budget_ms"))
+          })
       .def("reset", &ReducedSolver::reset)
       .def(
           "objective",
@@ -75,11 +95,11 @@ void bind_solve(py::module_& m) {
 
   // solve_full and refine: the same arguments and options; (positions, stats) with the stats of their
   // tables and "history", one dict per Newton iteration.
-  const auto options_of = [full_solve_options](const py::kwargs& keywords, const py::object& progress,
-                                                const char* function) {
-    FullSolveOptions options = from_keywords<FullSolveOptions>(keywords, full_solve_options, function);
-    options.progress = python_progress(progress);
-    return options;
+  const auto keywords_of = [full_solve_keywords](const py::kwargs& keywords, const py::object& progress,
+                                                  const char* function) {
+    auto given = from_keywords<FullSolveKeywords>(keywords, full_solve_keywords, function);
+    given.options.progress = python_progress(progress);
+    return given;
   };
   const auto positions_and_stats = [](auto& result, auto stats_table) {
     py::dict stats = to_dict(result, stats_table);
@@ -91,38 +111,37 @@ void bind_solve(py::module_& m) {
   };
   m.def(
       "solve_full",
-      [options_of, positions_and_stats](const VerticesRef& V, const FacesRef& F,
-                                        const std::vector<Eigen::VectorXi>& handles, const Transforms& transforms,
-                                        const VectorRef& weights, double stiffness,
-                                        const std::optional<RowMatrixX3d>& initial, const py::object& progress,
-                                        const py::kwargs& keywords) {
-        const FullSolveOptions options = options_of(keywords, progress, "solve_full");
+      [keywords_of, positions_and_stats](const VerticesRef& V, const FacesRef& F,
+                                         const std::vector<Eigen::VectorXi>& handles, const Transforms& transforms,
+                                         const VectorRef& weights, const std::optional<RowMatrixX3d>& initial,
+                                         const py::object& progress, const py::kwargs& keywords) {
+        const FullSolveKeywords given = keywords_of(keywords, progress, "solve_full");
         FullSolveResult result;
         {
           py::gil_scoped_release release;
-          result = solve_full(V, F, to_handles(handles), weights, transforms, stiffness, options,
+          result = solve_full(V, F, to_handles(handles), weights, transforms, given.pull, given.options,
                               initial ? &*initial : nullptr);
         }
         return positions_and_stats(result, [](auto visit) { for_each_full_solve_stat(visit); });
       },
-      py::arg("V"), py::arg("F"), py::arg("handles"), py::arg("transforms"), py::arg("weights"), py::arg("stiffness"),
-      py::kw_only(), py::arg("initial") = py::none(), py::arg("progress") = py::none());
+      py::arg("V"), py::arg("F"), py::arg("handles"), py::arg("transforms"), py::arg("weights"), py::kw_only(),
+      py::arg("initial") = py::none(), py::arg("progress") = py::none());
   m.def(
       "refine",
-      [options_of, positions_and_stats](const VerticesRef& V, const FacesRef& F,
-                                        const std::vector<Eigen::VectorXi>& handles, const Transforms& transforms,
-                                        const VectorRef& weights, double stiffness, const RowMatrixX3d& initial,
-                                        const py::object& progress, const py::kwargs& keywords) {
-        const FullSolveOptions options = options_of(keywords, progress, "refine");
+      [keywords_of, positions_and_stats](const VerticesRef& V, const FacesRef& F,
+                                         const std::vector<Eigen::VectorXi>& handles, const Transforms& transforms,
+                                         const VectorRef& weights, const RowMatrixX3d& initial,
+                                         const py::object& progress, const py::kwargs& keywords) {
+        const FullSolveKeywords given = keywords_of(keywords, progress, "refine");
         RefineResult result;
         {
           py::gil_scoped_release release;
-          result = refine(V, F, to_handles(handles), weights, transforms, stiffness, options, initial);
+          result = refine(V, F, to_handles(handles), weights, transforms, given.pull, given.options, initial);
         }
         return positions_and_stats(result, [](auto visit) { for_each_refine_stat(visit); });
       },
-      py::arg("V"), py::arg("F"), py::arg("handles"), py::arg("transforms"), py::arg("weights"), py::arg("stiffness"),
-      py::kw_only(), py::arg("initial"), py::arg("progress") = py::none());
+      py::arg("V"), py::arg("F"), py::arg("handles"), py::arg("transforms"), py::arg("weights"), py::kw_only(),
+      py::arg("initial"), py::arg("progress") = py::none());
 }
 
 }  // namespace modal_deform

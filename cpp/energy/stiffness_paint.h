@@ -21,9 +21,12 @@ namespace modal_deform {
 // to the eye; beyond it the stiffness matrix's condition grows for nothing.
 constexpr double kMaxStiffness = 1e4;
 
+// max_stiffness where nothing else says: a weight of 1 is 100 times as stiff as weight 0.
+constexpr double kDefaultMaxStiffness = 100.0;
+
 struct StiffnessPaint {
   Eigen::VectorXd weights;  // #V in [0, 1], or empty: the material is uniform
-  double max_stiffness = 1.0;
+  double max_stiffness = kDefaultMaxStiffness;
 
   bool uniform() const { return weights.size() == 0 || max_stiffness == 1.0; }
 

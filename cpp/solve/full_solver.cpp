@@ -34,11 +34,8 @@ Eigen::VectorXd checked_input(const VerticesRef& V, const FacesRef& F, const Han
   const int n = static_cast<int>(V.rows());
   Eigen::VectorXd handle_weights = checked_handle_weights(handles, weights, n);
   check_transforms(transforms, static_cast<int>(handles.size()));
-  require_stiffness(stiffness);
-  if (!(options.tolerance > 0 && options.tolerance < 1))
-    throw InputError(message("tolerance: expected a value in (0, 1), got ", options.tolerance));
-  if (options.max_iterations < 0)
-    throw InputError(message("max_iterations: expected at least 0, got ", options.max_iterations));
+  check_option(kPull, stiffness);
+  check_options(options, [](auto visit) { for_each_full_solve_option(visit); });
   if (initial) require_positions(flatten(*initial), 3 * n, "initial");
   for (size_t i = 0; i < options.held.size(); ++i)
     if (options.held[i] < 0 || options.held[i] >= n)

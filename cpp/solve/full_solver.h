@@ -48,16 +48,25 @@ struct FullSolveOptions {
   std::vector<int> held = {};
 };
 
-// The options by the names the bindings take them as keywords, with their defaults from
-// FullSolveOptions{} (the callback apart): visit(name, field) with `field` an accessor
-// o -> o.member.
+// The options as the Python API takes them (option.h), with their defaults from
+// FullSolveOptions{} (the callback apart): visit(option, field) with `field` an accessor
+// o -> o.member. The pull μ is solve_full's argument (kPull).
 template <typename Visit>
 void for_each_full_solve_option(Visit&& visit) {
-  visit("energy", [](auto& o) -> auto& { return o.energy; });
+  visit(Option{"energy", "The deformation energy: \"shells\" or \"arap\"."},
+        [](auto& o) -> auto& { return o.energy; });
   for_each_material_option(visit);
-  visit("tolerance", [](auto& o) -> auto& { return o.tolerance; });
-  visit("max_iterations", [](auto& o) -> auto& { return o.max_iterations; });
-  visit("held", [](auto& o) -> auto& { return o.held; });
+  visit(Option{"tolerance",
+               "Stops when the gradient norm is below this fraction of its value at rest (or at `initial`, if "
+               "larger).",
+               between_open(0, 1)},
+        [](auto& o) -> auto& { return o.tolerance; });
+  visit(Option{"max_iterations", "Newton iterations at most, all load steps together.", at_least(0)},
+        [](auto& o) -> auto& { return o.max_iterations; });
+  visit(Option{"held",
+               "Vertex indices held exactly where the solve starts (at rest, or at `initial`), as a region bake's "
+               "outside is; None holds none."},
+        [](auto& o) -> auto& { return o.held; });
 }
 
 struct FullSolveResult {

@@ -29,12 +29,27 @@
 #include <functional>
 #include <vector>
 
+#include "util/option.h"
+#include "util/require_weight.h"
 #include "util/types.h"
 
 namespace modal_deform {
 
 using Handles = std::vector<std::vector<int>>;    // per handle, its fine vertex indices
 using Transforms = std::vector<Eigen::Matrix4d>;  // per handle, a rigid transform (mesh units)
+
+// μ where nothing else says, for posing and dynamics alike: stiff enough that handles land within
+// a small fraction of a percent of the model's size (bench/results/accuracy.json), soft enough to
+// keep BFGS well conditioned.
+constexpr double kDefaultPull = 1000.0;
+
+// The pull μ as every table that takes it declares it (option.h); check_option(kPull, μ) refuses
+// a value out of range.
+inline constexpr Option kPull{"pull",
+                              "How hard the handles pull their vertices toward their targets (μ of the handle "
+                              "term): higher follows the controllers more exactly, lower lets the surface hold "
+                              "them back.",
+                              above_up_to(0, kMaxWeight)};
 
 // Throws InputError naming the first problem: no handle, an empty handle, an index outside
 // [0, num_vertices), an index repeated within a handle, or weights (empty, or one per handle)

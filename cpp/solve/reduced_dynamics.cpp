@@ -27,7 +27,7 @@ const Basis& checked(const Basis& basis) {
 }
 
 const SimulationOptions& checked(const SimulationOptions& options) {
-  check_simulation_options(options);
+  check_options(options, [](auto visit) { for_each_simulation_option(visit); });
   return options;
 }
 
@@ -41,32 +41,13 @@ Eigen::VectorXd checked_weights(const Handles& handles, const VectorRef& weights
 
 }  // namespace
 
-void check_simulation_options(const SimulationOptions& options) {
-  require_stiffness(options.stiffness);
-  if (!(options.fps > 0 && options.fps <= 1000))
-    throw InputError(message("fps: expected frames per second in (0, 1000], got ", options.fps));
-  if (!(options.period >= kMinPeriodFrames && options.period <= 1e6))
-    throw InputError(message("period: expected a period in frames in [", kMinPeriodFrames, ", 1e6], got ",
-                             options.period));
-  if (!(options.damping >= 0 && options.damping <= 1))
-    throw InputError(message("damping: expected a damping ratio in [0, 1], got ", options.damping));
-  if (options.substeps < 1 || options.substeps > kMaxSubsteps)
-    throw InputError(message("substeps: expected an integer in [1, ", kMaxSubsteps, "], got ", options.substeps));
-  if (options.memory_frames < 1)
-    throw InputError(message("memory_frames: expected at least 1, got ", options.memory_frames));
-  if (options.max_iterations < 1)
-    throw InputError(message("max_iterations: expected at least 1, got ", options.max_iterations));
-  if (!(options.tolerance > 0 && options.tolerance < 1))
-    throw InputError(message("tolerance: expected a value in (0, 1), got ", options.tolerance));
-}
-
 ReducedDynamics::ReducedDynamics(const Basis& basis, const Handles& handles, const VectorRef& weights,
                                  const SimulationOptions& options, EnergyKind energy)
     : basis_(checked(basis)),
       options_(checked(options)),
       ghost_energy_(basis, energy),
       handle_term_(HandleTerm(basis.rest, basis.mass, handles, checked_weights(handles, weights, basis.num_vertices()),
-                              options.stiffness * std::pow(basis.scale, 4)),
+                              options.pull * std::pow(basis.scale, 4)),
                    [&basis](int v) { return basis.vertex_rows(v); }, basis.dimension()),
       transforms_(handles.size(), Eigen::Matrix4d::Identity()),
       fine_positions_(basis) {

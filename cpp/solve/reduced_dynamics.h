@@ -60,8 +60,8 @@ namespace modal_deform {
 
 // The artist's parameters and their defaults (the Python API and the add-on take them from here).
 struct SimulationOptions {
-  double stiffness = 100.0;  // μ of the handle term (handle_term.h)
-  double period = 12.0;      // of the lowest flexible mode, in frames
+  double pull = kDefaultPull;  // μ of the handle term (handle_term.h)
+  double period = 12.0;        // of the lowest flexible mode, in frames
   double damping = 0.05;     // ζ of the lowest flexible mode, in [0, 1]
   double fps = 24.0;         // frames per second
   int substeps = 2;          // midpoint steps per frame
@@ -75,27 +75,42 @@ struct SimulationOptions {
   int memory_frames = 8;
 };
 
-// The fields of SimulationOptions by name (the Python API's keywords and SIMULATION_DEFAULTS):
-// visit(name, field) with field the accessor o -> o.member.
-template <typename Visit>
-void for_each_simulation_option(Visit&& visit) {
-  visit("stiffness", [](auto& o) -> auto& { return o.stiffness; });
-  visit("period", [](auto& o) -> auto& { return o.period; });
-  visit("damping", [](auto& o) -> auto& { return o.damping; });
-  visit("fps", [](auto& o) -> auto& { return o.fps; });
-  visit("substeps", [](auto& o) -> auto& { return o.substeps; });
-  visit("max_iterations", [](auto& o) -> auto& { return o.max_iterations; });
-  visit("tolerance", [](auto& o) -> auto& { return o.tolerance; });
-  visit("memory_frames", [](auto& o) -> auto& { return o.memory_frames; });
-}
-
 // The shortest period accepted: a vibration faster than this is not seen as one at the frame rate,
 // and the mass scale's map (tanh of ω h/2) needs ω h < π.
 constexpr double kMinPeriodFrames = 3.0;
 constexpr int kMaxSubsteps = 64;
 
-// Throws InputError naming the first option out of range.
-void check_simulation_options(const SimulationOptions& options);
+// The options as the Python API and the add-on take them (option.h), with their defaults from
+// SimulationOptions{}: visit(option, field) with field the accessor o -> o.member.
+template <typename Visit>
+void for_each_simulation_option(Visit&& visit) {
+  visit(kPull, [](auto& o) -> auto& { return o.pull; });
+  visit(Option{"period",
+               "Frames one swing of the lowest flexible mode takes (the slowest wobble): more make the mesh heavier "
+               "and lazier, fewer make it snappier.",
+               closed(kMinPeriodFrames, 1e6)},
+        [](auto& o) -> auto& { return o.period; });
+  visit(Option{"damping",
+               "Damping ratio of the lowest flexible mode, stiffer modes damped more: 0 swings on forever, 1 settles "
+               "without overshooting.",
+               closed(0, 1)},
+        [](auto& o) -> auto& { return o.damping; });
+  visit(Option{"fps", "Frames per second: velocities are per second.", above_up_to(0, 1000)},
+        [](auto& o) -> auto& { return o.fps; });
+  visit(Option{"substeps",
+               "Midpoint steps per frame: more follow fast controllers more closely and cost more per frame.",
+               closed(1, kMaxSubsteps)},
+        [](auto& o) -> auto& { return o.substeps; });
+  visit(Option{"max_iterations", "BFGS iterations per substep at most.", at_least(1)},
+        [](auto& o) -> auto& { return o.max_iterations; });
+  visit(Option{"tolerance", "BFGS's stopping tolerance per substep (bfgs.h).", between_open(0, 1)},
+        [](auto& o) -> auto& { return o.tolerance; });
+  visit(Option{"memory_frames",
+               "The most frames BFGS's memory of the curvature spans before it is forgotten (1: each frame learns "
+               "afresh).",
+               at_least(1)},
+        [](auto& o) -> auto& { return o.memory_frames; });
+}
 
 struct SimulationStepStats {
   int substeps = 0;

@@ -13,7 +13,7 @@ namespace modal_deform {
 namespace {
 
 double checked_stiffness(double stiffness) {
-  require_stiffness(stiffness);
+  check_option(kPull, stiffness);
   return stiffness;
 }
 
@@ -61,6 +61,11 @@ void ReducedSolver::set_transforms(const Transforms& transforms) {
   const double new_value = handle_term_.value_and_gradient(q(), handle_gradient_);
   handle_gradient_ -= handle_gradient_old_;
   bfgs_.objective_changed(new_value - old_value, handle_gradient_);
+}
+
+ReducedSolveStats ReducedSolver::solve(const ReducedSolveOptions& options) {
+  check_options(options, [](auto visit) { for_each_reduced_solve_option(visit); });
+  return solve(options.max_iterations, options.tolerance, options.budget_ms);
 }
 
 ReducedSolveStats ReducedSolver::solve(int max_iterations, double tolerance, double budget_ms) {

@@ -56,6 +56,45 @@ void for_each_reduced_solve_stat(Visit&& visit) {
   visit("line_search_failures", [](auto& s) -> auto& { return s.line_search_failures; });
 }
 
+// The solver's options as the Python API takes them (option.h): visit(option, field) with `field`
+// an accessor o -> o.member.
+struct ReducedSolverOptions {
+  double pull = kDefaultPull;
+  EnergyKind energy = EnergyKind::kShells;
+  bool warm_start = true;
+};
+
+template <typename Visit>
+void for_each_reduced_solver_option(Visit&& visit) {
+  visit(kPull, [](auto& o) -> auto& { return o.pull; });
+  visit(Option{"energy", "The energy evaluated on the ghost: \"shells\" (with the basis's material) or \"arap\"."},
+        [](auto& o) -> auto& { return o.energy; });
+  visit(Option{"warm_start",
+               "Start BFGS from the inverse of the reduced rest Hessian (the paper's warm start); False starts it "
+               "from the identity, for comparison."},
+        [](auto& o) -> auto& { return o.warm_start; });
+}
+
+// What one solve() may spend: a pose tick's share of a frame, or a Solve's iterations.
+struct ReducedSolveOptions {
+  int max_iterations = 10;
+  double tolerance = 1e-6;
+  double budget_ms = std::numeric_limits<double>::infinity();
+};
+
+template <typename Visit>
+void for_each_reduced_solve_option(Visit&& visit) {
+  visit(Option{"max_iterations", "BFGS iterations at most.", at_least(0)},
+        [](auto& o) -> auto& { return o.max_iterations; });
+  visit(Option{"tolerance", "ε of the Gill-Murray-Wright stopping test (paper eq. 14).", between_open(0, 1)},
+        [](auto& o) -> auto& { return o.tolerance; });
+  visit(Option{"budget_ms",
+               "No iteration begins once this many milliseconds have passed (the one under way is finished, so a "
+               "call always progresses); None: no limit.",
+               above_up_to(0, std::numeric_limits<double>::infinity())},
+        [](auto& o) -> auto& { return o.budget_ms; });
+}
+
 class ReducedSolver {
  public:
   // basis: validated here (validate_basis); it must outlive the solver, which keeps a reference
@@ -65,6 +104,10 @@ class ReducedSolver {
   // rest with identity transforms.
   ReducedSolver(const Basis& basis, const Handles& handles, const VectorRef& weights, double stiffness,
                 EnergyKind energy = EnergyKind::kShells, bool warm_start = true);
+  // The same with the options of a table (checked).
+  ReducedSolver(const Basis& basis, const Handles& handles, const VectorRef& weights,
+                const ReducedSolverOptions& options)
+      : ReducedSolver(basis, handles, weights, options.pull, options.energy, options.warm_start) {}
   ReducedSolver(const ReducedSolver&) = delete;
   ReducedSolver& operator=(const ReducedSolver&) = delete;
 
@@ -76,6 +119,8 @@ class ReducedSolver {
   // budget_ms milliseconds (Bfgs::minimize): a pose tick calls it once per frame.
   ReducedSolveStats solve(int max_iterations, double tolerance,
                           double budget_ms = std::numeric_limits<double>::infinity());
+  // The same with the options of a table, checked (InputError naming the one out of range).
+  ReducedSolveStats solve(const ReducedSolveOptions& options);
 
   // Back to rest (q = 0) and the initial inverse Hessian; the transforms stay.
   void reset();

@@ -1,5 +1,5 @@
-// The checks every entry point that takes an energy weight (bending, membrane), a handle weight
-// or the handle stiffness μ makes.
+// The checks every entry point that takes an energy weight (bending, membrane) or a handle weight
+// makes.
 #pragma once
 
 #include <cmath>
@@ -18,12 +18,6 @@ constexpr double kMaxWeight = 1e12;
 inline void require_weight(double weight, const char* name) {
   if (!(weight >= 0 && weight <= kMaxWeight))
     throw InputError(message(name, ": expected a finite weight >= 0 and at most ", kMaxWeight, ", got ", weight));
-}
-
-// Throws InputError unless the handle stiffness μ is in (0, kMaxWeight].
-inline void require_stiffness(double stiffness) {
-  if (!(stiffness > 0 && stiffness <= kMaxWeight))
-    throw InputError(message("stiffness: expected a finite value > 0 and at most ", kMaxWeight, ", got ", stiffness));
 }
 
 }  // namespace modal_deform

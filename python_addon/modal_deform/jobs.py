@@ -89,12 +89,13 @@ class BakeJob(_ThreadJob):
         self.fingerprint = storage.fingerprint(obj.data)
         self.vertex_groups = storage.groups(obj)
         region = self.vertex_groups.weights["region_group"]
-        self.options = dict(modes=settings.modes, derivatives=settings.derivatives if self.energy == "SHELLS" else 0,
-                            ghost=settings.ghost, energy=self.energy.lower(), bending=settings.bending,
-                            membrane=settings.membrane, stiffness_weights=self.vertex_groups.weights["stiffness_group"],
-                            max_stiffness=settings.max_stiffness,
-                            region=None if region is None else mesh_io.members(region),
-                            proxy=settings.proxy if settings.proxy_above else None, proxy_above=settings.proxy_above)
+        # The bake's numeric options are the settings' properties of the same names (properties.py).
+        self.options = {name: getattr(settings, name) for name, option in mdc.BAKE_OPTIONS.items()
+                        if option.kind in ("int", "float") and hasattr(settings, name)}
+        self.options.update(energy=self.energy.lower(), stiffness_weights=self.vertex_groups.weights["stiffness_group"],
+                            region=None if region is None else mesh_io.members(region))
+        if self.energy != "SHELLS":
+            self.options["derivatives"] = 0
         self.stage, self.fraction = "starting", 0.0
         self.basis = self.error = None
         self.seconds = 0.0
@@ -144,8 +145,8 @@ class RefineJob(_ThreadJob):
 
     thread_name = "modal_deform refine"
 
-    def __init__(self, context, obj, tolerance=mdc.FULL_SOLVE_OPTIONS["tolerance"],
-                 max_iterations=mdc.FULL_SOLVE_MAX_ITERATIONS):
+    def __init__(self, context, obj, tolerance=mdc.FULL_SOLVE_OPTIONS["tolerance"].default,
+                 max_iterations=mdc.FULL_SOLVE_OPTIONS["max_iterations"].default):
         self.object_name = obj.name
         self.pose = posing.Pose(context, obj)
         self.pose.follow_controllers()

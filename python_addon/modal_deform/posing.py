@@ -36,7 +36,7 @@ class Pose:
         self.obj = obj
         self.basis = storage.ready_basis(obj)
         self.handles, self.warnings = handles.resolve(obj, context.scene, self.basis.rest, self.basis.region)
-        self.solver = mdc.ReducedSolver(self.basis, [h.indices for h in self.handles], stiffness=settings.stiffness,
+        self.solver = mdc.ReducedSolver(self.basis, [h.indices for h in self.handles], pull=settings.stiffness,
                                         weights=[h.weight for h in self.handles],
                                         energy=settings.status.energy.lower())
         self._transforms = None
@@ -57,7 +57,7 @@ class Pose:
         self.stats = self.solver.solve(max_iterations=MAX_ITERATIONS_PER_UPDATE, budget_ms=budget_ms)
         return self.stats
 
-    def converge(self, max_iterations=CONVERGE_MAX_ITERATIONS, tolerance=mdc.SOLVE_TOLERANCE):
+    def converge(self, max_iterations=CONVERGE_MAX_ITERATIONS, tolerance=mdc.SOLVE_OPTIONS["tolerance"].default):
         """Iterate until the stopping test holds (or max_iterations): the result a script wants."""
         stats = self.solver.solve(max_iterations=max_iterations, tolerance=tolerance)
         self.stats = stats

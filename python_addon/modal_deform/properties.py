@@ -3,6 +3,8 @@
 The baked arrays are not here: they live in a separate datablock (storage.py) that ``basis``
 points to, so the object itself stays small for Blender's copy-on-write.
 """
+import math
+
 import bpy
 from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, FloatVectorProperty,
                        IntProperty, PointerProperty, StringProperty)
@@ -10,6 +12,21 @@ from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProp
 from . import core as mdc
 
 IDENTITY = ((1.0, 0.0, 0.0, 0.0), (0.0, 1.0, 0.0, 0.0), (0.0, 0.0, 1.0, 0.0), (0.0, 0.0, 0.0, 1.0))
+
+
+def _limits(option, **ui):
+    """A property's default and hard limits from the core's option (its closed bounds: an open one
+    is the UI's to set, e.g. with `min`), with the UI's own soft limits and overrides `ui`."""
+    limits = {"default": option.default}
+    if option.min > -math.inf and not option.min_open:
+        limits["min"] = option.min
+    if option.max < math.inf and not option.max_open:
+        limits["max"] = option.max
+    return {**limits, **ui}
+
+
+_BAKE = mdc.BAKE_OPTIONS
+_SIMULATION = mdc.SIMULATION_OPTIONS
 
 
 def _controller_changed(handle, context):
@@ -90,17 +107,16 @@ class ModalDeformDynamics(bpy.types.PropertyGroup):
         description="The mesh follows its controllers with inertia: parts away from the handles overshoot and "
                     "settle when the controllers stop, played live on the timeline and cached per frame")
     period: FloatProperty(
-        name="Period", default=mdc.SIMULATION_DEFAULTS["period"], min=mdc.MIN_PERIOD_FRAMES, soft_max=100.0,
-        update=_dynamics_changed,
+        name="Period", **_limits(_SIMULATION["period"], soft_max=100.0), update=_dynamics_changed,
         description="Frames one swing of the softest part takes (the slowest wobble): more frames make the "
                     "mesh heavier and lazier, fewer make it snappier")
     damping: FloatProperty(
-        name="Damping", default=mdc.SIMULATION_DEFAULTS["damping"], min=0.0, max=1.0, update=_dynamics_changed,
-        description="How quickly the swinging dies down: 0 swings on forever, 0.05 settles in a few swings, "
-                    "1 settles without overshooting")
+        name="Damping", **_limits(_SIMULATION["damping"]), update=_dynamics_changed,
+        description=f"How quickly the swinging dies down: {_SIMULATION['damping'].min:g} swings on forever, "
+                    f"{_SIMULATION['damping'].default:g} settles in a few swings, {_SIMULATION['damping'].max:g} "
+                    f"settles without overshooting")
     substeps: IntProperty(
-        name="Substeps", default=mdc.SIMULATION_DEFAULTS["substeps"], min=1, max=mdc.MAX_SUBSTEPS,
-        update=_dynamics_changed,
+        name="Substeps", **_limits(_SIMULATION["substeps"]), update=_dynamics_changed,
         description="Simulation steps per frame: more follow fast controllers more closely and cost more per "
                     "frame")
     frame_start: IntProperty(
@@ -114,39 +130,39 @@ class ModalDeformDynamics(bpy.types.PropertyGroup):
 
 class ModalDeformSettings(bpy.types.PropertyGroup):
     modes: IntProperty(
-        name="Modes", default=mdc.BAKE_OPTIONS["modes"], min=7, soft_max=60,
+        name="Modes", **_limits(_BAKE["modes"], soft_min=7, soft_max=60),
         description="How many natural ways of bending the mesh the bake finds (its vibration modes, 6 of them "
                     "just move and turn it): more let poses take more shapes, and make the bake and posing slower")
     derivatives: IntProperty(
-        name="Derivatives", default=mdc.BAKE_OPTIONS["derivatives"], min=0, soft_max=200,
+        name="Derivatives", **_limits(_BAKE["derivatives"], soft_max=200),
         description="Extra shapes that let large bends and twists keep the mesh's volume instead of shrinking it "
                     "(modal derivatives, Discrete Shells only): more make strong poses better and cost bake and "
                     "posing time")
     ghost: IntProperty(
-        name="Ghost Size", default=mdc.BAKE_OPTIONS["ghost"], min=4, soft_min=200, soft_max=5000,
+        name="Ghost Size", **_limits(_BAKE["ghost"], soft_min=200, soft_max=5000),
         description="Vertices of the coarse copy of the mesh (the ghost) that posing weighs the deformation on: "
                     "more follow the full mesh more closely, fewer make posing faster")
     proxy: IntProperty(
-        name="Proxy Size", default=mdc.PROXY, min=4, soft_min=10000, soft_max=150000,
+        name="Proxy Size", **_limits(_BAKE["proxy"], soft_min=10000, soft_max=150000),
         description="A dense mesh (more vertices than Proxy Over) is baked on a simplified copy of about this "
                     "many vertices, which every vertex follows with its own detail: fewer bake faster")
     proxy_above: IntProperty(
-        name="Proxy Over", default=mdc.PROXY_ABOVE, min=0, soft_max=500000,
+        name="Proxy Over", **_limits(_BAKE["proxy_above"], soft_max=500000),
         description="Meshes with more vertices than this are baked on a simplified copy of Proxy Size vertices, "
                     "which bakes much faster (0: never)")
     energy: EnumProperty(
-        name="Energy", default=mdc.BAKE_OPTIONS["energy"].upper(),
+        name="Energy", default=_BAKE["energy"].default.upper(),
         items=(("SHELLS", "Discrete Shells", "Resists bending and stretching like a thin shell (the paper's energy)"),
                ("ARAP", "As-Rigid-As-Possible", "Keeps every vertex neighbourhood rigid; bakes vibration modes "
                                                 "only, no modal derivatives")),
         description="How the surface resists being deformed: like a thin shell that keeps its curvature, or "
                     "keeping every small neighbourhood rigid")
     bending: FloatProperty(
-        name="Bending", default=mdc.BAKE_OPTIONS["bending"], min=0.0, soft_max=10.0,
+        name="Bending", **_limits(_BAKE["bending"], soft_max=10.0),
         description="How much the surface resists bending (Discrete Shells): higher keeps its curves, so poses "
                     "bend less and stretch more")
     membrane: FloatProperty(
-        name="Membrane", default=mdc.BAKE_OPTIONS["membrane"], min=0.0, soft_max=10.0,
+        name="Membrane", **_limits(_BAKE["membrane"], soft_max=10.0),
         description="How much the surface resists stretching and squashing (Discrete Shells): higher keeps its "
                     "size, so poses stretch less and bend more")
     stiffness_group: StringProperty(
@@ -155,15 +171,16 @@ class ModalDeformSettings(bpy.types.PropertyGroup):
                     "is the material, weight 1 is Max times as stiff. Empty: the same material everywhere. "
                     "Painting it anew needs a re-bake")
     max_stiffness: FloatProperty(
-        name="Max Stiffness", default=mdc.BAKE_OPTIONS["max_stiffness"], min=1.0, max=1e4, soft_max=1000.0,
+        name="Max Stiffness", **_limits(_BAKE["max_stiffness"], soft_max=1000.0),
         description="How many times stiffer than the material the Stiffness group's weight 1 is")
     region_group: StringProperty(
         name="Region Group",
         description="Vertex group of the only vertices that may move (weight above 0), as in Laplacian Deform: "
                     "every other vertex stays exactly where it is, so a hand or a head of a dense character bakes "
                     "quickly; handles must lie in it. Empty: the whole mesh moves")
+    # The pull μ; its identifier stays `stiffness` so that saved files keep their value.
     stiffness: FloatProperty(
-        name="Pull", default=1000.0, min=1e-3, soft_min=1.0, soft_max=1e5,
+        name="Pull", **_limits(mdc.SOLVER_OPTIONS["pull"], min=1e-3, soft_min=1.0, soft_max=1e5),
         description="How hard the handles pull their vertices toward the controllers: higher follows the "
                     "controllers more exactly, lower lets the surface hold them back")
     budget: FloatProperty(

@@ -289,7 +289,7 @@ TEST(Corpus, WeightsBeyondTheLimitAreRefused) {
   expect_input_error(
       [&] { solve_full(mesh.V, mesh.F, {{0}}, Eigen::VectorXd(), {I}, 1e300,
           FullSolveOptions{EnergyKind::kShells, {1, 1}, 1e-6, 3}); },
-      "stiffness: expected a finite value > 0 and at most 1e+12");
+      "pull: expected a value in (0, 1e+12], got 1e+300");
   expect_input_error([&] { checked_handle_weights({{0}}, Eigen::VectorXd::Constant(1, 1e300), 16); },
                      "weights[0] = 1e+300 is not a finite number in [0, 1e+12]");
 }

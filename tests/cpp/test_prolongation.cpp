@@ -130,7 +130,7 @@ TEST(BakeOnProxy, SmallerMeshesAreBakedAsTheyAre) {
   EXPECT_EQ(basis.vectors.rows(), 3 * mesh.V.rows());
   options.proxy_above = 300;
   options.proxy = 3;  // fewer than a mesh needs
-  expect_input_error([&] { bake(mesh.V, mesh.F, options, progress); }, "proxy: expected between");
+  expect_input_error([&] { bake(mesh.V, mesh.F, options, progress); }, "proxy: expected at least 4, got 3");
   options.proxy = 400;  // more than proxy_above
   expect_input_error([&] { bake(mesh.V, mesh.F, options, progress); }, "proxy: expected between");
   options.proxy_above = -1;

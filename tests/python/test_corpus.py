@@ -339,9 +339,9 @@ OPTIONS = {
     "derivatives beyond the pairs": (grid(), {"modes": 8, "derivatives": 16}, Refused(r"derivatives: 16 asked for")),
     "ghost larger than the mesh": (grid(), {"modes": 8, "ghost": 10**6}, WORKS),
     "ghost below 4": (grid(), {"ghost": 3}, Refused(r"ghost: expected at least 4")),
-    "NaN bending": (grid(), {"bending": np.nan}, Refused(r"bending: expected a finite weight")),
-    "negative membrane": (grid(), {"membrane": -1.0}, Refused(r"membrane: expected a finite weight")),
-    "bending above 1e12": (grid(), {"bending": 1e300}, Refused(r"bending: expected .* at most 1e\+12, got 1e\+300")),
+    "NaN bending": (grid(), {"bending": np.nan}, Refused(r"bending: expected a value in \[0, 1e\+12\], got nan")),
+    "negative membrane": (grid(), {"membrane": -1.0}, Refused(r"membrane: expected a value in \[0, 1e\+12\], got -1")),
+    "bending above 1e12": (grid(), {"bending": 1e300}, Refused(r"bending: expected a value in \[0, 1e\+12\], got 1e\+300")),
     "bending not a number": (grid(), {"bending": "stiff"}, Refused(r"bending: expected a number")),
     "unknown energy": (grid(), {"energy": "springs"}, Refused(r"energy: expected \"shells\" or \"arap\"")),
     "ARAP with derivatives": (grid(), {"energy": "arap"}, Refused(r"derivatives: the ARAP energy has no third")),
@@ -405,9 +405,9 @@ HANDLES = {
     "3x3 transform": (lambda n: [[0]], [np.eye(3)], None, 100.0, Refused(r"transforms\[0\]: expected a 4x4")),
     "negative weight": (lambda n: [[0]], [turn()], [-1.0], 100.0, Refused(r"weights\[0\] = -1")),
     "weights of the wrong length": (lambda n: [[0]], [turn()], [1.0, 2.0], 100.0, Refused(r"weights: expected \(1,\)")),
-    "zero stiffness": (lambda n: [[0]], [turn()], None, 0.0, Refused(r"stiffness: expected a finite value > 0")),
-    "NaN stiffness": (lambda n: [[0]], [turn()], None, np.nan, Refused(r"stiffness: expected a finite value > 0")),
-    "stiffness above 1e12": (lambda n: [[0]], [turn()], None, 1e300, Refused(r"stiffness: .* at most 1e\+12")),
+    "zero stiffness": (lambda n: [[0]], [turn()], None, 0.0, Refused(r"pull: expected a value in \(0, 1e\+12\], got 0")),
+    "NaN stiffness": (lambda n: [[0]], [turn()], None, np.nan, Refused(r"pull: expected a value in \(0, 1e\+12\], got nan")),
+    "stiffness above 1e12": (lambda n: [[0]], [turn()], None, 1e300, Refused(r"pull: expected a value in \(0, 1e\+12\], got 1e\+300")),
     "weight above 1e12": (lambda n: [[0]], [turn()], [1e300], 100.0, Refused(r"weights\[0\] = 1e\+300 is not")),
     "a far translation (1e6 extents)": (lambda n: [[0]], [turn(0.0, 2e6)], None, 100.0, WORKS),
     "a translation beyond 1e15": (lambda n: [[0]], [turn(0.0, -1.7e308)], None, 100.0,
@@ -423,12 +423,12 @@ def test_handle_case(tube, case, entry):
     handles = make(len(V))
 
     def reduced():
-        solver = mdc.ReducedSolver(basis, handles, stiffness=stiffness, weights=weights)
+        solver = mdc.ReducedSolver(basis, handles, pull=stiffness, weights=weights)
         solver.set_transforms(transforms)
         finite(solver.solve(max_iterations=20)["energy"], solver.positions())
 
     def full():
-        finite(mdc.solve_full(V, F, handles, transforms, stiffness=stiffness, weights=weights, max_iterations=20)[0])
+        finite(mdc.solve_full(V, F, handles, transforms, pull=stiffness, weights=weights, max_iterations=20)[0])
 
     expect(outcome, reduced if entry == "reduced" else full)
 

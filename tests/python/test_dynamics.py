@@ -69,7 +69,7 @@ def test_every_kind_of_basis_keeps_the_period_and_follows_a_controller(tube_base
     period, _ = damped_oscillation(released(basis, 25, damping=0.0))
     assert abs(period - 12.0) <= 0.02 * 12.0
     top = np.flatnonzero(V[:, 2] > 4 - 1e-9)
-    sim = mdc.Simulation(basis, [top])
+    sim = mdc.Simulation(basis, [top], pull=100.0)
     for frame in range(1, 13):
         X = sim.step([rigid([1, 0, 0], np.radians(5 * frame), V[top].mean(axis=0))])
         assert np.isfinite(X).all() and X.shape == V.shape
@@ -88,7 +88,7 @@ def random_controller(rng, centre):
 def test_fast_random_controllers_then_settling_to_the_pose(tube):
     V, F, handles, basis = tube
     diagonal = np.linalg.norm(np.ptp(V, axis=0))
-    sim = mdc.Simulation(basis, handles, stiffness=100.0, damping=0.3)
+    sim = mdc.Simulation(basis, handles, pull=100.0, damping=0.3)
     rng = np.random.default_rng(7)
     top_centre = V[handles[1]].mean(axis=0)
     for _ in range(60):
@@ -110,7 +110,7 @@ def test_fast_random_controllers_then_settling_to_the_pose(tube):
     assert (np.diff(energies) <= 1e-12 * energies[0]).all()
     assert energies[-1] < energies[0]
     # It settles where the quasi-static solver poses it.
-    solver = mdc.ReducedSolver(basis, handles, stiffness=100.0)
+    solver = mdc.ReducedSolver(basis, handles, pull=100.0)
     solver.set_transforms([np.eye(4), T])
     assert solver.solve(max_iterations=500, tolerance=1e-12)["converged"]
     assert np.abs(X - solver.positions()).max() <= 1e-4 * diagonal
@@ -125,17 +125,17 @@ def test_a_run_is_deterministic_and_its_state_reloads_bit_identical(tube):
     def run(sim, transforms):
         return [sim.step(T).copy() for T in transforms]
 
-    first, second = mdc.Simulation(basis, handles), mdc.Simulation(basis, handles)
+    first, second = mdc.Simulation(basis, handles, pull=100.0), mdc.Simulation(basis, handles, pull=100.0)
     a, b = run(first, moves), run(second, moves)
     assert all(np.array_equal(x, y) for x, y in zip(a, b))
     assert all(np.array_equal(x, y) for x, y in zip(first.state, second.state))
     # A cache: the state after frame 8 (the end of a block of BFGS's memory: memory_frames frames
     # from the start), reloaded into a fresh simulation, continues bit-identical.
-    assert first.memory_frames == mdc.SIMULATION_DEFAULTS["memory_frames"] == 8
-    cached = mdc.Simulation(basis, handles)
+    assert first.memory_frames == mdc.SIMULATION_OPTIONS["memory_frames"].default == 8
+    cached = mdc.Simulation(basis, handles, pull=100.0)
     run(cached, moves[:8])
     q, v = cached.state
-    reloaded = mdc.Simulation(basis, handles)
+    reloaded = mdc.Simulation(basis, handles, pull=100.0)
     reloaded.set_state(q, v, moves[7])
     assert all(np.array_equal(x, y) for x, y in zip(reloaded.state, (q, v)))
     assert reloaded.energy() == cached.energy()
@@ -158,7 +158,7 @@ def test_bfgs_memory_spans_blocks_of_frames_and_a_frame_inside_one_is_reached_ag
     V, F, handles, basis = tube
     centre = V[handles[1]].mean(axis=0)
     moves = [[np.eye(4), rigid([1, 0, 0], np.radians(5) * k, centre)] for k in range(1, 13)]
-    played = mdc.Simulation(basis, handles, memory_frames=4)
+    played = mdc.Simulation(basis, handles, memory_frames=4, pull=100.0)
     states, evaluations = [(played.state, [np.eye(4)] * 2)], 0
     for k, T in enumerate(moves):
         played.advance(T)
@@ -168,7 +168,7 @@ def test_bfgs_memory_spans_blocks_of_frames_and_a_frame_inside_one_is_reached_ag
     # Frame 7 from the cached state of frame 6 in a simulation that does not remember frames 5 and 6
     # (a set_state of a state not its own forgets): a different minimisation, the same motion
     # within the solver's tolerance.
-    jumped = mdc.Simulation(basis, handles, memory_frames=4)
+    jumped = mdc.Simulation(basis, handles, memory_frames=4, pull=100.0)
     jumped.set_state(*states[6][0], states[6][1])
     assert jumped.remembered_frames == 0
     jumped.advance(moves[6])
@@ -187,14 +187,14 @@ def test_bfgs_memory_spans_blocks_of_frames_and_a_frame_inside_one_is_reached_ag
     assert all(np.array_equal(x, y) for x, y in zip(jumped.state, states[7][0]))
     # memory_frames=1: each frame from the rest Hessian, a function of the state it starts from
     # alone, at more evaluations.
-    fresh = mdc.Simulation(basis, handles, memory_frames=1)
+    fresh = mdc.Simulation(basis, handles, memory_frames=1, pull=100.0)
     fresh_states, fresh_evaluations = [], 0
     for T in moves:
         fresh.advance(T)
         fresh_evaluations += fresh.stats["evaluations"]
         assert fresh.remembered_frames == 1
         fresh_states.append(fresh.state)
-    alone = mdc.Simulation(basis, handles, memory_frames=1)
+    alone = mdc.Simulation(basis, handles, memory_frames=1, pull=100.0)
     alone.set_state(*fresh_states[5], moves[5])
     alone.advance(moves[6])
     assert all(np.array_equal(x, y) for x, y in zip(alone.state, fresh_states[6]))
@@ -205,13 +205,13 @@ def test_bfgs_memory_spans_blocks_of_frames_and_a_frame_inside_one_is_reached_ag
 
 def test_parameters_are_defined_once_and_checked(bar):
     V, F, basis = bar
-    assert mdc.SIMULATION_DEFAULTS["period"] == 12.0 and mdc.SIMULATION_DEFAULTS["substeps"] == 2
+    assert mdc.SIMULATION_OPTIONS["period"].default == 12.0 and mdc.SIMULATION_OPTIONS["substeps"].default == 2
     sim = mdc.Simulation(basis, [])
     assert sim.dimension == basis.vectors.shape[1] and sim.num_handles == 0
     X = sim.step([])
     assert X.shape == V.shape and X.dtype == np.float32
     assert np.array_equal(X, sim.positions())
-    for name, value in [("period", 2.0), ("damping", -0.1), ("damping", 1.5), ("fps", 0.0), ("stiffness", -1.0),
+    for name, value in [("period", 2.0), ("damping", -0.1), ("damping", 1.5), ("fps", 0.0), ("pull", -1.0),
                         ("period", float("nan"))]:
         with pytest.raises(ValueError, match=name):
             mdc.Simulation(basis, [], **{name: value})
@@ -221,7 +221,7 @@ def test_parameters_are_defined_once_and_checked(bar):
         mdc.Simulation(V, [])
     with pytest.raises(ValueError, match=r"handles\[0\]"):
         mdc.Simulation(basis, [[len(V)]])
-    held = mdc.Simulation(basis, [[0, 1, 2]])
+    held = mdc.Simulation(basis, [[0, 1, 2]], pull=100.0)
     with pytest.raises(ValueError, match="transforms"):
         held.step([])
     sheared = np.eye(4)
@@ -239,7 +239,7 @@ def test_parameters_are_defined_once_and_checked(bar):
 
 def test_an_unconverged_step_says_so_and_stays_finite(tube):
     V, F, handles, basis = tube
-    sim = mdc.Simulation(basis, handles, max_iterations=1)
+    sim = mdc.Simulation(basis, handles, max_iterations=1, pull=100.0)
     rng = np.random.default_rng(5)
     centre = V[handles[1]].mean(axis=0)
     stats = []

@@ -4,7 +4,6 @@ import numpy as np
 import pytest
 
 import modal_deform.core as mdc
-from modal_deform.core.bake import PROXY
 
 from support import subdivision  # midpoint_subdivide: the project's own
 from support.poses import end_pull  # the benchmark's handles and pose
@@ -92,8 +91,9 @@ def test_proxy_options_and_progress():
     assert basis.on_proxy and stages[0] == "proxy" and stages[-1] == "prolongation"
     assert not mdc.bake(V, F, modes=10, derivatives=4, ghost=100, proxy=None).on_proxy
     assert not mdc.bake(V, F, modes=10, derivatives=4, ghost=100, proxy=400, proxy_above=len(V)).on_proxy
+    assert not mdc.bake(V, F, modes=10, derivatives=4, ghost=100, proxy=400, proxy_above=0).on_proxy  # 0: never
     for options, name in (({"proxy": 3, "proxy_above": 1000}, "proxy"), ({"proxy": 1500, "proxy_above": 1000}, "proxy"),
-                          ({"proxy": 400, "proxy_above": 0}, "proxy_above"), ({"proxy": "many"}, "proxy")):
+                          ({"proxy_above": -1}, "proxy_above"), ({"proxy": "many"}, "proxy")):
         with pytest.raises(ValueError, match=name):
             mdc.bake(V, F, modes=10, derivatives=4, ghost=100, **options)
 
@@ -113,7 +113,7 @@ def test_the_subdivided_dragon_on_a_proxy_poses_like_the_dragon(shared_mesh):
         return solver.positions()
 
     fine = mdc.bake(V_fine, F_fine, modes=20, derivatives=47, ghost=1000)
-    assert fine.on_proxy and fine.num_basis_vertices <= 1.1 * PROXY
+    assert fine.on_proxy and fine.num_basis_vertices <= 1.1 * mdc.BAKE_OPTIONS["proxy"].default
     stored = sum(a.nbytes for a in fine.to_arrays().values())
     assert stored < 0.25 * 12 * fine.dimension * len(V_fine)
     own = mdc.bake(V, F, modes=20, derivatives=47, ghost=1000)

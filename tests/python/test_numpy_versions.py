@@ -19,14 +19,14 @@ import modal_deform.core as mdc
 COPIED_INTO_THE_CORE = {
     "handles and q": """
         basis = mdc.bake(V, F, modes=8, derivatives=4, ghost=60)
-        solver = mdc.ReducedSolver(basis, handles, stiffness=100.0)
+        solver = mdc.ReducedSolver(basis, handles, pull=100.0)
         solver.set_transforms(transforms)
         solver.solve(max_iterations=5)
         value, gradient = solver.objective(solver.q)
         assert np.isfinite(value) and gradient.shape == solver.q.shape
     """,
     "an initial pose": """
-        X, stats = mdc.solve_full(V, F, handles, transforms, stiffness=100.0, initial=V.copy(), max_iterations=3)
+        X, stats = mdc.solve_full(V, F, handles, transforms, pull=100.0, initial=V.copy(), max_iterations=3)
         assert np.isfinite(X).all()
     """,
 }

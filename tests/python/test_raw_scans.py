@@ -34,7 +34,7 @@ def test_damaged_dragon_bakes_and_poses(seed):
     handle = np.flatnonzero(V[:, 0] < lo[0] + 0.2 * (hi[0] - lo[0]))
     T = np.eye(4)
     T[:3, 3] = 0.1 * (hi - lo)
-    solver = mdc.ReducedSolver(basis, [handle], stiffness=1000.0)
+    solver = mdc.ReducedSolver(basis, [handle], pull=1000.0)
     solver.set_transforms([T])
     assert solver.solve(max_iterations=200)["converged"]
     off = np.linalg.norm(solver.positions() - V - T[:3, 3], axis=1)

@@ -23,7 +23,7 @@ def test_outside_the_region_nothing_moves_and_the_inside_follows_its_handle(tube
     top = np.flatnonzero(V[:, 2] > 6 - 1e-9)
     T = np.eye(4)
     T[:3, 3] = [0.6, 0.0, -0.3]
-    solver = mdc.ReducedSolver(basis, [top], stiffness=1e3)
+    solver = mdc.ReducedSolver(basis, [top], pull=1e3)
     solver.set_transforms([T])
     stats = solver.solve(max_iterations=200, tolerance=1e-8)
     X = solver.positions()
@@ -42,10 +42,10 @@ def test_a_region_bake_matches_the_full_solve_with_the_outside_held(tube):
     outside = np.setdiff1d(np.arange(len(V)), region)
     T = np.eye(4)
     T[:3, 3] = [0.5, 0.0, 0.0]
-    solver = mdc.ReducedSolver(basis, [top], stiffness=1e3)
+    solver = mdc.ReducedSolver(basis, [top], pull=1e3)
     solver.set_transforms([T])
     solver.solve(max_iterations=300, tolerance=1e-9)
-    full, _ = mdc.solve_full(V, F, [top, outside], [T, np.eye(4)], stiffness=1e3, weights=[1.0, 1e3])
+    full, _ = mdc.solve_full(V, F, [top, outside], [T, np.eye(4)], pull=1e3, weights=[1.0, 1e3])
     error = np.abs(solver.positions()[region] - full[region]).max()
     assert error < 0.05 * 0.5, error
 
@@ -69,7 +69,7 @@ def test_a_dense_region_is_baked_on_a_proxy_of_its_own_faces():
     np.testing.assert_allclose(basis.prolongation_weights[region].sum(axis=1), 1.0, atol=1e-6)
     poses = []
     for b in (dense, basis, mdc.Basis.from_arrays(basis.to_arrays())):
-        solver = mdc.ReducedSolver(b, [top], stiffness=1e3)
+        solver = mdc.ReducedSolver(b, [top], pull=1e3)
         solver.set_transforms([T])
         assert solver.solve(max_iterations=300, tolerance=1e-8)["converged"]
         poses.append(solver.positions())
@@ -95,14 +95,14 @@ def test_refine_keeps_the_outside_exactly_where_it_was(tube):
     top = np.flatnonzero(V[:, 2] > 6 - 1e-9)
     T = np.eye(4)
     T[:3, 3] = [0.6, 0.0, -0.3]
-    solver = mdc.ReducedSolver(basis, [top], stiffness=1e3)
+    solver = mdc.ReducedSolver(basis, [top], pull=1e3)
     solver.set_transforms([T])
     solver.solve(max_iterations=200, tolerance=1e-8)
     start = solver.positions().astype(np.float64)
     X, stats = solver.refine(F)
     assert stats["converged"], stats
     assert X[outside].tobytes() == start[outside].tobytes()
-    held, held_stats = mdc.solve_full(V, F, [top], [T], stiffness=1e3, held=outside)
+    held, held_stats = mdc.solve_full(V, F, [top], [T], pull=1e3, held=outside)
     assert held_stats["converged"] and np.array_equal(held[outside], V[outside])
     assert np.abs(X - held).max() < 1e-4 * np.linalg.norm(np.ptp(V, axis=0))
     with pytest.raises(ValueError, match=rf"held\[1\] = {len(V)} is not a vertex"):
@@ -153,7 +153,7 @@ def test_the_solver_minimises_the_whole_mesh_energy_with_the_outside_held(tube):
     V, F, region = tube
     basis = mdc.bake(V, F, modes=12, derivatives=20, ghost=1000, region=region)
     q = np.random.default_rng(2).normal(scale=0.02, size=basis.dimension)
-    f1, f2 = (mdc.ReducedSolver(basis, [region[-10:]], stiffness=mu).objective(q)[0] for mu in (1.0, 2.0))
+    f1, f2 = (mdc.ReducedSolver(basis, [region[-10:]], pull=mu).objective(q)[0] for mu in (1.0, 2.0))
     s = basis.scale
     X = s * (V.reshape(-1) + basis.vectors.astype(np.float64) @ q)
     assert 2 * f1 - f2 == pytest.approx(mdc.DiscreteShells(s * V, F).value(X), rel=1e-6)

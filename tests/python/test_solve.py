@@ -32,7 +32,7 @@ def objective_gradient(V, F, handles, transforms, X, stiffness, energy):
 @pytest.mark.parametrize("energy", ["shells", "arap"])
 def test_solve_full_finds_a_stationary_point(tube, energy):
     V, F, handles, transforms = tube
-    X, stats = mdc.solve_full(V, F, handles, transforms, stiffness=100.0, energy=energy, tolerance=1e-10)
+    X, stats = mdc.solve_full(V, F, handles, transforms, pull=100.0, energy=energy, tolerance=1e-10)
     assert X.shape == V.shape and X.dtype == np.float64
     assert stats["converged"] and stats["iterations"] > 0
     assert stats["gradient_norm"] <= 1e-10 * stats["gradient_scale"]
@@ -40,7 +40,7 @@ def test_solve_full_finds_a_stationary_point(tube, energy):
     g0 = objective_gradient(V, F, handles, transforms, V, 100.0, energy)
     assert np.linalg.norm(g) <= 1e-8 * np.linalg.norm(g0)
     # The same solve again: the same positions to the bit.
-    assert np.array_equal(mdc.solve_full(V, F, handles, transforms, stiffness=100.0, energy=energy, tolerance=1e-10)[0], X)
+    assert np.array_equal(mdc.solve_full(V, F, handles, transforms, pull=100.0, energy=energy, tolerance=1e-10)[0], X)
 
 
 def test_solve_full_refuses_bad_input(tube):
@@ -68,8 +68,8 @@ def test_solve_full_refuses_bad_input(tube):
         mdc.solve_full(V, F, [], [])
     with pytest.raises(ValueError, match="energy"):
         mdc.solve_full(V, F, handles, transforms, energy="neo-hookean")
-    with pytest.raises(ValueError, match="stiffness"):
-        mdc.solve_full(V, F, handles, transforms, stiffness=-1.0)
+    with pytest.raises(ValueError, match="pull"):
+        mdc.solve_full(V, F, handles, transforms, pull=-1.0)
     with pytest.raises(ValueError, match=r"weights"):
         mdc.solve_full(V, F, handles, transforms, weights=[1.0, -2.0])
 
@@ -83,7 +83,7 @@ def tube_basis(tube):
 def converge(solver, tolerance=1e-8):
     stats = {"converged": False}
     for _ in range(50):
-        stats = solver.solve(20, tolerance)
+        stats = solver.solve(max_iterations=20, tolerance=tolerance)
         if stats["converged"]:
             break
     return stats
@@ -91,7 +91,7 @@ def converge(solver, tolerance=1e-8):
 
 def test_reduced_solver_poses_close_to_the_full_solve(tube, tube_basis):
     V, F, handles, transforms = tube
-    solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0)
+    solver = mdc.ReducedSolver(tube_basis, handles, pull=100.0)
     assert solver.dimension == tube_basis.dimension
     solver.set_transforms(transforms)
     energies = []
@@ -103,14 +103,14 @@ def test_reduced_solver_poses_close_to_the_full_solve(tube, tube_basis):
     assert converge(solver)["converged"]
     X = solver.positions()
     assert X.shape == V.shape and X.dtype == np.float32
-    reference, _ = mdc.solve_full(V, F, handles, transforms, stiffness=100.0)
+    reference, _ = mdc.solve_full(V, F, handles, transforms, pull=100.0)
     diagonal = np.linalg.norm(np.ptp(reference, axis=0))
     assert np.sqrt(np.mean(np.sum((X - reference) ** 2, axis=1))) < 0.02 * diagonal
 
 
 def test_a_time_budget_ends_a_solve_after_one_iteration(tube, tube_basis):
     _, _, handles, transforms = tube
-    solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0)
+    solver = mdc.ReducedSolver(tube_basis, handles, pull=100.0)
     solver.set_transforms(transforms)
     for _ in range(3):
         assert solver.solve(max_iterations=1000, budget_ms=1e-9)["iterations"] == 1
@@ -128,7 +128,7 @@ def test_positions_fill_the_callers_buffer(tube, tube_basis):
     rest = np.asarray(tube_basis.rest, dtype=np.float32)
     assert np.array_equal(solver.positions(), rest)
     solver.set_transforms(transforms)
-    solver.solve(10)
+    solver.solve(max_iterations=10)
     for shape in [rest.shape, (rest.size,)]:
         out = np.full(shape, np.nan, dtype=np.float32)
         assert solver.positions(out) is out
@@ -148,20 +148,20 @@ def test_positions_fill_the_callers_buffer(tube, tube_basis):
 
 def test_state_persists_across_solves(tube, tube_basis):
     _, _, handles, transforms = tube
-    once, twice = (mdc.ReducedSolver(tube_basis, handles, stiffness=100.0) for _ in range(2))
+    once, twice = (mdc.ReducedSolver(tube_basis, handles, pull=100.0) for _ in range(2))
     for solver in (once, twice):
         solver.set_transforms(transforms)
-    ten = once.solve(10, tolerance=1e-14)
-    first, second = twice.solve(5, tolerance=1e-14), twice.solve(5, tolerance=1e-14)
+    ten = once.solve(max_iterations=10, tolerance=1e-14)
+    first, second = twice.solve(max_iterations=5, tolerance=1e-14), twice.solve(max_iterations=5, tolerance=1e-14)
     assert first["iterations"] + second["iterations"] == ten["iterations"]
     assert np.array_equal(once.q, twice.q)
 
 
 def test_objective_is_what_the_solver_minimises(tube, tube_basis):
     _, _, handles, transforms = tube
-    solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0)
+    solver = mdc.ReducedSolver(tube_basis, handles, pull=100.0)
     solver.set_transforms(transforms)
-    stats = solver.solve(3, tolerance=1e-14)
+    stats = solver.solve(max_iterations=3, tolerance=1e-14)
     q = solver.q
     value, gradient = solver.objective(q)
     assert value == pytest.approx(stats["energy"], rel=1e-12)
@@ -179,19 +179,19 @@ def test_warm_start_saves_iterations(tube, tube_basis):
     _, _, handles, transforms = tube
     counts = {}
     for warm in (True, False):
-        solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0, warm_start=warm)
+        solver = mdc.ReducedSolver(tube_basis, handles, pull=100.0, warm_start=warm)
         solver.set_transforms(transforms)
-        counts[warm] = sum(solver.solve(20, tolerance=1e-10)["iterations"] for _ in range(50))
-        assert solver.solve(20, tolerance=1e-10)["converged"]
+        counts[warm] = sum(solver.solve(max_iterations=20, tolerance=1e-10)["iterations"] for _ in range(50))
+        assert solver.solve(max_iterations=20, tolerance=1e-10)["converged"]
     assert counts[True] < counts[False]
 
 
 def test_arap_objective_in_the_shells_basis(tube, tube_basis):
     V, F, handles, transforms = tube
-    solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0, energy="arap")
+    solver = mdc.ReducedSolver(tube_basis, handles, pull=100.0, energy="arap")
     solver.set_transforms(transforms)
     assert converge(solver)["converged"]
-    reference, _ = mdc.solve_full(V, F, handles, transforms, stiffness=100.0, energy="arap")
+    reference, _ = mdc.solve_full(V, F, handles, transforms, pull=100.0, energy="arap")
     diagonal = np.linalg.norm(np.ptp(reference, axis=0))
     assert np.sqrt(np.mean(np.sum((solver.positions() - reference) ** 2, axis=1))) < 0.04 * diagonal
 
@@ -200,8 +200,8 @@ def test_reduced_solver_refuses_bad_input(tube, tube_basis):
     _, _, handles, transforms = tube
     with pytest.raises(ValueError, match=r"handles\[1\]\[0\] = 999999"):
         mdc.ReducedSolver(tube_basis, [handles[0], [999999]])
-    with pytest.raises(ValueError, match="stiffness"):
-        mdc.ReducedSolver(tube_basis, handles, stiffness=0.0)
+    with pytest.raises(ValueError, match="pull"):
+        mdc.ReducedSolver(tube_basis, handles, pull=0.0)
     with pytest.raises(ValueError, match="energy"):
         mdc.ReducedSolver(tube_basis, handles, energy="springs")
     with pytest.raises(ValueError, match="weights"):
@@ -272,7 +272,7 @@ def test_solve_full_converges_from_rest_on_a_scan_with_flaps(shared_mesh):
     single load step tangled the fins and stalled at 4 times the minimum's objective."""
     V, F = shared_mesh("dragon_vrip_res4.ply.gz")
     handles, transforms = dragon_turn(V, 30)
-    X, stats = mdc.solve_full(V, F, handles, transforms, stiffness=100.0)
+    X, stats = mdc.solve_full(V, F, handles, transforms, pull=100.0)
     assert stats["converged"], stats
     assert stats["gradient_norm"] <= 1e-8 * stats["gradient_scale"]
     assert stats["steps"] >= 2 and stats["factorizations"] < 1.5 * stats["iterations"], stats
@@ -284,7 +284,7 @@ def test_solve_full_converges_from_rest_on_the_23k_dragon(shared_mesh):
     215 factorisations, not converged at 8 times the minimum's objective)."""
     V, F = shared_mesh("dragon_vrip_res3.ply.gz")
     handles, transforms = dragon_turn(V, 30)
-    _, stats = mdc.solve_full(V, F, handles, transforms, stiffness=100.0)
+    _, stats = mdc.solve_full(V, F, handles, transforms, pull=100.0)
     assert stats["converged"], stats
     assert stats["factorizations"] < 1.5 * stats["iterations"], stats
 
@@ -292,7 +292,7 @@ def test_solve_full_converges_from_rest_on_the_23k_dragon(shared_mesh):
 def converged_solver(tube, tube_basis):
     """The tube's reduced solver at its converged reduced pose, Refine's start."""
     _, _, handles, transforms = tube
-    solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0)
+    solver = mdc.ReducedSolver(tube_basis, handles, pull=100.0)
     solver.set_transforms(transforms)
     converge(solver)
     return solver
@@ -305,7 +305,7 @@ def test_refine_lowers_the_reduced_pose_to_a_converged_minimum(tube, tube_basis)
     X, stats = solver.refine(F)
     assert stats["converged"] and stats["steps"] == 1, stats
     assert stats["energy"] < stats["initial_energy"]
-    reference, full = mdc.solve_full(V, F, handles, transforms, stiffness=100.0)
+    reference, full = mdc.solve_full(V, F, handles, transforms, pull=100.0)
     assert full["converged"]
     assert stats["energy"] == pytest.approx(full["energy"], rel=1e-9)
     assert np.abs(X - reference).max() < 1e-6 * np.ptp(V)
@@ -339,7 +339,7 @@ def test_refine_that_does_not_converge_counts_both_solves(tube, tube_basis):
     V, F, handles, transforms = tube
     solver = converged_solver(tube, tube_basis)
     _, alone = solver.refine(F, max_iterations=1)
-    _, from_rest = mdc.solve_full(V, F, handles, transforms, stiffness=100.0, max_iterations=1)
+    _, from_rest = mdc.solve_full(V, F, handles, transforms, pull=100.0, max_iterations=1)
     assert not alone["converged"] and not from_rest["converged"]
     assert alone["iterations"] == len(alone["history"]) == 2, alone
     assert alone["factorizations"] >= 2 and alone["seconds"] >= from_rest["seconds"] / 10
@@ -347,7 +347,7 @@ def test_refine_that_does_not_converge_counts_both_solves(tube, tube_basis):
 
 def test_refine_reports_progress_and_cancels(tube, tube_basis):
     V, F, handles, transforms = tube
-    solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0)
+    solver = mdc.ReducedSolver(tube_basis, handles, pull=100.0)
     solver.set_transforms(transforms)
     reports = []
     solver.refine(F, progress=lambda stage, fraction: reports.append((stage, fraction)))
@@ -373,7 +373,7 @@ def test_refine_of_a_strong_turn_is_not_held_back_by_crushed_triangles(shared_me
     V, F = shared_mesh("dragon_vrip_res4.ply.gz")
     basis = mdc.bake(V, F, modes=15, derivatives=52, ghost=1000)
     handles, transforms = dragon_turn(V, 170)
-    solver = mdc.ReducedSolver(basis, handles, stiffness=100.0)
+    solver = mdc.ReducedSolver(basis, handles, pull=100.0)
     solver.set_transforms(transforms)
     solver.solve(max_iterations=2000, tolerance=1e-6)
     _, stats = solver.refine(F)
@@ -397,7 +397,7 @@ def test_positions_read_from_16_bits_stay_within_1e_4_of_the_diagonal(shared_mes
     V, F = shared_mesh("dragon_vrip_res4.ply.gz")
     basis = mdc.bake(V, F, modes=16, derivatives=45, ghost=500)
     handles, transforms = dragon_turn(V, 90)
-    solver = mdc.ReducedSolver(basis, handles, stiffness=1000.0)
+    solver = mdc.ReducedSolver(basis, handles, pull=1000.0)
     solver.set_transforms(transforms)
     assert converge(solver)["converged"]
     float32_map = basis.rest + (basis.vectors.astype(np.float64) @ solver.q).reshape(-1, 3)
@@ -435,7 +435,7 @@ def test_an_adapted_budget_reaches_the_same_pose_once_the_controller_stops(tube,
             for t in np.linspace(0, 1, 21)[1:]]
 
     def pose(budget_ms, measure):
-        solver = mdc.ReducedSolver(tube_basis, handles, stiffness=100.0)
+        solver = mdc.ReducedSolver(tube_basis, handles, pull=100.0)
         lag = []
         for update, placement in enumerate(path):
             solver.set_transforms(placement)

@@ -72,14 +72,14 @@ def difference_error(solver, seed=0):
     return min(errors) / (1 + abs(value))
 
 
-def follow(mdc, basis, V, pose, check_differences=False, stiffness=STIFFNESS, final_iterations=3000):
+def follow(mdc, basis, V, pose, check_differences=False, pull=STIFFNESS, final_iterations=3000):
     """Reaches `pose` in steps of at most STEP_DEGREES, each solved to convergence (tolerance
     1e-6); returns one dict of solve stats per step (with "difference_error" when asked). `mdc`:
     the modal_deform.core the basis came from (inside Blender, the installed add-on's)."""
     degrees = float(pose.split("_")[1])
     steps = int(np.ceil(degrees / STEP_DEGREES))
     handles, _ = transforms(V, pose, 0)
-    solver = mdc.ReducedSolver(basis, handles, stiffness=stiffness)
+    solver = mdc.ReducedSolver(basis, handles, pull=pull)
     path = []
     for k in range(1, steps + 1):
         solver.set_transforms(transforms(V, pose, degrees * k / steps)[1])

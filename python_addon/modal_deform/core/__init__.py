@@ -8,21 +8,20 @@ shells, ARAP), ``modes`` (vibration modes, rigid motions, modal-derivative solve
 (secondary motion); ``testing`` holds the generated test shapes.
 """
 from .._native import Cancelled, OutOfMemoryError
-from .bake import BAKE_OPTIONS, BAKE_STAGES, PROXY, PROXY_ABOVE, Basis, bake, bake_fraction
-from .dynamics import MAX_SUBSTEPS, MIN_PERIOD_FRAMES, SIMULATION_DEFAULTS, Simulation
-from .energy import Arap, DiscreteShells
-from .frame_budget import FrameBudget
 from . import testing
+from .bake import BAKE_OPTIONS, BAKE_STAGES, Basis, bake, bake_fraction
+from .dynamics import SIMULATION_OPTIONS, Simulation
+from .energy import MATERIAL_OPTIONS, Arap, DiscreteShells
+from .frame_budget import FrameBudget
 from .mesh import check, mass, read_mesh
 from .modes import rigid_motions, solve_in_range, vibration_modes
 from .reduction import ghost_mesh, restrict_to_ghost
-from .solve import FULL_SOLVE_MAX_ITERATIONS, FULL_SOLVE_OPTIONS, SOLVE_TOLERANCE, ReducedSolver, nearest_rigid, solve_full
+from .solve import FULL_SOLVE_OPTIONS, SOLVE_OPTIONS, SOLVER_OPTIONS, ReducedSolver, nearest_rigid, solve_full
 
 # FrameBudget, bake_fraction and nearest_rigid serve the add-on: mdc.<name> works, __all__ leaves them out.
 __all__ = [
-    "Arap", "BAKE_OPTIONS", "BAKE_STAGES", "Basis", "PROXY", "PROXY_ABOVE", "Cancelled", "DiscreteShells", "OutOfMemoryError", "bake", "check",
-    "ghost_mesh", "mass", "read_mesh", "restrict_to_ghost", "rigid_motions", "solve_in_range",
-    "vibration_modes",
+    "Arap", "BAKE_OPTIONS", "BAKE_STAGES", "Basis", "Cancelled", "DiscreteShells", "FULL_SOLVE_OPTIONS",
+    "MATERIAL_OPTIONS", "OutOfMemoryError", "ReducedSolver", "SIMULATION_OPTIONS", "SOLVER_OPTIONS", "SOLVE_OPTIONS",
+    "Simulation", "bake", "check", "ghost_mesh", "mass", "read_mesh", "restrict_to_ghost", "rigid_motions",
+    "solve_full", "solve_in_range", "vibration_modes",
 ]
-__all__ += ["FULL_SOLVE_MAX_ITERATIONS", "FULL_SOLVE_OPTIONS", "SOLVE_TOLERANCE", "ReducedSolver", "solve_full"]
-__all__ += ["MAX_SUBSTEPS", "MIN_PERIOD_FRAMES", "SIMULATION_DEFAULTS", "Simulation"]

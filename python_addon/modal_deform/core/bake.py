@@ -15,19 +15,14 @@ import warnings
 import numpy as np
 
 from .. import _native
-from . import _arrays
+from . import _arrays, _options
 
 # 2: the prolongation of a basis baked on a proxy; 3: the painted stiffness (stiffness_weights,
 # max_stiffness). Each field's version comes from the native schema.
 FORMAT_VERSION = 3
 
-#: ``bake``'s options and their defaults, the native core's (cpp/bake/bake.h, BakeOptions):
-#: {name: default}. Arrays default to empty ones, which ``bake`` takes as None.
-BAKE_OPTIONS = dict(_native.BAKE_OPTIONS)
-#: ``bake``'s defaults for dense meshes: more than PROXY_ABOVE vertices are baked on a proxy of
-#: about PROXY vertices (cpp/bake/bake.h says why; bench/results/multires.json).
-PROXY_ABOVE = BAKE_OPTIONS["proxy_above"]
-PROXY = BAKE_OPTIONS["proxy"]
+#: ``bake``'s options, the native core's (cpp/bake/bake.h, for_each_bake_option): {name: Option}.
+BAKE_OPTIONS = _options.table(_native.BAKE_OPTIONS)
 
 #: The bake's stages in the order they run, the names its progress reports and ``Basis.timings``
 #: use (the native core's list). A bake without a proxy skips the first and the last.
@@ -179,50 +174,19 @@ def _basis(basis):
     return basis
 
 
-def _count(value, name, minimum):
-    value = _arrays.integer(value, name)
-    if value < minimum:
-        raise ValueError(f"{name}: expected at least {minimum}, got {value}")
-    return min(value, np.iinfo(np.int32).max)
-
-
-def _flag(value, name):
-    if not isinstance(value, (bool, np.bool_)):
-        raise ValueError(f"{name}: expected True or False, got {value!r}")
-    return bool(value)
-
-
-def bake(V, F, modes=BAKE_OPTIONS["modes"], derivatives=BAKE_OPTIONS["derivatives"], ghost=BAKE_OPTIONS["ghost"],
-         energy=BAKE_OPTIONS["energy"], bending=BAKE_OPTIONS["bending"], membrane=BAKE_OPTIONS["membrane"], progress=None,
-         rotation_pairs=BAKE_OPTIONS["rotation_pairs"], proxy=PROXY, proxy_above=PROXY_ABOVE, stiffness_weights=None,
-         max_stiffness=BAKE_OPTIONS["max_stiffness"], region=None):
+@_options.takes_options(BAKE_OPTIONS)
+def bake(V, F, progress=None, **options):
     """Bake the reduced space of the triangle mesh (V (n, 3), F (m, 3)) for posing.
 
-    modes: vibration modes, the rigid motions of the simulated components (6 each) included;
-    derivatives: modal derivatives of pairs of modes, low eigenvalues first, in the paper's rule: all
-    modes but the translations and zero modes pair, the linearised rotations included, so that
-    ``modes=15, derivatives=52`` is the paper's 67-dimensional basis (``rotation_pairs=False``:
-    pairs of flexible modes only, the rule before; it needs more modes); ghost: the
-    ghost's target vertex count (at least 4; the mesh itself when it has fewer vertices);
-    energy: "shells" (discrete shells with weights ``bending`` and ``membrane``) or "arap" (only
-    with derivatives=0: ARAP has no third derivative); proxy, proxy_above: a mesh with more than
-    ``proxy_above`` vertices is baked on a proxy of about ``proxy`` vertices (4 to
-    ``proxy_above``), made by the ghost's edge collapse, and its basis carried to every fine
-    vertex by barycentric weights on the nearest proxy triangle (``Basis.on_proxy``; stages
-    "proxy" and "prolongation"); ``proxy=None`` bakes any mesh as it is.
-    stiffness_weights: None (a uniform material) or (n,) weights in [0, 1] painted per vertex, as
-    Blender's Cloth takes stiffness from a vertex group: each element's bending and membrane weight
-    is multiplied by 1 + (max_stiffness − 1) × the mean weight of its vertices (max_stiffness in
-    [1, 1e4]); the modes, derivatives, proxy and ghost all see it, and so does the solver (shells
-    only; all-zero weights give the plain bake).
-    region: None (the whole mesh moves) or the indices of the vertices that may move: every other
-    vertex stays exactly at rest (its rows of the basis, or on a proxy its prolongation weights, are
-    zero), the faces around the region hold it as a fixed boundary, and all the modes and
-    derivatives are spent inside it (no rigid motions, but for a part of the region that touches
-    nothing outside: its come as zero modes). Handles must lie in it. A region of more than
-    ``proxy_above`` vertices is baked on a proxy of its own faces of about ``proxy`` vertices,
-    whatever the size of the rest (a region that touches nothing outside it is then that proxy's
-    whole mesh, with rigid motions); ``Basis.region`` keeps the region, ascending.
+    The modal derivatives pair all modes but the translations and zero modes, the linearised
+    rotations included, so that ``modes=15, derivatives=52`` is the paper's 67-dimensional basis.
+    A dense mesh baked on a proxy (``Basis.on_proxy``) reports the stages "proxy" and
+    "prolongation" too; ``proxy=None`` bakes any mesh as it is. The painted stiffness is seen by
+    the modes, derivatives, proxy and ghost, and by the solver (shells only; all-zero weights give
+    the plain bake). With a region, all the modes and derivatives are spent inside it (no rigid
+    motions, but for a part of the region that touches nothing outside: its come as zero modes),
+    handles must lie in it, a region of more than ``proxy_above`` vertices is baked on a proxy of
+    its own faces, and ``Basis.region`` keeps it, ascending.
     ``progress(stage, fraction)`` is called
     at least every second or so (not during a CHOLMOD factorisation, about 2 s at 100k vertices);
     returning False raises ``Cancelled``, and an exception it raises propagates.
@@ -233,28 +197,21 @@ def bake(V, F, modes=BAKE_OPTIONS["modes"], derivatives=BAKE_OPTIONS["derivative
     the rigid motions, and get no modal derivatives.
     """
     V, F = _arrays.vertices(V), _arrays.faces(F)
-    if region is not None:
-        region = _arrays.indices(region, "region")
-        if not region.size:
+    if "region" in options:
+        options["region"] = _arrays.indices(options["region"], "region")
+        if not options["region"].size:
             raise ValueError("region: it has no vertices; give the vertices that may move, or None for the whole mesh")
-    if not isinstance(energy, str):
-        raise ValueError(f"energy: expected \"shells\" or \"arap\", got {energy!r}")
+    if "stiffness_weights" in options:
+        options["stiffness_weights"] = _arrays.stiffness_weights(options["stiffness_weights"], len(V))
     if progress is not None and not callable(progress):
         raise ValueError(f"progress: expected a callable progress(stage, fraction) or None, got {progress!r}")
-    native = _native.bake(V, F, progress=progress, modes=_count(modes, "modes", 1),
-                          derivatives=_count(derivatives, "derivatives", 0), ghost=_count(ghost, "ghost", 4),
-                          energy=energy, bending=_arrays.number(bending, "bending"),
-                          membrane=_arrays.number(membrane, "membrane"),
-                          rotation_pairs=_flag(rotation_pairs, "rotation_pairs"),
-                          proxy_above=0 if proxy is None else _count(proxy_above, "proxy_above", 1),
-                          proxy=4 if proxy is None else _count(proxy, "proxy", 4),
-                          stiffness_weights=_arrays.stiffness_weights(stiffness_weights, len(V)),
-                          max_stiffness=_arrays.number(max_stiffness, "max_stiffness"),
-                          region=np.zeros(0, np.int32) if region is None else region)
-    basis = Basis(native)
+    if "proxy" in options and options["proxy"] is None:
+        del options["proxy"]
+        options["proxy_above"] = 0
+    basis = Basis(_native.bake(V, F, progress=progress, **options))
     if basis.num_floppy:
         warnings.warn(f"the mesh is floppy: it has {basis.num_floppy} zero modes besides its rigid motions "
                       f"(mechanisms, e.g. large parts of the mesh joined at a single vertex, or the rigid motions of a part of "
-                      f"the region that touches nothing outside it); they are in the basis on top of the {modes} "
-                      f"modes asked for, without modal derivatives", stacklevel=2)
+                      f"the region that touches nothing outside it); they are in the basis on top of the "
+                      f"{options.get('modes', BAKE_OPTIONS['modes'].default)} modes asked for, without modal derivatives", stacklevel=2)
     return basis

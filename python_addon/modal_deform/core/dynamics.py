@@ -10,47 +10,32 @@ more). Both hold exactly for the lowest mode of small motions, whatever ``fps`` 
 import numpy as np
 
 from .. import _native
-from . import _arrays
+from . import _arrays, _options
 from .bake import _basis
-from .solve import _handles, _InBasis, _transforms, _weights
+from .solve import SOLVER_OPTIONS, _handles, _InBasis, _transforms, _weights
 
-#: The defaults of Simulation's parameters (the native core's SimulationOptions):
-#: stiffness, period (frames), damping (ratio), fps, substeps, max_iterations, tolerance, memory_frames.
-SIMULATION_DEFAULTS = dict(_native.SIMULATION_DEFAULTS)
-#: The shortest period accepted, in frames, and the most substeps a frame.
-MIN_PERIOD_FRAMES = _native.MIN_PERIOD_FRAMES
-MAX_SUBSTEPS = _native.MAX_SUBSTEPS
+#: Simulation's options, the native core's (cpp/solve/reduced_dynamics.h): {name: Option}.
+SIMULATION_OPTIONS = _options.table(_native.SIMULATION_OPTIONS)
 
 
 class Simulation(_InBasis):
     """Reduced dynamics of a baked basis driven by handles.
 
     ``basis``: from ``mdc.bake`` (kept alive). ``handles``: a list of vertex index arrays, one per
-    controller, possibly empty (a free body). ``stiffness``: μ of the handle term, as for
-    ReducedSolver. ``period``: of the lowest flexible mode, in frames (≥ MIN_PERIOD_FRAMES).
-    ``damping``: its damping ratio in [0, 1]. ``fps``: frames per second (velocities are per
-    second). ``substeps``: midpoint steps per frame (1 to MAX_SUBSTEPS). ``weights``: one per
-    handle (default 1); ``energy``: "shells" or "arap"; ``max_iterations``, ``tolerance``: BFGS's
-    per substep; ``memory_frames``: the most frames BFGS's memory of the curvature spans (see
-    step()). Starts at rest, at rest velocity, with every controller at the identity.
-    Raises ValueError naming the argument that is wrong.
+    controller, possibly empty (a free body); ``weights``: one per handle (default 1); ``energy``:
+    as for ReducedSolver. ``period`` and ``damping`` hold exactly for the lowest flexible mode of
+    small motions; see step() for ``memory_frames``. Starts at rest, at rest velocity, with every
+    controller at the identity. Raises ValueError naming the argument that is wrong.
     """
 
-    def __init__(self, basis, handles, stiffness=SIMULATION_DEFAULTS["stiffness"],
-                 period=SIMULATION_DEFAULTS["period"], damping=SIMULATION_DEFAULTS["damping"],
-                 fps=SIMULATION_DEFAULTS["fps"], substeps=SIMULATION_DEFAULTS["substeps"], weights=None,
-                 energy="shells", max_iterations=SIMULATION_DEFAULTS["max_iterations"],
-                 tolerance=SIMULATION_DEFAULTS["tolerance"], memory_frames=SIMULATION_DEFAULTS["memory_frames"]):
+    @_options.takes_options(SIMULATION_OPTIONS)
+    def __init__(self, basis, handles, weights=None, energy=SOLVER_OPTIONS["energy"].default, **options):
         basis = _basis(basis)
         handles = [] if _is_empty(handles) else _handles(handles)
         weights = np.zeros(0) if not handles else _weights(weights, len(handles))
-        self._native = _native.Simulation(
-            basis._native, handles, weights, str(energy), stiffness=_arrays.number(stiffness, "stiffness"),
-            period=_arrays.number(period, "period"), damping=_arrays.number(damping, "damping"),
-            fps=_arrays.number(fps, "fps"), substeps=_arrays.integer(substeps, "substeps"),
-            max_iterations=_arrays.integer(max_iterations, "max_iterations"),
-            tolerance=_arrays.number(tolerance, "tolerance"),
-            memory_frames=_arrays.integer(memory_frames, "memory_frames"))
+        if not isinstance(energy, str):
+            raise ValueError(f"energy: expected \"shells\" or \"arap\", got {energy!r}")
+        self._native = _native.Simulation(basis._native, handles, weights, energy, **options)
         self._basis = basis
         self.stats = None  #: the last step's: see step()
 

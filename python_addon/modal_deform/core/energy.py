@@ -2,7 +2,10 @@
 import numpy as np
 
 from .. import _native
-from . import _arrays
+from . import _arrays, _options
+
+#: The shells energy's material, the native core's (cpp/energy/material.h): {name: Option}.
+MATERIAL_OPTIONS = _options.table(_native.MATERIAL_OPTIONS)
 
 
 class _Energy:
@@ -56,22 +59,14 @@ class DiscreteShells(_Energy):
     triangle areas (over Ā); barred quantities are those of the rest mesh ``V``. ``bending`` is
     α and ``membrane`` β. The paper scales models to a longest bounding-box edge of 10 first.
 
-    Stiffness painted per vertex: ``stiffness_weights`` (n,) in [0, 1] (None: uniform) multiply each
-    element's α and β by 1 + (max_stiffness − 1) × the mean weight of its vertices (Blender Cloth's
-    convention), ``max_stiffness`` in [1, 1e4].
-
     V: (n, 3) rest positions, F: (m, 3) triangles. Raises ValueError for an unusable mesh, a
     weight that is negative or not finite, or bad stiffness weights (naming the vertex). Degenerate rest triangles and zero-length rest edges
     have no terms; non-manifold edges bend as if their sheets were welded pairwise.
     """
 
-    def __init__(self, V, F, bending=1.0, membrane=1.0, stiffness_weights=None, max_stiffness=1.0):
-        V = _arrays.vertices(V)
-        super().__init__(
-            _native.DiscreteShells(V, _arrays.faces(F), _arrays.number(bending, "bending"),
-                                   _arrays.number(membrane, "membrane"),
-                                   _arrays.stiffness_weights(stiffness_weights, len(V)),
-                                   _arrays.number(max_stiffness, "max_stiffness")))
+    @_options.takes_options(MATERIAL_OPTIONS)
+    def __init__(self, V, F, **material):
+        super().__init__(_native.DiscreteShells(_arrays.vertices(V), _arrays.faces(F), **material))
 
     @property
     def term_counts(self):

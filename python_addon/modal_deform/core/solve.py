@@ -6,7 +6,7 @@ scale s), the deformation energy plus the handle term
     μ Σ_h w_h Σ_{i∈h} s²m_i ‖s (x_i − (R_h x̄_i + t_h))‖²
 
 with m_i the lumped vertex masses, (R_h, t_h) handle h's rigid 4×4 transform of its rest
-positions (mesh units) and μ the stiffness. A handle is an array of vertex indices; a vertex may
+positions (mesh units) and μ the pull. A handle is an array of vertex indices; a vertex may
 belong to several handles (its pulls add up, so it settles between their targets in proportion to
 their weights), but not twice to one. Vertices without mass (in no triangle) pull with zero
 weight.
@@ -14,24 +14,16 @@ weight.
 import numpy as np
 
 from .. import _native
-from . import _arrays
-from .bake import PROXY_ABOVE, _basis
+from . import _arrays, _options
+from .bake import BAKE_OPTIONS, _basis
 
 #: The most vertices ReducedSolver.refine takes: the size bake takes without a proxy.
-REFINE_MAX_VERTICES = PROXY_ABOVE
-#: ``solve_full``'s options and their defaults, the native core's (cpp/solve/full_solver.h,
-#: FullSolveOptions): {name: default}; Refine takes the same.
-FULL_SOLVE_OPTIONS = dict(_native.FULL_SOLVE_OPTIONS)
-#: Newton iterations a full solve (and Refine) takes at most by default (full_solver.h says why so many).
-FULL_SOLVE_MAX_ITERATIONS = FULL_SOLVE_OPTIONS["max_iterations"]
-
-
-#: The default tolerance ε of ReducedSolver.solve's stopping test (paper eq. 14).
-SOLVE_TOLERANCE = 1e-6
-
-#: The default handle stiffness μ: stiff enough that handles land within a small fraction of a
-#: percent of the model's size in the test poses, soft enough to keep BFGS well conditioned.
-STIFFNESS = 1000.0
+REFINE_MAX_VERTICES = BAKE_OPTIONS["proxy_above"].default
+#: The options of ReducedSolver (cpp/solve/reduced_solver.h), of its solve() and of solve_full
+#: (cpp/solve/full_solver.h; Refine takes its tolerance and max_iterations): {name: Option}.
+SOLVER_OPTIONS = _options.table(_native.REDUCED_SOLVER_OPTIONS)
+SOLVE_OPTIONS = _options.table(_native.REDUCED_SOLVE_OPTIONS)
+FULL_SOLVE_OPTIONS = _options.table(_native.FULL_SOLVE_OPTIONS)
 
 
 def _handles(handles):
@@ -117,23 +109,21 @@ class ReducedSolver(_InBasis):
     """BFGS in a baked basis: x = x̄ + U q, energy on the ghost, handles exact on the fine mesh.
 
     ``basis``: from ``mdc.bake`` (kept alive by the solver). ``handles``: list of vertex index
-    arrays; ``weights``: one per handle (default 1); ``stiffness``: μ > 0; ``energy``: "shells"
-    (with the basis's material weights) or "arap". The solver starts at rest with every handle at
-    its rest position; the inverse Hessian's warm start is computed here, once per handle set
-    (``warm_start=False`` starts BFGS from the identity instead, for comparison).
+    arrays; ``weights``: one per handle (default 1). The solver starts at rest with every handle at
+    its rest position; the inverse Hessian's warm start is computed here, once per handle set.
     Long calls release the GIL; one solver must not be used from two threads at once.
     """
 
-    def __init__(self, basis, handles, stiffness=STIFFNESS, weights=None, energy="shells", warm_start=True):
+    @_options.takes_options(SOLVER_OPTIONS)
+    def __init__(self, basis, handles, weights=None, **options):
         basis = _basis(basis)
-        native_basis = basis._native
         handles = _handles(handles)
         weights = _weights(weights, len(handles))
-        stiffness = _arrays.number(stiffness, "stiffness")
-        self._native = _native.ReducedSolver(native_basis, handles, weights, stiffness, str(energy), bool(warm_start))
+        self._native = _native.ReducedSolver(basis._native, handles, weights, **options)
         self._basis = basis
         # What refine() solves on the full mesh: the same objective.
-        self._problem = dict(handles=handles, weights=weights, stiffness=stiffness, energy=str(energy))
+        options.pop("warm_start", None)
+        self._problem = dict(handles=handles, weights=weights, **options)
         self._transforms = [np.eye(4)] * len(handles)
 
     @property
@@ -151,12 +141,10 @@ class ReducedSolver(_InBasis):
         self._native.set_transforms(transforms)
         self._transforms = transforms
 
-    def solve(self, max_iterations=10, tolerance=SOLVE_TOLERANCE, budget_ms=None):
-        """Up to ``max_iterations`` BFGS iterations from the current state.
-
-        Stops early when the Gill–Murray–Wright test holds (paper eq. 14, tolerance ε), and begins
-        no iteration once ``budget_ms`` milliseconds (> 0; None: no limit) have passed: a frame's
-        share of time (the iteration under way is finished, so a call always progresses). Returns
+    @_options.takes_options(SOLVE_OPTIONS)
+    def solve(self, **options):
+        """BFGS iterations from the current state, until the Gill–Murray–Wright test holds (paper
+        eq. 14) or the budget is spent (a frame's share of time). Returns
         {"iterations", "energy" (the objective), "converged", "ms", "evaluations",
         "gradient_norm", "stalled", "line_search_failures"}: "stalled" when the call ended
         unconverged because no step lowers the objective (the line search failed even from the
@@ -164,18 +152,17 @@ class ReducedSolver(_InBasis):
         "line_search_failures" counts the failed line searches. q and the inverse Hessian carry
         over to the next call.
         """
-        return self._native.solve(_arrays.integer(max_iterations, "max_iterations"),
-                                  _arrays.number(tolerance, "tolerance"),
-                                  float("inf") if budget_ms is None else _arrays.number(budget_ms, "budget_ms"))
+        return self._native.solve(**options)
 
-    def refine(self, F, initial=None, tolerance=FULL_SOLVE_OPTIONS["tolerance"], max_iterations=FULL_SOLVE_MAX_ITERATIONS,
-               progress=None):
+    @_options.takes_options(FULL_SOLVE_OPTIONS, exclude=("pull", "energy", "bending", "membrane",
+                                                         "stiffness_weights", "max_stiffness", "held"))
+    def refine(self, F, initial=None, progress=None, **options):
         """Refine: the pose's exact minimum on the full mesh, by ``solve_full`` from a start.
 
         ``F`` (m, 3): the fine mesh's triangles (the basis keeps only its rest positions).
         ``initial`` (n, 3): where to start, by default the reduced pose ``positions()``; an
         animation passes the previous frame's refined answer. Same objective as ``solve``: the
-        handles, weights, stiffness, energy (with the basis's material weights, painted ones too) and the current
+        handles, weights, pull, energy (with the basis's material weights, painted ones too) and the current
         transforms; a region bake's outside stays exactly at rest (``solve_full``'s ``held``).
         ``progress(stage, fraction) -> bool`` is called from time to time (False
         cancels: ``Cancelled``). Returns (positions (n, 3) float64, stats) with the stats of
@@ -203,12 +190,10 @@ class ReducedSolver(_InBasis):
         basis, problem = self._basis, self._problem
         # A region bake's outside stays exactly at rest (where the reduced pose left it).
         held = np.setdiff1d(np.arange(n), basis.region) if len(basis.region) else None
-        return _on_full_mesh(_native.refine, basis.rest, F, problem["handles"], self._transforms,
-                             stiffness=problem["stiffness"], weights=problem["weights"], energy=problem["energy"],
+        return _on_full_mesh(_native.refine, basis.rest, F, self._transforms, initial=start, progress=progress,
                              bending=basis.bending, membrane=basis.membrane,
                              stiffness_weights=basis.stiffness_weights, max_stiffness=basis.max_stiffness,
-                             tolerance=tolerance, max_iterations=max_iterations, initial=start, progress=progress,
-                             held=held)
+                             held=held, **problem, **options)
 
     def objective(self, q):
         """The objective f(q) (ghost energy plus handle term, normalised frame) and its gradient
@@ -220,16 +205,12 @@ class ReducedSolver(_InBasis):
         self._native.reset()
 
 
-def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, energy=FULL_SOLVE_OPTIONS["energy"],
-               bending=FULL_SOLVE_OPTIONS["bending"], membrane=FULL_SOLVE_OPTIONS["membrane"], tolerance=FULL_SOLVE_OPTIONS["tolerance"],
-               max_iterations=FULL_SOLVE_OPTIONS["max_iterations"], initial=None, progress=None, stiffness_weights=None,
-               max_stiffness=FULL_SOLVE_OPTIONS["max_stiffness"], held=None):
+@_options.takes_options(FULL_SOLVE_OPTIONS)
+def solve_full(V, F, handles, transforms, weights=None, initial=None, progress=None, **options):
     """The reference: Newton's method on the full mesh for the reduced solver's objective.
 
-    V (n, 3), F (m, 3): the rest mesh; handles, transforms, weights, stiffness, energy as for
-    ReducedSolver, with ``bending`` and ``membrane`` the shells weights, ``stiffness_weights`` and
-    ``max_stiffness`` their painting per vertex as for ``bake``. ``held``: vertex indices that stay
-    exactly where the solve starts (at rest, or at ``initial``), as a region bake's outside does. From rest, large motions
+    V (n, 3), F (m, 3): the rest mesh; handles, transforms, weights, pull, energy as for
+    ReducedSolver, the material as for ``bake``. From rest, large motions
     are taken in load steps (the first turning each handle by at most 30° and moving its centre by
     at most a tenth of the bounding-box diagonal, later ones longer or shorter as the previous
     converged fast or slowly); with ``initial`` (n, 3) the solve starts there in one step
@@ -252,26 +233,21 @@ def solve_full(V, F, handles, transforms, stiffness=STIFFNESS, weights=None, ene
     turned a triangle over), "ratio" (the decrease over the model's, at α ≤ 1), "cg_iterations" (conjugate gradient iterations of the step; 0: a new
     factorisation solved it), "progress", "energy" and "gradient_norm" after it.
     """
-    return _on_full_mesh(_native.solve_full, V, F, handles, transforms, stiffness=stiffness, weights=weights,
-                         energy=energy, bending=bending, membrane=membrane, tolerance=tolerance,
-                         max_iterations=max_iterations, initial=initial, progress=progress,
-                         stiffness_weights=stiffness_weights, max_stiffness=max_stiffness, held=held)
+    return _on_full_mesh(_native.solve_full, V, F, transforms, handles=handles, weights=weights, initial=initial,
+                         progress=progress, **options)
 
 
-def _on_full_mesh(native, V, F, handles, transforms, *, stiffness, weights, energy, bending, membrane, tolerance,
-                  max_iterations, initial, progress, stiffness_weights, max_stiffness, held):
-    """``native`` (the core's solve_full or refine) called with solve_full's arguments checked."""
+def _on_full_mesh(native, V, F, transforms, *, handles, weights, initial, progress, **options):
+    """``native`` (the core's solve_full or refine) called with solve_full's arguments, the arrays
+    checked; the core checks the options."""
     V, F = _arrays.vertices(V), _arrays.faces(F)
     handles = _handles(handles)
-    max_iterations = _arrays.integer(max_iterations, "max_iterations")
+    if options.get("held") is not None:
+        options["held"] = _arrays.indices(options["held"], "held")
+    if options.get("stiffness_weights") is not None:
+        options["stiffness_weights"] = _arrays.stiffness_weights(options["stiffness_weights"], len(V))
     if progress is not None and not callable(progress):
         raise ValueError(f"progress: expected a callable or None, got {type(progress).__name__}")
     return native(V, F, handles, _transforms(transforms, len(handles)), _weights(weights, len(handles)),
-              _arrays.number(stiffness, "stiffness"),
-              initial=None if initial is None else _arrays.vertices(initial, "initial"),
-              progress=progress, energy=str(energy), bending=_arrays.number(bending, "bending"),
-              membrane=_arrays.number(membrane, "membrane"),
-              stiffness_weights=_arrays.stiffness_weights(stiffness_weights, len(V)),
-              max_stiffness=_arrays.number(max_stiffness, "max_stiffness"),
-              tolerance=_arrays.number(tolerance, "tolerance"), max_iterations=max_iterations,
-              held=[] if held is None else _arrays.indices(held, "held"))
+                  initial=None if initial is None else _arrays.vertices(initial, "initial"), progress=progress,
+                  **options)

@@ -49,7 +49,7 @@ class Player:
         self.pose = pose or posing.Pose(types.SimpleNamespace(scene=scene), obj)
         self.basis, self.handles = self.pose.basis, self.pose.handles
         dynamics = settings.dynamics
-        self.simulation = mdc.Simulation(self.basis, [h.indices for h in self.handles], stiffness=settings.stiffness,
+        self.simulation = mdc.Simulation(self.basis, [h.indices for h in self.handles], pull=settings.stiffness,
                                          period=dynamics.period, damping=dynamics.damping,
                                          fps=scene.render.fps / scene.render.fps_base, substeps=dynamics.substeps,
                                          weights=[h.weight for h in self.handles],

@@ -170,7 +170,7 @@ class MODAL_DEFORM_OT_solve(bpy.types.Operator):
 
     max_iterations: bpy.props.IntProperty(name="Max Iterations", default=posing.CONVERGE_MAX_ITERATIONS, min=1,
                                           description="BFGS iterations at most; fewer may leave the pose unfinished")
-    tolerance: bpy.props.FloatProperty(name="Tolerance", default=mdc.SOLVE_TOLERANCE, min=1e-12, max=0.5,
+    tolerance: bpy.props.FloatProperty(name="Tolerance", default=mdc.SOLVE_OPTIONS["tolerance"].default, min=1e-12, max=0.5,
                                        description="Stopping tolerance of the Gill-Murray-Wright test: smaller "
                                                    "solves more exactly and takes longer")
 
@@ -206,9 +206,9 @@ the "Modal Deform" shape key: the exact physically based shape, for a final fram
     bl_label = "Refine"
     bl_options = {"REGISTER", "UNDO"}
 
-    max_iterations: bpy.props.IntProperty(name="Max Iterations", default=mdc.FULL_SOLVE_MAX_ITERATIONS, min=1,
+    max_iterations: bpy.props.IntProperty(name="Max Iterations", default=mdc.FULL_SOLVE_OPTIONS["max_iterations"].default, min=1,
                                           description="Newton iterations at most; fewer may leave the pose unfinished")
-    tolerance: bpy.props.FloatProperty(name="Tolerance", default=mdc.FULL_SOLVE_OPTIONS["tolerance"], min=1e-12, max=0.5,
+    tolerance: bpy.props.FloatProperty(name="Tolerance", default=mdc.FULL_SOLVE_OPTIONS["tolerance"].default, min=1e-12, max=0.5,
                                        description="Factor by which the gradient must shrink: smaller solves more "
                                                    "exactly and takes longer")
 
