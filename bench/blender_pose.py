@@ -41,10 +41,11 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 # source tree's; two modal_deform packages in one Blender would register the core's types twice.
 sys.path.insert(0, str(ROOT / "blender_scripts"))
 sys.path.insert(0, str(ROOT / "bench"))
+sys.path.insert(0, str(ROOT / "tests"))
 from headless import (add_handle, bind_laplacian_deform, enable_addon,  # noqa: E402 (found through the lines above)
                       evaluated_positions)
-import subdivision  # noqa: E402 (the project's midpoint subdivision)
-MESHES = ROOT.parent / "shared" / "meshes"
+from support import SHARED_MESHES as MESHES  # noqa: E402
+from support import subdivision  # noqa: E402 (the project's midpoint subdivision, NumPy only)
 ADDON = "modal_deform"  # the add-on's module: bl_ext.<repository>.modal_deform when installed as an extension
 
 
@@ -126,7 +127,7 @@ def mesh_object(name, V, F):
 STEPS = ("controllers", "budget", "solve", "write", "tick", "evaluate", "iterations")
 #: Where the pose is shown while posing, with the posing display that shows it: the mesh as it is
 #: (no shape keys: the vertex positions); with "Basis" and "Modal Deform" keys, as a mesh posed and
-#: kept before has them, posed in a stand-in without shape keys (pose_displays.display's choice), or in
+#: kept before has them, posed in a stand-in without shape keys (pose.displays.display's choice), or in
 #: the "Modal Deform" key (the path such a mesh took before, and one whose other keys show takes).
 DISPLAYS = {"positions": "PositionsDisplay", "stand_in": "StandInDisplay", "shape_key": "ShapeKeyDisplay"}
 
@@ -139,10 +140,10 @@ def time_updates(obj, controller, updates, steps, display, draw=None):
     FrameBudget gives it), write (the pose written by the solver into Blender's array where the
     posing display named `display` shows it, and mesh.update()); then Blender's evaluation
     ("evaluate", view_layer.update()) and, given `draw`, what draw() takes ("draw")."""
-    posing, pose_displays, mdc = addon("posing", "pose_displays", "core")
+    posing, displays, mdc = addon("posing", "pose.displays", "core")
     pose = posing.Pose(bpy.context, obj)
     budget = mdc.FrameBudget(obj.modal_deform.budget)
-    shown = pose_displays.ShapeKeyDisplay(obj) if display == "ShapeKeyDisplay" else pose_displays.display(obj)
+    shown = displays.ShapeKeyDisplay(obj) if display == "ShapeKeyDisplay" else displays.display(obj)
     assert type(shown).__name__ == display, f"posed in a {type(shown).__name__}, not a {display}"
     size = max(obj.dimensions)
     start_matrix = controller.matrix_world.copy()
@@ -210,9 +211,9 @@ def time_shape_key_update(obj, block, repeats=10):
 
 def storage_figures(obj, folder):
     """Load time and file sizes of the stored basis; the cost of keeping it on the Object instead."""
-    pose_displays, storage = addon("pose_displays", "storage")
+    displays, storage = addon("pose.displays", "storage")
     figures = {}
-    state = pose_displays.ShapeKeyState(obj)
+    state = displays.ShapeKeyState(obj)
     key = state.ensure()
     figures["update_ms_basis_in_palette"] = time_shape_key_update(obj, key)
     obj["vectors_probe"] = np.frombuffer(obj.modal_deform.basis["vectors"], np.float32)

@@ -13,6 +13,7 @@ import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "python_addon"))
+sys.path.insert(0, str(ROOT / "tests"))  # the test-support package (subdivision, raw scans, poses)
 import package  # noqa: E402 (which extension zip serves which Python)
 RESULTS = ROOT / "bench" / "results"
 #: Posed meshes passed from one experiment to the next (accuracy -> blender -> renders); not committed.

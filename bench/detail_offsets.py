@@ -24,7 +24,7 @@ import shapes
 
 
 def rippled_tube(around=128, along=200, amplitude=0.06, waves=(24, 40)):
-    V, F = mdc.cylinder(around, along, 1.25, 10.0)
+    V, F = mdc.testing.cylinder(around, along, 1.25, 10.0)
     theta = np.arctan2(V[:, 1], V[:, 0])
     radial = amplitude * np.sin(waves[0] * theta) * np.sin(2 * np.pi * waves[1] * V[:, 2] / 10.0)
     V = V.copy()

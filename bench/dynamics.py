@@ -21,39 +21,17 @@ import time
 import numpy as np
 
 import modal_deform.core as mdc
-from common import ROOT, median_ms
+from common import median_ms
 from shapes import rigid_transform as rigid
-from subdivision import midpoint_subdivide
+from support.dynamics import AMPLITUDE, damped_oscillation, released  # noqa: F401
+from support import SHARED_MESHES as MESHES
+from support.subdivision import midpoint_subdivide
 
-MESHES = ROOT.parent / "shared" / "meshes"
 BAR = dict(modes=20, derivatives=30, ghost=300)
-AMPLITUDE = 0.01
-
-
-def damped_oscillation(trace):
-    """(period in frames, logarithmic decrement a period) of p_k = A r^k cos(θk + φ), from the
-    recurrence p_{k+1} = 2r cos θ p_k − r² p_{k−1} fitted by least squares."""
-    (a, b), *_ = np.linalg.lstsq(np.column_stack([trace[1:-1], trace[:-2]]), trace[2:], rcond=None)
-    r = np.sqrt(-b)
-    theta = np.arccos(a / (2 * r))
-    return float(2 * np.pi / theta), float(-np.log(r) * 2 * np.pi / theta)
-
-
-def released(basis, frames, **parameters):
-    """A free body released at rest from AMPLITUDE along its lowest flexible mode: the mode's
-    coordinate at the end of each frame."""
-    sim = mdc.Simulation(basis, [], **parameters)
-    mode = sim.lowest_mode
-    sim.set_state(AMPLITUDE * mode, np.zeros_like(mode))
-    trace = []
-    for _ in range(frames):
-        sim.step([])
-        trace.append(sim.state[0] @ mode)
-    return np.array(trace)
 
 
 def bar(quick):
-    V, F = mdc.bar(4, 4, 16, 1, 1, 4)
+    V, F = mdc.testing.bar(4, 4, 16, 1, 1, 4)
     basis = mdc.bake(V, F, **BAR)
     undamped = []
     for period, fps, substeps in [(12.0, 24.0, 2), (12.0, 24.0, 1), (24.0, 24.0, 1), (6.0, 60.0, 3), (4.0, 24.0, 2)]:

@@ -1,5 +1,5 @@
 """Multiresolution bake (issue 15): the shared dragon_vrip_res2 (100k vertices) midpoint-subdivided
-twice (about 1.6M vertices, bench/subdivision.py) baked on proxies of PROXIES vertices at the paper's
+twice (about 1.6M vertices, tests/support/subdivision.py) baked on proxies of PROXIES vertices at the paper's
 67 dimensions (20 modes + 47 derivatives, 1k ghost), in a fresh process per proxy size: bake
 seconds, peak resident memory, stored basis size, one update (new transforms, 10 BFGS iterations,
 positions), and the converged pose under the end-pull handles against the 100k dragon's own bake
@@ -19,7 +19,8 @@ _CHILD = textwrap.dedent("""
     sys.path.insert(0, {bench!r})
     import numpy as np
     import modal_deform.core as mdc
-    import common, shapes, subdivision
+    import common, shapes
+    from support import subdivision
 
     def peak_gb():
         return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20

@@ -1,5 +1,5 @@
 """The per-frame cache in headless Blender (issue 40): per frame, what playback costs (a cached frame
-read back, x = x̄ + U q into the display, playback_display.py; one simulation step live) and Blender's
+read back, x = x̄ + U q into the display, playback/frame_display.py; one simulation step live) and Blender's
 evaluation after it, the frames played (the display reading a stand-in) and, for a live step, stepped
 through with the timeline still (the display's attribute); and for FRAMES frames of the dragon (100k
 vertices), the cache's size and the .blend's against the same animation exported as a shape key per
@@ -75,10 +75,10 @@ def playback_handler(name):
     """The add-on's playback handler in bpy.app.handlers.`name`: the frame change's, and those Blender
     calls when the timeline starts or stops playing (Blender 4+), which headless frame changes do not
     call."""
-    return next(h for h in getattr(bpy.app.handlers, name) if h.__module__.endswith(".playback"))
+    return next(h for h in getattr(bpy.app.handlers, name) if h.__module__.endswith(".playback.timeline"))
 
 
-def timed_frames(obj, scene, playback, frame_cache, frames, stepping=False, rounds=ROUNDS, playing=True):
+def timed_frames(obj, scene, timeline, frame_cache, frames, stepping=False, rounds=ROUNDS, playing=True):
     """Handler, map and evaluation milliseconds over `frames`, each reached by scene.frame_set as
     the timeline reaches it, played (`playing`: between the calls of the add-on's playback handlers,
     the display reading a stand-in) or stepped through while still (the display's attribute):
@@ -114,16 +114,16 @@ def timed_frames(obj, scene, playback, frame_cache, frames, stepping=False, roun
             for index, frame in enumerate(frames):
                 scene.frame_set(frame)
                 returned = time.perf_counter()
-                assert obj.name not in playback.problems, playback.problems
+                assert obj.name not in timeline.problems, timeline.problems
                 figures["handler"][round_, index] = 1e3 * (clock["after"] - clock["before"])
                 figures["evaluate"][round_, index] = 1e3 * (returned - clock["after"])
                 if stepping:
-                    stats = playback.player(obj, scene).simulation.stats
+                    stats = timeline.player(obj, scene).simulation.stats
                     figures["step"][round_, index] = stats["ms"]
                     iterations.append(stats["iterations"])
                 q = frame_cache.get(obj).state(frame)[0]
                 start = time.perf_counter()
-                playback.player(obj, scene).positions(q, scratch)
+                timeline.player(obj, scene).positions(q, scratch)
                 figures["map"][round_, index] = 1e3 * (time.perf_counter() - start)
     finally:
         handlers.remove(before)
@@ -141,19 +141,19 @@ def timed_frames(obj, scene, playback, frame_cache, frames, stepping=False, roun
     return result
 
 
-def jump_forward(obj, scene, playback, frame_cache, frames):
+def jump_forward(obj, scene, timeline, frame_cache, frames):
     """Milliseconds per frame of a jump forward over `frames` frames simulated (the cache cut after
     its first frame, then the frame `frames` + 1 shown): each frame stepped from the one before at
     its own frame (set_frame), the last one mapped into the display."""
     cache = frame_cache.get(obj)
     cache.cut(cache.start + 1)
-    playback.set_frame(scene, cache.start + frames)
+    timeline.set_frame(scene, cache.start + frames)
     start = time.perf_counter()
-    playback.show(obj, scene)
+    timeline.show(obj, scene)
     return {"ms_per_frame": 1e3 * (time.perf_counter() - start) / frames, "frames": frames}
 
 
-def without_display(obj, playback, frame_cache, frames):
+def without_display(obj, timeline, frame_cache, frames):
     """Blender's evaluation of a copy of obj's mesh (which has no shape keys) on another object
     without the display's modifier (obj hidden), its vertex positions written from the cached
     frames: median milliseconds."""
@@ -163,7 +163,7 @@ def without_display(obj, playback, frame_cache, frames):
     copy = bpy.data.objects.new("Without the display", mesh)
     bpy.context.scene.collection.objects.link(copy)
     obj.hide_set(True)
-    player, cache = playback.player(obj, bpy.context.scene), frame_cache.get(obj)
+    player, cache = timeline.player(obj, bpy.context.scene), frame_cache.get(obj)
     evaluate = []
     for frame in frames:
         player.positions(cache.state(frame)[0], mesh_io.vertex_positions(mesh))
@@ -187,7 +187,7 @@ def main():
     args = arguments()
     blender_pose.ADDON = enable_addon().__name__
     blender_pose.clear_scene()
-    frame_cache, playback = blender_pose.addon("frame_cache", "playback")
+    frame_cache, timeline = blender_pose.addon("playback.frame_cache", "playback.timeline")
     name = "dragon_vrip_res4" if args.quick else "dragon_vrip_res2"
     obj, vertices, moving = blender_pose.posed_dragon(name, args.subdivide)
     settings = obj.modal_deform
@@ -211,7 +211,7 @@ def main():
     assert bpy.ops.modal_deform.bake_animation(frame_start=1, frame_end=frames) == {"FINISHED"}
     results["static_bake_seconds"] = time.perf_counter() - start
     results["static_cache_bytes"] = frame_cache.get(obj).nbytes()
-    results["static_read"] = timed_frames(obj, scene, playback, frame_cache, timed)
+    results["static_read"] = timed_frames(obj, scene, timeline, frame_cache, timed)
     with tempfile.TemporaryDirectory() as folder:
         if not args.no_sizes:
             results["blend_with_cache_bytes"] = saved_size(folder, "cache.blend")
@@ -221,15 +221,15 @@ def main():
 
         # Secondary motion: each frame simulated live from the one before, then read back.
         settings.dynamics.enabled = True
-        playback.set_frame(scene, 1)
-        playback.show(obj, scene)
-        results["dynamic_step"] = timed_frames(obj, scene, playback, frame_cache, timed, stepping=True)
-        results["dynamic_step_still"] = timed_frames(obj, scene, playback, frame_cache, timed, stepping=True,
+        timeline.set_frame(scene, 1)
+        timeline.show(obj, scene)
+        results["dynamic_step"] = timed_frames(obj, scene, timeline, frame_cache, timed, stepping=True)
+        results["dynamic_step_still"] = timed_frames(obj, scene, timeline, frame_cache, timed, stepping=True,
                                                      playing=False)
-        results["dynamic_read"] = timed_frames(obj, scene, playback, frame_cache, timed)
+        results["dynamic_read"] = timed_frames(obj, scene, timeline, frame_cache, timed)
         results["dynamic_cache_bytes_per_frame"] = frame_cache.get(obj).nbytes() / len(frame_cache.get(obj))
-        results["dynamic_jump"] = jump_forward(obj, scene, playback, frame_cache, len(timed))
-        results["without_display"] = without_display(obj, playback, frame_cache, timed)
+        results["dynamic_jump"] = jump_forward(obj, scene, timeline, frame_cache, len(timed))
+        results["without_display"] = without_display(obj, timeline, frame_cache, timed)
 
         if not args.no_sizes:
             # The static animation as a shape key per frame, as Bake Animation wrote it before the cache.

@@ -1,4 +1,4 @@
-"""Raw scans bake: a raw-scan-like mesh (bench/raw_scans.py: the shared dragon_vrip_res2
+"""Raw scans bake: a raw-scan-like mesh (tests/support/raw_scans.py: the shared dragon_vrip_res2
 midpoint-subdivided once, about 405k vertices, with every kind of scan damage) baked at the
 paper's 67 dimensions (20 modes + 47 derivatives, 1k ghost), each seed in a fresh process: wall
 time, peak resident memory, what the bake found. Targets (issue 15): at most 60 s within 4 GB.
@@ -16,7 +16,8 @@ _CHILD = textwrap.dedent("""
     sys.path.insert(0, {bench!r})
     import numpy as np
     import modal_deform.core as mdc
-    import raw_scans
+    import common  # puts the test-support package on sys.path
+    from support import raw_scans
     V, F = raw_scans.raw_scan({name!r}, levels={levels}, seed={seed})
     report = mdc.check(V, F)
     before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20

@@ -2,7 +2,7 @@
 Refine from the reduced pose.
 
 Meshes: the shared dragons at 23k (dragon_res3) and 100k (dragon_res2) vertices, and a
-raw-scan-like 23k dragon (bench/raw_scans.damaged, seed 0: slivers, needles, fins, debris).
+raw-scan-like 23k dragon (tests/support/raw_scans.damaged, seed 0: slivers, needles, fins, debris).
 Handles: the last 15% of the length at each end (1.5 units once scaled to a length of 10);
 stiffness 100. Poses: the far end turned about the long axis by 30, 90 and 170 degrees and moved
 by 9% of the length sideways and 4.5% up ("turn"), and bent about the up axis by 90 degrees
@@ -30,8 +30,8 @@ import numpy as np
 
 import common
 import modal_deform.core as mdc
-import raw_scans
 import shapes
+from support import raw_scans
 
 STIFFNESS = 100.0
 TURNS = (30, 90, 170)

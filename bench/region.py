@@ -13,8 +13,9 @@ import time
 import numpy as np
 
 import modal_deform.core as mdc
-from common import ROOT
-from subdivision import midpoint_subdivide
+import common  # noqa: F401 (puts the test-support package on sys.path)
+from support import SHARED_MESHES
+from support.subdivision import midpoint_subdivide
 
 RUNS = {"dense": 3, "proxy": 2}
 SIZES = {"modes": 15, "derivatives": 52, "ghost": 1000}
@@ -61,7 +62,7 @@ def whole_and_region(V, F, runs, proxy):
 
 def run(quick=False):
     name = "dragon_vrip_res4" if quick else "dragon_vrip_res2"
-    V, F = mdc.read_mesh(ROOT.parent / "shared" / "meshes" / f"{name}.ply.gz")
+    V, F = mdc.read_mesh(SHARED_MESHES / f"{name}.ply.gz")
     dense = whole_and_region(V, F, 1 if quick else RUNS["dense"], {"proxy": None})
     for _ in range(2):
         V, F = midpoint_subdivide(V, F)

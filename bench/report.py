@@ -559,7 +559,7 @@ def section_native(result):
 def section_raw_scan(result):
     p = result["parameters"]
     out = ["## Raw scans (issue 15)", "",
-           f"{p['mesh']} midpoint-subdivided {p['subdivisions']} time(s) and damaged by bench/raw_scans.py (every "
+           f"{p['mesh']} midpoint-subdivided {p['subdivisions']} time(s) and damaged by tests/support/raw_scans.py (every "
            f"kind of scan damage), baked with {p['modes']} modes + {p['derivatives']} derivatives and a "
            f"{p['ghost']}-vertex ghost, each seed in a fresh process. Targets: at most {p['targets']['seconds']:.0f} s "
            f"within {p['targets']['peak_gb']:.0f} GB.", ""]
@@ -578,7 +578,7 @@ def section_raw_scan(result):
 def section_multires(result):
     p, t = result["parameters"], result["parameters"]["targets"]
     out = ["## Multiresolution bake of a dense mesh (issue 15)", "",
-           f"{p['mesh']} midpoint-subdivided {p['subdivisions']} times (bench/subdivision.py), baked "
+           f"{p['mesh']} midpoint-subdivided {p['subdivisions']} times (tests/support/subdivision.py), baked "
            f"on a proxy with {p['modes']} modes + {p['derivatives']} derivatives and a {p['ghost']}-vertex ghost, "
            "each proxy size in a fresh process. Update: new transforms, 10 BFGS iterations and the fine positions, "
            "median over the end-pull animation. RMS: the converged end-pull pose against the dragon's own bake on "
@@ -753,7 +753,7 @@ def section_refine(result):
     p = result["parameters"]
     out = ["## Refine and the full solve on scans (issue 26)", "",
            "Newton on the full mesh (`mdc.solve_full`, tolerance "
-           f"{p['tolerance']:g} on the gradient norm) for the dragons and a raw-scan-like dragon (bench/raw_scans.py, "
+           f"{p['tolerance']:g} on the gradient norm) for the dragons and a raw-scan-like dragon (tests/support/raw_scans.py, "
            f"seed 0), handles on the 15% at each end, stiffness {p['stiffness']:g}: the far end turned about the long "
            "axis and moved by 9% of the length sideways and 4.5% up (turn), or bent about the up axis (bend). "
            f"Refine: the reduced pose ({p['basis']}, BFGS to convergence), then `ReducedSolver.refine` from it; gap "
@@ -813,8 +813,8 @@ def section_playback(result):
            f"{runs[0]['dynamic_step'].get('rounds', 1)} rounds of the same frames (a live step's frames simulated "
            "again each round: a neighbour's load on the machine left out): \"handler\" is the frame handler's work "
            "for the object "
-           "(playback.show: the checks, the cache read or the simulation step, x̄ + U q into the display, "
-           "playback_display.py), of it in brackets \"map\", x̄ + U q alone (the part that grows with the mesh), "
+           "(playback.timeline.show: the checks, the cache read or the simulation step, x̄ + U q into the display, "
+           "playback/frame_display.py), of it in brackets \"map\", x̄ + U q alone (the part that grows with the mesh), "
            "\"evaluate\" Blender's evaluation after it, to the return of frame_set. The frames are played: the "
            "add-on's playback handlers called around them, the display reads a stand-in mesh whose positions are "
            "the frame; \"timeline still\" steps the same frames with the timeline still (scrubbing), where the "

@@ -1,4 +1,4 @@
-"""The benchmark's test shapes and poses, in one place for the benchmarks and any test that wants them.
+"""The benchmark's test shapes and poses, in one place for the benchmarks.
 
 Generated shapes in the style of Botsch & Sorkine's linear-deformation benchmarks ("On Linear
 Variational Surface Deformation Methods", 2008), scaled so that the longest bounding-box edge is
@@ -6,8 +6,10 @@ Variational Surface Deformation Methods", 2008), scaled so that the longest boun
 classic motions (lift, bend, twist) and larger ones. The shared scans (bunny, dragons) are read in
 place with a generic pose: one end held, the other pulled and turned.
 
-The generated shapes and their first poses mirror tests/cpp/test_posing_accuracy.cpp (bumpy plane
-lifted in the middle, rods bent and twisted by their ends); change both together.
+The meshes are the core's test shapes (mdc.testing, the C++ tests' own primitives); the first
+poses follow tests/cpp/test_posing_accuracy.cpp, the reference (bumpy plane lifted in the middle,
+rods bent and twisted by their ends). The shared meshes, rigid transforms and the scans' end-pull
+pose come from the test-support package (tests/support), which this module puts on sys.path.
 
     shape = shapes.make("bar")
     for pose in shape.poses:
@@ -16,29 +18,19 @@ lifted in the middle, rods bent and twisted by their ends); change both together
 """
 import dataclasses
 import pathlib
-from typing import Callable
+import sys
 
 import numpy as np
 
 import modal_deform.core as mdc
 
-SHARED_MESHES = pathlib.Path(__file__).resolve().parents[2] / "shared" / "meshes"
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests"))
+from support import SCAN_FILES as _SCAN_FILES, SHARED_MESHES  # noqa: E402,F401
+from support.poses import Pose, end_handles, end_pull, rigid_transform, translation  # noqa: E402,F401
 
 #: Generated shapes and the shared scans, in the order tables list them.
 GENERATED = ("bumpy_plane", "cylinder", "bar")
 SCANS = ("bunny", "dragon_res4", "dragon_res3", "dragon_res2")
-_SCAN_FILES = {"bunny": "bunny.obj.gz", "dragon_res4": "dragon_vrip_res4.ply.gz",
-               "dragon_res3": "dragon_vrip_res3.ply.gz", "dragon_res2": "dragon_vrip_res2.ply.gz"}
-
-
-@dataclasses.dataclass(frozen=True)
-class Pose:
-    """A motion of the handles: ``at(t)`` the transforms (one 4x4 per handle, mesh units) a
-    fraction t in [0, 1] of the way from rest; reached in ``frames`` steps, as an animation."""
-    name: str
-    description: str
-    at: Callable[[float], list]
-    frames: int
 
 
 @dataclasses.dataclass(frozen=True)
@@ -54,25 +46,6 @@ class Shape:
 
     def pose(self, name):
         return next(p for p in self.poses if p.name == name)
-
-
-def rigid_transform(axis, angle, centre, t=(0.0, 0.0, 0.0)):
-    """The 4x4 transform x -> R (x - centre) + centre + t, R the rotation by ``angle`` (radians)
-    about ``axis``."""
-    axis = np.asarray(axis, dtype=np.float64)
-    axis = axis / np.linalg.norm(axis)
-    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-    R = np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K  # Rodrigues
-    T = np.eye(4)
-    T[:3, :3] = R
-    T[:3, 3] = np.asarray(centre) + np.asarray(t) - R @ np.asarray(centre)
-    return T
-
-
-def translation(t):
-    T = np.eye(4)
-    T[:3, 3] = t
-    return T
 
 
 def rod_end(length, axis, bend, twist):
@@ -98,7 +71,7 @@ def _rod_poses(length, axis, poses):
 def bumpy_plane(n=199):
     """Bumpy plane, 10 by 10 with 12 bumps ((n+1)² vertices, 40k by default): the border held,
     a disc of radius 1 in the middle moved."""
-    V, F = mdc.bumpy_plane(n, 10.0, 12, 1.0)
+    V, F = mdc.testing.bumpy_plane(n, 10.0, 12, 1.0)
     r = np.hypot(V[:, 0], V[:, 1])
     handles = [np.flatnonzero(np.abs(V[:, :2]).max(axis=1) > 5 - 1e-9), np.flatnonzero(r < 1)]
     centre = V[handles[1]].mean(axis=0)
@@ -126,7 +99,7 @@ def _rod_handles(V, length):
 def cylinder(around=64, along=80):
     """Open tube of radius 1.25 and length 10 (around x (along+1) vertices, 5k by default), its
     end rings as handles."""
-    V, F = mdc.cylinder(around, along, 1.25, 10.0)
+    V, F = mdc.testing.cylinder(around, along, 1.25, 10.0)
     deg = np.pi / 180
     poses = _rod_poses(10.0, (0, 0), (
         ("lift", "far ring shifted sideways by 2.5", 0, 0, 2.5, 3),
@@ -140,7 +113,7 @@ def cylinder(around=64, along=80):
 
 def bar(nx=12, nz=120):
     """Closed 1 x 1 x 10 box (about 6k vertices by default), its end faces as handles."""
-    V, F = mdc.bar(nx, nx, nz, 1.0, 1.0, 10.0)
+    V, F = mdc.testing.bar(nx, nx, nz, 1.0, 1.0, 10.0)
     deg = np.pi / 180
     poses = _rod_poses(10.0, (0.5, 0.5), (
         ("lift", "far end shifted sideways by 2", 0, 0, 2.0, 3),
@@ -151,31 +124,6 @@ def bar(nx=12, nz=120):
         ("twist_large", "twisted by 180 deg (the reference buckles)", 0, 180 * deg, 0, 6),
     ))
     return Shape("bar", V, F, _rod_handles(V, 10.0), poses, view=(1.0, -0.35, -0.3))
-
-
-def end_handles(V, fraction):
-    """Handles on the `fraction` of a scan's length at each end of its longest bounding-box axis
-    (low end first); with the (long, side, up) axes as unit vectors, the length and the high end's
-    centre."""
-    lo, hi = V.min(axis=0), V.max(axis=0)
-    a = int(np.argmax(hi - lo))
-    length = hi[a] - lo[a]
-    handles = [np.flatnonzero(V[:, a] < lo[a] + fraction * length),
-               np.flatnonzero(V[:, a] > hi[a] - fraction * length)]
-    axes = np.eye(3)[[a, (a + 1) % 3, (a + 2) % 3]]
-    return handles, axes, length, V[handles[1]].mean(axis=0)
-
-
-def end_pull(V):
-    """Handles of a scan along its longest bounding-box axis: the 10% at its low end held, the
-    10% at its high end; the pose turns that end by 0.6 rad about the up axis and moves it by a
-    quarter of the length sideways (as bench/bench_solve.cpp poses the dragon)."""
-    handles, (_, side, up), length, centre = end_handles(V, 0.1)
-    axis, shift = up, 0.25 * length * side
-
-    def at(t):
-        return [np.eye(4), rigid_transform(axis, 0.6 * t, centre, t * shift)]
-    return handles, (Pose("pull", "far 10% turned by 0.6 rad and moved by a quarter of the length", at, 6),)
 
 
 def end_turns(V, turns=(30, 90, 170), bend=90):

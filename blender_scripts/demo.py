@@ -68,12 +68,12 @@ def subdivided_suzanne(levels):
     return suzanne
 
 
-def interactive_updates(posing, pose_displays, obj, count):
+def interactive_updates(posing, displays, obj, count):
     """Time `count` updates of the interactive pose (what each timer tick of the Pose operator does:
     controllers -> solver within its budget -> shape key) after the controllers were placed: the
     first updates solve toward them, the later ones find the pose converged."""
     pose = posing.Pose(bpy.context, obj)
-    shown = pose_displays.display(obj)
+    shown = displays.display(obj)
     times = []
     for _ in range(count):
         start = time.perf_counter()
@@ -113,7 +113,7 @@ def curled_finger(mdc, name, painted, x):
     """A tube along z (a finger 2 long) at `x`, held at its base ring and its tip ring curled by 60°
     about each knuckle (about the y axis, seen from the camera); with `painted`, a Stiffness Group
     makes its three phalanges 100 times stiffer than its two knuckles. Returns the object, posed."""
-    V, F = mdc.cylinder(24, 60, 0.16, 2.0)
+    V, F = mdc.testing.cylinder(24, 60, 0.16, 2.0)
     V[:, 0] += x
     obj = bpy.data.objects.new(name, bpy.data.meshes.new(name))
     obj.data.from_pydata([tuple(v) for v in V], [], [tuple(f) for f in F])
@@ -194,8 +194,8 @@ def painted_row(mdc, posing, suzanne, V, output):
 def main():
     args = arguments()
     addon = enable_addon().__name__
-    posing, pose_displays, mesh_io, mdc = (importlib.import_module(f"{addon}.{name}")
-                                           for name in ("posing", "pose_displays", "mesh_io", "core"))
+    posing, displays, mesh_io, mdc = (importlib.import_module(f"{addon}.{name}")
+                                      for name in ("posing", "pose.displays", "mesh_io", "core"))
     output = pathlib.Path(args.output).resolve()
     output.mkdir(parents=True, exist_ok=True)
 
@@ -222,7 +222,7 @@ def main():
     head.controller.matrix_world = transform @ head.controller.matrix_world
     bpy.context.view_layer.update()
 
-    times = interactive_updates(posing, pose_displays, suzanne, 30)
+    times = interactive_updates(posing, displays, suzanne, 30)
     print(f"interactive pose: {np.median(times):.1f} ms per update (median of {len(times)}; first {times[0]:.1f} ms; "
           f"budget {suzanne.modal_deform.budget:.0f} ms for the solver)")
     assert bpy.ops.modal_deform.solve() == {"FINISHED"}
@@ -265,7 +265,7 @@ def main():
     print(f"wrote {output / 'demo.blend'}")
 
     start = time.perf_counter()
-    modules = (importlib.import_module(f"{addon}.{name}") for name in ("frame_cache", "posing"))
+    modules = (importlib.import_module(f"{addon}.{name}") for name in ("playback.frame_cache", "posing"))
     strip = demo_dynamics.secondary_motion(tuple(modules), output, args.dynamics_subdivisions, args.width // 2)
     print(f"rendered {strip} (secondary motion) in {time.perf_counter() - start:.1f} s")
 

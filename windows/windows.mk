@@ -21,7 +21,8 @@
 WIN         := build-windows
 WIN_PYTHONS := 3.11 3.13
 MINGW       := x86_64-w64-mingw32
-PACKAGES    += g++-mingw-w64-x86-64-posix binutils-mingw-w64-x86-64 mingw-w64-tools libz-mingw-w64-dev wine64
+# The Debian packages of the cross-build and Wine (the Makefile adds them to PACKAGES).
+WIN_PACKAGES := g++-mingw-w64-x86-64-posix binutils-mingw-w64-x86-64 mingw-w64-tools libz-mingw-w64-dev wine64
 # SuiteSparse's source at the version of Debian 12's libsuitesparse-dev, which the Linux wheels link.
 SUITESPARSE_DEB := 1:5.12.0+dfsg-2
 SUITESPARSE_SRC := $(WIN)/src/SuiteSparse-5.12.0
@@ -63,7 +64,6 @@ PIP_WINDOWS  = $(HOST_PYTHON) -m pip install -q --disable-pip-version-check --no
 .PHONY: wheels-windows test-windows test-windows-packaging test-windows-bpy bench-windows
 wheels-windows: $(WIN_PYTHONS:%=wheel-windows-%)
 .PRECIOUS: $(WIN)/python-%/stamp
-addon: wheels-windows
 
 # SuiteSparse from Debian's source package, checked by apt against Debian's signed Sources lists.
 APT_SOURCES = -o Dir::Etc::SourceList=/dev/null -o Dir::Etc::SourceParts=$(CURDIR)/$(WIN)/apt/sources.list.d \
@@ -216,7 +216,6 @@ test-windows-bpy-%: win-bpy-env-%
 # wheel), one after the other: JSON lines in bench/results/windows.jsonl, with how far the two
 # bases are apart (bench/platforms.py).
 BENCH_WINDOWS_MODELS := dragon_res3 dragon_res2
-bench: bench-windows
 bench-windows: $(BENCH_WINDOWS_MODELS:%=bench-windows-%)
 bench-windows-%: build win-install-3.11
 	@mkdir -p bench/results

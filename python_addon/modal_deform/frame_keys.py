@@ -1,7 +1,7 @@
 """An animation as shape keys: one key per frame, keyed to show on its frame only, so the result
 plays back and renders without the add-on. Frame f shows shape key "Modal Deform f" (value 1 at f, 0
 at f - 1 and f + 1, constant interpolation). The refined animation bake (jobs.AnimationJob) writes
-them, from its own solves or from the per-frame cache (frame_cache.py).
+them, from its own solves or from the per-frame cache (playback/frame_cache.py).
 """
 import re
 

@@ -1,7 +1,7 @@
 """numpy arrays from a Blender mesh, and shape keys written back.
 
 Positions are the base mesh's (``vertices.co``), the rest state every bake and pose starts from.
-Only an interactive pose writes them, and puts them back when it ends (pose_displays.PositionsDisplay).
+Only an interactive pose writes them, and puts them back when it ends (pose.displays.PositionsDisplay).
 """
 import ctypes
 import sys

@@ -5,18 +5,19 @@ playback.
 Per update: controller matrices → set_transforms → solve (within a time budget) →
 positions(out=Blender's own array: a shape key's or the vertex positions) → mesh.update().
 
-Where the interactive pose shows the pose while it runs is a display (pose_displays.py); meshes
-written mid-pose are repaired by pose_recovery.py. The interactive pose under way, the add-on's one
+Where the interactive pose shows the pose while it runs is a display (pose/displays.py); meshes
+written mid-pose are repaired by pose/recovery.py. The interactive pose under way, the add-on's one
 piece of posing state, is `running` here.
 """
 import numpy as np
 
 from . import core as mdc
-from . import handles, mesh_io, playback_display, storage
+from . import handles, mesh_io, storage
+from .playback import frame_display
 
 POSE_KEY = "Modal Deform"
-#: The interactive pose under way, or None: ops_pose's operator, set while it runs. Besides .pose
-#: (its Pose) it offers keep_in_shape_key(), request_end(how) and end(context, how).
+#: The interactive pose under way, or None: the Pose operator (pose/operators.py), set while it
+#: runs. Besides .pose (its Pose) it offers keep_in_shape_key(), request_end(how) and end(context, how).
 running = None
 #: The most BFGS iterations one update takes however much of its time budget is left: far more
 #: than a budget of milliseconds allows (bench/results/table1.json, "ms_per_iteration"), so the
@@ -101,7 +102,7 @@ def pose_key(obj):
     names of the keys created here)."""
     block, created = mesh_io.shape_key(obj, POSE_KEY)
     block.value, block.mute = 1.0, False
-    playback_display.remove(obj)
+    frame_display.remove(obj)
     return block, created
 
 

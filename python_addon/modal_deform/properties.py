@@ -77,7 +77,7 @@ class ModalDeformBakeStatus(bpy.types.PropertyGroup):
 
 # Secondary motion and the per-frame cache (issue 40): frame_cache.py, playback.py, ops_dynamics.py.
 def _dynamics_changed(dynamics, context):
-    from . import frame_cache
+    from .playback import frame_cache
     frame_cache.settings_changed(dynamics.id_data)
 
 

@@ -25,7 +25,7 @@ import bpy
 import numpy as np
 
 from . import core as mdc
-from . import mesh_io
+from . import app_handlers, mesh_io
 
 PREFIX = ".Modal Deform "
 _SHAPES = "shapes"
@@ -219,7 +219,6 @@ def ready_basis(obj):
     return load(obj)
 
 
-@bpy.app.handlers.persistent
 def _forget_geometry(scene, depsgraph):
     for update in depsgraph.updates:
         if update.is_updated_geometry and isinstance(update.id, bpy.types.Mesh):
@@ -229,19 +228,19 @@ def _forget_geometry(scene, depsgraph):
                 del _group_hashes[key]
 
 
-@bpy.app.handlers.persistent
 def _forget_everything(*args):
     _bases.clear()
     _fingerprints.clear()
     _group_hashes.clear()
 
 
+_HANDLERS = (("depsgraph_update_post", _forget_geometry), ("load_post", _forget_everything))
+
+
 def register():
-    bpy.app.handlers.depsgraph_update_post.append(_forget_geometry)
-    bpy.app.handlers.load_post.append(_forget_everything)
+    app_handlers.register(_HANDLERS)
 
 
 def unregister():
-    bpy.app.handlers.depsgraph_update_post.remove(_forget_geometry)
-    bpy.app.handlers.load_post.remove(_forget_everything)
+    app_handlers.unregister(_HANDLERS)
     _forget_everything()

@@ -7,7 +7,8 @@ import textwrap
 
 import bpy
 
-from . import frame_cache, handles, ops_preview, playback, posing, storage
+from . import handles, ops_preview, posing, storage
+from .playback import frame_cache, timeline
 
 
 # Width of a character of the interface font at scale 1, in pixels, for wrapping text (a little above
@@ -224,7 +225,7 @@ class VIEW3D_PT_modal_deform_dynamics(_Panel, bpy.types.Panel):
         except ValueError as error:
             cache, problem = None, str(error)
         else:
-            problem = playback.problems.get(obj.name)
+            problem = timeline.problems.get(obj.name)
         if cache is None or not len(cache):
             wrapped_label(box, context, "Cache empty: play or Bake", icon="INFO")
         else:

@@ -100,6 +100,8 @@ def main():
     if arguments.blend:
         bpy.ops.wm.open_mainfile(filepath=str(arguments.blend))
     sys.argv = [str(arguments.script), *argv[split:]]
+    # The test-support package and the script's folder, as support.in_blender gives the app.
+    sys.path[:0] = [str(pathlib.Path(__file__).resolve().parents[1]), str(arguments.script.resolve().parent)]
     runpy.run_path(str(arguments.script), run_name="__main__")
 
 

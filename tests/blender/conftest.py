@@ -3,31 +3,33 @@
 Which Blender: the environment variable BLENDER_PYTHON names the Python of a virtual environment
 holding `bpy` (Blender 4.2+ as a module; `make test-bpy-4.5`, `make test-bpy-5.0`); without it,
 the Blender app on PATH (Debian's 3.4.1; `make test-blender`).
-- App: `blender -b [file] --factory-startup --python-exit-code 1 --python SCRIPT -- ARGS`; the
-  scripts enable the add-on from the source tree (the ADDON_PATH environment variable).
+- App: `blender -b [file] --factory-startup --python-exit-code 1 --python SCRIPT -- ARGS`, after a
+  --python-expr that makes the test-support package importable (support.in_blender); the scripts
+  enable the add-on from the source tree (support.blender.enable_addon).
 - bpy: bpy_session.py runs the script after installing the extension zip from dist/ (`make addon`)
   with Blender's installer, in a session that sees neither the source tree's add-on nor the build
-  machine's libraries: no ADDON_PATH, PYTHONPATH unset, LD_LIBRARY_PATH empty, user folders in the
+  machine's libraries: PYTHONPATH unset, LD_LIBRARY_PATH empty, user folders in the
   test's temporary folder.
 - Windows bpy under Wine (`make test-windows-bpy-5.3`): BLENDER_PYTHON is
   tests/windows/wine_python.py and WINDOWS_PYTHON the python.exe of the Windows bpy environment;
   the Windows zips are installed.
-A script signals failure by raising (exit code 1).
+A script fails by raising (exit code 1) and passes by running to its end: the tests read its output
+only for what it reports.
 """
 import os
 import pathlib
 import subprocess
-import sys
 
 import pytest
+
+import package
+import support
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SCRIPTS = pathlib.Path(__file__).resolve().parent / "scripts"
 BLENDER_PYTHON = os.environ.get("BLENDER_PYTHON")
 WINDOWS_PYTHON = os.environ.get("WINDOWS_PYTHON")
 DIST = pathlib.Path(os.environ.get("MODAL_DEFORM_DIST", ROOT / "dist"))
-sys.path.insert(0, str(ROOT / "python_addon"))
-import package  # noqa: E402
 
 
 def built(pattern):
@@ -88,8 +90,8 @@ def run_blender(tmp_path, extension_zip):
             base.update(LD_LIBRARY_PATH="", BLENDER_USER_RESOURCES=str(tmp_path / "blender_user"))
         else:
             command = ["blender", "-b"] + ([str(blend)] if blend is not None else [])
-            command += ["--factory-startup", "--python-exit-code", "1", "--python", str(script), "--", *map(str, args)]
-            base = dict(os.environ, ADDON_PATH=str(ROOT / "python_addon"))
+            command += ["--factory-startup", "--python-exit-code", "1", *support.in_blender(script), "--", *map(str, args)]
+            base = dict(os.environ)
         environment = dict(base, TEST_TMP=str(tmp_path), **(env or {}))
         result = subprocess.run(command, capture_output=True, text=True, timeout=timeout, env=environment, cwd=tmp_path)
         if check:

@@ -185,8 +185,7 @@ def test_install_enable_disable_enable(run_blender, extension_zip, tmp_path):
     else:
         zip_path, user_folder = built(package.legacy_zip_name()), tmp_path / "user_scripts"
         env = {"BLENDER_USER_SCRIPTS": str(user_folder)}
-    result = run_blender("install_enable_disable.py", zip_path, user_folder, env=env, addon=False)
-    assert "INSTALL_OK" in result.stdout
+    run_blender("install_enable_disable.py", zip_path, user_folder, env=env, addon=False)
 
 
 @pytest.mark.skipif(not BLENDER_PYTHON, reason="extensions are Blender 4.2+")
@@ -200,7 +199,6 @@ def test_the_other_pythons_and_the_other_platforms_extensions_are_refused(run_bl
     unexplained = []
     for blenders in others:
         result = run_blender("install_refused.py", zip_for(blenders, platform), addon=False)
-        assert "REFUSED" in result.stdout, result.stdout
         bounds = "|".join(re.escape(v) for v in (EXTENSIONS[blenders].blender_min, EXTENSIONS[blenders].blender_max) if v)
         if not re.search(r"This Blender version \([\d.]+\) (doesn't meet the minimum supported version|must be "
                          rf"less than the maximum version) \(({bounds})\)", result.stdout):
@@ -208,7 +206,6 @@ def test_the_other_pythons_and_the_other_platforms_extensions_are_refused(run_bl
     (own,) = [blenders for blenders, extension in EXTENSIONS.items() if extension.python == python]
     (other_platform,) = set(package.PLATFORMS) - {platform}
     result = run_blender("install_refused.py", zip_for(own, other_platform), addon=False)
-    assert "REFUSED" in result.stdout, result.stdout
     if package.PLATFORMS[other_platform].manifest not in result.stdout:
         unexplained.append(result.stdout)
     if unexplained and WINDOWS_PYTHON:

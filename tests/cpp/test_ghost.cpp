@@ -288,7 +288,7 @@ TEST(Ghost, MessyInputGivesACleanGhost) {
 
 // A 30 by 30 grid of side 1 with a fin of no thickness standing on its middle row: 3 rows of
 // quads, 0.003 high each (a tenth of the grid's spacing), on the same vertices on both sides, cut
-// along one diagonal on the front and the other on the back. So bench/subdivision.split_edges cuts
+// along one diagonal on the front and the other on the back. So tests/support/subdivision.split_edges cuts
 // the two copies of a scan's double-sheet face, and so the dragon refined to 3.2M vertices is full
 // of them. (#V = 961 grid vertices, then the fin's, row after row.)
 TriangleMesh grid_with_a_fin(int* first_fin_vertex) {

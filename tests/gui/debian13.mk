@@ -12,9 +12,10 @@ DEBIAN13_PACKAGES := blender xvfb xauth python3-numpy x11-apps imagemagick
 DEBIAN13_RECIPE   := mmdebstrap --mode=root --variant=minbase --include=$(subst $(space),$(comma),$(DEBIAN13_PACKAGES)) \
 	trixie $(DEBIAN13_ROOT).new $(DEBIAN13_MIRROR)
 
-# Every `make deps` installs mmdebstrap: a target-specific addition would be lost when deps was
-# already made for another target of the same make.
-PACKAGES += mmdebstrap
+# The host's package that makes the root. The Makefile adds it to PACKAGES, so every `make deps`
+# installs it: a target-specific addition would be lost when deps was already made for another
+# target of the same make.
+DEBIAN13_HOST_PACKAGES := mmdebstrap
 debian13-root: deps
 	@test "$$(cat $(DEBIAN13)/recipe 2>/dev/null)" = "$(DEBIAN13_RECIPE)" || { \
 		rm -rf $(DEBIAN13_ROOT) $(DEBIAN13_ROOT).new $(DEBIAN13)/recipe && mkdir -p $(DEBIAN13) \

@@ -11,6 +11,8 @@ import subprocess
 
 import pytest
 
+import support
+
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SCRIPTS = pathlib.Path(__file__).resolve().parent / "scripts"
 XVFB = ["xvfb-run", "-a", "-s", "-screen 0 1280x800x24"]
@@ -23,7 +25,7 @@ LEGACY_ZIP = "modal_deform-*-legacy-linux_x64.zip"
 
 def debian12():
     """Debian 12's Blender 3.4.1 app with the add-on of the source tree."""
-    return [], dict(ADDON_PATH=str(ROOT / "python_addon"))
+    return [], {}
 
 
 def debian13():
@@ -41,7 +43,7 @@ def debian13():
                                   install], capture_output=True, env=env, check=True, timeout=300)
     [addons] = home.glob(".config/blender/*/scripts/addons")
     assert list((addons / "modal_deform").glob("_native.cpython-313-*.so")), "the legacy zip has no core for 3.13"
-    return IN_DEBIAN13, dict(ADDON_PATH=str(addons), HOME=str(home), MODAL_DEFORM_GRAB="x11")
+    return IN_DEBIAN13, dict(HOME=str(home), MODAL_DEFORM_GRAB="x11")
 
 
 @pytest.fixture(scope="module", params=[debian12, debian13], ids=lambda window: window.__name__)
@@ -65,7 +67,7 @@ def run_script(window, script):
     wrote none, failed a step or printed a Python traceback (a panel's draw() that raises only prints)."""
     prefix, env, artefacts = window
     (artefacts / "result.json").unlink(missing_ok=True)
-    command = prefix + XVFB + ["blender", "--factory-startup", "--enable-event-simulate", "--python", str(script),
+    command = prefix + XVFB + ["blender", "--factory-startup", "--enable-event-simulate", *support.in_blender(script),
                                "--", str(artefacts)]
     run = subprocess.run(command, capture_output=True, text=True, timeout=900, env=env, cwd=artefacts)
     output = f"{run.stdout[-4000:]}\n{run.stderr[-4000:]}"

@@ -1,11 +1,7 @@
-"""Shared fixtures: the scanned meshes from ../shared/meshes and generated shapes."""
-import pathlib
-
+"""Shared fixtures: the scanned meshes from ../shared/meshes, read once a session."""
 import pytest
 
-import modal_deform.core as mdc
-
-SHARED_MESHES = pathlib.Path(__file__).resolve().parents[2].parent / "shared" / "meshes"
+from support.meshes import read_shared
 
 
 @pytest.fixture(scope="session")
@@ -15,7 +11,7 @@ def shared_mesh():
 
     def read(name):
         if name not in cache:
-            cache[name] = mdc.read_mesh(SHARED_MESHES / name)
+            cache[name] = read_shared(name)
         return cache[name]
 
     return read

@@ -17,7 +17,7 @@ def side_by_side(first, second, offset):
 
 @pytest.fixture(scope="module")
 def two_tubes():
-    tube = mdc.cylinder(14, 6, 0.5, 2.0)
+    tube = mdc.testing.cylinder(14, 6, 0.5, 2.0)
     return side_by_side(tube, tube, [3.0, 0.0, 0.0])
 
 
@@ -188,7 +188,7 @@ def test_the_papers_pairs_give_its_67_dimensions(two_tubes):
     modes give 78 pairs, so 52 derivatives make its 67-dimensional basis; pairs of flexible modes
     only (rotation_pairs=False, the rule before) are 45. Rotations of two components do not pair
     (their derivative is zero), so two tubes drop no column."""
-    tube = mdc.cylinder(14, 6, 0.5, 2.0)
+    tube = mdc.testing.cylinder(14, 6, 0.5, 2.0)
     basis = mdc.bake(*tube, modes=15, derivatives=52, ghost=60)
     assert (basis.dimension, basis.num_dropped) == (67, 0)
     with pytest.raises(ValueError, match="derivatives: 52 asked for, but the 9 modes .* only 45 pairs"):
@@ -240,7 +240,7 @@ def test_one_bar_runs_forward_through_the_stages(on_proxy):
     """The stages come in the order of BAKE_STAGES (the native core's list), so the bar made of
     them only moves forward, to the end: on a dense mesh it fell back to 0 during the prolongation,
     and jumped to the ghost and back while the ordering waited for it."""
-    V, F = mdc.bumpy_plane(40)
+    V, F = mdc.testing.bumpy_plane(40)
     calls = []
     basis = mdc.bake(V, F, modes=10, derivatives=4, ghost=100, proxy=400 if on_proxy else None, proxy_above=1000,
                      progress=lambda stage, fraction: calls.append((stage, fraction)))

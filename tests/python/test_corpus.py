@@ -35,7 +35,7 @@ def finite(*arrays):
 # --- Meshes ------------------------------------------------------------------------------------
 
 def grid():
-    return mdc.grid(3, 3)
+    return mdc.testing.grid(3, 3)
 
 
 def with_vertices(V, F, extra):
@@ -103,7 +103,7 @@ def sliver_flap(height):
 
 def inner_sliver(height):
     """A wavy 6x6 grid whose face 30 has its third vertex `height` above its first edge's middle."""
-    V, F = mdc.grid(6, 6, 2.0, 2.0)
+    V, F = mdc.testing.grid(6, 6, 2.0, 2.0)
     V = V.copy()
     V[:, 2] = 0.1 * np.sin(3 * V[:, 0]) * np.cos(2 * V[:, 1])
     p, q, r = F[30]
@@ -176,7 +176,7 @@ MESHES = {
     # Three zero modes from the cones' relative rotation: the bake deflates them and solves again.
     "non-manifold vertex": (two_fans_at_a_vertex, WORKS, {}),
     "open boundary": (grid, WORKS, {}),
-    "closed surface": (lambda: mdc.bar(1, 1, 2), WORKS, {}),
+    "closed surface": (lambda: mdc.testing.bar(1, 1, 2), WORKS, {}),
     "many components (debris)": (debris, WORKS, {}),
     "inverted faces": (flipped(1), WORKS, {}),
     "inconsistently oriented faces": (flipped(2), WORKS, {}),
@@ -361,7 +361,7 @@ def test_bake_option_case(case):
 
 @pytest.fixture(scope="module")
 def tube():
-    V, F = mdc.cylinder(8, 4, radius=0.5, length=2.0)
+    V, F = mdc.testing.cylinder(8, 4, radius=0.5, length=2.0)
     return V, F, mdc.bake(V, F, modes=12, derivatives=8, ghost=20)
 
 

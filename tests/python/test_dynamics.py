@@ -1,28 +1,25 @@
 """Secondary motion through the Python API: mdc.Simulation (cpp/solve/reduced_dynamics.h)."""
-import pathlib
-import sys
 
 import numpy as np
 import pytest
 
 import modal_deform.core as mdc
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "bench"))
-from dynamics import damped_oscillation, released  # noqa: E402  (the benchmark's free-body measurement)
-from shapes import rigid_transform as rigid  # noqa: E402
+from support.dynamics import damped_oscillation, released  # the benchmark's free-body measurement
+from support.poses import rigid_transform as rigid
 
 
 @pytest.fixture(scope="module")
 def bar():
     """A closed bar, baked small: a free body for the period and damping checks."""
-    V, F = mdc.bar(4, 4, 16, 1, 1, 4)
+    V, F = mdc.testing.bar(4, 4, 16, 1, 1, 4)
     return V, F, mdc.bake(V, F, modes=12, derivatives=20, ghost=300)
 
 
 @pytest.fixture(scope="module")
 def tube():
     """A tube of 1000 vertices held at its bottom ring, its top ring on a controller."""
-    V, F = mdc.cylinder(25, 40, radius=1.0, length=4.0)
+    V, F = mdc.testing.cylinder(25, 40, radius=1.0, length=4.0)
     handles = [np.flatnonzero(V[:, 2] < 1e-9), np.flatnonzero(V[:, 2] > 4 - 1e-9)]
     return V, F, handles, mdc.bake(V, F, modes=16, derivatives=30, ghost=400)
 
@@ -54,7 +51,7 @@ def test_damping_ratio_gives_the_logarithmic_decrement(bar, damping):
 def tube_bases():
     """The tube baked as a whole, with a painted stiffness, on a proxy, and as a region (its upper
     half)."""
-    V, F = mdc.cylinder(25, 40, radius=1.0, length=4.0)
+    V, F = mdc.testing.cylinder(25, 40, radius=1.0, length=4.0)
     sizes = dict(modes=16, derivatives=30, ghost=400)
     upper = np.flatnonzero(V[:, 2] > 2.0)
     bases = {"whole": mdc.bake(V, F, **sizes),

@@ -48,14 +48,14 @@ def test_mirror_image_is_not_free(bunny):
 
 
 def test_third_derivative_is_refused_with_the_reason():
-    V, F = mdc.cylinder(8, 3)
+    V, F = mdc.testing.cylinder(8, 3)
     E = mdc.Arap(V, F)
     with pytest.raises(ValueError, match="shells"):
         E.third(V, V, V)
 
 
 def test_bad_input_is_named():
-    V, F = mdc.cylinder(8, 3)
+    V, F = mdc.testing.cylinder(8, 3)
     with pytest.raises(ValueError, match=r"F\[0\]"):
         mdc.Arap(V, F + 1000)
     E = mdc.Arap(V, F)

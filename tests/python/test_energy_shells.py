@@ -122,7 +122,7 @@ def test_hessian_is_the_derivative_of_the_gradient(bunny):
     ],
 )
 def test_bad_input_raises_value_error_naming_it(call, needle):
-    V, F = mdc.cylinder(6, 2)
+    V, F = mdc.testing.cylinder(6, 2)
     E = mdc.DiscreteShells(V, F)
     with pytest.raises(ValueError) as error:
         call(V, F, E)

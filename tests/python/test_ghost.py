@@ -1,6 +1,4 @@
-import pathlib
 import re
-import sys
 
 import numpy as np
 import pytest
@@ -9,10 +7,8 @@ from scipy.sparse.csgraph import connected_components
 
 import modal_deform.core as mdc
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "bench"))
-import raw_scans  # noqa: E402  (midpoint_subdivide)
-
-SHARED_MESHES = pathlib.Path(__file__).resolve().parents[2].parent / "shared" / "meshes"
+from support.meshes import read_shared
+from support.subdivision import midpoint_subdivide
 
 
 def normals(V, F):
@@ -41,8 +37,8 @@ def euler_characteristic(V, F):
 
 
 def two_cylinders():
-    Va, Fa = mdc.cylinder(24, 20, 1.0, 4.0)
-    Vb, Fb = mdc.cylinder(16, 30, 0.5, 6.0)
+    Va, Fa = mdc.testing.cylinder(24, 20, 1.0, 4.0)
+    Vb, Fb = mdc.testing.cylinder(16, 30, 0.5, 6.0)
     return np.vstack([Va, Vb + [3.0, 0.0, 0.0]]), np.vstack([Fa, Fb + len(Va)])
 
 
@@ -83,8 +79,8 @@ def assert_valid_ghost(V, F, M, Vg, Fg, ghost_map):
 def test_ghost_is_valid_and_reaches_the_target(shared_mesh, name, target):
     V, F = {
         "bunny": lambda: shared_mesh("bunny.obj.gz"),
-        "grid": lambda: mdc.grid(30, 30, 10.0, 10.0),
-        "cylinder": lambda: mdc.cylinder(32, 30, 1.0, 6.0),
+        "grid": lambda: mdc.testing.grid(30, 30, 10.0, 10.0),
+        "cylinder": lambda: mdc.testing.cylinder(32, 30, 1.0, 6.0),
         "two cylinders": two_cylinders,
     }.get(name, lambda: shared_mesh(name))()
     Vg, Fg, ghost_map = mdc.ghost_mesh(V, F, vertices=target)
@@ -95,8 +91,8 @@ def test_ghost_is_valid_and_reaches_the_target(shared_mesh, name, target):
 
 @pytest.mark.parametrize(
     "make, target",
-    [(lambda V, F: (V, F), 20), (lambda V, F: mdc.grid(30, 30, 10.0, 10.0), 12),
-     (lambda V, F: mdc.cylinder(32, 30, 1.0, 6.0), 12), (lambda V, F: two_cylinders(), 24)],
+    [(lambda V, F: (V, F), 20), (lambda V, F: mdc.testing.grid(30, 30, 10.0, 10.0), 12),
+     (lambda V, F: mdc.testing.cylinder(32, 30, 1.0, 6.0), 12), (lambda V, F: two_cylinders(), 24)],
     ids=["bunny", "grid", "cylinder", "two cylinders"],
 )
 def test_topology_and_boundary_are_kept(shared_mesh, make, target):
@@ -158,7 +154,7 @@ def test_progress_reports_the_ghost_stage_and_false_cancels(shared_mesh):
 
 
 def test_an_error_in_the_progress_callback_reaches_the_caller():
-    V, F = mdc.grid(20, 20)
+    V, F = mdc.testing.grid(20, 20)
 
     def broken(stage, fraction):
         raise KeyError("from the callback")
@@ -167,7 +163,7 @@ def test_an_error_in_the_progress_callback_reaches_the_caller():
         mdc.ghost_mesh(V, F, vertices=50, progress=broken)
 
 
-V_GRID, F_GRID = mdc.grid(4, 4)
+V_GRID, F_GRID = mdc.testing.grid(4, 4)
 
 
 @pytest.mark.parametrize(
@@ -198,9 +194,9 @@ def test_a_subdivided_scan_leaves_no_island_of_fine_triangles(target):
     one fine vertex each, 32 faces below a hundredth of the median area; the 1.6M dragon's ghost had
     891 such faces), which a pose crushes and turns over first: every collapse around them made
     some needle a little thinner (the rule per face), or turned a needle's normal."""
-    V, F = mdc.read_mesh(SHARED_MESHES / "dragon_vrip_res4.ply.gz")
+    V, F = read_shared("dragon_vrip_res4.ply.gz")
     for _ in range(2):
-        V, F = raw_scans.midpoint_subdivide(V, F)
+        V, F = midpoint_subdivide(V, F)
     G, GF, ghost_map = mdc.ghost_mesh(V, F, target)
     assert len(G) <= target
     sizes = np.bincount(ghost_map[ghost_map >= 0])

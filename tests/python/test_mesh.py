@@ -29,11 +29,11 @@ def test_mass_sums_to_area(shared_mesh):
 
 
 def test_generated_shapes_are_closed_or_open_as_promised():
-    V, F = mdc.bar(2, 2, 6)
+    V, F = mdc.testing.bar(2, 2, 6)
     assert mdc.check(V, F)["boundary_edges"]["count"] == 0
-    V, F = mdc.cylinder(12, 4)
+    V, F = mdc.testing.cylinder(12, 4)
     assert mdc.check(V, F)["boundary_edges"]["count"] == 24
-    V, F = mdc.bumpy_plane(20, bumps=5)
+    V, F = mdc.testing.bumpy_plane(20, bumps=5)
     assert V.shape == (21 * 21, 3) and np.ptp(V[:, 2]) > 0.1
 
 

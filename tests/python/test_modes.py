@@ -48,7 +48,7 @@ def laplacian_stiffness(V, F):
 
 
 def jittered_bar(nx, ny, nz, seed):
-    V, F = mdc.bar(nx, ny, nz, 1.0, 1.0, 2.0)
+    V, F = mdc.testing.bar(nx, ny, nz, 1.0, 1.0, 2.0)
     return V + np.random.default_rng(seed).uniform(-0.05, 0.05, V.shape), F
 
 

@@ -1,6 +1,4 @@
 """The multiresolution bake (issue 15): dense meshes baked on a proxy and carried to every vertex."""
-import sys
-import pathlib
 
 import numpy as np
 import pytest
@@ -8,14 +6,13 @@ import pytest
 import modal_deform.core as mdc
 from modal_deform.core.bake import PROXY
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "bench"))
-import subdivision  # noqa: E402  (midpoint_subdivide: the project's own)
-import shapes  # noqa: E402  (end_pull: the benchmark's handles and pose)
+from support import subdivision  # midpoint_subdivide: the project's own
+from support.poses import end_pull  # the benchmark's handles and pose
 
 
 @pytest.fixture(scope="module")
 def plane_on_proxy():
-    V, F = mdc.bumpy_plane(100)  # 10,201 vertices
+    V, F = mdc.testing.bumpy_plane(100)  # 10,201 vertices
     return V, F, mdc.bake(V, F, modes=12, derivatives=10, ghost=200, proxy=2000, proxy_above=5000)
 
 
@@ -79,7 +76,7 @@ def test_round_trip_and_damaged_prolongation(plane_on_proxy):
 
 
 def test_a_version_1_basis_still_loads():
-    V, F = mdc.bumpy_plane(20)
+    V, F = mdc.testing.bumpy_plane(20)
     arrays = mdc.bake(V, F, modes=10, derivatives=4, ghost=100).to_arrays()
     old = {name: a for name, a in arrays.items() if not name.startswith("prolongation")}
     old["format_version"] = np.array(1, dtype=np.int32)
@@ -88,7 +85,7 @@ def test_a_version_1_basis_still_loads():
 
 
 def test_proxy_options_and_progress():
-    V, F = mdc.bumpy_plane(40)
+    V, F = mdc.testing.bumpy_plane(40)
     stages = []
     basis = mdc.bake(V, F, modes=10, derivatives=4, ghost=100, proxy=400, proxy_above=1000,
                      progress=lambda stage, fraction: stages.append(stage))
@@ -109,7 +106,7 @@ def test_the_subdivided_dragon_on_a_proxy_poses_like_the_dragon(shared_mesh):
     V_fine, F_fine = subdivision.midpoint_subdivide(V, F)
 
     def posed(basis, V):
-        handles, poses = shapes.end_pull(V)
+        handles, poses = end_pull(V)
         solver = mdc.ReducedSolver(basis, handles)
         solver.set_transforms(poses[0].at(1.0))
         solver.solve(max_iterations=300, tolerance=1e-9)

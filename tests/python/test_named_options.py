@@ -16,7 +16,7 @@ ARRAYS = {"stiffness_weights", "region", "held"}
 
 @pytest.fixture(scope="module")
 def tube():
-    V, F = mdc.cylinder(12, 8, radius=1.0, length=3.0)
+    V, F = mdc.testing.cylinder(12, 8, radius=1.0, length=3.0)
     handles = [np.flatnonzero(V[:, 2] < 1e-9), np.flatnonzero(V[:, 2] > 3 - 1e-9)]
     turned = np.eye(4)
     turned[:3, 3] = [0.3, 0.0, 0.2]

@@ -37,7 +37,7 @@ def test_arrays_copied_into_the_core(path):
     script = textwrap.dedent("""
         import numpy as np
         import modal_deform.core as mdc
-        V, F = mdc.cylinder(8, 6, radius=1.0, length=3.0)
+        V, F = mdc.testing.cylinder(8, 6, radius=1.0, length=3.0)
         handles = [np.flatnonzero(V[:, 2] < 1e-9).astype(np.int32), np.flatnonzero(V[:, 2] > 3 - 1e-9)]
         turn = np.eye(4)
         turn[:3, :3] = [[0, -1, 0], [1, 0, 0], [0, 0, 1]]

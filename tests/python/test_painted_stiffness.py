@@ -43,7 +43,7 @@ def ring_turning(V, posed):
 @pytest.fixture(scope="module")
 def bar():
     """A tube along z, 6 long, its end rings turned by ±40° about x: bent into an arc."""
-    V, F = mdc.cylinder(10, 30, radius=0.5, length=6.0)
+    V, F = mdc.testing.cylinder(10, 30, radius=0.5, length=6.0)
     ends = [np.flatnonzero(V[:, 2] < 1e-9), np.flatnonzero(V[:, 2] > 6 - 1e-9)]
     transforms = [turn_about_x(-0.7, [0, 0, 0], [0, 0, 0.4]), turn_about_x(0.7, [0, 0, 6], [0, 0, -0.4])]
     return V, F, ends, transforms
@@ -79,7 +79,7 @@ def test_a_stiff_middle_third_stays_nearly_rigid(bar):
 def test_a_finger_bends_at_its_knuckles():
     """A tube of three stiff phalanges and two soft knuckles, its tip ring curled by 120°: nearly
     all of the turning happens at the knuckles, where the uniform tube turns along its length."""
-    V, F = mdc.cylinder(10, 40, radius=0.4, length=5.0)
+    V, F = mdc.testing.cylinder(10, 40, radius=0.4, length=5.0)
     knuckles = ((V[:, 2] > 1.5) & (V[:, 2] < 2.0)) | ((V[:, 2] > 3.25) & (V[:, 2] < 3.75))
     base, tip = np.flatnonzero(V[:, 2] < 1e-9), np.flatnonzero(V[:, 2] > 5 - 1e-9)
     # The tip ring where a finger curled by 60° at each knuckle would put it.

@@ -1,4 +1,4 @@
-"""Raw scans: meshes with every kind of scan damage (bench/raw_scans.py, made from the shared
+"""Raw scans: meshes with every kind of scan damage (tests/support/raw_scans.py, made from the shared
 dragons) bake and pose; near-degenerate elements have bounded stiffness; a bake that cannot fit
 in memory is refused up front with the sizes, and a lack of memory is never reported as a matrix
 that is not positive definite. The 400k-vertex raw scan is in make bench (bench/raw_scan.py)."""
@@ -14,9 +14,7 @@ import pytest
 
 import modal_deform.core as mdc
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "bench"))
-import raw_scans  # noqa: E402
+from support import SHARED_MESHES, raw_scans
 
 
 @pytest.mark.parametrize("seed", [0, 1])
@@ -52,7 +50,7 @@ def test_pairs_of_slivers_bake(seed):
     simulated (shape ratio 1e-3 to 1e-2): those hinges were up to 3e8 times as stiff as an
     equilateral one, which threw the shift of K - sigma M far below the modes (seed 1 failed: "sigma
     ... is too far below the largest eigenvalue given")."""
-    V, F = mdc.grid(25, 25, 10.0, 10.0)
+    V, F = mdc.testing.grid(25, 25, 10.0, 10.0)
     V = V.copy()
     V[:, 2] = 0.3 * np.sin(0.7 * V[:, 0]) * np.cos(0.5 * V[:, 1])
     V, F = raw_scans.damaged(V, F, seed=seed, rates={kind: 0 for kind in raw_scans.RATES} | {"sliver_pairs": 1000})
@@ -79,11 +77,11 @@ def test_sliver_stiffness_is_bounded_and_sound_elements_keep_theirs():
     the sliver thins, and the terms away from the sliver are untouched."""
     largest = []
     for ratio in (1e-1, 1e-2, 1e-3):
-        V, F = _sliver(*mdc.grid(6, 6, 2.0, 2.0), ratio)
+        V, F = _sliver(*mdc.testing.grid(6, 6, 2.0, 2.0), ratio)
         K = mdc.DiscreteShells(V, F).hessian(V)
         largest.append(np.abs(K.diagonal()).max())
     assert largest[2] < 2 * largest[1], largest  # was about 1e3 times larger per tenfold thinning
-    V, F = mdc.grid(6, 6, 2.0, 2.0)
+    V, F = mdc.testing.grid(6, 6, 2.0, 2.0)
     Vs, Fs = _sliver(V, F, 1e-3)
     far = np.flatnonzero(np.linalg.norm(V - V[F[30]].mean(axis=0), axis=1) > 1.2)
     dofs = (3 * far[:, None] + np.arange(3)).ravel()
@@ -111,7 +109,7 @@ def run_limited(code, address_space, setup=""):
         sys.path.insert(0, {str(pathlib.Path(mdc.__file__).parents[2])!r})
         import numpy as np
         import modal_deform.core as mdc
-        V, F = mdc.read_mesh({str(ROOT.parent / "shared" / "meshes" / "dragon_vrip_res3.ply.gz")!r})
+        V, F = mdc.read_mesh({str(SHARED_MESHES / "dragon_vrip_res3.ply.gz")!r})
     """) + textwrap.dedent(setup) + textwrap.dedent(f"""
         pages = int(open("/proc/self/statm").read().split()[0])
         limit = pages * resource.getpagesize() + {address_space}

@@ -7,7 +7,7 @@ import modal_deform.core as mdc
 
 @pytest.fixture(scope="module")
 def tube():
-    V, F = mdc.cylinder(10, 30, radius=0.5, length=6.0)
+    V, F = mdc.testing.cylinder(10, 30, radius=0.5, length=6.0)
     return V, F, np.flatnonzero(V[:, 2] > 3.0 - 1e-9)
 
 
@@ -54,7 +54,7 @@ def test_a_dense_region_is_baked_on_a_proxy_of_its_own_faces():
     """A region of more free vertices than proxy_above is baked on a proxy of the region and the
     faces around it: the outside is held exactly by zero prolongation weights, and the pose agrees
     with the region's dense bake."""
-    V, F = mdc.cylinder(40, 120, radius=0.5, length=6.0)
+    V, F = mdc.testing.cylinder(40, 120, radius=0.5, length=6.0)
     region = np.flatnonzero(V[:, 2] > 3.0 - 1e-9)
     outside = np.setdiff1d(np.arange(len(V)), region)
     top = np.flatnonzero(V[:, 2] > 6 - 1e-9)

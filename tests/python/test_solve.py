@@ -1,20 +1,17 @@
 """Posing through the Python API: mdc.solve_full and mdc.ReducedSolver."""
-import pathlib
-import sys
 
 import numpy as np
 import pytest
 
 import modal_deform.core as mdc
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "bench"))
-from shapes import rigid_transform as rigid  # noqa: E402
+from support.poses import rigid_transform as rigid
 
 
 @pytest.fixture(scope="module")
 def tube():
     """A tube along z held at its bottom ring, its top ring turned and pushed."""
-    V, F = mdc.cylinder(16, 12, radius=1.0, length=3.0)
+    V, F = mdc.testing.cylinder(16, 12, radius=1.0, length=3.0)
     handles = [np.flatnonzero(V[:, 2] < 1e-9), np.flatnonzero(V[:, 2] > 3 - 1e-9)]
     transforms = [np.eye(4), rigid([1, 0, 1], 0.8, [0, 0, 3], [0.8, 0, -0.3])]
     return V, F, handles, transforms

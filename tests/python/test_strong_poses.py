@@ -3,20 +3,14 @@ degrees converge, never stall, on the bar, the 23k dragon, a proxy bake and a ra
 along every solve path the objective is continuous with the gradient the solver follows (centred
 differences along a random direction). The 100k and 1.6M dragons are in make bench
 (bench/strong_poses.py); Suzanne is in the Blender tests (scripts/strong_pose.py)."""
-import pathlib
-import sys
 import warnings
 
 import numpy as np
 import pytest
 
 import modal_deform.core as mdc
-
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "bench"))
-import raw_scans  # noqa: E402
-import strong_poses  # noqa: E402  (the poses and the difference check, shared with make bench)
-
-SHARED_MESHES = pathlib.Path(__file__).resolve().parents[2].parent / "shared" / "meshes"
+from support import raw_scans, strong_poses  # the poses and the difference check, shared with make bench
+from support.meshes import read_shared
 
 
 def _bake(V, F, **options):
@@ -27,13 +21,13 @@ def _bake(V, F, **options):
 
 def _mesh(name):
     if name == "bar":
-        V, F = mdc.bar(12, 12, 120, 1.0, 1.0, 10.0)
+        V, F = mdc.testing.bar(12, 12, 120, 1.0, 1.0, 10.0)
         return V, F, _bake(V, F, derivatives=47, ghost=1000)
     if name == "dragon_23k":
-        V, F = mdc.read_mesh(SHARED_MESHES / "dragon_vrip_res3.ply.gz")
+        V, F = read_shared("dragon_vrip_res3.ply.gz")
         return V, F, _bake(V, F, derivatives=47, ghost=1000)
     if name == "dragon_on_proxy":
-        V, F = mdc.read_mesh(SHARED_MESHES / "dragon_vrip_res4.ply.gz")
+        V, F = read_shared("dragon_vrip_res4.ply.gz")
         V, F = raw_scans.midpoint_subdivide(V, F)  # 21k vertices on a proxy of 3k
         return V, F, _bake(V, F, derivatives=47, ghost=1000, proxy=3000, proxy_above=10000)
     V, F = raw_scans.raw_scan("dragon_res4", levels=0, seed=0)

@@ -72,7 +72,7 @@ def test_the_callers_openblas_threads_are_kept_during_and_after_the_bake():
             seen.append(openblas.openblas_get_num_threads())
             return True
 
-        mdc.bake(*mdc.cylinder(14, 6, 0.5, 2.0), modes=12, derivatives=6, ghost=40, progress=progress)
+        mdc.bake(*mdc.testing.cylinder(14, 6, 0.5, 2.0), modes=12, derivatives=6, ghost=40, progress=progress)
         assert seen and set(seen) == {setting}
         assert openblas.openblas_get_num_threads() == setting
     finally:

@@ -6,16 +6,15 @@ import io
 import pathlib
 import re
 import subprocess
-import sys
 import tomllib
 import zipfile
 
 import pytest
 
+import package
+
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 DIST = ROOT / "dist"
-sys.path.insert(0, str(ROOT / "python_addon"))
-import package  # noqa: E402
 
 OBJDUMP = "x86_64-w64-mingw32-objdump"
 # DLLs of Windows itself: the kernel, msvcrt.dll (the C runtime MinGW-w64 links, part of Windows

@@ -4,15 +4,13 @@ the motion changed, Esc or a failure leaves it as it was; exported to PC2 and MD
 Blender's Mesh Cache modifier plays and to shape keys (a cancelled export changes nothing); then
 saved with the shape keys."""
 import os
-import sys
 
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-import support  # noqa: E402
+import bpy
+import numpy as np
+from support import blender as support
 
-frame_cache, jobs, ops_dynamics, playback, playback_display, posing = support.enable_addon(
-    "frame_cache", "jobs", "ops_dynamics", "playback", "playback_display", "posing")
+frame_cache, jobs, operators, timeline, frame_display, posing = support.enable_addon(
+    "playback.frame_cache", "jobs", "playback.operators", "playback.timeline", "playback.frame_display", "posing")
 obj, V, controller = support.keyed_suzanne(10, 15, 20, 400)
 scene = bpy.context.scene
 scene.frame_set(3)
@@ -25,14 +23,14 @@ assert support.mesh_state(obj) == before and frame_cache.get(obj) is None
 
 # The job the operator ticks on its timer: cancelled (Esc) after three frames, or failing on the
 # third, it leaves the cache (none here) and the mesh as they were, and the frame where it was.
-job = ops_dynamics.CacheJob(bpy.context, obj, 1, 10)
+job = operators.CacheJob(bpy.context, obj, 1, 10)
 job.start()
 assert job.tick() and job.tick() and job.tick() and job.overall == 0.3 and len(frame_cache.get(obj)) == 3
 job.cancel()
 assert not job.tick()
 assert job.finish() == ("WARNING", "Cache bake cancelled: the cache is as it was") and not job.written
 assert support.mesh_state(obj) == before and scene.frame_current == 4 and frame_cache.get(obj) is None
-job = ops_dynamics.CacheJob(bpy.context, obj, 1, 10)
+job = operators.CacheJob(bpy.context, obj, 1, 10)
 job.player.next = lambda *args, **kwargs: 1 / 0  # frame 2, after frame 1's first()
 job.run()
 level, message = job.finish()
@@ -44,7 +42,7 @@ assert bpy.ops.modal_deform.bake_animation(frame_start=1, frame_end=10) == {"FIN
 cache = frame_cache.get(obj)
 assert cache.kind == "STATIC" and (cache.start, cache.end) == (1, 10) and scene.frame_current == 4
 assert cache.nbytes() < 20000, cache.nbytes()  # a shape key per frame would take 12 bytes a vertex
-assert obj.data.shape_keys is None and obj.modifiers[0].name == playback_display.MODIFIER, "not shown by the display"
+assert obj.data.shape_keys is None and obj.modifiers[0].name == frame_display.MODIFIER, "not shown by the display"
 assert np.array_equal(support.positions(obj), V), "the artist's mesh changed"
 
 # Against the solve per frame as Bake Animation did it before the cache (a pose, converged frame
@@ -63,7 +61,7 @@ moved = np.abs(shown[10] - V).max()
 assert moved > 0.3, f"the animated handle did not move the mesh ({moved})"
 
 # Scrubbing back reads the cache: nothing is solved.
-player = playback.player(obj, scene)
+player = timeline.player(obj, scene)
 player.first = player.next = None
 for frame in (7, 2, 9):
     scene.frame_set(frame)
@@ -113,13 +111,12 @@ for fmt in ("PC2", "MDD"):
         error = np.abs(support.evaluated_positions(copy) - expected).max()
         assert error < 1e-6, f"{fmt} frame {frame}: the Mesh Cache modifier plays {error} away"
     bpy.data.objects.remove(copy)
-print("POINT_CACHE_OK")
 
 # Shape keys: one per frame in place of the cache (the export cancelled after two frames changes
 # nothing), and the file saved for a Blender without the add-on.
 before = support.mesh_state(obj)
-job = jobs.AnimationJob(bpy.context, obj, ops_dynamics.cached_frames(obj),
-                        positions=ops_dynamics.cached_positions(obj, scene))
+job = jobs.AnimationJob(bpy.context, obj, operators.cached_frames(obj),
+                        positions=operators.cached_positions(obj, scene))
 assert job.tick() and job.tick() and len(obj.data.shape_keys.key_blocks) == 3
 job.cancel()
 assert job.finish() == ("WARNING", "Shape key export cancelled: nothing changed")
@@ -134,4 +131,3 @@ for frame, expected in final.items():
 np.save(support.tmp("rest.npy"), V)
 scene.frame_set(1)
 bpy.ops.wm.save_as_mainfile(filepath=support.tmp("animated.blend"))
-print("ANIMATED")

@@ -1,11 +1,7 @@
 """The stored basis follows an object appended or linked from a saved file (undo: tests/gui)."""
-import os
-import sys
-
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-import support  # noqa: E402
+import bpy
+import numpy as np
+from support import blender as support
 
 storage = support.enable_addon("storage")
 
@@ -30,4 +26,3 @@ for link in (False, True):
     assert storage.stale_reason(obj) == ""
     loaded = storage.load(obj).to_arrays()
     assert all(baked[k].tobytes() == loaded[k].tobytes() for k in baked), f"link={link}: basis differs"
-print("APPEND_LINK_OK")

@@ -3,13 +3,9 @@
 Arguments: suzanne | dragon PATH. Writes TEST_TMP/baked.blend, TEST_TMP/basis.npz (the basis as
 baked) and TEST_TMP/rest.npy (the base mesh's positions).
 """
-import os
-import sys
-
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-import support  # noqa: E402
+import bpy
+import numpy as np
+from support import blender as support
 
 mdc, posing, storage = support.enable_addon("core", "posing", "storage")
 

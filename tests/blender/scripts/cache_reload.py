@@ -1,15 +1,11 @@
 """Open the file cache_save.py wrote: the cache is there bit for bit, plays back what it showed
 before the save without computing anything, simulates the frame after it as before the save, and
 a mesh edited since the bake is refused."""
-import os
-import sys
+import bpy
+import numpy as np
+from support import blender as support
 
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-import support  # noqa: E402
-
-frame_cache, playback = support.enable_addon("frame_cache", "playback")
+frame_cache, timeline = support.enable_addon("playback.frame_cache", "playback.timeline")
 obj = bpy.data.objects["Suzanne"]
 scene = bpy.context.scene
 cache = frame_cache.get(obj)
@@ -18,7 +14,7 @@ with open(support.tmp("digest.txt")) as f:
 assert np.array_equal(support.positions(obj), np.load(support.tmp("rest.npy"))), "the artist's mesh changed"
 shown = np.load(support.tmp("shown.npy"))
 assert support.evaluated_positions(obj).tobytes() == shown[0].tobytes(), "the file does not show the frame saved"
-player = playback.player(obj, scene)
+player = timeline.player(obj, scene)
 player.first = player.next = None  # nothing is computed: every frame is read back
 for frame in (12, 1, 7, 3):
     scene.frame_set(frame)
@@ -36,6 +32,5 @@ bpy.ops.object.mode_set(mode="EDIT")
 bpy.ops.object.mode_set(mode="OBJECT")
 obj.data.vertices[0].co.x += 0.1
 scene.frame_set(5)
-assert "edited after the bake" in playback.problems.get(obj.name, ""), playback.problems
+assert "edited after the bake" in timeline.problems.get(obj.name, ""), timeline.problems
 assert support.evaluated_positions(obj).tobytes() == support.positions(obj).tobytes()
-print("CACHE_RELOADED")

@@ -1,14 +1,10 @@
 """Cache an animation of Suzanne (static, or simulated with `dynamic`), record what it holds and
 shows, and save the file."""
-import os
-import sys
+import bpy
+import numpy as np
+from support import blender as support
 
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-import support  # noqa: E402
-
-frame_cache, playback = support.enable_addon("frame_cache", "playback")
+frame_cache, timeline = support.enable_addon("playback.frame_cache", "playback.timeline")
 kind = support.arguments()[0]
 obj, V, _ = support.keyed_suzanne(6, 15, 20, 400)
 obj.modal_deform.dynamics.enabled = kind == "dynamic"
@@ -29,4 +25,4 @@ bpy.ops.wm.save_as_mainfile(filepath=support.tmp("cached.blend"))
 # The frame after the cache, computed after the save: the reloaded file computes it again.
 scene.frame_set(13)
 np.save(support.tmp("next.npy"), support.evaluated_positions(obj))
-print("CACHE_SAVED", cache.nbytes())
+print("the cache holds", cache.nbytes(), "bytes")

@@ -4,16 +4,12 @@ scrubbing back reads the cache; a jump forward simulates every frame in between 
 same bits as playing, and so do frames simulated again after a cut in the middle of a block of
 BFGS's memory; a changed keyframe or setting invalidates what follows; Bake gives the same
 bits again; Free empties the cache; a mesh edited between frames and a damaged cache are refused."""
-import os
-import sys
+import bpy
+import numpy as np
+from support import blender as support
 
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-import support  # noqa: E402
-
-frame_cache, frame_keys, playback, playback_display, posing = support.enable_addon(
-    "frame_cache", "frame_keys", "playback", "playback_display", "posing")
+frame_cache, frame_keys, timeline, frame_display, posing = support.enable_addon(
+    "playback.frame_cache", "frame_keys", "playback.timeline", "playback.frame_display", "posing")
 obj, V = support.baked_suzanne(2, 20, 52, 1000)  # the demo's Suzanne and the default basis
 size = np.ptp(V, axis=0).max()
 # The core of the head is held by the controller, tilted fast and stopped (as the demo does); the
@@ -53,7 +49,7 @@ assert along[4:12].max() > 1.05, f"no overshoot after the stop: {np.round(along,
 assert np.abs(along[-5:] - 1).max() < 0.02, f"the motion does not settle: {np.round(along, 3)}"
 
 # Scrubbing back reads the cache: nothing is simulated.
-player = playback.player(obj, scene)
+player = timeline.player(obj, scene)
 player.next = player.first = None
 for frame in (12, 3, 30):
     scene.frame_set(frame)
@@ -70,7 +66,7 @@ for frame in (40, 7, 20):
 # A cut in the middle of a block of BFGS's memory (memory_frames frames from the cache's start;
 # the simulation holds frame 40's): the frames after it simulated again, from the block's first
 # frame, the same bits as playing.
-memory_frames = playback.player(obj, scene).simulation.memory_frames
+memory_frames = timeline.player(obj, scene).simulation.memory_frames
 assert 1 < memory_frames < 11, memory_frames
 frame_cache.get(obj).cut(2 + memory_frames + memory_frames // 2)
 scene.frame_set(30)
@@ -81,7 +77,7 @@ for frame in (30, 2 + memory_frames + memory_frames // 2, 2 + 2 * memory_frames)
 
 # Free, then a jump forward: every frame up to it simulated, the same bits as playing.
 assert bpy.ops.modal_deform.free_cache() == {"FINISHED"}
-assert frame_cache.get(obj) is None and not playback_display.shows(obj)
+assert frame_cache.get(obj) is None and not frame_display.shows(obj)
 assert support.evaluated_positions(obj).tobytes() == V.tobytes(), "Free left a frame shown"
 scene.frame_set(25)
 assert frame_cache.get(obj).end == 25 and scene.frame_current == 25
@@ -120,29 +116,29 @@ scene.frame_set(8)
 assert frame_cache.get(obj).end == 8
 assert frame_cache.get(obj).array("q")[0].tobytes() == frame_cache.get(obj).state(1)[0].tobytes()
 assert np.abs(key() - played[8]).max() > 0.01 * size, "frame 8 kept the old motion"
-pose = playback.player(obj, scene).pose
+pose = timeline.player(obj, scene).pose
 dynamics.damping = 0.3
 assert frame_cache.get(obj) is None
 scene.frame_set(9)
 assert frame_cache.get(obj).end == 9
 # A change of a dynamics setting keeps the pose's solver (it starts from rest at the first frame):
 # the same bits as a player made anew.
-assert playback.player(obj, scene).pose is pose
+assert timeline.player(obj, scene).pose is pose
 kept = key()
-playback.free(obj)
+timeline.free(obj)
 scene.frame_set(9)
-assert playback.player(obj, scene).pose is not pose and key().tobytes() == kept.tobytes()
+assert timeline.player(obj, scene).pose is not pose and key().tobytes() == kept.tobytes()
 
 # Playing compares the mesh's positions with the bake's only when Blender reported an update of the
 # mesh (after an edit, or in the next frame's evaluation; never for playback's own writes): an edit
 # between frames is refused either way, and undoing it plays again.
 compared = []
-same_positions = playback.mesh_io.same_positions
-playback.mesh_io.same_positions = lambda mesh, co: compared.append(mesh.name) or same_positions(mesh, co)
+same_positions = timeline.mesh_io.same_positions
+timeline.mesh_io.same_positions = lambda mesh, co: compared.append(mesh.name) or same_positions(mesh, co)
 for frame in (10, 11, 12):
     scene.frame_set(frame)
     bpy.context.view_layer.update()
-assert compared == [] and obj.name not in playback.problems, (compared, playback.problems)
+assert compared == [] and obj.name not in timeline.problems, (compared, timeline.problems)
 
 
 def move_vertex(x):
@@ -157,16 +153,15 @@ for frame, reported in ((13, bpy.context.view_layer.update), (15, lambda: None))
     move_vertex(x + 0.1)
     reported()
     scene.frame_set(frame)
-    assert "edited after the bake" in playback.problems.get(obj.name, ""), (frame, playback.problems)
+    assert "edited after the bake" in timeline.problems.get(obj.name, ""), (frame, timeline.problems)
     move_vertex(x)
     scene.frame_set(frame + 1)
-    assert obj.name not in playback.problems, (frame, playback.problems)
+    assert obj.name not in timeline.problems, (frame, timeline.problems)
 assert len(compared) == 4, compared
-playback.mesh_io.same_positions = same_positions
+timeline.mesh_io.same_positions = same_positions
 # A damaged cache (an array gone) is refused with a message, and the mesh shows its rest; Free takes it away.
 del dynamics.cache["q"]
 scene.frame_set(12)
-assert "is damaged (no 'q')" in playback.problems.get(obj.name, ""), playback.problems
+assert "is damaged (no 'q')" in timeline.problems.get(obj.name, ""), timeline.problems
 assert key().tobytes() == V.tobytes()
 assert bpy.ops.modal_deform.free_cache() == {"FINISHED"} and dynamics.cache is None
-print("DYNAMICS_OK")

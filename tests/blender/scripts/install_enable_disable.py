@@ -8,9 +8,8 @@ Arguments: ZIP USER_FOLDER (where Blender installs into)."""
 import os
 import sys
 
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import support  # noqa: E402
+import bpy
+from support import blender as support
 
 zip_path, user_folder = support.arguments()
 handlers = {name: len(getattr(bpy.app.handlers, name)) for name in ("depsgraph_update_post", "load_post")}
@@ -56,4 +55,3 @@ enable_and_bake()
 disable()
 enable_and_bake()
 disable()
-print("INSTALL_OK")

@@ -4,11 +4,9 @@ installed or enabled.
 
 Arguments: ZIP."""
 import os
-import sys
 
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import support  # noqa: E402
+import bpy
+from support import blender as support
 
 (zip_path,) = support.arguments()
 try:
@@ -18,4 +16,4 @@ except RuntimeError as error:  # the operator's error report
 assert "bl_ext.user_default.modal_deform" not in bpy.context.preferences.addons, f"installed and enabled: {result}"
 repository = bpy.utils.user_resource('EXTENSIONS', path="user_default")
 assert not os.path.exists(os.path.join(repository, "modal_deform")), f"files left in {repository}: {result}"
-print("REFUSED", result)
+print("the installer returned:", result)

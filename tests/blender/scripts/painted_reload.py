@@ -1,13 +1,9 @@
 """Open the file painted_stiffness.py wrote: the painted basis is still fresh and poses as before; a
 deleted stiffness group makes the basis stale and the bake refuse; its middle third, painted stiff,
 stayed nearly rigid where a uniform bake bends it."""
-import os
-import sys
-
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-import support  # noqa: E402
+import bpy
+import numpy as np
+from support import blender as support
 
 posing, storage = support.enable_addon("posing", "storage")
 
@@ -41,4 +37,3 @@ settings.stiffness_group = ""
 assert bpy.ops.modal_deform.bake() == {"FINISHED"}
 uniform = middle_deviation()
 assert painted < 0.2 * uniform, (painted, uniform)
-print("PAINTED_RELOADED")

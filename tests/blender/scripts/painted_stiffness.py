@@ -4,18 +4,15 @@ are painted anew, a missing group refused; posed, and saved for painted_reload.p
 Writes TEST_TMP/painted.blend and TEST_TMP/painted_pose.npy (the pose's shape key).
 """
 import math
-import os
-import sys
 
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-from mathutils import Matrix  # noqa: E402
-import support  # noqa: E402
+import bpy
+import numpy as np
+from mathutils import Matrix
+from support import blender as support
 
 mdc, posing, storage = support.enable_addon("core", "posing", "storage")
 
-V, F = mdc.cylinder(10, 30, 0.5, 6.0)
+V, F = mdc.testing.cylinder(10, 30, 0.5, 6.0)
 obj = support.mesh_object("Bar", V, F)
 settings = obj.modal_deform
 settings.modes, settings.derivatives, settings.ghost = 16, 40, 2000
@@ -57,4 +54,3 @@ assert bpy.ops.modal_deform.solve() == {"FINISHED"}
 np.save(support.tmp("painted_pose.npy"), support.key_positions(obj, posing.POSE_KEY))
 assert support.positions(obj).tobytes() == V.astype(np.float32).tobytes(), "the base mesh changed"
 bpy.ops.wm.save_as_mainfile(filepath=support.tmp("painted.blend"))
-print("PAINTED_OK")

@@ -5,17 +5,13 @@ added mid-pose (a copy of the posed positions) gets the rest as its reference; a
 the artist's shape keys is posed in the key and gets them back untouched; a mesh written mid-pose
 by a path without save handlers (an undo step of a controller's move, autosave, a crash file) is
 repaired after undo and after loading: rest from the stored basis, pose into the key."""
-import os
-import sys
+import bpy
+import numpy as np
+from mathutils import Matrix
+from support import blender as support
+from support.blender import evaluated_positions
 
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-from mathutils import Matrix  # noqa: E402
-import support  # noqa: E402
-from headless import evaluated_positions  # noqa: E402
-
-posing, pose_displays, storage = support.enable_addon("posing", "pose_displays", "storage")
+posing, displays, storage = support.enable_addon("posing", "pose.displays", "storage")
 
 obj, rest = support.baked_suzanne(1, 12, 10, 300)
 support.top_and_bottom_handles(obj, rest)
@@ -51,7 +47,7 @@ def undone_to_mid_pose(display):
     controller's move pushes one), the pose kept, then undone to that step; returns the object as
     undo read it again and the pose."""
     bpy.ops.ed.undo_push(message="before posing")
-    shown = pose_displays.display(obj)
+    shown = displays.display(obj)
     assert type(shown) is display
     pose = pose_shown(shown)
     posed = support.positions(obj)
@@ -71,30 +67,30 @@ def artists_key(value):
 
 
 # No shape keys: posed in the vertex positions, the mesh flagged meanwhile; Esc restores exactly.
-shown = pose_displays.display(obj)
-assert type(shown) is pose_displays.PositionsDisplay
+shown = displays.display(obj)
+assert type(shown) is displays.PositionsDisplay
 pose_shown(shown)
-assert obj.data.shape_keys is None and obj.data.get(pose_displays.POSING_FLAG)
+assert obj.data.shape_keys is None and obj.data.get(displays.POSING_FLAG)
 assert np.abs(support.positions(obj) - rest).max() > 0.05, "the pose is not in the vertex positions"
 shown.restore()
-assert support.positions(obj).tobytes() == rest.tobytes() and obj.data.get(pose_displays.POSING_FLAG) is None
+assert support.positions(obj).tobytes() == rest.tobytes() and obj.data.get(displays.POSING_FLAG) is None
 
 # Kept: the rest back in the base mesh and in "Basis", the pose in the key, the same through the
 # modifiers as it was shown.
-shown = pose_displays.display(obj)
+shown = displays.display(obj)
 pose = pose_shown(shown)
 posed = support.positions(obj)
 shown = keep_as_shown(shown, pose)
-assert type(shown) is pose_displays.ShapeKeyDisplay
+assert type(shown) is displays.ShapeKeyDisplay
 assert support.positions(obj).tobytes() == rest.tobytes()
 assert support.key_positions(obj, "Basis").tobytes() == rest.tobytes()
 assert support.key_positions(obj, posing.POSE_KEY).tobytes() == posed.tobytes()
-assert obj.data.get(pose_displays.POSING_FLAG) is None
+assert obj.data.get(displays.POSING_FLAG) is None
 
 # The artist adds a shape key mid-pose: the first one copies the positions, which hold the pose;
 # kept, the reference key holds the rest again.
 obj.shape_key_clear()
-shown = pose_displays.display(obj)
+shown = displays.display(obj)
 pose = pose_shown(shown)
 posed = support.positions(obj)
 obj.shape_key_add(name="Basis")
@@ -103,34 +99,31 @@ shown = shown.keep(pose)
 assert support.positions(obj).tobytes() == rest.tobytes()
 assert support.key_positions(obj, "Basis").tobytes() == rest.tobytes()
 assert support.key_positions(obj, posing.POSE_KEY).tobytes() == posed.tobytes()
-print("POSITIONS_OK")
 
 # The artist's own shape key: posed in the key, the artist's key and the mesh as they were after Esc.
 obj.shape_key_clear()
 obj.shape_key_add(name="Basis")
 artists_key(0.5)
 before = support.mesh_state(obj)
-shown = pose_displays.display(obj)
-assert type(shown) is pose_displays.ShapeKeyDisplay
+shown = displays.display(obj)
+assert type(shown) is displays.ShapeKeyDisplay
 pose_shown(shown)
 assert support.positions(obj).tobytes() == rest.tobytes()
 shown.restore()
 assert support.mesh_state(obj) == before, "the artist's shape keys changed"
 obj.shape_key_clear()
-print("SHAPE_KEYS_OK")
 
 # An undo step taken mid-pose (a controller's move pushes one) holds the pose in the positions:
 # undoing to it after the pose was kept repairs it.
-obj, posed = undone_to_mid_pose(pose_displays.PositionsDisplay)
-assert obj.data.get(pose_displays.POSING_FLAG) is None, "undo left a posed mesh"
+obj, posed = undone_to_mid_pose(displays.PositionsDisplay)
+assert obj.data.get(displays.POSING_FLAG) is None, "undo left a posed mesh"
 assert support.positions(obj).tobytes() == rest.tobytes(), "undo left the pose in the base mesh"
 assert support.key_positions(obj, posing.POSE_KEY).tobytes() == posed.tobytes()
 obj.shape_key_clear()
-print("UNDO_OK")
 
 # A file written mid-pose without save handlers (autosave, a crash file; here a plain save with no
 # interactive pose running to move the pose first): loading it repairs the mesh.
-shown = pose_displays.display(obj)
+shown = displays.display(obj)
 pose_shown(shown)
 posed = support.positions(obj)
 path = support.tmp("saved_mid_pose.blend")
@@ -138,11 +131,10 @@ bpy.ops.wm.save_as_mainfile(filepath=path, copy=True)
 shown.restore()
 bpy.ops.wm.open_mainfile(filepath=path)
 obj = bpy.data.objects["Suzanne"]
-assert obj.data.get(pose_displays.POSING_FLAG) is None
+assert obj.data.get(displays.POSING_FLAG) is None
 assert support.positions(obj).tobytes() == rest.tobytes(), "loading left the pose in the base mesh"
 assert support.key_positions(obj, posing.POSE_KEY).tobytes() == posed.tobytes()
 assert storage.stale_reason(obj) == "", "the repaired mesh does not fit its basis"
-print("LOAD_OK")
 
 # A mesh posed and kept before (here just repaired: "Basis" and "Modal Deform"), with an artist's
 # key at 0: posed in a stand-in without shape keys, the artist's mesh untouched; Esc puts it back.
@@ -150,24 +142,24 @@ mesh = obj.data
 controller = obj.modal_deform.handles[0].controller
 smile = artists_key(0.0)
 before = support.mesh_state(obj)
-shown = pose_displays.display(obj)
-assert type(shown) is pose_displays.StandInDisplay
-assert obj.data != mesh and obj.data.shape_keys is None and obj.data.get(pose_displays.STAND_IN_OF) == mesh
+shown = displays.display(obj)
+assert type(shown) is displays.StandInDisplay
+assert obj.data != mesh and obj.data.shape_keys is None and obj.data.get(displays.STAND_IN_OF) == mesh
 controller.matrix_world = Matrix.Translation((0.0, 0.2, 0.0)) @ controller.matrix_world
 bpy.context.view_layer.update()
 pose = pose_shown(shown)
 assert support.mesh_state(obj) != before
 shown.restore()
 assert obj.data == mesh and support.mesh_state(obj) == before, "Esc did not put the artist's mesh back"
-assert not [m for m in bpy.data.meshes if m.get(pose_displays.STAND_IN_OF)], "the stand-in is left behind"
+assert not [m for m in bpy.data.meshes if m.get(displays.STAND_IN_OF)], "the stand-in is left behind"
 
 # Kept: the pose in the key, the artist's keys and the rest as they were, the same through the
 # modifiers as it was shown.
-shown = pose_displays.display(obj)
+shown = displays.display(obj)
 pose = pose_shown(shown)
 posed = support.positions(obj)
 shown = keep_as_shown(shown, pose)
-assert type(shown) is pose_displays.ShapeKeyDisplay and obj.data == mesh
+assert type(shown) is displays.ShapeKeyDisplay and obj.data == mesh
 assert support.key_positions(obj, posing.POSE_KEY).tobytes() == posed.tobytes()
 for name in ("Basis", "Smile"):
     assert support.key_positions(obj, name).tobytes() == dict(
@@ -175,14 +167,14 @@ for name in ("Basis", "Smile"):
 
 # The artist's key shown (at 0.5): posed in the key, as before.
 smile.value = 0.5
-shown = pose_displays.display(obj)
-assert type(shown) is pose_displays.ShapeKeyDisplay
+shown = displays.display(obj)
+assert type(shown) is displays.ShapeKeyDisplay
 shown.restore()
 smile.value = 0.0
 
 # Mid-pose, the artist's key starts to show (an animated value): the pose goes on in the key. A
 # key added to the stand-in is carried over to the mesh as the same offset from its reference.
-shown = pose_displays.display(obj)
+shown = displays.display(obj)
 pose = pose_shown(shown)
 smile.value = 0.3
 assert not shown.shows_pose()
@@ -200,23 +192,21 @@ expected = np.zeros_like(offset)
 expected[0, 0] = 0.2
 assert np.abs(offset - expected).max() < 1e-5, "the key added mid-pose was not carried over"
 obj.shape_key_remove(obj.data.shape_keys.key_blocks["Frown"])
-print("STAND_IN_OK")
 
 # An undo step and a file written mid-pose hold the stand-in on the object: the artist's mesh comes
 # back on undo and on loading, with the pose in the key.
-obj, posed = undone_to_mid_pose(pose_displays.StandInDisplay)
-assert obj.data.name == "Suzanne" and obj.data.get(pose_displays.STAND_IN_OF) is None, "undo left the stand-in"
-assert not [m for m in bpy.data.meshes if m.get(pose_displays.STAND_IN_OF)]
+obj, posed = undone_to_mid_pose(displays.StandInDisplay)
+assert obj.data.name == "Suzanne" and obj.data.get(displays.STAND_IN_OF) is None, "undo left the stand-in"
+assert not [m for m in bpy.data.meshes if m.get(displays.STAND_IN_OF)]
 assert support.key_positions(obj, posing.POSE_KEY).tobytes() == posed.tobytes()
-shown = pose_displays.display(obj)
+shown = displays.display(obj)
 pose_shown(shown)
 posed = support.positions(obj)
 bpy.ops.wm.save_as_mainfile(filepath=path, copy=True)
 shown.restore()
 bpy.ops.wm.open_mainfile(filepath=path)
 obj = bpy.data.objects["Suzanne"]
-assert obj.data.name == "Suzanne" and not [m for m in bpy.data.meshes if m.get(pose_displays.STAND_IN_OF)]
+assert obj.data.name == "Suzanne" and not [m for m in bpy.data.meshes if m.get(displays.STAND_IN_OF)]
 assert support.key_positions(obj, posing.POSE_KEY).tobytes() == posed.tobytes()
 assert support.positions(obj).tobytes() == rest.tobytes()
 assert storage.stale_reason(obj) == "", "the mesh put back does not fit its basis"
-print("STAND_IN_UNDO_LOAD_OK")

@@ -1,13 +1,9 @@
 """A dense mesh through the same Bake button: baked on a proxy (small thresholds here), the proxy
 size in the status the Basis panel shows, the proxy basis and its prolongation stored and read back
 bit for bit after a reload, posed into the fine shape key, and a mode previewed on every vertex."""
-import os
-import sys
-
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-import support  # noqa: E402
+import bpy
+import numpy as np
+from support import blender as support
 
 ops_preview, posing, storage = support.enable_addon("ops_preview", "posing", "storage")
 
@@ -53,4 +49,4 @@ settings.preview_amplitude = 0.1
 assert bpy.ops.modal_deform.preview_mode() == {"FINISHED"}
 preview = support.key_positions(obj, ops_preview.PREVIEW_KEY)
 assert abs(np.linalg.norm(preview - rest, axis=1).max() - 0.1 * size) < 1e-3 * size
-print("PROXY_OK", n, settings.status.proxy_vertices)
+print(n, "vertices posed through a proxy of", settings.status.proxy_vertices)

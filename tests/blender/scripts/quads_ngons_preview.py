@@ -1,12 +1,9 @@
 """Quads and n-gons are triangulated for the energy without touching the faces; mode preview."""
 import math
-import os
-import sys
 
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-import support  # noqa: E402
+import bpy
+import numpy as np
+from support import blender as support
 
 ops_preview, storage = support.enable_addon("ops_preview", "storage")
 
@@ -51,4 +48,3 @@ settings.preview_amplitude = -0.2  # the key follows the slider
 assert abs(np.linalg.norm(support.key_positions(obj, ops_preview.PREVIEW_KEY) - rest, axis=1).max() - 0.8) < 1e-4
 assert bpy.ops.modal_deform.preview_mode() == {"FINISHED"}
 assert not ops_preview.showing(obj)
-print("NGONS_OK")

@@ -1,12 +1,8 @@
 """Refine: the pose polished on the full mesh into the "Modal Deform" key (base mesh untouched), a
 cancelled refine that leaves the key as it was, and the refined animation bake."""
-import os
-import sys
-
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-import support  # noqa: E402
+import bpy
+import numpy as np
+from support import blender as support
 
 jobs, core = support.enable_addon("jobs", "core")
 # Suzanne unsubdivided (507 vertices): the full solves stay short in each of the four Blenders tested.
@@ -46,4 +42,3 @@ assert bpy.ops.modal_deform.bake_animation(frame_start=1, frame_end=3, refine=Tr
 names = [b.name for b in obj.data.shape_keys.key_blocks]
 assert [f"Modal Deform {f:04d}" for f in range(1, 4)] == names[-3:], names
 assert np.array_equal(support.positions(obj), rest)
-print("REFINE_OK")

@@ -3,14 +3,10 @@ pulled up; every vertex outside the ear stays exactly where it was. The ear alon
 than Proxy Above, so it is baked on a proxy of its own faces. Stale when the region is
 painted anew; a handle outside the region is refused. Saves TEST_TMP/region.blend for
 region_reload.py."""
-import os
-import sys
-
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-from mathutils import Matrix  # noqa: E402
-import support  # noqa: E402
+import bpy
+import numpy as np
+from mathutils import Matrix
+from support import blender as support
 
 posing, storage = support.enable_addon("posing", "storage")
 
@@ -48,4 +44,3 @@ group.remove([int(np.flatnonzero(~ear)[0])])
 assert storage.stale_reason(obj) == ""
 np.save(support.tmp("region_pose.npy"), pose)
 bpy.ops.wm.save_as_mainfile(filepath=support.tmp("region.blend"))
-print("REGION_OK")

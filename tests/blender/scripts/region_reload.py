@@ -1,13 +1,9 @@
 """Open the file region_bake.py wrote: the region bake is fresh, poses as before, and the ear's
 tip pulled further still leaves every vertex outside the ear exactly where it was, refined too."""
-import os
-import sys
-
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-from mathutils import Matrix  # noqa: E402
-import support  # noqa: E402
+import bpy
+import numpy as np
+from mathutils import Matrix
+from support import blender as support
 
 posing, storage = support.enable_addon("posing", "storage")
 
@@ -31,4 +27,3 @@ assert bpy.ops.modal_deform.refine() == {"FINISHED"}
 refined = support.key_positions(obj, posing.POSE_KEY)
 assert refined[~ear].tobytes() == V[~ear].tobytes(), "Refine moved a vertex outside the region"
 assert np.abs(refined - pose).max() > 1e-4, "Refine left the reduced pose as it was"
-print("REGION_RELOADED")

@@ -1,14 +1,11 @@
 """Open the file bake_and_save.py wrote: the basis must be bit for bit what was baked; then move
 one controller, solve, and check the pose (handles on target, base mesh untouched)."""
 import math
-import os
-import sys
 
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-from mathutils import Matrix  # noqa: E402
-import support  # noqa: E402
+import bpy
+import numpy as np
+from mathutils import Matrix
+from support import blender as support
 
 handles, posing, storage = support.enable_addon("handles", "posing", "storage")
 
@@ -42,4 +39,4 @@ for handle, T in zip(resolved, handles.transforms(obj, resolved)):
     target = rest[handle.indices] @ T[:3, :3].T + T[:3, 3]
     error = np.linalg.norm(pose[handle.indices] - target, axis=1).mean() / size
     assert error < 0.01, f"handle {handle.name} misses its target by {error:.2%} of the model's size"
-print("SOLVED", obj.name, "moved", np.abs(pose - rest).max() / size)
+print(obj.name, "posed: moved by", np.abs(pose - rest).max() / size, "of its size")

@@ -1,10 +1,6 @@
 """A mesh edited after the bake is detected and refused; bad handles get clear messages."""
-import os
-import sys
-
-sys.path.insert(0, os.path.dirname(__file__))
-import bpy  # noqa: E402
-import support  # noqa: E402
+import bpy
+from support import blender as support
 
 storage = support.enable_addon("storage")
 
@@ -68,5 +64,3 @@ assert bpy.ops.modal_deform.bake() == {"FINISHED"}
 assert storage.stale_reason(obj) == "" and len(support.stored_bases()) == 1
 assert bpy.ops.modal_deform.clear_basis() == {"FINISHED"}
 assert obj.modal_deform.basis is None and len(support.stored_bases()) == 0
-
-print("STALE_OK")

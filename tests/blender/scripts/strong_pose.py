@@ -1,14 +1,9 @@
 """Suzanne (subdivided twice, baked through the operator) under strong poses (issue 22): turns of
 90 and 170 degrees about her longest axis and bends of 90 and 180 degrees converge without a
-stall, with the objective continuous along the way (bench/strong_poses.py, as the pytest cases)."""
-import os
-import sys
-
-sys.path.insert(0, os.path.dirname(__file__))
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "..", "bench"))
-import bpy  # noqa: E402
-import support  # noqa: E402
-import strong_poses  # noqa: E402
+stall, with the objective continuous along the way (support.strong_poses, as the pytest cases)."""
+import bpy
+from support import blender as support
+from support import strong_poses
 
 storage, core = support.enable_addon("storage", "core")
 
@@ -23,4 +18,3 @@ for pose in strong_poses.POSES:
     worst = max(step["difference_error"] for step in path)
     assert worst < 1e-4, (pose, worst)
     print(pose, sum(step["iterations"] for step in path), "iterations, energy", path[-1]["energy"])
-print("STRONG_POSES_OK")

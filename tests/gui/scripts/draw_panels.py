@@ -8,13 +8,11 @@ Each screenshot is of the whole window (OUTPUT/window-<state>.png) and of the si
 draw() raises prints a traceback, which the test looks for. Writes OUTPUT/result.json (window.run).
 """
 import os
-import sys
 
 import bpy
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from window import (click, enable_addon, output, override, run, say, screenshot, show_sidebar_tab, sidebar,  # noqa: E402
+from window import (click, enable_addon, output, override, run, say, screenshot, show_sidebar_tab, sidebar,
                     subdivided_suzanne, view3d)
 
 # Seconds for the sidebar to settle after a change: Blender 4.x animates panels opening and moving.

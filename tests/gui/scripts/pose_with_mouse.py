@@ -13,7 +13,6 @@ Writes OUTPUT/result.json ({"ok": bool, "log": [...]}) and screenshots, then qui
 """
 import importlib
 import os
-import sys
 import threading
 import time
 
@@ -22,10 +21,8 @@ import bpy
 import numpy as np
 from mathutils import Vector
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "blender_scripts"))
-from headless import evaluated_positions  # noqa: E402
-from window import (enable_addon, override, output, run, say, screenshot, show_sidebar_tab,  # noqa: E402
+from support.blender import evaluated_positions
+from window import (enable_addon, override, output, run, say, screenshot, show_sidebar_tab,
                     subdivided_suzanne, view3d)
 
 
@@ -52,7 +49,8 @@ def wait_until(condition, seconds):
 
 def steps():
     enable_addon()
-    from modal_deform import ops_pose, pose_displays, posing
+    from modal_deform import posing
+    from modal_deform.pose import displays
 
     # Scene: Suzanne (2 subdivision levels, 7,958 vertices) seen from the front, sidebar open.
     obj = subdivided_suzanne(2)
@@ -145,8 +143,8 @@ def steps():
     # The timer solves until converged; the mesh follows the controller. Suzanne has no shape keys:
     # the pose is shown in its vertex positions, the mesh flagged as posed meanwhile.
     yield from wait_until(lambda: posing.running.pose.stats["converged"], 30)
-    assert type(posing.running.shown) is pose_displays.PositionsDisplay
-    assert obj.data.shape_keys is None and obj.data.get(pose_displays.POSING_FLAG)
+    assert type(posing.running.shown) is displays.PositionsDisplay
+    assert obj.data.shape_keys is None and obj.data.get(displays.POSING_FLAG)
     pose = base_positions(obj)
     followed = pose[group].mean(axis=0) - rest[group].mean(axis=0)
     assert np.linalg.norm(followed - moved) < 0.05 * np.linalg.norm(moved), (followed, moved)
@@ -162,7 +160,7 @@ def steps():
     assert posing.running is None, "Esc did not end the pose"
     assert obj.data.shape_keys is None, "Esc left shape keys behind"
     assert base_positions(obj).tobytes() == rest.tobytes()
-    assert obj.data.get(pose_displays.POSING_FLAG) is None
+    assert obj.data.get(displays.POSING_FLAG) is None
     say("Esc restored the mesh")
 
     # Saving while the pose is in the vertex positions: the file has the rest mesh and the pose in
@@ -181,7 +179,7 @@ def steps():
         data_to.objects = [obj.name]
     copy = data_to.objects[0]
     assert base_positions(copy).tobytes() == rest.tobytes(), "the saved base mesh is not the rest mesh"
-    assert copy.data.get(pose_displays.POSING_FLAG) is None
+    assert copy.data.get(displays.POSING_FLAG) is None
     assert np.abs(key_positions(copy, posing.POSE_KEY) - posed).max() < 1e-5, "the saved pose is not the pose"
     bpy.data.objects.remove(copy)
     controller.location.x -= 0.1
@@ -215,7 +213,7 @@ def steps():
     assert base_positions(obj).tobytes() == rest.tobytes(), "Edit Mode took the pose for the rest mesh"
     assert key_positions(obj, "Basis").tobytes() == rest.tobytes()
     assert np.abs(key_positions(obj, posing.POSE_KEY) - posed).max() < 0.05, "the pose was not kept"
-    assert obj.data.get(pose_displays.POSING_FLAG) is None
+    assert obj.data.get(displays.POSING_FLAG) is None
     obj.shape_key_clear()
     controller.location = placed
     with override():
@@ -290,7 +288,7 @@ def steps():
     # timeline played: every frame shown is simulated into the cache (frames Blender drops to keep
     # time are simulated on the way), read through a stand-in while playing (Blender 4+); stopped, the
     # stand-in is gone and scrubbing back reads the cache.
-    from modal_deform import frame_cache, playback, playback_display
+    from modal_deform.playback import frame_cache, frame_display, timeline
     scene = bpy.context.scene
     scene.frame_start, scene.frame_end = 1, 48
     scene.frame_set(1)
@@ -302,22 +300,22 @@ def steps():
     with override():
         bpy.ops.screen.animation_play()
     yield from wait_until(lambda: scene.frame_current >= 16, 60)
-    playing_stand_in = playback_display.has_stand_in(obj)
+    playing_stand_in = frame_display.has_stand_in(obj)
     with override():
         bpy.ops.screen.animation_cancel(restore_frame=False)
     yield 0.3
     assert playing_stand_in == hasattr(bpy.app.handlers, "animation_playback_pre"), "no stand-in while playing"
-    assert not playback_display.has_stand_in(obj) and not [
-        o for o in bpy.data.objects if o.get(playback_display.STAND_IN)], "a stand-in after playback stopped"
+    assert not frame_display.has_stand_in(obj) and not [
+        o for o in bpy.data.objects if o.get(frame_display.STAND_IN)], "a stand-in after playback stopped"
     cache = frame_cache.get(obj)
-    assert playback.problems.get(obj.name) is None, playback.problems
+    assert timeline.problems.get(obj.name) is None, timeline.problems
     assert cache is not None and cache.kind == "DYNAMIC", "playing made no cache"
     assert cache.end >= 16, f"playing simulated frames {cache.start} to {cache.end} of {scene.frame_current}"
     screenshot("dynamics.png")
     shown = evaluated_positions(obj)
     assert np.abs(shown - rest).max() > 0.1, "the played mesh did not follow the controller"
     expected = np.empty_like(shown)
-    playback.player(obj, scene).positions(cache.state(8)[0], expected)
+    timeline.player(obj, scene).positions(cache.state(8)[0], expected)
     with override():
         scene.frame_set(8)
     assert evaluated_positions(obj).tobytes() == expected.tobytes(), "scrubbing did not read the cache"
@@ -340,7 +338,7 @@ def steps():
         assert bpy.ops.modal_deform.pose("INVOKE_DEFAULT") == {"RUNNING_MODAL"}
     controller.location.z += 0.3
     yield 0.5
-    assert type(posing.running.shown) is pose_displays.StandInDisplay and obj.data != mesh
+    assert type(posing.running.shown) is displays.StandInDisplay and obj.data != mesh
     assert base_positions(obj).tobytes() != rest.tobytes(), "the pose did not follow the controller"
     addon_utils.disable("modal_deform", default_set=True)
     assert posing.running is None, "disabling the add-on left the pose running"
@@ -356,18 +354,18 @@ def steps():
     # And with the pose in the vertex positions (no shape keys): the rest mesh comes back exactly.
     addon_utils.enable("modal_deform", default_set=True)
     posing = importlib.import_module("modal_deform.posing")
-    pose_displays = importlib.import_module("modal_deform.pose_displays")
+    displays = importlib.import_module("modal_deform.pose.displays")
     obj.shape_key_clear()
     with override():
         assert bpy.ops.modal_deform.pose("INVOKE_DEFAULT") == {"RUNNING_MODAL"}
     controller.location.z -= 0.3
     yield 0.5
-    assert type(posing.running.shown) is pose_displays.PositionsDisplay
+    assert type(posing.running.shown) is displays.PositionsDisplay
     assert np.abs(base_positions(obj) - rest).max() > 0.05, "the pose did not follow the controller"
     addon_utils.disable("modal_deform", default_set=True)
     assert posing.running is None, "disabling the add-on left the pose running"
     assert base_positions(obj).tobytes() == rest.tobytes(), "disabling did not restore the vertex positions"
-    assert obj.data.shape_keys is None and obj.data.get(pose_displays.POSING_FLAG) is None
+    assert obj.data.shape_keys is None and obj.data.get(displays.POSING_FLAG) is None
     say("disabling the add-on mid-pose restored the vertex positions")
 
 

@@ -1,4 +1,4 @@
-"""What the GUI scripts share: the add-on enabled from ADDON_PATH, the 3D Viewport of the window, its
+"""What the GUI scripts share: the add-on enabled (support.blender), the 3D Viewport of the window, its
 sidebar's Modal Deform tab, screenshots, and the run itself as steps between which Blender handles
 the simulated events (run(steps)), ending in OUTPUT/result.json ({"ok": bool, "log": [...]}).
 
@@ -11,8 +11,8 @@ import subprocess
 import sys
 import traceback
 
-import addon_utils
 import bpy
+from support import blender
 
 output = sys.argv[sys.argv.index("--") + 1]
 log = []
@@ -24,12 +24,9 @@ def say(*words):
 
 
 def enable_addon():
-    """Enable Modal Deform from ADDON_PATH (the source tree, or the folder Blender installed the
-    legacy zip into); fail if it does not register (addon_utils only prints why)."""
-    sys.path.insert(0, os.environ["ADDON_PATH"])
-    addon_utils.enable("modal_deform", default_set=True)
-    assert "modal_deform" in bpy.context.preferences.addons, "enabling the add-on failed (see the messages above)"
-    module = sys.modules["modal_deform"]
+    """Enable Modal Deform (the legacy zip Blender installed into the user folder, else the source
+    tree's); fail if it does not register (addon_utils only prints why)."""
+    module = blender.enable_addon()
     say(f"Blender {bpy.app.version_string} (Python {sys.version.split()[0]}), add-on from {module.__file__}")
 
 
@@ -52,14 +49,8 @@ def override():
 
 def subdivided_suzanne(levels):
     """Empties the scene and adds Suzanne subdivided `levels` times, shaded smooth; returns her."""
-    for obj in list(bpy.data.objects):
-        bpy.data.objects.remove(obj)
     with override():
-        bpy.ops.mesh.primitive_monkey_add()
-        obj = bpy.context.object
-        modifier = obj.modifiers.new("Subdivision", "SUBSURF")
-        modifier.levels = levels
-        bpy.ops.object.modifier_apply(modifier=modifier.name)
+        obj = blender.suzanne(levels)
         bpy.ops.object.shade_smooth()
     return obj
 

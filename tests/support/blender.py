@@ -1,16 +1,19 @@
-"""Helpers shared by the headless test scripts (imported from the script's folder)."""
+"""Inside Blender: what the test scripts share (``from support import blender as support``).
+
+Enabling the add-on and making handles are blender_scripts/headless.py's, the user-facing helpers
+the demo and the benchmarks use too: this module puts that folder on sys.path and builds on them.
+"""
 import importlib
 import os
+import pathlib
 import sys
 
-import addon_utils
 import bpy
 import numpy as np
 
-# Handles are made as the demo and the benchmark make them (select, Add Handle).
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "..", "blender_scripts"))
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "blender_scripts"))
 import headless  # noqa: E402
-from headless import add_handle, evaluated_positions  # noqa: E402,F401 (the scripts call them from support)
+from headless import add_handle, evaluated_positions  # noqa: E402,F401 (the scripts call them from here)
 
 
 def enable_addon(*modules):

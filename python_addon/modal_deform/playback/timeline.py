@@ -7,7 +7,7 @@ the simulation from the previous frame's state) and cached; a frame further on i
 computing every frame in between (a jump forward simulates from the last cached frame and maps
 only the frame it shows). Before the cache's first frame the mesh holds that frame's shape.
 
-The result is shown by playback_display.py: mapped straight into a point attribute that a Geometry
+The result is shown by frame_display.py: mapped straight into a point attribute that a Geometry
 Nodes modifier sets the positions from, or while the timeline plays into a stand-in mesh the modifier
 reads (the artist's positions and shape keys are not written).
 Frames computed here are checked against what they were computed from each time they are shown
@@ -19,12 +19,10 @@ import types
 import bpy
 import numpy as np
 
-from . import core as mdc
-from . import frame_cache, handles, mesh_io, playback_display, posing, storage
-
-#: Errors that stop an object's playback with a message for the panel (not baked, stale, a bad
-#: handle or setting); the display goes, and the mesh shows what it shows without it.
-FAILURES = (storage.NotReady, handles.HandleError, ValueError, RuntimeError)
+from .. import core as mdc
+from .. import app_handlers, handles, mesh_io, posing, storage
+from ..ops_common import FAILURES
+from . import frame_cache, frame_display
 
 # Runtime state, by object name: the Player (solver or simulation kept between frames), and the
 # last problem met (shown in the panel). Forgotten when a file is loaded.
@@ -32,7 +30,7 @@ _players = {}
 problems = {}
 # True while playback changes the frame itself (catching up): the handler then does nothing.
 _busy = False
-# True while the timeline plays (Blender 4+): objects shown then read a stand-in (playback_display).
+# True while the timeline plays (Blender 4+): objects shown then read a stand-in (frame_display).
 _playing = False
 
 
@@ -222,10 +220,10 @@ def show(obj, scene, edits_reported=False):
     index = cache.row(frame)
     if index is not None and not np.array_equal(player_.transforms(obj).ravel(), cache.array("transforms")[index]):
         cache.cut(frame)
-    mesh = playback_display.frame_mesh(obj, stand_in=_playing)
+    mesh = frame_display.frame_mesh(obj, stand_in=_playing)
 
     def display():  # a frame simulated here is mapped by its step straight into it (no copy between)
-        return playback_display.frame_positions(mesh)
+        return frame_display.frame_positions(mesh)
 
     if not fill(obj, scene, cache, shown, player_, out=display, curves=curves):
         player_.positions(cache.array("q")[cache.row(shown)], display())
@@ -237,7 +235,7 @@ def free(obj):
     frame_cache.free(obj)
     _players.pop(obj.name, None)
     problems.pop(obj.name, None)
-    playback_display.remove(obj)
+    frame_display.remove(obj)
 
 
 def _edits_reported(depsgraph):
@@ -251,23 +249,22 @@ def _edits_reported(depsgraph):
         obj = bpy.data.objects.get(name)
         if obj is not None and obj.type == "MESH" and obj.data.as_pointer() in edited:
             found.compared = None
-            playback_display.end_stand_in(obj)
+            frame_display.end_stand_in(obj)
 
 
-@bpy.app.handlers.persistent
 def _frame_changed(scene, depsgraph=None):
     if _busy:
         return
     if depsgraph is not None:
         _edits_reported(depsgraph)
-    displayed = playback_display.in_use()
+    displayed = frame_display.in_use()
     for obj in scene.objects:
         if not wants_playback(obj):
             if displayed and obj.type == "MESH" and obj.library is None:
                 if not plays(obj):  # freed, dynamics off
-                    playback_display.remove(obj)
+                    frame_display.remove(obj)
                 elif _playing:  # Edit, Sculpt or Paint Mode: the mesh itself shows there
-                    playback_display.end_stand_in(obj)
+                    frame_display.end_stand_in(obj)
             continue
         try:
             show(obj, scene, edits_reported=depsgraph is not None)
@@ -276,68 +273,58 @@ def _frame_changed(scene, depsgraph=None):
             if problems.get(obj.name) != str(error):
                 print(f"Modal Deform: '{obj.name}' cannot play: {error}")
             problems[obj.name] = str(error)
-            playback_display.remove(obj)
+            frame_display.remove(obj)
 
 
-@bpy.app.handlers.persistent
 def _geometry_updated(scene, depsgraph):
     _edits_reported(depsgraph)
 
 
-@bpy.app.handlers.persistent
 def _undone(*args):
     """After an undo or redo, which reads objects and meshes back from memory, the Players (which
     hold the handles' controllers) are made again, comparing their meshes again; with the timeline
     still, a stand-in the undo step held goes."""
     _players.clear()
     if not _playing:
-        playback_display.end_stand_ins()
+        frame_display.end_stand_ins()
 
 
-@bpy.app.handlers.persistent
 def _forget(*args):
     global _playing
     _players.clear()
     problems.clear()
     _playing = False
-    playback_display.end_stand_ins()  # a file written mid-playback
+    frame_display.end_stand_ins()  # a file written mid-playback
 
 
-@bpy.app.handlers.persistent
 def _playback_started(*args):
     global _playing
     _playing = True
 
 
-@bpy.app.handlers.persistent
 def _playback_stopped(*args):
     global _playing
     _playing = False
-    playback_display.end_stand_ins()
+    frame_display.end_stand_ins()
 
 
-@bpy.app.handlers.persistent
 def _before_saving(*args):
     """The file holds the mesh once: the stand-ins go, and come back at the next frame played."""
-    playback_display.end_stand_ins()
+    frame_display.end_stand_ins()
 
 
 # Blender's handlers and ours; the playback handlers are Blender 4's.
-_HANDLERS = [("frame_change_post", _frame_changed), ("depsgraph_update_post", _geometry_updated),
+_HANDLERS = (("frame_change_post", _frame_changed), ("depsgraph_update_post", _geometry_updated),
              ("undo_post", _undone), ("redo_post", _undone), ("load_post", _forget),
              ("save_pre", _before_saving), ("animation_playback_pre", _playback_started),
-             ("animation_playback_post", _playback_stopped)]
+             ("animation_playback_post", _playback_stopped))
 
 
 def register():
-    for name, handler in _HANDLERS:
-        if hasattr(bpy.app.handlers, name):
-            getattr(bpy.app.handlers, name).append(handler)
+    app_handlers.register(_HANDLERS)
 
 
 def unregister():
-    for name, handler in _HANDLERS:
-        if hasattr(bpy.app.handlers, name):
-            getattr(bpy.app.handlers, name).remove(handler)
+    app_handlers.unregister(_HANDLERS)
     _forget()
-    playback_display.remove_all()
+    frame_display.remove_all()

@@ -1,5 +1,5 @@
 """The per-frame cache of an object's reduced state, in the .blend file: what a static animation
-bake or the simulation computed for each frame, played back as x = x̄ + U q (playback.py).
+bake or the simulation computed for each frame, played back as x = x̄ + U q (timeline.py).
 
 What: from the cache's first frame on, one row per frame of q (r,) (the coordinates of the basis
 vectors) and, for a simulation, of its velocity; a few hundred bytes a frame where a shape key per
@@ -26,7 +26,7 @@ import json
 import bpy
 import numpy as np
 
-from . import mesh_io, storage
+from .. import mesh_io, storage
 
 PREFIX = ".Modal Deform Cache "
 _ARRAYS = ("q", "v", "transforms", "curves")
@@ -225,7 +225,7 @@ def settings_changed(obj):
 
 def controller_curves(obj):
     """The animation curves of obj's controllers, as (path, F-curve): path "controller:data_path[index]"."""
-    from .frame_keys import action_fcurves
+    from ..frame_keys import action_fcurves
     found = []
     for handle in obj.modal_deform.handles:
         controller = handle.controller

@@ -6,9 +6,10 @@ import os
 import bpy
 import numpy as np
 
-from . import frame_cache, handles, playback, point_cache
-from .jobs import AnimationJob, FrameJob
-from .ops_common import JobOperator, mesh_poll
+from .. import handles
+from ..jobs import AnimationJob, FrameJob
+from ..ops_common import FAILURES, JobOperator, mesh_poll
+from . import frame_cache, point_cache, timeline
 
 
 class CacheJob(FrameJob):
@@ -24,15 +25,15 @@ class CacheJob(FrameJob):
         if end < start:
             raise ValueError(f"frame range: the end ({end}) is before the start ({start})")
         super().__init__(range(start, end + 1))
-        self.player = playback.player(obj, self.scene)  # raises for the artist before anything changes
+        self.player = timeline.player(obj, self.scene)  # raises for the artist before anything changes
         self.frame_before = self.scene.frame_current
         self.old = dynamics.cache
         dynamics.cache = None  # kept (0 users) until finish() or cancel()
         self.cache = frame_cache.create(obj, self.scene, start)
 
     def _frame(self, frame):
-        playback.set_frame(self.scene, frame)
-        playback.fill(self.obj, self.scene, self.cache, frame, self.player)
+        timeline.set_frame(self.scene, frame)
+        timeline.fill(self.obj, self.scene, self.cache, frame, self.player)
 
     def finish(self):
         if self.cancelling:
@@ -40,8 +41,8 @@ class CacheJob(FrameJob):
         if self.error is not None:
             return "ERROR", f"Cache bake failed: {self.error}"
         self._drop(self.old)
-        playback.set_frame(self.scene, self.frame_before)
-        playback.show(self.obj, self.scene)
+        timeline.set_frame(self.scene, self.frame_before)
+        timeline.show(self.obj, self.scene)
         self.written = True
         what = "simulation" if self.cache.kind == "DYNAMIC" else "animation"
         return "INFO", (f"Cached the {what} of {len(self.frames)} frames ({self.frames[0]} to {self.frames[-1]}) in "
@@ -81,7 +82,7 @@ def cached_frames(obj):
 def cached_positions(obj, scene):
     """frame -> #V by 3 float32 positions of obj's cached frame (the mesh must still fit its basis)."""
     cache = frame_cache.get(obj)
-    player = playback.player(obj, scene)
+    player = timeline.player(obj, scene)
     out = np.empty((len(obj.data.vertices), 3), np.float32)
 
     def positions(frame):
@@ -100,7 +101,7 @@ class MODAL_DEFORM_OT_free_cache(bpy.types.Operator):
     poll = classmethod(cache_poll)
 
     def execute(self, context):
-        playback.free(handles.owner(context.object))
+        timeline.free(handles.owner(context.object))
         return {"FINISHED"}
 
 
@@ -123,7 +124,7 @@ back and render without the add-on; the cache is then freed, as the keys take it
     def _finish(self):
         result = super()._finish()
         if self.job.written:
-            playback.free(self.job.obj)
+            timeline.free(self.job.obj)
         return result
 
 
@@ -162,7 +163,7 @@ and other packages read, for machines without the add-on"""
             frames = cached_frames(obj)
             point_cache.write(path, self.file_format, len(obj.data.vertices), frames,
                               scene.render.fps / scene.render.fps_base, cached_positions(obj, scene))
-        except (OSError, *playback.FAILURES) as error:
+        except (OSError, *FAILURES) as error:
             self.report({"ERROR"}, f"Export failed: {error}")
             return {"CANCELLED"}
         self.report({"INFO"}, f"Wrote {len(frames)} frames ({frames[0]} to {frames[-1]}) to {path}: add a Mesh Cache "

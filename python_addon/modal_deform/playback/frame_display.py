@@ -10,14 +10,14 @@ leaves the positions alone (the Named Attribute node's "Exists" is Set Position'
 the selection, and goes with it). The stand-in goes (end_stand_in) when playback stops, before a file
 is saved, when the artist edits the mesh, leaves Object Mode or puts a modifier before the display's,
 and after a file is loaded or an undo while the timeline is still. The display goes (remove) when
-the cache is freed or no longer plays, when a pose shows (pose_displays.display, posing.pose_key) and
+the cache is freed or no longer plays, when a pose shows (pose.displays.display, posing.pose_key) and
 when the add-on is disabled. Why, and what a file written mid-playback holds: docs/design.md, "How a
 pose is shown and kept".
 """
 import bpy
 import numpy as np
 
-from . import mesh_io
+from .. import mesh_io
 
 #: The modifier on an object that plays a cache, and its node group (one per file, shared), which
 #: carries the ID property MARK: the modifier is the one whose node group has it, whatever their names.

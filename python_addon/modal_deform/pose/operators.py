@@ -4,10 +4,11 @@ import time
 
 import bpy
 
-from . import core as mdc
-from . import handles, mesh_io, pose_displays, posing
-from .jobs import RefineJob
-from .ops_common import FAILURES, JobOperator, mesh_poll
+from .. import core as mdc
+from .. import handles, mesh_io, posing
+from ..jobs import RefineJob
+from ..ops_common import FAILURES, JobOperator, mesh_poll
+from . import displays
 
 
 class MODAL_DEFORM_OT_pose(bpy.types.Operator):
@@ -28,7 +29,7 @@ keeps the pose, Esc restores the mesh as it was"""
             return {"CANCELLED"}
         for warning in self.pose.warnings:
             self.report({"WARNING"}, warning)
-        self.shown = pose_displays.display(obj)
+        self.shown = displays.display(obj)
         self.area = context.area
         self.request = None
         self.tick_ms = 0.0

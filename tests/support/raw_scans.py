@@ -28,9 +28,8 @@ damage a scan has, each placed at random (seeded) and in proportion to the mesh'
 """
 import numpy as np
 
-import modal_deform.core as mdc
-import shapes
-from subdivision import midpoint_subdivide
+from support.meshes import read_scan
+from support.subdivision import midpoint_subdivide
 
 #: What each kind of damage does to a mesh, per 10,000 faces of the input.
 RATES = {"slivers": 20, "sliver_pairs": 2, "needles": 10, "seams": 3, "duplicates": 4, "double_sheets": 2, "flips": 20,
@@ -172,7 +171,7 @@ def damaged(V, F, seed=0, rates=None):
 def raw_scan(name="dragon_res2", levels=1, seed=0, rates=None):
     """A shared scan midpoint-subdivided `levels` times and damaged (dragon_res2, one level: about
     400k vertices)."""
-    V, F = mdc.read_mesh(shapes.SHARED_MESHES / shapes._SCAN_FILES[name])
+    V, F = read_scan(name)
     for _ in range(levels):
         V, F = midpoint_subdivide(V, F)
     return damaged(V, F, seed=seed, rates=rates)

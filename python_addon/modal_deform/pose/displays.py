@@ -5,18 +5,19 @@ keys standing in for a mesh whose only key that moves it is the "Modal Deform" o
 a mesh posed before), which Blender both evaluates without blending shape keys, or else the "Modal
 Deform" shape key (ShapeKeyDisplay). Each offers array() (where the pose is written), shows_pose(),
 and ends with the pose in the shape key (keep) or the mesh as it was (restore). The marks a display
-leaves on a mesh (POSING_FLAG, STAND_IN_OF) let pose_recovery.py repair a mesh written mid-pose.
+leaves on a mesh (POSING_FLAG, STAND_IN_OF) let recovery.py repair a mesh written mid-pose.
 """
 import bpy
 import numpy as np
 
-from . import mesh_io, playback_display, posing
+from .. import mesh_io, posing
+from ..playback import frame_display
 
 #: A mesh ID property: while it is set, the mesh's positions hold a pose and its rest is the
-#: stored basis's. A file or undo step written mid-pose carries it, and pose_recovery repairs them.
+#: stored basis's. A file or undo step written mid-pose carries it, and recovery.py repairs them.
 POSING_FLAG = "modal_deform_posing"
 #: A mesh ID property of a stand-in (StandInDisplay): the artist's mesh it stands in for. An ID
-#: property is a user, so that mesh is saved with a file written mid-pose, and pose_recovery puts it back.
+#: property is a user, so that mesh is saved with a file written mid-pose, and recovery.py puts it back.
 STAND_IN_OF = "modal_deform_stand_in_of"
 
 
@@ -59,7 +60,7 @@ def display(obj):
     """Where the interactive pose shows the pose of obj: the vertex positions of a mesh without
     shape keys, a stand-in's when only the "Modal Deform" key moves the mesh, else that key. A frame
     playback shows goes first (it would hide the pose)."""
-    playback_display.remove(obj)
+    frame_display.remove(obj)
     if obj.data.shape_keys is None:
         return PositionsDisplay(obj)
     return StandInDisplay(obj) if only_pose_key_moves(obj, obj.data) else ShapeKeyDisplay(obj)
@@ -130,7 +131,7 @@ class PositionsDisplay(_TransientDisplay):
     Blender evaluates a dense mesh many times faster (bench/results/bpy_pose.json, "evaluate" of
     "positions" against "shape_key").
     The rest positions are kept to put back; the mesh carries POSING_FLAG meanwhile, so a file or
-    undo step written mid-pose is repaired (pose_recovery.recover) instead of taking the pose for the rest."""
+    undo step written mid-pose is repaired (recovery.recover) instead of taking the pose for the rest."""
 
     def __init__(self, obj):
         self.obj = obj

@@ -1,10 +1,11 @@
 """Crash and undo recovery of the interactive pose. A file saved mid-pose first moves the pose into
 the "Modal Deform" shape key (save_pre); after undo, redo or a file loaded, the pose under way ends
-and meshes written mid-pose (they carry a display's marks, pose_displays) are repaired (recover).
+and meshes written mid-pose (they carry a display's marks, displays.py) are repaired (recover).
 """
 import bpy
 
-from . import mesh_io, pose_displays, posing, storage
+from .. import app_handlers, mesh_io, posing, storage
+from . import displays
 
 
 def recover():
@@ -17,11 +18,11 @@ def recover():
         mesh = obj.data
         if obj.type != "MESH" or mesh.library is not None or posing.is_posing(obj):
             continue
-        if mesh.get(pose_displays.STAND_IN_OF) is not None:
+        if mesh.get(displays.STAND_IN_OF) is not None:
             pose = mesh_io.vertex_positions(mesh).copy()
-            pose_displays.put_mesh_back(obj, mesh)
+            displays.put_mesh_back(obj, mesh)
             mesh_io.write_shape_key(obj.data, posing.pose_key(obj)[0], pose)
-        elif mesh.get(pose_displays.POSING_FLAG) is not None:
+        elif mesh.get(displays.POSING_FLAG) is not None:
             _recover_positions(obj)
 
 
@@ -37,11 +38,10 @@ def _recover_positions(obj):
         print(f"Modal Deform: '{obj.name}' was saved while posing and its mesh no longer fits its basis")
         return
     pose = mesh_io.vertex_positions(mesh).copy()
-    pose_displays.put_rest_back(mesh, rest)
+    displays.put_rest_back(mesh, rest)
     mesh_io.write_shape_key(mesh, posing.pose_key(obj)[0], pose)
 
 
-@bpy.app.handlers.persistent
 def _keep_before_save(*args):
     """A file saved mid-pose holds the rest mesh and the pose in its shape key: a pose shown in the
     vertex positions moves into the key first, and the pose goes on there."""
@@ -52,7 +52,6 @@ def _keep_before_save(*args):
             pass
 
 
-@bpy.app.handlers.persistent
 def _recover_after_undo_or_load(*args):
     """Undo, redo or a file loaded replaced the data: a pose under way ends (its next event) and
     meshes written mid-pose are repaired (recover)."""
@@ -61,16 +60,13 @@ def _recover_after_undo_or_load(*args):
     recover()
 
 
-_HANDLERS = ((bpy.app.handlers.save_pre, _keep_before_save), (bpy.app.handlers.undo_post, _recover_after_undo_or_load),
-             (bpy.app.handlers.redo_post, _recover_after_undo_or_load),
-             (bpy.app.handlers.load_post, _recover_after_undo_or_load))
+_HANDLERS = (("save_pre", _keep_before_save), ("undo_post", _recover_after_undo_or_load),
+             ("redo_post", _recover_after_undo_or_load), ("load_post", _recover_after_undo_or_load))
 
 
 def register():
-    for handlers, handler in _HANDLERS:
-        handlers.append(handler)
+    app_handlers.register(_HANDLERS)
 
 
 def unregister():
-    for handlers, handler in _HANDLERS:
-        handlers.remove(handler)
+    app_handlers.unregister(_HANDLERS)
