@@ -142,9 +142,9 @@ def shape_key_co(mesh, block):
     A mesh's shape key keeps its positions as one contiguous float[3] array per key, which
     ``block.data[0]`` points at. Writing into it directly takes a hundredth of the time
     ``foreach_set`` takes (it goes through RNA item by item), which would cost a tenth of the pose's
-    frame budget (docs/measurements.md, "The add-on in Blender"). The length is checked against the mesh every time, and the address read anew, so a
-    key reallocated since (undo, edit) is never written through an old pointer: use the view at
-    once, never keep it.
+    frame budget (docs/measurements.md, "The add-on in Blender"). The length is checked against the
+    mesh every time, and the address read anew, so a key reallocated since (undo, edit) is never
+    written through an old pointer: use the view at once, never keep it.
     """
     count = len(block.data)
     if count != len(mesh.vertices) or block.id_data != mesh.shape_keys:

@@ -1,18 +1,18 @@
-"""Where playback shows a frame: a point attribute of the mesh that a Geometry Nodes modifier, first in
-the object's stack, sets the positions from (Set Position from a Named Attribute); while the timeline
-plays (Blender 4+), a stand-in mesh without shape keys whose positions are the frame, which the
-modifier reads instead (frame_mesh(stand_in=True)) because Blender evaluates it faster
+"""Where playback shows a frame: a point attribute of the mesh that a Geometry Nodes modifier, first
+in the object's stack, sets the positions from (Set Position from a Named Attribute); while the
+timeline plays (Blender 4+), a stand-in mesh without shape keys whose positions are the frame, which
+the modifier reads instead (frame_mesh(stand_in=True)) because Blender evaluates it faster
 (bench/results/playback.json, "evaluate_ms" of "dynamic_step" against "dynamic_step_still").
 
 The artist's positions and shape keys are never written. Where the attribute is missing the modifier
 leaves the positions alone (the Named Attribute node's "Exists" is Set Position's selection; Blender
 3.4 has no such output: there a BOOLEAN point attribute, SHOWN, written True with the attribute, is
-the selection, and goes with it). The stand-in goes (end_stand_in) when playback stops, before a file
-is saved, when the artist edits the mesh, leaves Object Mode or puts a modifier before the display's,
-and after a file is loaded or an undo while the timeline is still. The display goes (remove) when
-the cache is freed or no longer plays, when a pose shows (pose.displays.display, posing.pose_key) and
-when the add-on is disabled. Why, and what a file written mid-playback holds: docs/design.md, "How a
-pose is shown and kept".
+the selection, and goes with it). The stand-in goes (end_stand_in) when playback stops, before a
+file is saved, when the artist edits the mesh, leaves Object Mode or puts a modifier before the
+display's, and after a file is loaded or an undo while the timeline is still. The display goes
+(remove) when the cache is freed or no longer plays, when a pose shows (pose.displays.display,
+posing.pose_key) and when the add-on is disabled. Why, and what a file written mid-playback holds:
+docs/design.md, "How a pose is shown and kept".
 """
 import bpy
 import numpy as np
