@@ -15,12 +15,9 @@ writes into DESTINATION one zip per entry of EXTENSIONS and the legacy zip:
   modal_deform/_native.cpython-3XY-*.so (Python imports the one of its own version) and the
   libraries auditwheel bundled beside them in modal_deform/_native.libs/.
 
-Why one extension zip per Python: pybind11 has no stable ABI, so each Python needs its own wheel.
-Blender 4.2.0 installs every wheel of its platform whatever its Python and keeps one per package
-name, so a zip holding cp311 and cp313 wheels would give 4.2.0 the wrong one; Blender 5.1 and later
-(Python 3.13) refuse an extension whose wheels are all for another Python. Each zip holds the one
-wheel of its Blenders' Python and says so with blender_version_min / blender_version_max, which
-every Blender's installer checks ("doesn't meet the minimum supported version (5.1.0)").
+One extension zip per Python, each naming its Blenders with blender_version_min /
+blender_version_max: pybind11 has no stable ABI (why that takes a zip each: docs/design.md, "Which
+zip for which Blender").
 
 The Windows x64 wheels (win_amd64, cross-built by `make wheels-windows`), when given, get the same
 split: modal_deform-<version>-<blenders>-windows_x64.zip, its manifest saying `platforms =

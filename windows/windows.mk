@@ -42,13 +42,8 @@ WIN_TEST_COMMON := pytest==9.2.0 iniconfig==2.3.1 pluggy==1.7.0 packaging==26.4 
 WIN_TEST_3.11   := numpy==1.26.4 scipy==1.15.3 $(WIN_TEST_COMMON)
 WIN_TEST_3.13   := numpy==2.5.5 scipy==1.18.1 $(WIN_TEST_COMMON)
 WIN_TEST_3.11-numpy2 := numpy==2.4.6 scipy==1.17.1 $(WIN_TEST_COMMON)
-# Open (issue 39): the 5k dragon's Refine of a 170° turn converges on Windows too (60 iterations,
-# Linux 57, within the test's 90), but into another local minimum: energy 26.058077 against Linux's
-# 26.056165 (7e-5 higher). The bases differ by float32 rounding (OpenBLAS 0.3.34 of scipy-openblas32
-# against Debian's 0.3.21, msvcrt's and MinGW-w64's maths against glibc's), and the strong turn's
-# path amplifies that into another basin. There the exact Hessian shifted by the final τ (8.7e-4)
-# does not factor, so the last step takes the projected one, where the test asks for the exact one
-# (quadratic convergence at the end); its other assertions hold.
+# Deselected: under Wine the strong turn's Refine ends in another local minimum, where the exact
+# Hessian does not factor and the test asks for it (docs/design.md, "Windows x64").
 WIN_DESELECT    := --deselect tests/python/test_solve.py::test_refine_of_a_strong_turn_is_not_held_back_by_crushed_triangles
 WIN_SUITE_3.11  := tests/python
 WIN_SUITE_3.13  := tests/python

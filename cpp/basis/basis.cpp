@@ -17,8 +17,8 @@ void require(bool condition, const std::string& what) {
   if (!condition) throw InputError("basis: " + what);
 }
 
-// Checked as one contiguous vector: Eigen's allFinite on a row-major matrix (vectors) took 0.26 s
-// at 100k vertices and 67 columns, against 0.012 s over its storage.
+// Checked as one contiguous vector: Eigen's allFinite on a row-major matrix (vectors) is many
+// times slower than over its storage (docs/measurements.md, "Choices in the core").
 template <typename Matrix>
 void require_finite(const Matrix& matrix, const char* name) {
   using Vector = Eigen::Matrix<typename Matrix::Scalar, Eigen::Dynamic, 1>;
@@ -131,7 +131,8 @@ void validate_basis(const Basis& b) {
   require_finite(b.eigenvalues, "eigenvalues");
   require_shared([&] { require_positions(flatten(b.ghost_vertices), b.ghost_vertices.size(), "ghost_vertices"); });
   require_finite(b.ghost_vectors, "ghost_vectors");
-  // The messages are formatted only for an offending entry: per entry they took 1.2 s at 100k vertices.
+  // The messages are formatted only for an offending entry: formatting one per entry would cost
+  // far more than the check (docs/measurements.md, "Choices in the core").
   for (Eigen::Index v = 0; v < n; ++v)
     if (b.ghost_map[v] < 0 || b.ghost_map[v] >= g)
       require(false, message("ghost_map[", v, "] = ", b.ghost_map[v], " is outside [0, ", g, ")"));
@@ -154,7 +155,7 @@ void validate_basis(const Basis& b) {
   } catch (const InputError& error) {
     throw InputError(message("basis: ghost_vertices and ghost_faces (scaled) are not a usable mesh: ", error.what()));
   }
-  // Row by row, along vectors' storage (a column-wise reduction of the row-major array took 0.07 s).
+  // Row by row, along vectors' storage (a column-wise reduction of the row-major array is slower).
   Eigen::RowVectorXf largest_row = Eigen::RowVectorXf::Zero(r);
   for (Eigen::Index i = 0; i < b.vectors.rows(); ++i) largest_row = largest_row.cwiseMax(b.vectors.row(i).cwiseAbs());
   const Eigen::VectorXf largest = largest_row.transpose();

@@ -3,22 +3,12 @@
 //
 //   E(x) = Σ_i min_{R_i ∈ SO(3)} Σ_{j ∈ N(i)} w_ij ‖(x_i − x_j) − R_i (x̄_i − x̄_j)‖²   (S&A eq. 3, 7)
 //
-// with one cell per vertex (its one-ring of edges, "spokes") and cotangent weights of the rest mesh,
-// w_ij = ½ (cot α_ij + cot β_ij) (cotangent_weights: one cotangent on boundary edges, k on
-// non-manifold edges, degenerate faces add nothing, slivers clamped). Units: length².
-//
-// Weights are clamped to w_ij ≥ 0: an edge whose opposite angles sum to more than 180 degrees
-// (obtuse triangles; 14% of the edges of the decimated dragons) drops out. With a negative weight
-// a cell's rest covariance can be indefinite, so the best rotation at rest is not the identity:
-// E(x̄) < 0 and ∇E(x̄) ≠ 0 (201 cells of dragon_vrip_res4), which breaks the rest state every stage
-// relies on. With w ≥ 0 the energy is a sum of squares: E ≥ 0, zero on rigid motions of each
-// component, the rotation fit (local step) is a Procrustes problem and, for fixed rotations, E is
-// a convex quadratic in x (a graph Laplacian with non-negative weights). A face adds
-// ½ sin α / (sin β sin γ) > 0 to the weights of the two edges at its corner α, so a vertex keeps
-// an edge unless all its faces are degenerate (or slivers beyond the cotangent clamp). Vertices
-// without edges (those, and unreferenced vertices) add nothing to E; their Hessian rows are zero.
-//
-// Calls on one object are thread-safe: the energy keeps no state between calls.
+// with one cell per vertex (its one-ring of edges) and cotangent weights of the rest mesh,
+// w_ij = ½ (cot α_ij + cot β_ij), clamped to w_ij ≥ 0 so that E ≥ 0 with its minimum at rest
+// (a negative weight can make a cell's best rotation at rest other than the identity). Units:
+// length². Vertices without edges add nothing; their Hessian rows are zero. Why the clamp and
+// what it keeps: docs/design.md, "ARAP". Calls on one object are thread-safe: the energy keeps no
+// state between calls.
 #pragma once
 
 #include <vector>

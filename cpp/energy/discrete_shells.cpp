@@ -254,7 +254,7 @@ double add_gradient(const Term& term, const double* x, Owned owned, double* out)
 }
 
 // Terms that add_gradients_in_lanes evaluates at once: one SSE2 packet of doubles, the wheel's
-// baseline (4, two packets, was slower).
+// baseline (4, two packets, are slower).
 constexpr int kLanes = 2;
 using TermLanes = Lanes<kLanes>;
 

@@ -3,8 +3,8 @@
 //
 // The fill-reducing ordering is METIS nested dissection of the graph of nodes, groups of
 // dofs_per_node consecutive rows (3 for x, y, z): the fill of ordering every row, with a ninth of
-// the graph to partition. On a 300k-row shells pattern this halves the analysis and keeps the
-// factor a tenth smaller than AMD's, which makes each solve faster.
+// the graph to partition. On a shells pattern this shortens the analysis and keeps the factor
+// smaller than AMD's, which makes each solve faster (docs/measurements.md, "Choices in the core").
 //
 // The symbolic analysis (fill-reducing ordering, supernodes) depends only on the sparsity pattern
 // and is kept across numeric factorisations of matrices with the same pattern, such as K − σM for

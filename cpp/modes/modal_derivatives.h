@@ -50,7 +50,7 @@ Eigen::MatrixXd solve_in_range(const SparseMatrix& K, const VectorRef& mass, con
 // solve(P B, X, report), which writes a solution of K X = P B into X (its kernel part is removed
 // here) and may tell the bar what part of the block is done; then the residuals P B − K X are
 // checked. A solve that knows that residual from its own recurrence leaves it in PB and returns
-// true, sparing the product with K (as long as a solve step at 100k vertices); one that returns
+// true, sparing the product with K (as costly as a step of the solve); one that returns
 // false leaves PB as it was, and the residual is computed here.
 // m: the diagonal of M (3n); Z: a checked kernel basis (checked_kernel_basis); decoupled:
 // decoupled_dofs. Throws InputError for a B of the wrong size or not finite, NumericalError when

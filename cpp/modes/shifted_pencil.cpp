@@ -22,12 +22,11 @@ namespace {
 
 // σ = −kShiftFraction · tr K / tr M, or kDeflatedShiftFraction when a kernel is deflated. The
 // trace ratio is a mass-weighted mean of the spectrum, far above its low end and growing with the
-// resolution (2.6e6 on the dragon with 23k vertices, 2.1e8 with 100k, whose lowest flexible
-// eigenvalues are 0.024 and 0.037), so σ sits just below λ = 0 while K − σM stays far from
-// singular. Zero modes left in K (undeflated ones, a floppy mesh's mechanisms) want σ not too
-// close to 0: at 1e-10 the residuals of the other modes of two small spring networks exceed
-// 1e-8 of the top eigenvalue. The wanted modes want it not far below them, or Lanczos needs more
-// solves per mode.
+// resolution (the dragons': docs/measurements.md, "The eigensolver"), so σ sits just below λ = 0
+// while K − σM stays far from singular. Zero modes left in K (undeflated ones, a floppy mesh's
+// mechanisms) want σ not too close to 0: at 1e-10 the residuals of the other modes of two small
+// spring networks exceed 1e-8 of the top eigenvalue. The wanted modes want it not far below
+// them, or Lanczos needs more solves per mode.
 // The deflated fraction also sets how often the bake's derivative solves refine: their
 // contraction is −σ/(λ − σ), so a σ ten times closer to 0 saves a refinement step (a solve as wide
 // as the derivatives); much closer (1e-12) leaves small meshes' modes above their residual
@@ -43,13 +42,12 @@ constexpr double kRoundingFloor = 1e-12;
 // Lanczos stops when ‖T y − ν y‖_M ≤ kEigenTolerance |ν| for each wanted Ritz pair: tight enough
 // for the residuals tests/cpp/test_vibration_modes.cpp asks for after the final inverse iteration.
 constexpr double kEigenTolerance = 1e-10;
-// A Ritz estimate stops falling near the rounding of the largest ν, ε ν_max: on the 5k dragon with
-// its 9 zero modes undeflated (ν = 1.4e5), the estimates of the modes with tolerances of 0.6 to
-// 0.9 ε ν_max hovered at 1 to 2 ε ν_max over 700 Lanczos vectors. A pair whose tolerance
-// kEigenTolerance |ν| is below ε ν_max is out of reach once its Ritz value has settled (its
-// estimate below kSettledEstimate |ν|: early Ritz values are low, so the 23k dragon's 136th mode
-// looked out of reach but converged); pairs all within kRoundingLevels ε ν_max have stalled when
-// kStalledBlocks blocks do not halve the worst estimate relative to its tolerance.
+// A Ritz estimate stops falling near the rounding of the largest ν, ε ν_max (docs/measurements.md,
+// "The eigensolver"). A pair whose tolerance kEigenTolerance |ν| is below ε ν_max is out of reach
+// once its Ritz value has settled (its estimate below kSettledEstimate |ν|: early Ritz values are
+// low, so a mode can look out of reach and still converge); pairs all within kRoundingLevels
+// ε ν_max have stalled when kStalledBlocks blocks do not halve the worst estimate relative to its
+// tolerance.
 constexpr double kSettledEstimate = 1e-6;
 constexpr double kRoundingLevels = 10;
 constexpr size_t kStalledBlocks = 4;
@@ -57,7 +55,8 @@ constexpr size_t kStalledBlocks = 4;
 // dropped (the Krylov space has closed, up to rounding).
 constexpr double kDependentNorm = 1e-8;
 // Lanczos vectors allowed: kMaxColumnsPerMode per wanted mode, at least kMinColumns (a flat plate's
-// 4 lowest modes took more than 56), plus the first block. The dragons take 5 to 6 per mode.
+// few lowest modes take more than their share), plus the first block; twice what the dragons take
+// (docs/measurements.md, "The eigensolver").
 constexpr int kMaxColumnsPerMode = 12;
 constexpr int kMinColumns = 120;
 // Right-hand sides per block solve. A single solve streams the whole factor; a block shares the
@@ -68,8 +67,9 @@ constexpr int kBlockWidth = 8;
 
 // solve_in_range refines until the error left on each eigenvector it does not know is below this
 // fraction of that component, in at most this many steps. Those components are the small,
-// high-frequency part of a modal derivative: on dragon_vrip_res2 one step leaves it within 4.3e-4
-// (the contraction at σ's kDeflatedShiftFraction), about where the pinned solve gets (4e-4).
+// high-frequency part of a modal derivative: one step (the contraction at σ's
+// kDeflatedShiftFraction) leaves it about where the pinned solve gets (docs/measurements.md,
+// "The eigensolver").
 constexpr double kRefinementTolerance = 1e-3;
 constexpr int kMaxRefinementSteps = 6;
 
@@ -188,8 +188,8 @@ class BlockLanczos {
   // W −= Q Qᵀ M W over the first `columns` of Q; returns the coefficients removed. W = T Q_j lies
   // in the span of the blocks j − 1, j and j + 1 but for what rounding lost: first the
   // recurrence's large parts along the last two blocks, then one pass over all of Q for the small
-  // rest, which a single pass removes to rounding. Half the work of two full passes, which took as
-  // long as the solves on the 23k dragon.
+  // rest, which a single pass removes to rounding. Half the work of two full passes, which cost as
+  // much as the solves (docs/measurements.md, "The eigensolver").
   Eigen::MatrixXd orthogonalize(Eigen::MatrixXd& W, Eigen::Index columns) const {
     Eigen::MatrixXd C = Eigen::MatrixXd::Zero(columns, W.cols());
     const Eigen::Index recent = std::max<Eigen::Index>(0, previous_first_);
@@ -462,8 +462,8 @@ Eigen::MatrixXd ShiftedPencil::solve_in_range(Eigen::MatrixXd B, Progress* progr
   // whose factor the modes' residuals (computed with K) have checked already.
   // The updates of X and R go through the rows once, block by block in parallel (rather than a
   // pass over 3n rows per statement on one thread). Each product is a statement of its own: nested
-  // in one expression, Eigen evaluated M (σY − ΦΛw) coefficient by coefficient, which took as long
-  // as the solve. Y stays in the factor's solution buffer, which is kept from step to step.
+  // in one expression, Eigen evaluates M (σY − ΦΛw) coefficient by coefficient, as slowly as the
+  // solve. Y stays in the factor's solution buffer, which is kept from step to step.
   const auto step = [&](Eigen::MatrixXd& R, Eigen::Ref<Eigen::MatrixXd> X) {
     const CholmodLLT::Solution Y = factor_.solve_in_workspace(R);
     const Eigen::MatrixXd w = correction.asDiagonal() * inner_product(modes, R);

@@ -32,8 +32,8 @@ struct Group {
 };
 
 // The simulated vertices in a uniform grid of about two a cell, for the regions' queries: a scan
-// has hundreds of attached groups (the 100k dragon 500), and a pass over every simulated vertex
-// for each took 0.8 s.
+// has hundreds of attached groups, and a pass over every simulated vertex for each is slow
+// (docs/measurements.md, "Choices in the core").
 class VertexGrid {
  public:
   explicit VertexGrid(const RowMatrixX3d& P) : P_(P) {
@@ -170,13 +170,10 @@ Attachment attach(const VerticesRef& V, const FacesRef& F) {
   const Eigen::VectorXd area = face_areas(V, F);
 
   // Pieces: the sound faces joined across edges, and the area of each (at its root face). A
-  // doubled triangle counts once: two copies fold onto each other, their common hinges at an angle
-  // of π whose sign is undefined, and a fin (a vertex on such a pair alone) was held by nothing
-  // across them. On the shared 100k dragon each fin gave a zero mode, M-orthonormalised to 1e6
-  // times the median entry at its tiny mass, and the derivatives' largest entries sat there too (a
-  // reduced pose drew spikes). One copy is a flap welded to the surface at its non-manifold edge;
-  // leaving both out freed the doubled triangles that bridge surface vertices (a reduced pose
-  // stretched some 15 times and turned them over).
+  // doubled triangle counts once: its two copies fold onto each other at hinges whose angle's sign
+  // is undefined, so a fin on such a pair alone would be a zero mode; one copy is a flap welded to
+  // the surface, while leaving both out would free the doubled triangles that bridge surface
+  // vertices (docs/design.md, "Attachment").
   std::vector<char> sound(static_cast<size_t>(m), 1);
   for (int f : duplicate_faces(F)) sound[static_cast<size_t>(f)] = 0;
   for (int f = 0; f < m; ++f)

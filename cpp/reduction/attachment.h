@@ -1,36 +1,15 @@
 // Which vertices the bake simulates, and how the others follow them.
 //
-// Every connected component adds 6 zero modes, every mechanism more, and real scans come with
-// debris: tiny components, unreferenced vertices, vertices whose faces have no area, doubled
-// triangles (folded fins), blobs hanging from the surface by one vertex. The bake spends its modes only on
-// the simulated vertices; the others are attached and ride along.
-//
-// The rule. Sound faces are neither degenerate nor slivers (face_shape_ratio above
-// kMinSimulatedShape) nor copies (laid again on an earlier face's three vertices: a scan's
-// doubled triangles count once). Sound faces sharing an edge form pieces; a piece is simulated
-// when its area is at least kSimulatedAreaFraction (10%) of the largest piece's, and so are its
-// vertices. Every other vertex
-// is attached: unreferenced vertices, vertices on degenerate or sliver faces only, and the
-// vertices of smaller pieces (scan debris; Suzanne's eyes, about 7% of her vertices each; a small
-// closed blob or flap joined to the surface at one vertex, which would turn about it at no cost).
-// Simulated pieces that share a vertex are one component: they share rigid motions, and turning
-// about the shared vertex is a zero mode of the bake. The energy, the mass and the eigenproblem
-// use only the simulated submesh: the sound faces of the simulated pieces.
-//
-// How attached vertices follow. Attached vertices joined by faces (a small piece, less any vertex
-// it shares with a simulated one) or a single attached vertex
-// move as one affine body with the surface around them: their displacement is the affine
-// field t + A (p − m) fitted by mass-weighted least squares to the displacements of the simulated
-// vertices nearby, m their mean. The region: the simulated vertices within 1.5 times the
-// group's radius from its centre, grown until it holds at least 16 vertices and is not flat
-// (thinner than a tenth of its extent). Every affine motion of that region, rigid motions
-// included, carries over exactly; a region that deforms is followed on average, so an eye stays
-// in its socket rather than following four far-apart vertices. A flat region could not tell how
-// its normal turns under a large rotation, hence the growing. Only when the whole simulated mesh
-// is flat (a sheet) is the fit affine in its plane, the normal turning as the plane does (the
-// skew completion of A): every linearised rigid motion, which is what the rigid columns of the
-// basis are, is still reproduced exactly. The fit is linear in the displacements, so it applies
-// to each basis vector (x = x̄ + U q stays linear).
+// Every connected component adds 6 zero modes, every mechanism more, and scans come with debris.
+// So sound faces (neither degenerate, slivers nor copies of an earlier face) sharing an edge form
+// pieces, and a piece is simulated when its area is at least kSimulatedAreaFraction of the largest
+// piece's. Every other vertex is attached (unreferenced vertices, vertices on unsound faces only,
+// the vertices of smaller pieces) and takes no part in the energy, the mass or the eigenproblem.
+// Attached vertices joined by faces, or a single one, move as one affine body fitted by
+// mass-weighted least squares to the simulated vertices around them, a region grown until it is
+// not flat: every affine motion, rigid motions included, carries over exactly, and the fit is
+// linear in the displacements, so it applies to each basis vector (x = x̄ + U q stays linear).
+// The rule, the fit and their reasons: docs/design.md, "Attachment".
 #pragma once
 
 #include <vector>
@@ -43,9 +22,8 @@ namespace modal_deform {
 constexpr double kSimulatedAreaFraction = 0.1;
 // Faces thinner than this (face_shape_ratio: an angle below about 0.06°) are not simulated. The
 // bending stiffness of a sliver's hinges grows as the inverse square of its thinness (the inverse
-// cube when the sliver alone carries a vertex); measured on small grids, a sliver of 6e-5 threw
-// the eigensolver's shift, and one of 6e-6 made the lowest modes rounding noise (scan debris; the
-// shared dragons have one face below 1e-3 in 202k).
+// cube when the sliver alone carries a vertex), and much thinner slivers throw the eigensolver's
+// shift or leave the lowest modes to rounding (docs/measurements.md, "Meshes as they come").
 constexpr double kMinSimulatedShape = 1e-3;
 
 struct Attachment {

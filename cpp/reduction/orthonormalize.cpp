@@ -12,7 +12,7 @@ namespace modal_deform {
 namespace {
 
 // Columns orthonormalised together, at most: the wider the block, the fewer passes over the basis
-// and the faster its products (on the 100k dragon's 73 columns, blocks of 32 took 0.52 s).
+// and the faster its products (docs/measurements.md, "Choices in the core").
 constexpr Eigen::Index kBlockColumns = 80;
 // The squared M-norms of X's columns: the diagonal of Xᵀ M X without the rest of it.
 Eigen::VectorXd squared_m_norms(const Eigen::Ref<const Eigen::MatrixXd>& X, const VectorRef& dof_mass) {

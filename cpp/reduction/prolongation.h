@@ -9,15 +9,8 @@
 //
 // so the fine detail, x̄_i minus its closest point on the proxy, stays fixed in the rest frame
 // and rides along with the interpolated displacement. The fine basis is thus P U_proxy, stored
-// as the proxy basis plus P: 24 bytes per fine vertex instead of 12 r.
-//
-// Why the rest frame: turning each vertex's detail with its proxy triangle's frame was measured
-// against it (bench/detail_offsets.py: a rippled tube of 25.7k vertices on a 3.2k proxy, bent by
-// 90° and 120°, ripples 0.26% of the diagonal RMS). Against the full nonlinear solve both are off
-// by the same 1.83% / 2.62% RMS of the diagonal (the reduced space's own error; the fine mesh's
-// own bake: 1.46% / 2.21%); the turned detail is closer by 0.002 points, while the two differ by
-// up to 1.4% at single vertices. Turning would need the proxy's rest positions, a frame per proxy
-// triangle every frame and a rotation per fine vertex, for no measurable gain.
+// as the proxy basis plus P: 24 bytes per fine vertex instead of 12 r. Turning the detail with its
+// triangle's frame gains nothing measurable (docs/design.md, "Prolongation").
 #pragma once
 
 #include "util/types.h"

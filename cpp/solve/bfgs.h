@@ -4,24 +4,10 @@
 // The state (x, the inverse Hessian H, f and ∇f at x) persists between calls of minimize, so an
 // interactive session runs a few iterations per frame and continues from where it stopped. When
 // the objective changes (a handle moved), the caller either says by how much f and ∇f changed at
-// x (cheap when only a known term changed) or has them re-evaluated.
-//
-// Stopping (paper eq. 14, after Gill, Murray & Wright, Practical Optimization, 8.2.3.2): with
-// tolerance ε, iteration k ends the search when
-//   f(x_{k−1}) − f(x_k) < ε (1 + |f(x_k)|),
-//   ‖x_{k−1} − x_k‖ < √ε (1 + ‖x_k‖),
-//   ‖∇f(x_k)‖ ≤ ∛ε (1 + |f(x_k)|)
-// all hold (Euclidean norms), and before any iteration when ‖∇f(x)‖ ≤ ε (1 + |f(x)|) (GMW's
-// test U4, e.g. at rest with the handles at rest), or when a line search fails on a step whose
-// predicted decrease −∇fᵀp is below 1e-12 (1 + |f|), which f cannot resolve (a minimum at working
-// precision: a small ε can ask for more than that). Once converged, further calls return at once
-// until the objective changes.
-//
-// With Finish::kPredicted the test is also taken before each step on the step BFGS predicts,
-// p = −H∇f: when the decrease its quadratic model predicts, ½|∇fᵀp|, and ‖p‖ pass the first two
-// bounds and ‖∇f‖ the third, x + p is taken unevaluated and the call ends converged. Near a minimum the
-// quasi-Newton step is accepted whole, so x + p is the point the last step would reach, without
-// the evaluation that only confirms it: for a caller that needs x alone, not f and ∇f there.
+// x (cheap when only a known term changed) or has them re-evaluated. Stopping: paper eq. 14 (GMW
+// 8.2.3.2), and converged calls return at once until the objective changes. With
+// Finish::kPredicted the quasi-Newton step that passes the test is taken unevaluated, for a caller
+// that needs x alone. The test's bounds and why: docs/design.md, "BFGS".
 #pragma once
 
 #include <limits>

@@ -1,29 +1,16 @@
 // Handles and the handle term of the posing objective (paper section 5, E_C): on the fine mesh
 // for the full solve, and restricted to the reduced coordinates for the reduced solver.
 //
-// A handle is a set of fine vertices that follows a rigid transform T_h = [R_h t_h; 0 0 0 1] of
-// its rest positions, with a weight w_h ≥ 0. With a coefficient c (μs⁴ for mesh units in the
-// normalised frame, normalization.h; μ for positions already normalised) the term is
+// A handle is a set of fine vertices that follows a rigid transform T_h of its rest positions,
+// with a weight w_h ≥ 0; with c = μs⁴ (mesh units, normalization.h) or μ (normalised positions):
 //
 //   E_C(x) = c Σ_h w_h Σ_{i∈h} m_i ‖x_i − R_h x̄_i − t_h‖²                    (HandleTerm)
+//   E_C(q) = qᵀ A q + 2 bᵀ q + e   on x = x̄ + U q                          (ReducedHandleTerm)
 //
-// with m_i the lumped masses. Restricted to x = x̄ + U q (U_i the 3 by r rows of vertex i),
-//
-//   E_C(q) = qᵀ A q + 2 bᵀ q + e                                            (ReducedHandleTerm)
-//
-// A = c Σ_h w_h Σ_i m_i U_iᵀU_i depends only on the handle set; with x̄_i = k_h + r_i about the
-// handle's mass centroid k_h, D_h = I − R_h and e_h = D_h k_h − t_h,
-//
-//   b = c Σ_h w_h (C_h vec(D_h) + T_h e_h),   e = c Σ_h w_h (tr(D_h S_h D_hᵀ) + M_h ‖e_h‖²),
-//
-// where C_h = Σ_i m_i U_iᵀ ⊗ r_iᵀ (r by 9), T_h = Σ_i m_i U_iᵀ (r by 3), S_h = Σ_i m_i r_i r_iᵀ and
-// M_h = Σ_i m_i are computed once. Moving handles then costs O(r) per handle, and evaluating the
-// term O(r²), whatever the number of handle vertices. (Centring keeps e exact when the mesh lies
-// far from the origin: no large terms cancel.)
-//
-// A vertex may belong to several handles: its terms add, so it settles between their targets in
-// proportion to their weights. A vertex listed twice in one handle is an input error. Vertices
-// without mass (in no triangle) pull with zero weight.
+// A and per-handle moments about each handle's mass centroid are computed once, so moving handles
+// costs O(r) per handle and evaluating the term O(r²), whatever the number of handle vertices.
+// A vertex in several handles settles between their targets by their weights. The formulas for
+// b and e: docs/design.md, "The handle term".
 #pragma once
 
 #include <functional>

@@ -32,8 +32,8 @@ class LoadPath {
 
 // The loads a solve visits, from 0 to 1. From rest the first increment is a sixth of the
 // suggested one: longer, its first Newton step (nearly the linear elastic answer) tangles fins and
-// flaps (on the 5k dragon turned by 30° at once, triangles collapsed and the solve stalled at 4
-// times the minimum's objective). Each next increment doubles after an easy step (at most
+// flaps, collapses triangles and stalls the solve far above the minimum (docs/measurements.md,
+// "Choices in the core"). Each next increment doubles after an easy step (at most
 // kFewIterations), up to the suggested one, and halves after a hard one (more than
 // kManyIterations, or its tolerance not reached). From a given start there is one step, the full
 // load.

@@ -1,22 +1,15 @@
 // The basis vectors U (rows by r, float32) stored a second time in 16 bits, for the map
 // x = x̄ + U q that the pose writes to the fine mesh every update (paper section 5, "map q to the
 // fine mesh"). That map reads all of U for a few multiply-adds per entry, so it runs at memory
-// speed: 81 MB at 100k vertices and 67 dimensions, 2.7 ms at the 30 GB/s of this project's 2-core
-// machines. Half the bytes take half the time.
+// speed: half the bytes take half the time.
 //
 // Each block of kRowsPerBlock rows stores, per column j, its largest |U_kj| as a scale s_bj and the
-// entries as round(32767 U_kj / s_bj) in int16. Rounding moves an entry by at most s_bj / 65534,
-// so a row k of block b maps with an error of at most
-//
-//   e_b(q) = Σ_j s_bj |q_j| / 65534,
-//
-// known per block for each q before mapping it. A block is stored column by column, so the map
-// multiplies and adds along its rows with no sum across a vector per row. A block whose bound
-// exceeds the caller's tolerance is mapped from the float32 rows instead: every coordinate is then
-// within the tolerance of the float32 map. Measured on the 100k dragon at 67 dimensions, a
-// tolerance of 3e-5 of the diagonal sends at most 0.6% of the blocks to float32 for poses up to a
-// 90 degree turn (flaps of the scan, which move far, carry the large bounds); per column instead
-// of per block, 16 bits alone missed 1e-4 of the diagonal there (2.2e-4), float16 by far (1.6e-3).
+// entries as round(32767 U_kj / s_bj) in int16, so a row of block b maps with an error of at most
+// e_b(q) = Σ_j s_bj |q_j| / 65534, known per block for each q before mapping it. A block is stored
+// column by column (no sum across a vector per row). A block whose bound exceeds the caller's
+// tolerance is mapped from the float32 rows instead: every coordinate is then within the
+// tolerance of the float32 map. How often that happens, and why per block: docs/design.md,
+// "The 16-bit map".
 #pragma once
 
 #include <cstdint>

@@ -5,8 +5,9 @@
 namespace modal_deform {
 namespace {
 
-// The local solve is small (the 100k dragon's: 17 vertices free, 200 around them): it goes to the
-// full solve's tolerance; at 1e-3 the full solve then took 2 factorisations more.
+// The local solve is small (tens of vertices free, a few hundred around them): it goes to the
+// full solve's tolerance, since a looser one costs the full solve more factorisations
+// (docs/measurements.md, "Choices in the core").
 constexpr double kRelaxTolerance = 1e-8;
 constexpr int kRelaxIterations = 100;
 

@@ -167,7 +167,7 @@ void ShiftedNewton::update_shift(double cut, double ratio) {
     // Too long a step: lean towards steepest descent. Where τD dominates the Hessian (the floppy
     // parts that made the step too long) the step shrinks as 1/τ, so τ grows at least by the
     // factor the line search cut the step by (from a poor start, τ must rise by ten orders of
-    // magnitude, which doubling alone took ten iterations to reach).
+    // magnitude, which doubling alone would take ten iterations to reach).
     shift_ *= std::max(growth_, std::min(1 / cut, kMaxCutGrowth));
     growth_ = std::min(2 * growth_, kMaxGrowth);
   }

@@ -1,33 +1,14 @@
 // Newton's method on the full solve's objective F (pose_objective.h) with the Hessian shifted,
-// ∇²F + τD (D the normalised lumped mass per coordinate), factored once an iteration. CHOLMOD's
-// analysis of the Hessian's pattern is kept for the whole solve, and τ from one iteration (and
-// load step) to the next.
+// ∇²F + τD (D the normalised lumped mass per coordinate). CHOLMOD's analysis of the Hessian's
+// pattern is kept for the whole solve, and τ from one iteration (and load step) to the next.
 //
-// τ follows how well the quadratic model predicted the decrease (Levenberg–Marquardt with Nielsen's
-// update: shrunk after a good step, grown after a poor one — at least by the factor the line search
-// cut the step by — and tenfold when the factorisation finds the matrix not positive definite,
-// never below PoseObjective::smallest_shift so that a free component's rigid motions stay
-// regularised). A large τ shortens the step where curvature is low (flaps) and leaves it Newton's
-// where curvature is high, unlike a line search, which would shorten it everywhere. The step is
-// then backtracked (Armijo, line_search.h) when F does not decrease enough or a triangle turns
-// over. A step cut only because longer ones turned a triangle over does not grow τ: the model was
-// right wherever F was evaluated, and the triangles are a few crushed ones (area 0.1–10% of rest)
-// that a full step passes through zero area; growing τ by such cuts would keep it far above its
-// floor and the whole mesh would creep. Such a search starts at 0.9 of the way to where the first
-// triangle would turn over
-// (PoseObjective::step_to_turning). The Hessian is the projected one (each element's made
-// semidefinite) far from the minimum, and the exact one near it wherever it factors at the current
-// τ (quadratic convergence). A full step that decreased F by more than 1.5 times what the model
-// promised (the projected Hessian overestimating the curvature of a flap bent away from a saddle)
-// is extended to α = 2, 4, 8 while F falls.
-//
-// A factorisation costs as much as a dozen or more solves with the factor (bench/results/native.json,
-// BM_CholmodFactorize against BM_CholmodSolve/1), and from one iteration to the next the shifted
-// Hessian changes little. So an iteration first solves its Newton system by conjugate gradients
-// preconditioned by the last factor, to the relative residual of an inexact Newton method
-// (Eisenstat & Walker 1996, choice 2; near the minimum proportional to ‖∇F‖, which keeps Newton's
-// convergence quadratic), and factors the matrix only when that meets nonpositive curvature or, by
-// its decrease so far, would not converge within kMaxCgIterations.
+// τ follows how well the quadratic model predicted the decrease (Levenberg–Marquardt with
+// Nielsen's update), never below PoseObjective::smallest_shift; the step is then backtracked
+// (Armijo, line_search.h) when F does not decrease enough or a triangle turns over. The Hessian is
+// the projected one far from the minimum and the exact one near it wherever it factors. An
+// iteration first solves by conjugate gradients preconditioned by the last factor, to an inexact
+// Newton tolerance (Eisenstat & Walker 1996), and factors only when that would not converge.
+// Why each of these: docs/design.md, "Newton's iterations".
 #pragma once
 
 #include <functional>
@@ -104,7 +85,7 @@ class ShiftedNewton {
   // tried first, at the current τ only: where it is not definite there (a flap still bent far from
   // rest), the projected one (Energy::projected_hessian) serves instead for the next
   // kRetryExactAfter iterations. Growing τ until the exact Hessian factors would damp the whole
-  // mesh (on the 23k dragon τ rose to 3e6 and the next ten iterations crept). Returns whether it
+  // mesh (docs/measurements.md, "Choices in the core"). Returns whether it
   // made progress: F fell by more than its rounding, or ‖∇F‖ by half (near the minimum, where F's
   // decrease is below rounding).
   // By conjugate gradients the Newton system is solved to the relative residual `forcing` (> 0).
@@ -127,9 +108,8 @@ class ShiftedNewton {
   static constexpr double kExtendAbove = 1.5;
   static constexpr double kMaxExtension = 8;
   // The fraction of the way to the first triangle's turning point the line search starts at when
-  // that point is nearer than a full step. Refine's iterations on the 23k dragon at turn 170: 55
-  // at 0.8, 45 at 0.9 and 0.99, 75 halving from 1; at turn 90: 87 at 0.5 (another minimum), 18
-  // at 0.9, 27 at 0.99, 22 halving from 1.
+  // that point is nearer than a full step: the fewest Refine iterations on the 23k dragon's strong
+  // turns (docs/measurements.md, "Choices in the core").
   static constexpr double kToTurning = 0.9;
 
   // trial_ (the full step's point, F lower there than the model promised: the projected Hessian

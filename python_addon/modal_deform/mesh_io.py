@@ -45,8 +45,8 @@ def group_weights(obj, group_name):
     """(#V,) float64 weights of the vertex group, 0 for the vertices not in it, or None when the
     object has no group of that name.
 
-    Blender has no bulk access to group weights: this walks the vertices once (about 0.1 s for
-    100k vertices), so callers read a group once, not per update.
+    Blender has no bulk access to group weights: this walks the vertices once (too slow for every
+    update: docs/measurements.md, "The add-on in Blender"), so callers read a group once.
     """
     group = obj.vertex_groups.get(group_name)
     if group is None:
@@ -140,11 +140,11 @@ def shape_key_co(mesh, block):
     Blender's own array, for the solver to write the pose straight into (no array and copy between).
 
     A mesh's shape key keeps its positions as one contiguous float[3] array per key, which
-    ``block.data[0]`` points at. Writing into it directly takes 0.05 ms for 126k vertices where
-    ``foreach_set`` takes 5.5 ms (it goes through RNA item by item): a tenth of the pose's frame
-    budget. The length is checked against the mesh every time, and the address read anew, so a
-    key reallocated since (undo, edit) is never written through an old pointer: use the view at
-    once, never keep it.
+    ``block.data[0]`` points at. Writing into it directly takes a hundredth of the time
+    ``foreach_set`` takes (it goes through RNA item by item), which would cost a tenth of the pose's
+    frame budget (docs/measurements.md, "The add-on in Blender"). The length is checked against the
+    mesh every time, and the address read anew, so a key reallocated since (undo, edit) is never
+    written through an old pointer: use the view at once, never keep it.
     """
     count = len(block.data)
     if count != len(mesh.vertices) or block.id_data != mesh.shape_keys:

@@ -12,8 +12,8 @@ import sys
 def _passive_openmp_wait():
     """GCC's OpenMP (the core's loops and CHOLMOD's) reads its wait policy once, when the core loads
     it. By default its idle threads spin at every barrier, and on cores that other work shares (the
-    artist's Blender draws while it bakes) they take the core from the thread that has work: the
-    passive wait made the 23k dragon's bake 0.78 times as long on a loaded 2-core machine. Set only
+    artist's Blender draws while it bakes) they take the core from the thread that has work
+    (bench/results/bake_busy.json; docs/measurements.md, "A bake beside a busy core"). Set only
     while the core loads and only when the user chose no policy: other add-ons never see it. An
     OpenMP runtime loaded before the core (Debian's Blender shares the system's) keeps its own."""
     if {"OMP_WAIT_POLICY", "GOMP_SPINCOUNT"} & os.environ.keys():

@@ -20,7 +20,7 @@ POSE_KEY = "Modal Deform"
 #: runs. Besides .pose (its Pose) it offers keep_in_shape_key(), request_end(how) and end(context, how).
 running = None
 #: The most BFGS iterations one update takes however much of its time budget is left: far more
-#: than a budget of milliseconds allows (an iteration costs 0.2 ms at 67 dimensions), so the
+#: than a budget of milliseconds allows (bench/results/table1.json, "ms_per_iteration"), so the
 #: budget or convergence ends an update.
 MAX_ITERATIONS_PER_UPDATE = 1000
 #: BFGS iterations at most of a solve to convergence (the Solve operator, scripts).
@@ -66,7 +66,7 @@ class Pose:
     def write(self, co):
         """x̄ + U q into `co`, a view of one of the mesh's arrays in Blender (mesh_io.shape_key_co,
         mesh_io.vertex_positions), and the mesh tagged for redraw. The solver writes (in parallel)
-        straight into a contiguous array, which saves a copy of 19 MB per update at 1.6M vertices;
+        straight into a contiguous array, which saves a copy of the whole mesh per update;
         Blender 3.4's vertices (strided MVert) take a copy."""
         if co.flags.c_contiguous:
             self.solver.positions(co)

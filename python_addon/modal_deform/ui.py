@@ -199,7 +199,7 @@ class VIEW3D_PT_modal_deform_preview(_Panel, bpy.types.Panel):
                         icon="HIDE_OFF" if showing else "HIDE_ON", depress=showing)
 
 
-# Dynamics and the per-frame cache (issue 40).
+# Dynamics and the per-frame cache.
 class VIEW3D_PT_modal_deform_dynamics(_Panel, bpy.types.Panel):
     bl_label = "Dynamics"
     bl_parent_id = "VIEW3D_PT_modal_deform"

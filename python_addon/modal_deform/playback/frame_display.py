@@ -1,31 +1,18 @@
-"""Where playback shows a frame: a point attribute of the mesh that a Geometry Nodes modifier, first in
-the object's stack, sets the positions from (Set Position from a Named Attribute).
+"""Where playback shows a frame: a point attribute of the mesh that a Geometry Nodes modifier, first
+in the object's stack, sets the positions from (Set Position from a Named Attribute); while the
+timeline plays (Blender 4+), a stand-in mesh without shape keys whose positions are the frame, which
+the modifier reads instead (frame_mesh(stand_in=True)) because Blender evaluates it faster
+(bench/results/playback.json, "evaluate_ms" of "dynamic_step" against "dynamic_step_still").
 
-The artist's positions and shape keys are never written: Edit Mode (the modifier is hidden there)
-shows the rest, and a file written mid-playback (a crash's autosave) holds the mesh as it was plus
-the frame in the attribute. Where the attribute is missing the modifier leaves the positions alone
-(the Named Attribute node's "Exists" is Set Position's selection; Blender 3.4 has no such output:
-there a BOOLEAN point attribute, SHOWN, written True with the attribute, is the selection, and goes
-with it), so taking the attribute away shows the mesh as before, and a mesh joined to one that
-plays keeps its own positions. Blender evaluates the modifier in 4.8 to 9.0 ms at 1.6M vertices
-where it blended the playback shape key this replaces in 11.4 to 20.0 (bench/results/playback.json,
-"evaluate_ms", against its record at 246d346); Blender 4+ copies the attribute's array once a frame
-when it is written (positions(): 1.7 ms at 1.6M), as the evaluated mesh shares it until then.
-
-While the timeline plays (from Blender 4 on, whose playback handlers say when), the modifier reads a
-stand-in instead (frame_mesh(stand_in=True)): a copy of the mesh without shape keys, in no scene,
-whose positions are the frame, passed on whole by an Object Info node. Blender then evaluates a mesh
-whose positions were written rather than a Set Position, in less than half the time
-(bench/results/playback.json, "evaluate_ms" of "dynamic_step" against "dynamic_step_still"). The
-stand-in goes (end_stand_in) when playback stops, before a file is saved, when the artist edits the
-mesh, leaves Object Mode or puts a modifier before the display's, and after a file is loaded or an
-undo while the timeline is still: the attribute then holds its frame, so the display shows the same.
-A file written mid-playback without save_pre (a crash's autosave) holds the stand-in, which shows
-the frame as the attribute does.
-
-Taken away (remove) when the cache is freed or no longer plays, when a pose shows (the interactive
-pose, or a result in the "Modal Deform" shape key: pose.displays.display, posing.pose_key) and when
-the add-on is disabled.
+The artist's positions and shape keys are never written. Where the attribute is missing the modifier
+leaves the positions alone (the Named Attribute node's "Exists" is Set Position's selection; Blender
+3.4 has no such output: there a BOOLEAN point attribute, SHOWN, written True with the attribute, is
+the selection, and goes with it). The stand-in goes (end_stand_in) when playback stops, before a
+file is saved, when the artist edits the mesh, leaves Object Mode or puts a modifier before the
+display's, and after a file is loaded or an undo while the timeline is still. The display goes
+(remove) when the cache is freed or no longer plays, when a pose shows (pose.displays.display,
+posing.pose_key) and when the add-on is disabled. Why, and what a file written mid-playback holds:
+docs/design.md, "How a pose is shown and kept".
 """
 import bpy
 import numpy as np

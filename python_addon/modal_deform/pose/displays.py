@@ -128,7 +128,8 @@ class _TransientDisplay:
 
 class PositionsDisplay(_TransientDisplay):
     """The pose in the vertex positions of a mesh without shape keys: with no shape keys to blend,
-    Blender's evaluation of a 1.6M-vertex mesh takes 0.1 ms instead of 10 to 20 (docs/benchmarks.md).
+    Blender evaluates a dense mesh many times faster (bench/results/bpy_pose.json, "evaluate" of
+    "positions" against "shape_key").
     The rest positions are kept to put back; the mesh carries POSING_FLAG meanwhile, so a file or
     undo step written mid-pose is repaired (recovery.recover) instead of taking the pose for the rest."""
 
@@ -151,9 +152,10 @@ class PositionsDisplay(_TransientDisplay):
 class StandInDisplay(_TransientDisplay):
     """The pose in the vertex positions of a copy of the mesh without its shape keys, standing in for
     the mesh on obj while posing, when only the "Modal Deform" key moves it (only_pose_key_moves; a
-    mesh posed and kept before): Blender evaluates any mesh with shape keys, even all muted, in 13
-    ms at 1.6M vertices, a mesh without them in 0.2 (docs/benchmarks.md). The artist's mesh, its keys
-    and their animation are not touched until the pose is kept; restore() puts it back on obj."""
+    mesh posed and kept before): Blender evaluates any mesh with shape keys, even all muted, far
+    slower than a mesh without them (bench/results/bpy_pose.json, "evaluate" of "stand_in" against
+    "shape_key"). The artist's mesh, its keys and their animation are not touched until the pose is
+    kept; restore() puts it back on obj."""
 
     def __init__(self, obj):
         self.obj, self.mesh = obj, obj.data
