@@ -1,57 +1,14 @@
 // The bake: the paper's preprocess (sections 4 and 5), from a mesh to the reduced space the
-// solver poses in. One forward pipeline:
-//
-//   1. validate_mesh; scale = normalizing_scale(V): the energy lives in the paper's normalised
-//      frame (longest bounding-box edge 10). The basis keeps the rest mesh and its masses.
-//   2. Simulated vertices (attachment.h): components with less than 10% of the largest one's
-//      area, unreferenced vertices and vertices without mass are attached, not simulated; they
-//      follow the affine motion fitted to the simulated surface around them.
-//   3. K = ∇²E(x̄) of the simulated submesh, M lumped.
-//   4. The shifted pencil (shifted_pencil.h): K − σM, factored once for steps 5 and 6, with the
-//      rigid motions of the components as its kernel (analytic, M-orthonormal, 6 per component).
-//      CHOLMOD orders K while the ghost is simplified beside it (edge collapse of the whole mesh
-//      to about `ghost` vertices).
-//   5. Vibration modes: the lowest eigenpairs M-orthogonal to the kernel (deflation). A floppy
-//      mesh (large parts joined at a single vertex; scan debris is attached in step 2) has
-//      further zero modes, with λ < kZeroEigenvalue tr K/tr M: they come on top of `modes` (a
-//      scan's count of mechanisms is not known before the bake, and each would take the place
-//      of a deformation mode), stay in the basis after the rigid motions (Basis::num_floppy) and
-//      join the pencil's kernel.
-//   6. Modal derivatives (eq. 13) for the pairs of the modes other than translations and zero
-//      modes (the linearised rotations and the flexible modes), in the paper's order:
-//      right-hand sides ∇³E(x̄)(φᵢ, φⱼ) (third_batch), solved in the range of K in the pencil,
-//      corrected on the eigenpairs found and refined: one CHOLMOD factorisation in all, the most
-//      expensive step at 100k vertices.
-//   7. [rigid motions, zero modes, modes, derivatives] M-orthonormalised (orthonormalize.h),
-//      numerically dependent derivatives dropped (Basis::num_dropped).
-//   8. Attached rows, conversion to mesh units (x = x̄ + U q), float32 vectors; the ghost's
-//      vectors restricted from them.
-//
-// A region (options.region) changes steps 2 to 4: the simulated vertices are the region's, the
-// energy is that of the faces touching it with the vertices outside clamped, K and M are the
-// blocks of the simulated vertices, there are no rigid motions (a free part of the region has
-// them as zero modes), and the rows of the vertices outside are zero (region.h; the part of the
-// mesh that moves: region_bake.h).
-//
-// A mesh of more than options.proxy_above vertices goes through steps 2 to 8 as a proxy: the fine
-// mesh simplified by the same edge collapse to about options.proxy vertices ("proxy"), baked in the
-// fine mesh's normalised frame; then each fine vertex gets its barycentric weights on the nearest
-// proxy triangle ("prolongation"). The Basis keeps the fine rest positions and masses, the
-// proxy's vectors and the prolongation (proxy_bake.h): memory and storage grow with the fine
-// mesh only by those weights. A region of more than options.proxy_above free vertices is baked so too: the proxy
-// is its submesh's, simplified with the free and clamped vertices kept apart (so the line between
-// them stays), baked as a region, and every fine vertex outside the region gets zero weights.
-//
-// Stages (kBakeStages in util/bake_stages.h, in the order they run) are timed into Basis::timings and
-// reported through Progress with the same names: for a proxy bake "proxy" first; "attachment",
-// "hessian", "factorisation" (CHOLMOD's analysis, reported before the ghost, and the numeric
-// factorisation of the pencil; the pencil times its own parts), "ghost" (the wait for the ghost beyond the analysis: it is
-// simplified on a thread of its own beside it), "modes" (the rest of them), "third derivatives",
-// "derivative solves", "orthonormalisation", "assembly" (step 8: the fine and the ghost's
-// vectors); for a proxy bake "prolongation" last; seconds.
-// A cancel throws Cancelled at the next report and leaves nothing behind. CHOLMOD cannot report
-// during its analysis and factorisation, nor a blocked solve during its right-hand sides: the bar
-// pauses there (bench/results/bake_busy.json times them).
+// solver poses in. One forward pipeline, in the mesh's normalised frame: the simulated vertices
+// (attachment.h; the others attached), K = ∇²E(x̄) and lumped M, the shifted pencil K − σM
+// factored once (CHOLMOD's ordering beside the ghost's edge collapse), the lowest vibration modes
+// (a floppy mesh's zero modes on top of `modes`), modal derivatives (eq. 13) of the pairs of modes
+// other than translations and zero modes, M-orthonormalisation, and the float32 vectors in mesh
+// units with the ghost's restricted from them. A region bakes only its vertices (region.h); a
+// mesh of more than options.proxy_above vertices is baked on a proxy and prolongated
+// (proxy_bake.h). Stages are timed into Basis::timings and reported through Progress under the
+// names of kBakeStages (util/bake_stages.h); a cancel throws Cancelled at the next report and
+// leaves nothing behind. Each step and its reasons: docs/design.md, "The bake's stages".
 #pragma once
 
 #include <string>

@@ -1,24 +1,13 @@
 // The reference solve: Newton's method on the full mesh for the reduced solver's objective, to
 // measure how far the reduced answer is from the true minimiser and to polish a pose on the full
-// mesh (Refine, refine.h).
-//
-// In the normalised frame y = s x (s = normalizing_scale(V)):
+// mesh (Refine, refine.h). In the normalised frame y = s x (s = normalizing_scale(V)):
 //
 //   F(y) = E(y) + μ Σ_h w_h Σ_{i∈h} s²m_i ‖y_i − s (R_h x̄_i + t_h)‖²
 //
-// with E the discrete shells energy (bending, membrane, painted stiffness) or ARAP of the rest mesh s V, and m_i the
-// lumped masses of (V, F): the reduced solver's objective with U = I and no ghost.
-//
-// The pieces: the objective (pose_objective.h); a start's stretched vertices relaxed first
-// (relax_stretched.h: a reduced pose's fins and needles); Newton on the shifted Hessian, keeping CHOLMOD's
-// analysis for the whole solve and backtracking along its step (shifted_newton.h: what makes it
-// converge on scans with floppy flaps and fins); the load steps from rest (load_steps.h). Each
-// load step starts from the previous answer moved on along the path the last step took (a secant
-// predictor) when F is lower there; intermediate loads are solved to a loose tolerance.
-//
-// Where F has a kink rather than a minimum (a sliver triangle collapsed: its bending terms'
-// angle flips as its normal does), F stops decreasing while ‖∇F‖ stays large; the solve then
-// stops and reports that it did not converge.
+// The pieces: the objective (pose_objective.h), a start's stretched vertices relaxed first
+// (relax_stretched.h), Newton on the shifted Hessian (shifted_newton.h), load steps from rest
+// (load_steps.h). A solve that stops on a kink of F rather than a minimum reports that it did not
+// converge. Why each piece: docs/design.md, "The full solve".
 #pragma once
 
 #include <vector>

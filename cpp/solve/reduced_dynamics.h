@@ -1,50 +1,13 @@
 // Secondary motion: the dynamics M ẍ + D ẋ + ∇E(x) = f whose quasi-static limits are the poses
-// (paper section 3, "connection to physical simulation"), in the reduced space x = x̄ + U q of a
-// baked basis, the energy on the ghost and the handle term exact on the fine mesh, as in
-// ReducedSolver.
-//
-// Mass: the basis is M-orthonormal in the normalised frame (basis.h), so the reduced mass matrix
-// is ρI, with ρ the mass scale the artist's period sets. Time runs in seconds; the artist gives
-// frames: `period` is the period of the lowest flexible mode in frames at `fps`.
-//
-// Integrator: the implicit midpoint rule, q_{n+1} = q_n + h v_m, ρ(v_{n+1} − v_n) = −h (∇V(q_m) +
-// D v_m), with q_m and v_m the means of the step's ends (Hairer, Lubich & Wanner, Geometric
-// Numerical Integration, 2nd ed., I.1.2 and VI.3). It is symplectic and conserves the energy of a
-// quadratic potential for every h: no numerical damping, where a 12-frame vibration at 2 substeps
-// a frame keeps 45% of its amplitude a period under implicit Euler and 97.6% under BDF2 (their
-// amplification factors at ωh = π/12). Its one error on a linear system, a phase lag, is removed
-// for the lowest mode by the mass scale (below). As a minimisation over the middle state x = q_m
-// (an incremental potential, h the substep):
-//
-//   Φ(x) = ½‖x − q_n − (h/2) v_n‖² + κ [(1 + 2β/h) V(x, t_m) − (2β/h) ∇V(q_n, t_n)ᵀx],
-//   κ = h²/(4ρ),  V = E + E_C,
-//
-// whose stationarity is the scheme with the Rayleigh damping force D v_m = β (2/h)(∇V(q_m, t_m) −
-// ∇V(q_n, t_n)) ≈ β d(∇V)/dt: stiffness-proportional damping with the tangent stiffness of the energy
-// and of the handles' springs, relative to the controllers' motion, so neither a rigid motion nor
-// following the controllers is damped. E_C at the substep's middle time, the controllers'
-// transforms interpolated between frames (rotation by slerp, each handle's centre on a line). Then
-// q_{n+1} = 2x − q_n, v_{n+1} = 4(x − q_n)/h − v_n. Φ is minimised by Bfgs with the inverse of Φ's
-// Hessian at rest, computed once, started at q_n, where the state holds E and ∇E (the energy check
-// evaluates them at each substep's end): its first trial, the quasi-Newton step from there, is the
-// inertial prediction q_n + (h/2) v_n corrected by the forces at q_n, and costs the evaluation a
-// start at the prediction would spend on the prediction alone.
-//
-// Parameters from the artist's (exact for the lowest flexible mode of the linearised system): the
-// target poles s = ω(−ζ ± i√(1 − ζ²)), ω = 2π fps/period, are reached in discrete time when the
-// model's poles are s_c = (2/h) tanh(s h/2) (the midpoint rule maps s_c to
-// (1 + s_c h/2)/(1 − s_c h/2) = e^{sh}); with λ₁ the lowest flexible eigenvalue of the reduced rest
-// Hessian K of the ghost energy, ρ = λ₁/(s_c s̄_c) and β = −(s_c + s̄_c)/(s_c s̄_c) (for ζ = 1 a
-// double real pole).
-//
-// Energy: H = ½ρ‖v‖² + E(q) + E_C(q). Away from a quadratic potential the midpoint rule's energy
-// drifts, and an unconverged minimisation (a violent motion) extrapolated to q_{n+1} = 2x − q_n
-// can create energy: so every substep is checked. H_{n+1} may exceed H_n by at most the work the
-// moving handles did, W = E_C(x, t_{n+1}) − E_C(x, t_n); an excess is taken from the kinetic
-// energy (the velocity scaled down); when the potential energy alone exceeds it, the substep is
-// taken by implicit Euler instead (substep() says why that one cannot exceed it). A simulation
-// thus never gains energy it was not given, and never blows up; the step's statistics say how
-// often the check intervened.
+// (paper section 3), in the reduced space x = x̄ + U q of a baked basis, the energy on the ghost
+// and the handle term exact on the fine mesh, as in ReducedSolver. The reduced mass is ρI (the
+// basis is M-orthonormal). Each substep is the implicit midpoint rule (symplectic: no numerical
+// damping), written as the minimisation of an incremental potential Φ over the middle state, with
+// stiffness-proportional Rayleigh damping relative to the controllers' motion, and solved by the
+// warm-started Bfgs. ρ and the damping β come from the artist's `period` (frames at `fps`) and
+// damping ratio, exact for the lowest flexible mode. An energy check on every substep keeps a
+// simulation from gaining energy it was not given. The scheme, Φ, the parameters' derivation and
+// the check: docs/design.md, "Secondary motion (cpp/solve/reduced_dynamics.h)".
 //
 // Not thread-safe: one simulation per thread.
 #pragma once

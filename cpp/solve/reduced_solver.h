@@ -1,21 +1,12 @@
 // The interactive solver (paper section 5): BFGS in the reduced space x = x̄ + U q, with the
-// energy evaluated on the ghost and the handle term exact on the fine mesh.
+// energy evaluated on the ghost and the handle term exact on the fine mesh:
 //
-// Objective, in the normalised frame (scale s = basis.scale):
+//   f(q) = E_ghost(s (x̄_s + U_s q)) + E_C(q)        (normalised frame, s = basis.scale)
 //
-//   f(q) = E_ghost(s (x̄_s + U_s q)) + E_C(q)
-//
-// E_ghost is the discrete shells energy with the basis's weights, or ARAP, of the ghost mesh
-// scaled by s, its painted stiffness the ghost vertices' means of the fine weights; E_C the handle term with stiffness μ (handle_term.h). An iteration costs one or a
-// few evaluations of E_ghost and its gradient (O(#ghost vertices · r)) plus O(r²) for BFGS and
-// the handles, whatever the size of the fine mesh; only positions() touches the fine mesh.
-//
-// Warm start (paper): BFGS's initial inverse Hessian is the inverse of the reduced Hessian of f
-// at rest, s² U_sᵀ ∇²E_ghost(s x̄_s) U_s + 2A, computed once per solver (per handle set). Motions
-// that neither the energy nor the handles resist (rigid motions when the handles are a single
-// vertex or collinear, or a whole component without a handle) make it singular; it is inverted
-// after adding δI with δ = 1e-8 times its largest diagonal entry, which leaves the well-determined
-// directions alone and lets BFGS learn the curvature along the free ones from its first steps.
+// An iteration costs O(#ghost vertices · r) + O(r²), whatever the size of the fine mesh; only
+// positions() touches the fine mesh. Warm start (paper): BFGS's initial inverse Hessian is the
+// inverse of the reduced Hessian of f at rest, regularised where motions are free. The objective's
+// terms and the regularisation: docs/design.md, "The reduced solver".
 //
 // Not thread-safe: one solver per thread.
 #pragma once

@@ -92,7 +92,8 @@ class ModalDeformBakeStatus(bpy.types.PropertyGroup):
         name="Region Hash", description="Weights of the region vertex group at the bake (empty: the whole mesh)")
 
 
-# Secondary motion and the per-frame cache (issue 40): frame_cache.py, playback.py, ops_dynamics.py.
+# Secondary motion and the per-frame cache: playback/frame_cache.py, playback/timeline.py,
+# playback/operators.py.
 def _dynamics_changed(dynamics, context):
     from .playback import frame_cache
     frame_cache.settings_changed(dynamics.id_data)

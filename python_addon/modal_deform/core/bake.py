@@ -188,7 +188,8 @@ def bake(V, F, progress=None, **options):
     handles must lie in it, a region of more than ``proxy_above`` vertices is baked on a proxy of
     its own faces, and ``Basis.region`` keeps it, ascending.
     ``progress(stage, fraction)`` is called
-    at least every second or so (not during a CHOLMOD factorisation, about 2 s at 100k vertices);
+    at least every second or so (not during a CHOLMOD factorisation, which takes seconds on large
+    meshes: bench/results/table1.json, "bake_stages_s");
     returning False raises ``Cancelled``, and an exception it raises propagates.
 
     Returns a ``Basis`` with dimension modes + num_floppy + derivatives - num_dropped. Raises

@@ -2,7 +2,7 @@
 
 The dynamics whose quasi-static limits are the poses (paper section 3), integrated in the reduced
 space x = x̄ + U q by the implicit midpoint rule written as a minimisation, each step solved by
-the warm-started BFGS of posing (cpp/solve/reduced_dynamics.h has the scheme and its reasons).
+the warm-started BFGS of posing (docs/design.md, "Secondary motion", has the scheme and its reasons).
 The artist's parameters are in frames: ``period``, the period of the lowest flexible mode (it sets
 the mass), and ``damping``, that mode's damping ratio ζ (Rayleigh damping, stiffer modes damped
 more). Both hold exactly for the lowest mode of small motions, whatever ``fps`` and ``substeps``.
