@@ -21,11 +21,12 @@ objective gap (f(reduced) - f(full)) / f(full) with f the posing objective, shel
 handle term, in the normalised frame (the shapes are normalised already). A reference that did not
 converge is reported and left out of every comparison.
 """
-import numpy as np
 
-import modal_deform.core as mdc
+import numpy as np
 import shapes
 from common import MESHES, rms_error
+
+import modal_deform.core as mdc
 
 #: The paper's (modes, derivatives), its modes counting the rigid motions.
 SIZES = ((8, 6), (10, 20), (15, 52), (20, 110), (30, 270))
@@ -34,12 +35,20 @@ TOLERANCE = 1e-8
 STIFFNESS = mdc.solve.STIFFNESS
 BASES = ("paper pairs", "flexible pairs", "linear modes")
 #: The poses measured per shape (bench/shapes.py).
-POSES = {"bar": ("twist", "bend_60", "bend", "bend_large", "twist_large"),
-         "cylinder": ("bend", "bend_twist", "bend_large"),
-         "bumpy_plane": ("lift", "bend")}
+POSES = {
+    "bar": ("twist", "bend_60", "bend", "bend_large", "twist_large"),
+    "cylinder": ("bend", "bend_twist", "bend_large"),
+    "bumpy_plane": ("lift", "bend"),
+}
 SHAPES = tuple(POSES)
-SIZES_OF = {"bumpy_plane": dict(n=99)}  # 10k vertices: full solves and 300-dim bases fit the bench's time
-QUICK_SIZES = {"bar": dict(nx=4, nz=30), "cylinder": dict(around=16, along=20), "bumpy_plane": dict(n=20)}
+SIZES_OF = {
+    "bumpy_plane": dict(n=99)
+}  # 10k vertices: full solves and 300-dim bases fit the bench's time
+QUICK_SIZES = {
+    "bar": dict(nx=4, nz=30),
+    "cylinder": dict(around=16, along=20),
+    "bumpy_plane": dict(n=20),
+}
 #: The absolute goals the report checks the paper pairs against: objective gap at 67 and 130
 #: dimensions, RMS error at 130.
 GOALS = {"gap_67": 0.5, "gap_130": 0.2, "rms_130": 0.015}
@@ -61,7 +70,9 @@ def bake(shape, kind, modes, derivatives):
     if kind == "paper pairs":
         return mdc.bake(shape.V, shape.F, modes, derivatives, ghost=ghost)
     if kind == "flexible pairs":
-        return mdc.bake(shape.V, shape.F, modes + RIGID, derivatives, ghost=ghost, rotation_pairs=False)
+        return mdc.bake(
+            shape.V, shape.F, modes + RIGID, derivatives, ghost=ghost, rotation_pairs=False
+        )
     return mdc.bake(shape.V, shape.F, modes + derivatives, 0, ghost=ghost)
 
 
@@ -94,16 +105,30 @@ def meshes_for_renders(shape, pose, reference):
     """What render_figures.py and the Laplacian Deform comparison (blender_pose.py) read: the mesh,
     the camera's view direction, the handles and the pose's transforms in LAPLACIAN_FRAMES steps."""
     steps = [pose.at(k / LAPLACIAN_FRAMES) for k in range(1, LAPLACIAN_FRAMES + 1)]
-    return {"shape": shape.name, "pose": pose.name, "F": shape.F, "rest": shape.V, "full": reference,
-            "view": shape.view, "handle0": shape.handles[0], "handle1": shape.handles[1], "transforms": steps}
+    return {
+        "shape": shape.name,
+        "pose": pose.name,
+        "F": shape.F,
+        "rest": shape.V,
+        "full": reference,
+        "view": shape.view,
+        "handle0": shape.handles[0],
+        "handle1": shape.handles[1],
+        "transforms": steps,
+    }
 
 
 def reference(shape, pose, energy, mass, start=None):
     """solve_full's minimum of the pose: (positions, objective, converged, stats); from rest, or
     from `start` (n, 3), a reduced pose, as Refine does."""
-    X, stats = mdc.solve_full(shape.V, shape.F, shape.handles, pose.at(1.0), pull=STIFFNESS, initial=start)
-    print(f"  {shape.name} {pose.name}: reference {'converged' if stats['converged'] else 'NOT converged'} "
-          f"after {stats['iterations']} Newton iterations", flush=True)
+    X, stats = mdc.solve_full(
+        shape.V, shape.F, shape.handles, pose.at(1.0), pull=STIFFNESS, initial=start
+    )
+    print(
+        f"  {shape.name} {pose.name}: reference {'converged' if stats['converged'] else 'NOT converged'} "
+        f"after {stats['iterations']} Newton iterations",
+        flush=True,
+    )
     return X, objective(energy, mass, shape, pose.at(1.0), X), bool(stats["converged"]), stats
 
 
@@ -113,16 +138,33 @@ def measured_row(shape, kind, modes, derivatives, basis, pose, full, energy, mas
     reference, f_full, reference_converged, _ = full
     X, converged = pose_reduced(basis, shape, pose)
     f = objective(energy, mass, shape, pose.at(1.0), X)
-    return {"shape": shape.name, "vertices": len(shape.V), "basis": kind, "modes": modes, "derivatives": derivatives,
-            "dimension": basis.dimension, "dropped": basis.num_dropped, "pose": pose.name,
-            "reference_converged": reference_converged, "converged": converged,
-            "rms_error": rms_error(X, reference), "objective": f, "objective_full": f_full,
-            "objective_gap": (f - f_full) / f_full}, X
+    return {
+        "shape": shape.name,
+        "vertices": len(shape.V),
+        "basis": kind,
+        "modes": modes,
+        "derivatives": derivatives,
+        "dimension": basis.dimension,
+        "dropped": basis.num_dropped,
+        "pose": pose.name,
+        "reference_converged": reference_converged,
+        "converged": converged,
+        "rms_error": rms_error(X, reference),
+        "objective": f,
+        "objective_full": f_full,
+        "objective_gap": (f - f_full) / f_full,
+    }, X
 
 
 def reference_record(shape, pose, full):
-    return {"shape": shape.name, "pose": pose.name, "converged": full[2], "iterations": full[3]["iterations"],
-            "objective": full[1], "seconds": full[3]["seconds"]}
+    return {
+        "shape": shape.name,
+        "pose": pose.name,
+        "converged": full[2],
+        "iterations": full[3]["iterations"],
+        "objective": full[1],
+        "seconds": full[3]["seconds"],
+    }
 
 
 def run(quick=False):
@@ -130,7 +172,9 @@ def run(quick=False):
     rows, poses, references, rendered = [], {}, [], {}
     for name in SHAPES:
         shape = shapes.make(name, **(QUICK_SIZES if quick else SIZES_OF).get(name, {}))
-        assert abs(np.ptp(shape.V, axis=0).max() - 10) < 1e-9, "the objective assumes the normalised frame"
+        assert abs(np.ptp(shape.V, axis=0).max() - 10) < 1e-9, (
+            "the objective assumes the normalised frame"
+        )
         measured = [shape.pose(p) for p in POSES[name]]
         poses[name] = [(p.name, p.description) for p in measured]
         energy, mass = mdc.DiscreteShells(shape.V, shape.F), mdc.mass(shape.V, shape.F)
@@ -140,16 +184,26 @@ def run(quick=False):
             for kind in BASES:
                 basis = bake(shape, kind, modes, derivatives)
                 for pose in measured:
-                    row, X = measured_row(shape, kind, modes, derivatives, basis, pose, full[pose.name], energy, mass)
+                    row, X = measured_row(
+                        shape, kind, modes, derivatives, basis, pose, full[pose.name], energy, mass
+                    )
                     rows.append(row)
-                    if (modes, derivatives) == RENDERED_SIZE and kind in RENDERED_KINDS \
-                            and pose.name in RENDERED.get(name, ()):
-                        arrays = rendered.setdefault((name, pose.name), meshes_for_renders(shape, pose, full[pose.name][0]))
+                    if (
+                        (modes, derivatives) == RENDERED_SIZE
+                        and kind in RENDERED_KINDS
+                        and pose.name in RENDERED.get(name, ())
+                    ):
+                        arrays = rendered.setdefault(
+                            (name, pose.name), meshes_for_renders(shape, pose, full[pose.name][0])
+                        )
                         arrays[RENDERED_KINDS[kind]] = X
-                used = [r for r in rows[-len(measured):] if r["reference_converged"]]
-                print(f"  {name} ({modes}, {derivatives}) {kind}, {basis.dimension} dims: mean RMS error "
-                      f"{np.mean([r['rms_error'] for r in used]):.2e}, mean objective gap "
-                      f"{np.mean([r['objective_gap'] for r in used]):.3f}", flush=True)
+                used = [r for r in rows[-len(measured) :] if r["reference_converged"]]
+                print(
+                    f"  {name} ({modes}, {derivatives}) {kind}, {basis.dimension} dims: mean RMS error "
+                    f"{np.mean([r['rms_error'] for r in used]):.2e}, mean objective gap "
+                    f"{np.mean([r['objective_gap'] for r in used]):.3f}",
+                    flush=True,
+                )
     MESHES.mkdir(parents=True, exist_ok=True)
     for (name, pose), arrays in rendered.items():
         np.savez(MESHES / f"{name}_{pose}.npz", **arrays)
@@ -161,16 +215,44 @@ def run(quick=False):
         energy, mass = mdc.DiscreteShells(shape.V, shape.F), mdc.mass(shape.V, shape.F)
         bases = {kind: bake(shape, kind, *SCAN_SIZE) for kind in SCAN_BASES}
         for pose in shape.poses:
-            full = reference(shape, pose, energy, mass, start=pose_reduced(bases["paper pairs"], shape, pose)[0])
+            full = reference(
+                shape, pose, energy, mass, start=pose_reduced(bases["paper pairs"], shape, pose)[0]
+            )
             scan_references.append(reference_record(shape, pose, full))
-            scan_rows += [measured_row(shape, kind, *SCAN_SIZE, basis, pose, full, energy, mass)[0]
-                          for kind, basis in bases.items()]
-            print(f"  {name} {pose.name}: " + ", ".join(f"{r['basis']} RMS {r['rms_error']:.2e} gap "
-                                                       f"{r['objective_gap']:.3f}" for r in scan_rows[-2:]), flush=True)
-    parameters = {"shapes": SHAPES, "sizes": sizes, "bases": BASES, "stiffness": STIFFNESS,
-                  "tolerance": TOLERANCE, "poses": poses, "goals": GOALS,
-                  "vertices": {name: next(r["vertices"] for r in rows if r["shape"] == name) for name in SHAPES},
-                  "rendered": {"size": RENDERED_SIZE, "poses": RENDERED},
-                  "scans": {"size": SCAN_SIZE, "bases": SCAN_BASES, "poses": scan_poses, "vertices": scan_vertices}}
-    return parameters, {"rows": rows, "references": references, "scan_rows": scan_rows,
-                        "scan_references": scan_references}
+            scan_rows += [
+                measured_row(shape, kind, *SCAN_SIZE, basis, pose, full, energy, mass)[0]
+                for kind, basis in bases.items()
+            ]
+            print(
+                f"  {name} {pose.name}: "
+                + ", ".join(
+                    f"{r['basis']} RMS {r['rms_error']:.2e} gap {r['objective_gap']:.3f}"
+                    for r in scan_rows[-2:]
+                ),
+                flush=True,
+            )
+    parameters = {
+        "shapes": SHAPES,
+        "sizes": sizes,
+        "bases": BASES,
+        "stiffness": STIFFNESS,
+        "tolerance": TOLERANCE,
+        "poses": poses,
+        "goals": GOALS,
+        "vertices": {
+            name: next(r["vertices"] for r in rows if r["shape"] == name) for name in SHAPES
+        },
+        "rendered": {"size": RENDERED_SIZE, "poses": RENDERED},
+        "scans": {
+            "size": SCAN_SIZE,
+            "bases": SCAN_BASES,
+            "poses": scan_poses,
+            "vertices": scan_vertices,
+        },
+    }
+    return parameters, {
+        "rows": rows,
+        "references": references,
+        "scan_rows": scan_rows,
+        "scan_references": scan_references,
+    }

@@ -22,6 +22,7 @@ Inside each Python, one bake of the 5k dragon first checks the threads: the Open
 core's runtime reports (OMP_DISPLAY_ENV) and the thread counts of every OpenBLAS in the process
 during the bake (bake_once.py --threads).
 """
+
 import json
 import os
 import re
@@ -49,8 +50,13 @@ def bakes_of(meshes):
     """(python, mesh size, variant) of each bake: every Python as shipped at every size, and plain Python
     with OpenMP spinning at the first size."""
     first = next(iter(meshes))
-    return tuple((python, size, variant) for python in PYTHONS for size in meshes for variant in VARIANTS
-                 if variant == "shipped" or (python == "python" and size == first))
+    return tuple(
+        (python, size, variant)
+        for python in PYTHONS
+        for size in meshes
+        for variant in VARIANTS
+        if variant == "shipped" or (python == "python" and size == first)
+    )
 
 
 def name(bake):
@@ -67,21 +73,42 @@ def in_fresh_process(python, arguments, environment, folder, one_core=False):
     on the first core only."""
     pin = {"preexec_fn": on_one_core} if one_core else {}
     if python == "python":
-        inherited = {k: v for k, v in os.environ.items() if k not in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT")}
-        run = subprocess.run([sys.executable, "-W", "ignore", str(SCRIPT), *arguments], cwd=ROOT, capture_output=True,
-                             text=True, check=True, env=inherited | environment, **pin)
+        inherited = {
+            k: v for k, v in os.environ.items() if k not in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT")
+        }
+        run = subprocess.run(
+            [sys.executable, "-W", "ignore", str(SCRIPT), *arguments],
+            cwd=ROOT,
+            capture_output=True,
+            text=True,
+            check=True,
+            env=inherited | environment,
+            **pin,
+        )
     else:
-        run = common.in_bpy(python.split()[1], SCRIPT, arguments, folder, env=environment, capture_output=True,
-                            text=True, **pin)
+        run = common.in_bpy(
+            python.split()[1],
+            SCRIPT,
+            arguments,
+            folder,
+            env=environment,
+            capture_output=True,
+            text=True,
+            **pin,
+        )
     return json.loads(run.stdout.strip().splitlines()[-1]), run.stderr
 
 
 def thread_check(python, folder):
     """What the core's OpenMP runtime reports of its wait, and the OpenBLAS thread counts seen."""
-    result, stderr = in_fresh_process(python, [CHECK_MESH, "--threads"], {"OMP_DISPLAY_ENV": "verbose"}, folder)
-    return {"omp_wait_policy": re.findall(r"OMP_WAIT_POLICY = '(\w+)'", stderr),
-            "gomp_spincount": re.findall(r"GOMP_SPINCOUNT = '(\d+)'", stderr),
-            "openblas_threads_seen": result["openblas_threads_seen"]}
+    result, stderr = in_fresh_process(
+        python, [CHECK_MESH, "--threads"], {"OMP_DISPLAY_ENV": "verbose"}, folder
+    )
+    return {
+        "omp_wait_policy": re.findall(r"OMP_WAIT_POLICY = '(\w+)'", stderr),
+        "gomp_spincount": re.findall(r"GOMP_SPINCOUNT = '(\d+)'", stderr),
+        "openblas_threads_seen": result["openblas_threads_seen"],
+    }
 
 
 def bake_triple(bake, mesh, reverse, folder):
@@ -89,11 +116,16 @@ def bake_triple(bake, mesh, reverse, folder):
     and beside one `yes`, back to back (in reverse order when `reverse`)."""
     python, _, variant = bake
     timings = {"stages": {}}
-    for condition in (CONDITIONS[::-1] if reverse else CONDITIONS):
-        busy = subprocess.Popen(["yes"], stdout=subprocess.DEVNULL, start_new_session=True) \
-            if condition == "busy" else None
+    for condition in CONDITIONS[::-1] if reverse else CONDITIONS:
+        busy = (
+            subprocess.Popen(["yes"], stdout=subprocess.DEVNULL, start_new_session=True)
+            if condition == "busy"
+            else None
+        )
         try:
-            result = in_fresh_process(python, [mesh], VARIANTS[variant], folder, one_core=condition == "one_core")[0]
+            result = in_fresh_process(
+                python, [mesh], VARIANTS[variant], folder, one_core=condition == "one_core"
+            )[0]
         finally:
             if busy is not None:
                 busy.kill()
@@ -106,21 +138,35 @@ def bake_triple(bake, mesh, reverse, folder):
 def summary(bakes, rounds):
     """Medians over the rounds per bake: seconds, busy / quiet and busy / one core bake by bake, busy / quiet
     also per stage; shipped / spinning."""
+
     def median(values):
         return statistics.median(list(values))
+
     out = {}
     for bake in bakes:
         triples = [r[name(bake)] for r in rounds]
-        out[name(bake)] = {**{c: median(p[c] for p in triples) for c in CONDITIONS},
-                           **{f"busy_over_{c}": median(p["busy"] / p[c] for p in triples)
-                              for c in ("quiet", "one_core")},
-                           "stages_busy_over_quiet": {
-                               stage: median(p["stages"]["busy"][stage] / p["stages"]["quiet"][stage] for p in triples)
-                               for stage in triples[0]["stages"]["quiet"] if triples[0]["stages"]["quiet"][stage] > 0},
-                           "load_before": [min(p["load_before"] for p in triples),
-                                           max(p["load_before"] for p in triples)]}
+        out[name(bake)] = {
+            **{c: median(p[c] for p in triples) for c in CONDITIONS},
+            **{
+                f"busy_over_{c}": median(p["busy"] / p[c] for p in triples)
+                for c in ("quiet", "one_core")
+            },
+            "stages_busy_over_quiet": {
+                stage: median(
+                    p["stages"]["busy"][stage] / p["stages"]["quiet"][stage] for p in triples
+                )
+                for stage in triples[0]["stages"]["quiet"]
+                if triples[0]["stages"]["quiet"][stage] > 0
+            },
+            "load_before": [
+                min(p["load_before"] for p in triples),
+                max(p["load_before"] for p in triples),
+            ],
+        }
     shipped, spinning = (name(b) for b in bakes if b[0] == "python" and b[1] == bakes[0][1])
-    out["shipped_over_spinning"] = {c: median(r[shipped][c] / r[spinning][c] for r in rounds) for c in CONDITIONS}
+    out["shipped_over_spinning"] = {
+        c: median(r[shipped][c] / r[spinning][c] for r in rounds) for c in CONDITIONS
+    }
     return out
 
 
@@ -131,21 +177,38 @@ def run(quick=False):
     with tempfile.TemporaryDirectory() as folder:
         checks = {python: thread_check(python, folder) for python in PYTHONS}
         for python, check in checks.items():
-            print(f"   {python}: OpenMP wait {check['omp_wait_policy']}, spin count {check['gomp_spincount']}; "
-                  f"OpenBLAS threads seen {check['openblas_threads_seen']}", flush=True)
+            print(
+                f"   {python}: OpenMP wait {check['omp_wait_policy']}, spin count {check['gomp_spincount']}; "
+                f"OpenBLAS threads seen {check['openblas_threads_seen']}",
+                flush=True,
+            )
         for index in range(1 if quick else ROUNDS):
             round_ = {}
             for bake in bakes:
                 load = os.getloadavg()[0]
-                round_[name(bake)] = bake_triple(bake, meshes[bake[1]], index % 2 == 1, folder) | {"load_before": load}
+                round_[name(bake)] = bake_triple(bake, meshes[bake[1]], index % 2 == 1, folder) | {
+                    "load_before": load
+                }
                 p = round_[name(bake)]
-                print(f"   round {index + 1}, {name(bake)}: quiet {p['quiet']:.1f} s, one core {p['one_core']:.1f} s, "
-                      f"busy {p['busy']:.1f} s, busy / quiet {p['busy'] / p['quiet']:.2f}, busy / one core "
-                      f"{p['busy'] / p['one_core']:.2f} (load {load:.1f})", flush=True)
+                print(
+                    f"   round {index + 1}, {name(bake)}: quiet {p['quiet']:.1f} s, one core {p['one_core']:.1f} s, "
+                    f"busy {p['busy']:.1f} s, busy / quiet {p['busy'] / p['quiet']:.2f}, busy / one core "
+                    f"{p['busy'] / p['one_core']:.2f} (load {load:.1f})",
+                    flush=True,
+                )
             rounds.append(round_)
     result = summary(bakes, rounds)
-    parameters = {"meshes": meshes, "check_mesh": CHECK_MESH, "modes": 15, "derivatives": 52, "ghost": 1000,
-                  "rounds": len(rounds), "bakes": [list(b) for b in bakes], "variants": VARIANTS,
-                  "busy": "one `yes` process beside the bake",
-                  "one_core": "quiet, the affinity set to one core", "load_before": os.getloadavg()}
+    parameters = {
+        "meshes": meshes,
+        "check_mesh": CHECK_MESH,
+        "modes": 15,
+        "derivatives": 52,
+        "ghost": 1000,
+        "rounds": len(rounds),
+        "bakes": [list(b) for b in bakes],
+        "variants": VARIANTS,
+        "busy": "one `yes` process beside the bake",
+        "one_core": "quiet, the affinity set to one core",
+        "load_before": os.getloadavg(),
+    }
     return parameters, {"checks": checks, "rounds": rounds, "summary": result}

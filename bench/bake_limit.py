@@ -6,21 +6,29 @@ memory, and CHOLMOD alone analysing and factoring the same stiffness matrix in t
 side one, 8 and 52 wide. Medians over the runs; the ratio to CHOLMOD
 is taken run by run, so that both sides of it saw the same load.
 """
+
 import json
 import pathlib
 import statistics
 import subprocess
 import tempfile
 
-import modal_deform.core as mdc
 from common import ROOT
+
+import modal_deform.core as mdc
 
 BINARY = ROOT / "build" / "bench" / "modal_deform_bench"
 RUNS = 3
 #: At 100k vertices, issue 25's for the 67-dimensional bake: seconds, ratio to CHOLMOD's analysis and
 #: factorisation, peak memory (GB of 2^30 bytes); issue 14's for the 130-dimensional one (issue 25
 #: sets none): seconds and peak.
-TARGETS = {"seconds_67": 10.0, "ratio_67": 2.7, "peak_gb_67": 1.8, "seconds_130": 12.0, "peak_gb_130": 2.0}
+TARGETS = {
+    "seconds_67": 10.0,
+    "ratio_67": 2.7,
+    "peak_gb_67": 1.8,
+    "seconds_130": 12.0,
+    "peak_gb_130": 2.0,
+}
 #: Block widths at which bench_bake.cpp times CHOLMOD's solves with the factor it made alone.
 SOLVE_WIDTHS = ("1", "8", "52")
 #: The stages of a bake without a proxy.
@@ -30,16 +38,28 @@ STAGE_KEYS = mdc.BAKE_STAGES[1:-1]
 def bake_in_fresh_process(benchmark_filter):
     with tempfile.TemporaryDirectory() as folder:
         out = pathlib.Path(folder) / "bake.json"
-        subprocess.run([str(BINARY), f"--benchmark_filter={benchmark_filter}", f"--benchmark_out={out}",
-                        "--benchmark_out_format=json"], check=True, capture_output=True)
+        subprocess.run(
+            [
+                str(BINARY),
+                f"--benchmark_filter={benchmark_filter}",
+                f"--benchmark_out={out}",
+                "--benchmark_out_format=json",
+            ],
+            check=True,
+            capture_output=True,
+        )
         raw = json.loads(out.read_text())
     bakes = {}
     for b in raw["benchmarks"]:
         dimension = "67" if "modes:15/" in b["name"] else "130"
-        bakes[dimension] = {"seconds": b["real_time"], "cholmod_s": b["cholmod_s"], "peak_gb": b["peak_rss_MB"] / 1024,
-                            "dimension_with_zero_modes": b["dimension"],
-                            "stages": {k: b[k] for k in STAGE_KEYS if k in b},
-                            "solve_ms_per_rhs": {w: b[f"solve_ms_per_rhs_{w}"] for w in SOLVE_WIDTHS}}
+        bakes[dimension] = {
+            "seconds": b["real_time"],
+            "cholmod_s": b["cholmod_s"],
+            "peak_gb": b["peak_rss_MB"] / 1024,
+            "dimension_with_zero_modes": b["dimension"],
+            "stages": {k: b[k] for k in STAGE_KEYS if k in b},
+            "solve_ms_per_rhs": {w: b[f"solve_ms_per_rhs_{w}"] for w in SOLVE_WIDTHS},
+        }
     return bakes
 
 
@@ -56,8 +76,12 @@ def summary(runs):
             "cholmod_s": statistics.median(b["cholmod_s"] for b in bakes),
             "ratio": statistics.median(b["seconds"] / b["cholmod_s"] for b in bakes),
             "peak_gb": max(b["peak_gb"] for b in bakes),
-            "stages": {k: statistics.median(b["stages"].get(k, 0.0) for b in bakes) for k in STAGE_KEYS},
-            "solve_ms_per_rhs": {w: statistics.median(b["solve_ms_per_rhs"][w] for b in bakes) for w in SOLVE_WIDTHS},
+            "stages": {
+                k: statistics.median(b["stages"].get(k, 0.0) for b in bakes) for k in STAGE_KEYS
+            },
+            "solve_ms_per_rhs": {
+                w: statistics.median(b["solve_ms_per_rhs"][w] for b in bakes) for w in SOLVE_WIDTHS
+            },
         }
     return out
 
@@ -66,17 +90,41 @@ def checks(result):
     """(what, measured, target, unit) for each target that this run measured."""
     rows = []
     if "67" in result:
-        rows += [(f"bake at 67 dimensions ≤ {TARGETS['seconds_67']:g} s (issue 25)", result["67"]["seconds"],
-                  TARGETS["seconds_67"], "s"),
-                 (f"bake / CHOLMOD analyse + factor at 67 ≤ {TARGETS['ratio_67']:g} (issue 25)", result["67"]["ratio"],
-                  TARGETS["ratio_67"], "x"),
-                 (f"peak memory at 67 ≤ {TARGETS['peak_gb_67']:g} GB (issue 25)", result["67"]["peak_gb"],
-                  TARGETS["peak_gb_67"], "GB")]
+        rows += [
+            (
+                f"bake at 67 dimensions ≤ {TARGETS['seconds_67']:g} s (issue 25)",
+                result["67"]["seconds"],
+                TARGETS["seconds_67"],
+                "s",
+            ),
+            (
+                f"bake / CHOLMOD analyse + factor at 67 ≤ {TARGETS['ratio_67']:g} (issue 25)",
+                result["67"]["ratio"],
+                TARGETS["ratio_67"],
+                "x",
+            ),
+            (
+                f"peak memory at 67 ≤ {TARGETS['peak_gb_67']:g} GB (issue 25)",
+                result["67"]["peak_gb"],
+                TARGETS["peak_gb_67"],
+                "GB",
+            ),
+        ]
     if "130" in result:
-        rows += [(f"bake at 130 dimensions ≤ {TARGETS['seconds_130']:g} s (issue 14)", result["130"]["seconds"],
-                  TARGETS["seconds_130"], "s"),
-                 (f"peak memory at 130 ≤ {TARGETS['peak_gb_130']:g} GB (issue 14)", result["130"]["peak_gb"],
-                  TARGETS["peak_gb_130"], "GB")]
+        rows += [
+            (
+                f"bake at 130 dimensions ≤ {TARGETS['seconds_130']:g} s (issue 14)",
+                result["130"]["seconds"],
+                TARGETS["seconds_130"],
+                "s",
+            ),
+            (
+                f"peak memory at 130 ≤ {TARGETS['peak_gb_130']:g} GB (issue 14)",
+                result["130"]["peak_gb"],
+                TARGETS["peak_gb_130"],
+                "GB",
+            ),
+        ]
     return rows
 
 
@@ -86,12 +134,28 @@ def run(quick=False):
     runs = []
     for index in range(1 if quick else RUNS):
         runs.append(bake_in_fresh_process(benchmark_filter))
-        print(f"   run {index + 1}: " + ", ".join(f"{d} dims {b['seconds']:.1f} s (CHOLMOD {b['cholmod_s']:.1f} s, "
-                                                    f"peak {b['peak_gb']:.2f} GB)" for d, b in runs[-1].items()),
-              flush=True)
+        print(
+            f"   run {index + 1}: "
+            + ", ".join(
+                f"{d} dims {b['seconds']:.1f} s (CHOLMOD {b['cholmod_s']:.1f} s, "
+                f"peak {b['peak_gb']:.2f} GB)"
+                for d, b in runs[-1].items()
+            ),
+            flush=True,
+        )
     result = summary(runs)
     for what, measured, target, unit in checks(result):
-        print(f"   {what}: {measured:.2f} {unit} — {'met' if measured <= target else 'NOT met'}", flush=True)
-    parameters = {"mesh": "dragon_vrip_res2", "ghost": 1000, "runs": len(runs), "binary": str(BINARY.relative_to(ROOT)),
-                  "filter": benchmark_filter, "sizes": {"67": [15, 52], "130": [20, 110]}, "targets": TARGETS}
+        print(
+            f"   {what}: {measured:.2f} {unit} — {'met' if measured <= target else 'NOT met'}",
+            flush=True,
+        )
+    parameters = {
+        "mesh": "dragon_vrip_res2",
+        "ghost": 1000,
+        "runs": len(runs),
+        "binary": str(BINARY.relative_to(ROOT)),
+        "filter": benchmark_filter,
+        "sizes": {"67": [15, 52], "130": [20, 110]},
+        "targets": TARGETS,
+    }
     return parameters, {"runs": runs, "summary": result}

@@ -11,6 +11,7 @@ it has its own) for its thread count while the bake runs, and the JSON has
 "openblas_threads_seen": {library: the counts seen}: on 2 cores the core's OpenBLAS runs on one
 thread inside CHOLMOD's calls and NumPy's keeps its own.
 """
+
 import argparse
 import contextlib
 import ctypes
@@ -27,7 +28,11 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 MESHES = ROOT.parent / "shared" / "meshes"
 #: How OpenBLAS builds name their thread count: plain, 64-bit integer (NumPy 1's wheels), SciPy's
 #: (NumPy 2's wheels).
-THREAD_COUNT_NAMES = ("openblas_get_num_threads", "openblas_get_num_threads64_", "scipy_openblas_get_num_threads64_")
+THREAD_COUNT_NAMES = (
+    "openblas_get_num_threads",
+    "openblas_get_num_threads64_",
+    "scipy_openblas_get_num_threads64_",
+)
 SAMPLE_SECONDS = 0.002
 
 
@@ -40,6 +45,7 @@ def core():
         return importlib.import_module("modal_deform.core")
     sys.path.insert(0, str(ROOT / "tests" / "blender"))
     from bpy_session import MODULE
+
     return importlib.import_module(f"{MODULE}.core")
 
 
@@ -47,7 +53,11 @@ def openblas_thread_counts():
     """{folder/file of each OpenBLAS mapped in this process: its function returning its thread count}."""
     np.dot(np.ones((64, 64)), np.ones((64, 64)))  # NumPy's BLAS is loaded
     with open("/proc/self/maps") as maps:
-        paths = {line.split()[-1] for line in maps if len(line.split()) == 6 and "openblas" in line.rsplit("/", 1)[-1]}
+        paths = {
+            line.split()[-1]
+            for line in maps
+            if len(line.split()) == 6 and "openblas" in line.rsplit("/", 1)[-1]
+        }
     counts = {}
     for path in sorted(paths):
         library = ctypes.CDLL(path)
@@ -81,10 +91,16 @@ class ThreadSampler:
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("mesh", help="a file of the shared meshes")
-    parser.add_argument("--threads", action="store_true", help="sample the OpenBLAS thread counts during the bake")
-    arguments = parser.parse_args(sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:])
+    parser.add_argument(
+        "--threads", action="store_true", help="sample the OpenBLAS thread counts during the bake"
+    )
+    arguments = parser.parse_args(
+        sys.argv[sys.argv.index("--") + 1 :] if "--" in sys.argv else sys.argv[1:]
+    )
     mdc = core()
     V, F = mdc.read_mesh(str(MESHES / arguments.mesh))
     sampler = ThreadSampler() if arguments.threads else contextlib.nullcontext()
@@ -93,7 +109,9 @@ def main():
         basis = mdc.bake(V, F, modes=15, derivatives=52, ghost=1000)
     result = {"seconds": time.perf_counter() - start, "stages": basis.timings}
     if arguments.threads:
-        result["openblas_threads_seen"] = {library: sorted(seen) for library, seen in sampler.seen.items()}
+        result["openblas_threads_seen"] = {
+            library: sorted(seen) for library, seen in sampler.seen.items()
+        }
     print(json.dumps(result), flush=True)
 
 

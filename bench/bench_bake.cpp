@@ -96,7 +96,9 @@ CholmodAlone cholmod_alone(const TriangleMesh& mesh) {
 double cpu_seconds() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
-  const auto seconds = [](const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * t.tv_usec; };
+  const auto seconds = [](const timeval& t) {
+    return static_cast<double>(t.tv_sec) + 1e-6 * t.tv_usec;
+  };
   return seconds(usage.ru_utime) + seconds(usage.ru_stime);
 }
 
@@ -109,7 +111,8 @@ void BM_Bake(benchmark::State& state) {
   Basis basis;
   std::map<std::string, double> cpu;
   for (auto _ : state) {
-    std::ofstream("/proc/self/clear_refs") << "5";  // restart the high-water mark at the current RSS
+    std::ofstream("/proc/self/clear_refs")
+        << "5";  // restart the high-water mark at the current RSS
     cpu.clear();
     std::string stage = "validation";
     double since = cpu_seconds();
@@ -130,7 +133,8 @@ void BM_Bake(benchmark::State& state) {
   }
   const CholmodAlone alone = cholmod_alone(mesh);
   state.counters["cholmod_s"] = alone.seconds;
-  for (const auto& [width, ms] : alone.ms_per_rhs) state.counters["solve_ms_per_rhs_" + std::to_string(width)] = ms;
+  for (const auto& [width, ms] : alone.ms_per_rhs)
+    state.counters["solve_ms_per_rhs_" + std::to_string(width)] = ms;
   for (const auto& [stage, seconds] : basis.timings) state.counters[stage] = seconds;
   for (const auto& [stage, seconds] : cpu) state.counters["cpu " + stage] = seconds;
   state.counters["dimension"] = basis.dimension();

@@ -32,7 +32,9 @@ const Problem& dragon() {
     Problem p{testing::spring_network_hessian(mesh.V, mesh.F), lumped_mass(mesh.V, mesh.F), {}, {}};
     const std::vector<int> labels = build_topology(mesh.V, mesh.F).vertex_component;
     p.Z = rigid_motions(
-        mesh.V, Eigen::Map<const Eigen::VectorXi>(labels.data(), static_cast<Eigen::Index>(labels.size())), p.mass);
+        mesh.V,
+        Eigen::Map<const Eigen::VectorXi>(labels.data(), static_cast<Eigen::Index>(labels.size())),
+        p.mass);
     const Eigen::VectorXd m = dof_masses(p.mass);
     const std::vector<bool> decoupled = decoupled_dofs(p.K, p.mass);
     p.shift = 1e-8 * p.K.diagonal().sum() / m.sum() * m;
@@ -92,7 +94,8 @@ BENCHMARK(BM_CholmodSolve)
 void BM_VibrationModes(benchmark::State& state) {
   const Problem& p = dragon();
   for (auto _ : state) {
-    const VibrationModes modes = vibration_modes(p.K, p.mass, static_cast<int>(state.range(0)), p.Z);
+    const VibrationModes modes =
+        vibration_modes(p.K, p.mass, static_cast<int>(state.range(0)), p.Z);
     state.counters["solves"] = modes.solves;
     state.counters["max_residual"] = modes.residuals.maxCoeff();
   }

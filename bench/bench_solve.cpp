@@ -5,9 +5,9 @@
 #include <cmath>
 #include <map>
 
+#include "bake/bake.h"
 #include "mesh/primitives.h"
 #include "mesh/read_mesh.h"
-#include "bake/bake.h"
 #include "solve/full_solver.h"
 #include "solve/quantized_vectors.h"
 #include "solve/reduced_solver.h"
@@ -33,15 +33,16 @@ struct Rod {
   TriangleMesh mesh;
   Handles handles{{}, {}};
   Transforms transforms;
-  Rod(TriangleMesh m, double L, const Eigen::Vector3d& axis, double bend, double twist) : mesh(std::move(m)) {
+  Rod(TriangleMesh m, double L, const Eigen::Vector3d& axis, double bend, double twist)
+      : mesh(std::move(m)) {
     for (int v = 0; v < mesh.V.rows(); ++v) {
       if (mesh.V(v, 2) < 1e-9) handles[0].push_back(v);
       if (mesh.V(v, 2) > L - 1e-9) handles[1].push_back(v);
     }
     Eigen::Matrix4d down = Eigen::Matrix4d::Identity();
     down(2, 3) = -L;
-    const Eigen::Matrix4d end =
-        rigid({-1, 0, 0}, bend, axis + Eigen::Vector3d(0, L / bend, 0)) * down * rigid({0, 0, 1}, twist, axis);
+    const Eigen::Matrix4d end = rigid({-1, 0, 0}, bend, axis + Eigen::Vector3d(0, L / bend, 0)) *
+                                down * rigid({0, 0, 1}, twist, axis);
     transforms = {Eigen::Matrix4d::Identity(), end};
   }
 };
@@ -54,7 +55,8 @@ const Basis& dragon_basis(int dimension) {
   if (bases.empty()) {
     const TriangleMesh mesh = read_mesh(MODAL_DEFORM_SHARED_MESHES "/dragon_vrip_res2.ply.gz");
     Progress quiet;
-    Basis full = bake(mesh.V, mesh.F, BakeOptions{25, 105, 1000, EnergyKind::kShells, {1.0, 1.0}}, quiet);
+    Basis full =
+        bake(mesh.V, mesh.F, BakeOptions{25, 105, 1000, EnergyKind::kShells, {1.0, 1.0}}, quiet);
     Basis prefix = full;
     prefix.vectors = full.vectors.leftCols(67);
     prefix.ghost_vectors = full.ghost_vectors.leftCols(67);
@@ -83,7 +85,8 @@ struct DragonPose {
     head_centre /= static_cast<double>(handles[1].size());
   }
   Transforms at(double t) const {
-    return {Eigen::Matrix4d::Identity(), rigid({0, 0, 1}, 0.6 * t, head_centre, {0, 0.25 * length * t, 0})};
+    return {Eigen::Matrix4d::Identity(),
+            rigid({0, 0, 1}, 0.6 * t, head_centre, {0, 0.25 * length * t, 0})};
   }
 };
 
@@ -124,7 +127,8 @@ void BM_Positions(benchmark::State& state) {
   for (auto _ : state) solver.positions(out);
   state.counters["vertices"] = basis.num_vertices();
   state.counters["dimension"] = basis.dimension();
-  state.SetBytesProcessed(state.iterations() * basis.vectors.size() * static_cast<int64_t>(sizeof(float)));
+  state.SetBytesProcessed(state.iterations() * basis.vectors.size() *
+                          static_cast<int64_t>(sizeof(float)));
 }
 BENCHMARK(BM_Positions)->Arg(67)->Arg(130)->Unit(benchmark::kMillisecond);
 
@@ -139,12 +143,14 @@ void BM_MapBits(benchmark::State& state) {
   solver.solve(20, 1e-6);
   const Eigen::VectorXf q = solver.q().cast<float>();
   const QuantizedVectors quantized(basis.vectors);
-  const double diagonal = (basis.rest.colwise().maxCoeff() - basis.rest.colwise().minCoeff()).norm();
+  const double diagonal =
+      (basis.rest.colwise().maxCoeff() - basis.rest.colwise().minCoeff()).norm();
   const double tolerance = state.range(0) == 16 ? FinePositions::kTolerance * diagonal : 0.0;
   Eigen::VectorXf out(3 * basis.num_vertices());
   const Eigen::VectorXf rest = flatten(basis.rest).cast<float>();
   Eigen::Index from_float32 = 0;
-  for (auto _ : state) from_float32 = quantized.map(basis.vectors, q, rest.data(), tolerance, out.data());
+  for (auto _ : state)
+    from_float32 = quantized.map(basis.vectors, q, rest.data(), tolerance, out.data());
   state.counters["blocks_from_float32"] = static_cast<double>(from_float32) / quantized.blocks();
 }
 BENCHMARK(BM_MapBits)->Arg(32)->Arg(16)->Unit(benchmark::kMillisecond);
@@ -153,8 +159,8 @@ void run(benchmark::State& state, const Rod& rod) {
   const EnergyKind energy = state.range(0) == 0 ? EnergyKind::kShells : EnergyKind::kArap;
   FullSolveResult result;
   for (auto _ : state)
-    result = solve_full(rod.mesh.V, rod.mesh.F, rod.handles, Eigen::VectorXd(), rod.transforms, 1000,
-        FullSolveOptions{energy, {1.0, 1.0}, 1e-8, 200});
+    result = solve_full(rod.mesh.V, rod.mesh.F, rod.handles, Eigen::VectorXd(), rod.transforms,
+                        1000, FullSolveOptions{energy, {1.0, 1.0}, 1e-8, 200});
   state.SetLabel(energy == EnergyKind::kShells ? "shells" : "arap");
   state.counters["vertices"] = static_cast<double>(rod.mesh.V.rows());
   state.counters["steps"] = result.steps;

@@ -20,7 +20,9 @@ mesh.update(). Blender then evaluates
 the mesh for display ("evaluate": view_layer.update()). Medians over the updates, with the
 controller moving a little each time.
 """
+
 import argparse
+import importlib
 import json
 import math
 import os
@@ -29,8 +31,6 @@ import resource
 import sys
 import tempfile
 import time
-
-import importlib
 
 import bpy
 import numpy as np
@@ -42,28 +42,45 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "blender_scripts"))
 sys.path.insert(0, str(ROOT / "bench"))
 sys.path.insert(0, str(ROOT / "tests"))
-from headless import (add_handle, bind_laplacian_deform, enable_addon,  # noqa: E402 (found through the lines above)
-                      evaluated_positions)
+from headless import add_handle, bind_laplacian_deform, enable_addon, evaluated_positions  # noqa: E402 (found through the lines above)
 from support import SHARED_MESHES as MESHES  # noqa: E402
 from support import subdivision  # noqa: E402 (the project's midpoint subdivision, NumPy only)
+
 ADDON = "modal_deform"  # the add-on's module: bl_ext.<repository>.modal_deform when installed as an extension
 
 
 def arguments():
-    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    argv = sys.argv[sys.argv.index("--") + 1 :] if "--" in sys.argv else []
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("--output", default="bench/results/blender_pose.json")
     parser.add_argument("--updates", type=int, default=30, help="pose updates timed per basis")
-    parser.add_argument("--laplacian-updates", type=int, default=3, help="Laplacian Deform updates timed")
-    parser.add_argument("--shapes", help="folder of .npz meshes (bench/accuracy.py) to compare Laplacian Deform on")
-    parser.add_argument("--quick", action="store_true", help="dragon_vrip_res4 and a coarser Suzanne (smoke test)")
-    parser.add_argument("--pose-only", action="store_true", help="only the pose updates (no storage, no Laplacian)")
-    parser.add_argument("--subdivide", type=int, default=0,
-                        help="midpoint-subdivide the dragon this many times first (2: 1.6M vertices, baked on a "
-                             "proxy; the 67-dimensional basis only, pose updates only)")
-    parser.add_argument("--double", action="store_true",
-                        help="then split as many edges as there are vertices (subdivision.split_edges): twice the "
-                             "vertices (with --subdivide 2: 3.2M)")
+    parser.add_argument(
+        "--laplacian-updates", type=int, default=3, help="Laplacian Deform updates timed"
+    )
+    parser.add_argument(
+        "--shapes", help="folder of .npz meshes (bench/accuracy.py) to compare Laplacian Deform on"
+    )
+    parser.add_argument(
+        "--quick", action="store_true", help="dragon_vrip_res4 and a coarser Suzanne (smoke test)"
+    )
+    parser.add_argument(
+        "--pose-only", action="store_true", help="only the pose updates (no storage, no Laplacian)"
+    )
+    parser.add_argument(
+        "--subdivide",
+        type=int,
+        default=0,
+        help="midpoint-subdivide the dragon this many times first (2: 1.6M vertices, baked on a "
+        "proxy; the 67-dimensional basis only, pose updates only)",
+    )
+    parser.add_argument(
+        "--double",
+        action="store_true",
+        help="then split as many edges as there are vertices (subdivision.split_edges): twice the "
+        "vertices (with --subdivide 2: 3.2M)",
+    )
     parser.add_argument("--proxy", type=int, help="the object's Proxy Size (default: the add-on's)")
     return parser.parse_args(argv)
 
@@ -129,7 +146,11 @@ STEPS = ("controllers", "budget", "solve", "write", "tick", "evaluate", "iterati
 #: (no shape keys: the vertex positions); with "Basis" and "Modal Deform" keys, as a mesh posed and
 #: kept before has them, posed in a stand-in without shape keys (pose.displays.display's choice), or in
 #: the "Modal Deform" key (the path such a mesh took before, and one whose other keys show takes).
-DISPLAYS = {"positions": "PositionsDisplay", "stand_in": "StandInDisplay", "shape_key": "ShapeKeyDisplay"}
+DISPLAYS = {
+    "positions": "PositionsDisplay",
+    "stand_in": "StandInDisplay",
+    "shape_key": "ShapeKeyDisplay",
+}
 
 
 def time_updates(obj, controller, updates, steps, display, draw=None):
@@ -148,8 +169,11 @@ def time_updates(obj, controller, updates, steps, display, draw=None):
     size = max(obj.dimensions)
     start_matrix = controller.matrix_world.copy()
     for i in range(updates):
-        controller.matrix_world = (Matrix.Translation((0.0, 0.01 * size * i, 0.005 * size * i)) @ start_matrix
-                                   @ Matrix.Rotation(math.radians(1.0 * i), 4, "X"))
+        controller.matrix_world = (
+            Matrix.Translation((0.0, 0.01 * size * i, 0.005 * size * i))
+            @ start_matrix
+            @ Matrix.Rotation(math.radians(1.0 * i), 4, "X")
+        )
         bpy.context.view_layer.update()
         tick = time.perf_counter()
         pose.follow_controllers()
@@ -169,8 +193,12 @@ def time_updates(obj, controller, updates, steps, display, draw=None):
             t = time.perf_counter()
             draw()
             steps["draw"].append(milliseconds(t))
-        budget.measured(steps["tick"][-1] - steps["solve"][-1] + steps["evaluate"][-1]
-                        + (steps["draw"][-1] if draw is not None else 0.0))
+        budget.measured(
+            steps["tick"][-1]
+            - steps["solve"][-1]
+            + steps["evaluate"][-1]
+            + (steps["draw"][-1] if draw is not None else 0.0)
+        )
     controller.matrix_world = start_matrix
     shown.restore()
 
@@ -189,7 +217,10 @@ def time_displays(obj, controller, updates, rounds=2, draw=None):
             time_updates(obj, controller, updates, steps[name], display, draw)
             if name != "positions":
                 obj.shape_key_clear()
-    figures = {name: {step: float(np.median(values)) for step, values in s.items()} for name, s in steps.items()}
+    figures = {
+        name: {step: float(np.median(values)) for step, values in s.items()}
+        for name, s in steps.items()
+    }
     for f in figures.values():
         f["update"] = f["tick"] + f["evaluate"]
     return figures
@@ -276,7 +307,12 @@ def laplacian_deform(updates, subdivisions):
     free = np.ones(len(V), bool)
     free[anchors] = False
     solved = bool(np.abs(evaluated_positions(obj)[free] - V[free]).max() > 0)
-    return {"vertices": len(V), "bind_s": bind, "update_ms": float(np.median(times)), "solved": solved}
+    return {
+        "vertices": len(V),
+        "bind_s": bind,
+        "update_ms": float(np.median(times)),
+        "solved": solved,
+    }
 
 
 def laplacian_on_shapes(folder):
@@ -286,13 +322,16 @@ def laplacian_on_shapes(folder):
     mdc = addon("core")
     sys.path.insert(0, str(ROOT / "bench"))
     from common import rms_error
+
     rows = []
     for path in sorted(pathlib.Path(folder).glob("*.npz")):
         data = dict(np.load(path))
         V, F, steps = data["rest"], data["F"], data["transforms"]
         clear_scene()
         obj = mesh_object("Shape", V, F)
-        empty, bind = bind_laplacian_deform(obj, np.concatenate([data["handle0"], data["handle1"]]), data["handle1"])
+        empty, bind = bind_laplacian_deform(
+            obj, np.concatenate([data["handle0"], data["handle1"]]), data["handle1"]
+        )
         laplacian_ms = []
         for transforms in steps:
             empty.matrix_world = Matrix(transforms[1].tolist())
@@ -301,7 +340,9 @@ def laplacian_on_shapes(folder):
             laplacian_ms.append(milliseconds(t))
         data["laplacian"] = evaluated_positions(obj).astype(np.float64)
 
-        solver = mdc.ReducedSolver(mdc.bake(V, F, modes=20, derivatives=47, ghost=1000), [data["handle0"], data["handle1"]])
+        solver = mdc.ReducedSolver(
+            mdc.bake(V, F, modes=20, derivatives=47, ghost=1000), [data["handle0"], data["handle1"]]
+        )
         out = np.empty(V.shape, np.float32)
         ours_ms = []
         for transforms in steps:
@@ -314,15 +355,28 @@ def laplacian_on_shapes(folder):
             pass
         ours = solver.positions().astype(np.float64)
         energy = mdc.DiscreteShells(V, F)
-        rows.append({"shape": str(data["shape"]), "pose": str(data["pose"]), "vertices": len(V),
-                     "laplacian_bind_s": bind, "laplacian_update_ms": float(np.median(laplacian_ms)),
-                     "ours_update_ms": float(np.median(ours_ms)), "energy_full": energy.value(data["full"]),
-                     "energy_ours": energy.value(ours), "energy_laplacian": energy.value(data["laplacian"]),
-                     "rms_ours": rms_error(ours, data["full"]), "rms_laplacian": rms_error(data["laplacian"], data["full"])})
+        rows.append(
+            {
+                "shape": str(data["shape"]),
+                "pose": str(data["pose"]),
+                "vertices": len(V),
+                "laplacian_bind_s": bind,
+                "laplacian_update_ms": float(np.median(laplacian_ms)),
+                "ours_update_ms": float(np.median(ours_ms)),
+                "energy_full": energy.value(data["full"]),
+                "energy_ours": energy.value(ours),
+                "energy_laplacian": energy.value(data["laplacian"]),
+                "rms_ours": rms_error(ours, data["full"]),
+                "rms_laplacian": rms_error(data["laplacian"], data["full"]),
+            }
+        )
         np.savez(path, **data)
-        print(f"{rows[-1]['shape']} {rows[-1]['pose']}: Laplacian {rows[-1]['laplacian_update_ms']:.1f} ms, energy "
-              f"{rows[-1]['energy_laplacian']:.4g}; ours {rows[-1]['ours_update_ms']:.2f} ms, energy "
-              f"{rows[-1]['energy_ours']:.4g}; full {rows[-1]['energy_full']:.4g}", flush=True)
+        print(
+            f"{rows[-1]['shape']} {rows[-1]['pose']}: Laplacian {rows[-1]['laplacian_update_ms']:.1f} ms, energy "
+            f"{rows[-1]['energy_laplacian']:.4g}; ours {rows[-1]['ours_update_ms']:.2f} ms, energy "
+            f"{rows[-1]['energy_ours']:.4g}; full {rows[-1]['energy_full']:.4g}",
+            flush=True,
+        )
     return rows
 
 
@@ -335,10 +389,14 @@ def main():
     obj, vertices, moving = posed_dragon(mesh, args.subdivide, args.double)
     if args.subdivide or args.double:
         args.pose_only = True
-        mesh = f"{mesh} subdivided {args.subdivide}x" + (", edges split to double" if args.double else "")
+        mesh = f"{mesh} subdivided {args.subdivide}x" + (
+            ", edges split to double" if args.double else ""
+        )
     results = {"mesh": mesh, "vertices": vertices, "bases": {}}
     # The paper's 67 and 130 dimensions (bench_solve.cpp bakes the same 130).
-    for modes, derivatives in ((15, 52),) if args.subdivide or args.double else ((15, 52), (25, 105)):
+    for modes, derivatives in (
+        ((15, 52),) if args.subdivide or args.double else ((15, 52), (25, 105))
+    ):
         settings = obj.modal_deform
         settings.modes, settings.derivatives, settings.ghost = modes, derivatives, 1000
         if args.proxy is not None:
@@ -350,46 +408,77 @@ def main():
         figures = time_displays(obj, moving.controller, args.updates)
         figures.update(bake_s=bake, proxy_vertices=settings.status.proxy_vertices)
         results["bases"][str(dimension)] = figures
-        print(f"{dimension} dimensions: baked in {bake:.1f} s (proxy {settings.status.proxy_vertices} vertices); "
-              + "; ".join(f"{display}: ours {figures[display]['tick']:.1f} ms + Blender's evaluation "
-                          f"{figures[display]['evaluate']:.1f} ms" for display in DISPLAYS), flush=True)
+        print(
+            f"{dimension} dimensions: baked in {bake:.1f} s (proxy {settings.status.proxy_vertices} vertices); "
+            + "; ".join(
+                f"{display}: ours {figures[display]['tick']:.1f} ms + Blender's evaluation "
+                f"{figures[display]['evaluate']:.1f} ms"
+                for display in DISPLAYS
+            ),
+            flush=True,
+        )
     results["blender"] = bpy.app.version_string
-    results["peak_gb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20  # the bake's, on dense meshes
+    results["peak_gb"] = (
+        resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20
+    )  # the bake's, on dense meshes
     if not args.pose_only:
         with tempfile.TemporaryDirectory() as folder:
             results["storage"] = storage_figures(obj, folder)
-        results["laplacian_deform"] = laplacian_deform(args.laplacian_updates, 2 if args.quick else 4)
+        results["laplacian_deform"] = laplacian_deform(
+            args.laplacian_updates, 2 if args.quick else 4
+        )
     if args.shapes:
         results["shapes"] = laplacian_on_shapes(args.shapes)
-    results["parameters"] = {"mesh": mesh, "updates": args.updates, "laplacian_updates": args.laplacian_updates,
-                             "suzanne_subdivisions": 2 if args.quick else 4, "shapes": args.shapes,
-                             "bases": "(15, 52) and (25, 105) modes, derivatives; 1k ghost"}
+    results["parameters"] = {
+        "mesh": mesh,
+        "updates": args.updates,
+        "laplacian_updates": args.laplacian_updates,
+        "suzanne_subdivisions": 2 if args.quick else 4,
+        "shapes": args.shapes,
+        "bases": "(15, 52) and (25, 105) modes, derivatives; 1k ghost",
+    }
 
-    print(f"\nPose update on {mesh} ({vertices} vertices), headless Blender {bpy.app.version_string}, shared 2-core "
-          "machine; ms, medians")
-    print(f"{'dims':>5} {'display':>10} {'ctrl':>6} {'budget':>6} {'solve':>6} {'write':>6} {'tick':>6} {'eval':>6} "
-          f"{'iters':>5}")
+    print(
+        f"\nPose update on {mesh} ({vertices} vertices), headless Blender {bpy.app.version_string}, shared 2-core "
+        "machine; ms, medians"
+    )
+    print(
+        f"{'dims':>5} {'display':>10} {'ctrl':>6} {'budget':>6} {'solve':>6} {'write':>6} {'tick':>6} {'eval':>6} "
+        f"{'iters':>5}"
+    )
     for dims, b in results["bases"].items():
         for display in DISPLAYS:
             f = b[display]
-            print(f"{dims:>5} {display:>10} {f['controllers']:6.2f} {f['budget']:6.2f} {f['solve']:6.2f} "
-                  f"{f['write']:6.2f} "
-                  f"{f['tick']:6.2f} {f['evaluate']:6.1f} {f['iterations']:5.0f}")
+            print(
+                f"{dims:>5} {display:>10} {f['controllers']:6.2f} {f['budget']:6.2f} {f['solve']:6.2f} "
+                f"{f['write']:6.2f} "
+                f"{f['tick']:6.2f} {f['evaluate']:6.1f} {f['iterations']:5.0f}"
+            )
     if not args.pose_only:
         lap = results["laplacian_deform"]
-        print(f"\nLaplacian Deform, Suzanne {lap['vertices']} vertices: bind {lap['bind_s']:.1f} s, "
-              f"{lap['update_ms']:.0f} ms per update (solved: {lap['solved']})")
+        print(
+            f"\nLaplacian Deform, Suzanne {lap['vertices']} vertices: bind {lap['bind_s']:.1f} s, "
+            f"{lap['update_ms']:.0f} ms per update (solved: {lap['solved']})"
+        )
         for dims, b in results["bases"].items():
-            f = b["positions"]  # what a mesh without shape keys gets, as the Laplacian Deform's mesh has none
+            f = b[
+                "positions"
+            ]  # what a mesh without shape keys gets, as the Laplacian Deform's mesh has none
             f["laplacian_ratio_tick"] = lap["update_ms"] / f["tick"]
             f["laplacian_ratio_tick_and_evaluate"] = lap["update_ms"] / (f["tick"] + f["evaluate"])
-            print(f"  ratio to Modal Deform at {dims} dims: {f['laplacian_ratio_tick']:.0f}x per tick, "
-                  f"{f['laplacian_ratio_tick_and_evaluate']:.0f}x with Blender's evaluation of both")
+            print(
+                f"  ratio to Modal Deform at {dims} dims: {f['laplacian_ratio_tick']:.0f}x per tick, "
+                f"{f['laplacian_ratio_tick_and_evaluate']:.0f}x with Blender's evaluation of both"
+            )
         s = results["storage"]
-        print(f"\nStorage: .blend {s['blend_mb']:.1f} MB, grows {s['blend_growth_mb']:.1f} MB for {s['basis_data_mb']:.1f} MB "
-              f"of basis; open {s['open_blend_s']:.2f} s; basis load {s['basis_load_s'] * 1e3:.0f} ms")
-        print(f"Shape-key update + evaluation: {s['update_ms_basis_in_palette']:.1f} ms with the basis in its palette, "
-              f"{s['update_ms_basis_on_object']:.1f} ms with the vectors on the Object")
+        print(
+            f"\nStorage: .blend {s['blend_mb']:.1f} MB, grows {s['blend_growth_mb']:.1f} MB for {s['basis_data_mb']:.1f} MB "
+            f"of basis; open {s['open_blend_s']:.2f} s; basis load {s['basis_load_s'] * 1e3:.0f} ms"
+        )
+        print(
+            f"Shape-key update + evaluation: {s['update_ms_basis_in_palette']:.1f} ms with the basis in its palette, "
+            f"{s['update_ms_basis_on_object']:.1f} ms with the vectors on the Object"
+        )
     output = pathlib.Path(args.output)
     output.parent.mkdir(parents=True, exist_ok=True)
     output.write_text(json.dumps(results, indent=1))

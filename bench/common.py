@@ -1,5 +1,6 @@
 """What every benchmark experiment shares: the machine and commit it ran on, timing, and its
 results file bench/results/<experiment>.json (parameters and figures, read by bench/report.py)."""
+
 import json
 import os
 import pathlib
@@ -15,6 +16,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "python_addon"))
 sys.path.insert(0, str(ROOT / "tests"))  # the test-support package (subdivision, raw scans, poses)
 import package  # noqa: E402 (which extension zip serves which Python)
+
 RESULTS = ROOT / "bench" / "results"
 #: Posed meshes passed from one experiment to the next (accuracy -> blender -> renders); not committed.
 MESHES = ROOT / "bench" / "results" / "tmp" / "meshes"
@@ -28,20 +30,45 @@ FRAME_TARGETS_MS = {100250: 4.0, 1606964: 16.0}
 
 def machine():
     """CPU model, cores, memory and uname of this machine."""
-    cpu = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo") if line.startswith("model name")),
-               platform.processor())
-    memory_kb = next(int(line.split()[1]) for line in open("/proc/meminfo") if line.startswith("MemTotal"))
-    return {"cpu": cpu, "cores": os.cpu_count(), "memory_gb": round(memory_kb / 2**20, 1),
-            "uname": " ".join(platform.uname()), "load_average": os.getloadavg()}
+    cpu = next(
+        (
+            line.split(":", 1)[1].strip()
+            for line in open("/proc/cpuinfo")
+            if line.startswith("model name")
+        ),
+        platform.processor(),
+    )
+    memory_kb = next(
+        int(line.split()[1]) for line in open("/proc/meminfo") if line.startswith("MemTotal")
+    )
+    return {
+        "cpu": cpu,
+        "cores": os.cpu_count(),
+        "memory_gb": round(memory_kb / 2**20, 1),
+        "uname": " ".join(platform.uname()),
+        "load_average": os.getloadavg(),
+    }
 
 
 def commit():
     """The checked-out commit, with "+dirty" when the work tree differs from it (outside the
     benchmark's own outputs, which a run rewrites as it goes)."""
+
     def git(*args):
-        return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True).stdout.strip()
-    dirty = git("status", "--porcelain", "--untracked-files=no", "--", ".", ":!bench/results", ":!docs/benchmarks.md",
-                ":!docs/figures")
+        return subprocess.run(
+            ["git", *args], cwd=ROOT, capture_output=True, text=True
+        ).stdout.strip()
+
+    dirty = git(
+        "status",
+        "--porcelain",
+        "--untracked-files=no",
+        "--",
+        ".",
+        ":!bench/results",
+        ":!docs/benchmarks.md",
+        ":!docs/figures",
+    )
     return git("rev-parse", "HEAD") + ("+dirty" if dirty else "")
 
 
@@ -49,9 +76,16 @@ def write(experiment, command, parameters, figures, seconds):
     """bench/results/<experiment>.json: machine, commit, the command that made it, parameters,
     figures and the experiment's wall time."""
     RESULTS.mkdir(parents=True, exist_ok=True)
-    record = {"experiment": experiment, "command": command, "machine": machine(), "commit": commit(),
-              "date": time.strftime("%Y-%m-%d %H:%M:%S %Z"), "seconds": round(seconds, 1),
-              "parameters": parameters, "figures": figures}
+    record = {
+        "experiment": experiment,
+        "command": command,
+        "machine": machine(),
+        "commit": commit(),
+        "date": time.strftime("%Y-%m-%d %H:%M:%S %Z"),
+        "seconds": round(seconds, 1),
+        "parameters": parameters,
+        "figures": figures,
+    }
     path = RESULTS / f"{experiment}.json"
     path.write_text(json.dumps(record, indent=1, default=_plain) + "\n")
     return path
@@ -100,15 +134,31 @@ def in_bpy(version, script, arguments, folder, **run):
     `run`: subprocess.run's further arguments (environment variables in `env`, added to this
     process's); returns what it returns."""
     python = ROOT / ".venv" / f"bpy-{version}" / "bin" / "python"
-    tag = subprocess.run([str(python), "-c", "import sys; print('%d.%d' % sys.version_info[:2])"],
-                         capture_output=True, text=True, check=True).stdout.strip()
+    tag = subprocess.run(
+        [str(python), "-c", "import sys; print('%d.%d' % sys.version_info[:2])"],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout.strip()
     extension = next(e for e in package.EXTENSIONS if e.python == tag)
     user = pathlib.Path(folder) / f"user-{version}"
     environment = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
     environment.update(run.pop("env", {}), LD_LIBRARY_PATH="", BLENDER_USER_RESOURCES=str(user))
     try:
-        return subprocess.run([str(python), str(ROOT / "tests" / "blender" / "bpy_session.py"), "--extension",
-                               str(ROOT / "dist" / package.extension_zip_name(extension)), str(script), "--",
-                               *arguments], check=True, cwd=ROOT, env=environment, **run)
+        return subprocess.run(
+            [
+                str(python),
+                str(ROOT / "tests" / "blender" / "bpy_session.py"),
+                "--extension",
+                str(ROOT / "dist" / package.extension_zip_name(extension)),
+                str(script),
+                "--",
+                *arguments,
+            ],
+            check=True,
+            cwd=ROOT,
+            env=environment,
+            **run,
+        )
     finally:
         shutil.rmtree(user, ignore_errors=True)

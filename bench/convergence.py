@@ -11,11 +11,12 @@ Newton and steepest descent use SciPy's strong-Wolfe line search on ReducedSolve
 (halving the step to sufficient decrease where it finds no Wolfe step);
 the BFGS runs are the solver itself, one iteration per call (its state carries over).
 """
+
 import numpy as np
 import scipy.optimize
+import shapes
 
 import modal_deform.core as mdc
-import shapes
 
 ITERATIONS = 60
 CASES = (("bar", "bend"), ("cylinder", "bend_twist"), ("bar", "bend_large"))
@@ -29,8 +30,9 @@ class Problem:
         self.solver = mdc.ReducedSolver(basis, shape.handles)
         self.solver.set_transforms(transforms)
         s = basis.scale
-        self.ghost_energy = mdc.DiscreteShells(s * basis.ghost_vertices, basis.ghost_faces, basis.bending,
-                                               basis.membrane)
+        self.ghost_energy = mdc.DiscreteShells(
+            s * basis.ghost_vertices, basis.ghost_faces, basis.bending, basis.membrane
+        )
         self.ghost_rest = s * basis.ghost_vertices.reshape(-1)
         self.ghost_vectors = s * np.asarray(basis.ghost_vectors)
         # The handle term is quadratic in q: its Hessian is exact from differences of its gradient.
@@ -40,7 +42,9 @@ class Problem:
         self.handle_hessian = np.column_stack([handle_gradient(e) - at_rest for e in np.eye(r)])
 
     def ghost_gradient(self, q):
-        return self.ghost_vectors.T @ self.ghost_energy.gradient(self.ghost_rest + self.ghost_vectors @ q)
+        return self.ghost_vectors.T @ self.ghost_energy.gradient(
+            self.ghost_rest + self.ghost_vectors @ q
+        )
 
     def hessian(self, q):
         H = self.ghost_energy.hessian(self.ghost_rest + self.ghost_vectors @ q)
@@ -62,10 +66,18 @@ def descend(problem, direction):
     trace = [value]
     for _ in range(ITERATIONS):
         p = direction(q, gradient)
-        step, *_ = scipy.optimize.line_search(problem.value, problem.gradient, q, p, gradient, value, c2=0.9)
+        step, *_ = scipy.optimize.line_search(
+            problem.value, problem.gradient, q, p, gradient, value, c2=0.9
+        )
         if step is None:  # no Wolfe step found: backtrack to sufficient decrease alone (Armijo)
-            step = next((a for a in 0.5 ** np.arange(40) if problem.value(q + a * p) <= value + 1e-4 * a * (gradient @ p)),
-                        None)
+            step = next(
+                (
+                    a
+                    for a in 0.5 ** np.arange(40)
+                    if problem.value(q + a * p) <= value + 1e-4 * a * (gradient @ p)
+                ),
+                None,
+            )
         if step is None:  # no decrease left at this precision
             break
         q = q + step * p
@@ -85,6 +97,7 @@ def newton_direction(problem):
             except np.linalg.LinAlgError:
                 shift = max(2 * shift, 1e-8 * np.abs(np.diag(H)).max())
         return -scipy.linalg.cho_solve((L, True), gradient)
+
     return direction
 
 
@@ -104,21 +117,46 @@ def bfgs(basis, shape, transforms, warm):
 def run(quick=False):
     cases = []
     for name, pose_name in CASES:
-        shape = shapes.make(name, **({"bar": dict(nx=4, nz=30), "cylinder": dict(around=16, along=20)}[name]
-                                     if quick else {}))
+        shape = shapes.make(
+            name,
+            **(
+                {"bar": dict(nx=4, nz=30), "cylinder": dict(around=16, along=20)}[name]
+                if quick
+                else {}
+            ),
+        )
         basis = mdc.bake(shape.V, shape.F, *DIMENSION, ghost=1000)
         transforms = shape.pose(pose_name).at(1.0)
         problem = Problem(basis, shape, transforms)
-        runs = {"Newton": descend(problem, newton_direction(problem)),
-                "BFGS, warm start": bfgs(basis, shape, transforms, True),
-                "BFGS, cold start": bfgs(basis, shape, transforms, False),
-                "steepest descent": descend(problem, lambda q, gradient: -gradient)}
+        runs = {
+            "Newton": descend(problem, newton_direction(problem)),
+            "BFGS, warm start": bfgs(basis, shape, transforms, True),
+            "BFGS, cold start": bfgs(basis, shape, transforms, False),
+            "steepest descent": descend(problem, lambda q, gradient: -gradient),
+        }
         traces = {method: trace for method, (trace, _) in runs.items()}
-        cases.append({"shape": name, "pose": pose_name, "vertices": len(shape.V), "dimension": basis.dimension,
-                      "ghost": len(basis.ghost_vertices), "minimum": min(min(t) for t in traces.values()),
-                      "traces": traces, "final_gradient_norms": {method: norm for method, (_, norm) in runs.items()}})
-        print(f"  {name} {pose_name}: " + ", ".join(f"{k} {len(t) - 1} it -> {t[-1]:.6g}" for k, t in traces.items()),
-              flush=True)
-    parameters = {"cases": CASES, "modes_derivatives": DIMENSION, "iterations": ITERATIONS,
-                  "stiffness": mdc.solve.STIFFNESS, "line_search": "scipy.optimize.line_search (strong Wolfe, c2=0.9)"}
+        cases.append(
+            {
+                "shape": name,
+                "pose": pose_name,
+                "vertices": len(shape.V),
+                "dimension": basis.dimension,
+                "ghost": len(basis.ghost_vertices),
+                "minimum": min(min(t) for t in traces.values()),
+                "traces": traces,
+                "final_gradient_norms": {method: norm for method, (_, norm) in runs.items()},
+            }
+        )
+        print(
+            f"  {name} {pose_name}: "
+            + ", ".join(f"{k} {len(t) - 1} it -> {t[-1]:.6g}" for k, t in traces.items()),
+            flush=True,
+        )
+    parameters = {
+        "cases": CASES,
+        "modes_derivatives": DIMENSION,
+        "iterations": ITERATIONS,
+        "stiffness": mdc.solve.STIFFNESS,
+        "line_search": "scipy.optimize.line_search (strong Wolfe, c2=0.9)",
+    }
     return parameters, {"cases": cases}

@@ -14,13 +14,14 @@ fine mesh's own bake for comparison. RMS over all vertices relative to the bound
 
     PYTHONPATH=python_addon /usr/bin/python3 bench/detail_offsets.py
 """
+
 import json
 import sys
 
 import numpy as np
+import shapes
 
 import modal_deform.core as mdc
-import shapes
 
 
 def rippled_tube(around=128, along=200, amplitude=0.06, waves=(24, 40)):
@@ -67,6 +68,7 @@ def main():
 
     def bent(degrees):
         return [np.eye(4), shapes.rod_end(10.0, (0, 0), degrees * np.pi / 180, 0)]
+
     proxy = len(V) // 8
     basis = mdc.bake(V, F, modes=20, derivatives=47, ghost=1000, proxy=proxy, proxy_above=proxy)
     own = mdc.bake(V, F, modes=20, derivatives=47, ghost=1000, proxy=None)
@@ -84,18 +86,24 @@ def main():
                 solver.solve(max_iterations=50)
             solver.solve(max_iterations=500, tolerance=1e-9)
             return solver
+
         solver = converged(basis)
         X_rest = solver.positions().astype(np.float64)
         X_rotated = rotated_frame_positions(basis, proxy_rest, solver.q)
         X_own = converged(own).positions().astype(np.float64)
         results["poses"][f"bend {degrees}"] = figures = {
-            "rest_frame": rms(X_rest, X_full, diagonal), "rotated_frame": rms(X_rotated, X_full, diagonal),
+            "rest_frame": rms(X_rest, X_full, diagonal),
+            "rotated_frame": rms(X_rotated, X_full, diagonal),
             "own_bake": rms(X_own, X_full, diagonal),
-            "rest_frame_vs_own": rms(X_rest, X_own, diagonal), "rotated_frame_vs_own": rms(X_rotated, X_own, diagonal),
+            "rest_frame_vs_own": rms(X_rest, X_own, diagonal),
+            "rotated_frame_vs_own": rms(X_rotated, X_own, diagonal),
             # How far apart the two placements are, and how large the detail is.
             "between_frames": rms(X_rest, X_rotated, diagonal),
-            "between_frames_max": float(np.linalg.norm(X_rest - X_rotated, axis=1).max() / diagonal),
-            "offsets": rms(detail_offsets(basis, proxy_rest), 0.0, diagonal)}
+            "between_frames_max": float(
+                np.linalg.norm(X_rest - X_rotated, axis=1).max() / diagonal
+            ),
+            "offsets": rms(detail_offsets(basis, proxy_rest), 0.0, diagonal),
+        }
         print(f"bend {degrees}", json.dumps(figures), flush=True)
     json.dump(results, sys.stdout)
     print()

@@ -16,16 +16,17 @@
 - tolerance: BFGS's stopping tolerance against the frames of a tight solve (the 5k dragon, the
   demo's motion): why SIMULATION_OPTIONS["tolerance"] is what it is.
 """
+
 import time
 
 import numpy as np
-
-import modal_deform.core as mdc
 from common import median_ms
 from shapes import rigid_transform as rigid
-from support.dynamics import AMPLITUDE, damped_oscillation, released  # noqa: F401
 from support import SHARED_MESHES as MESHES
+from support.dynamics import AMPLITUDE, damped_oscillation, released  # noqa: F401
 from support.subdivision import midpoint_subdivide
+
+import modal_deform.core as mdc
 
 # The handles' pull the dynamics records were made with.
 PULL = 100.0
@@ -37,18 +38,46 @@ def bar(quick):
     V, F = mdc.testing.bar(4, 4, 16, 1, 1, 4)
     basis = mdc.bake(V, F, **BAR)
     undamped = []
-    for period, fps, substeps in [(12.0, 24.0, 2), (12.0, 24.0, 1), (24.0, 24.0, 1), (6.0, 60.0, 3), (4.0, 24.0, 2)]:
-        trace = released(basis, int(10 * period) + 1, period=period, damping=0.0, fps=fps, substeps=substeps)
+    for period, fps, substeps in [
+        (12.0, 24.0, 2),
+        (12.0, 24.0, 1),
+        (24.0, 24.0, 1),
+        (6.0, 60.0, 3),
+        (4.0, 24.0, 2),
+    ]:
+        trace = released(
+            basis, int(10 * period) + 1, period=period, damping=0.0, fps=fps, substeps=substeps
+        )
         measured, _ = damped_oscillation(trace)
-        undamped.append({"period": period, "fps": fps, "substeps": substeps, "measured_period": measured,
-                         "amplitude_after_10_periods": float(np.abs(trace[-int(np.ceil(period)):]).max() / AMPLITUDE)})
+        undamped.append(
+            {
+                "period": period,
+                "fps": fps,
+                "substeps": substeps,
+                "measured_period": measured,
+                "amplitude_after_10_periods": float(
+                    np.abs(trace[-int(np.ceil(period)) :]).max() / AMPLITUDE
+                ),
+            }
+        )
     damped = []
     for zeta in (0.02, 0.05, 0.1, 0.2, 0.5):
         trace = released(basis, 48, damping=zeta)
         measured, decrement = damped_oscillation(trace)
-        damped.append({"damping": zeta, "measured_period": measured, "decrement": decrement,
-                       "expected_decrement": 2 * np.pi * zeta / np.sqrt(1 - zeta**2)})
-    return {"vertices": len(V), "dimension": basis.dimension, "undamped": undamped, "damped": damped}
+        damped.append(
+            {
+                "damping": zeta,
+                "measured_period": measured,
+                "decrement": decrement,
+                "expected_decrement": 2 * np.pi * zeta / np.sqrt(1 - zeta**2),
+            }
+        )
+    return {
+        "vertices": len(V),
+        "dimension": basis.dimension,
+        "undamped": undamped,
+        "damped": damped,
+    }
 
 
 def tail_and_head(V):
@@ -60,7 +89,10 @@ def tail_and_head(V):
 def demo_motion(V, handles, frames):
     """The head turns 60° about the vertical in 12 frames, then stays."""
     centre = V[handles[1]].mean(axis=0)
-    return [[np.eye(4), rigid([0, 0, 1], np.radians(60) * min(f, 12) / 12, centre)] for f in range(1, frames + 1)]
+    return [
+        [np.eye(4), rigid([0, 0, 1], np.radians(60) * min(f, 12) / 12, centre)]
+        for f in range(1, frames + 1)
+    ]
 
 
 def per_frame_cost(basis, V, handles, moves, **parameters):
@@ -78,26 +110,43 @@ def per_frame_cost(basis, V, handles, moves, **parameters):
         start = time.perf_counter()
         sim.positions(out)
         map_ms.append(1e3 * (time.perf_counter() - start))
-    summary = lambda xs: {"median": float(np.median(xs)), "p95": float(np.percentile(xs, 95)), "max": float(max(xs))}
-    return {"frames": len(moves), "step_ms": summary(step_ms), "map_ms": summary(map_ms),
-            "map_back_to_back_ms": median_ms(lambda: sim.positions(out), 20),
-            "iterations": summary(iterations), "evaluations": summary(evaluations),
-            "ms_per_evaluation": summary([t / e for t, e in zip(step_ms, evaluations) if e]),
-            "step_ms_per_frame": step_ms, "iterations_per_frame": iterations}
+    summary = lambda xs: {
+        "median": float(np.median(xs)),
+        "p95": float(np.percentile(xs, 95)),
+        "max": float(max(xs)),
+    }
+    return {
+        "frames": len(moves),
+        "step_ms": summary(step_ms),
+        "map_ms": summary(map_ms),
+        "map_back_to_back_ms": median_ms(lambda: sim.positions(out), 20),
+        "iterations": summary(iterations),
+        "evaluations": summary(evaluations),
+        "ms_per_evaluation": summary([t / e for t, e in zip(step_ms, evaluations) if e]),
+        "step_ms_per_frame": step_ms,
+        "iterations_per_frame": iterations,
+    }
 
 
 def cost(quick):
     runs = {}
-    for name in (["dragon_vrip_res4"] if quick else ["dragon_vrip_res3", "dragon_vrip_res2"]):
+    for name in ["dragon_vrip_res4"] if quick else ["dragon_vrip_res3", "dragon_vrip_res2"]:
         V, F = mdc.read_mesh(MESHES / f"{name}.ply.gz")
         start = time.perf_counter()
         basis = mdc.bake(V, F)
         bake_s = time.perf_counter() - start
         handles = tail_and_head(V)
-        runs[name] = {"vertices": len(V), "dimension": basis.dimension, "ghost": len(basis.ghost_vertices),
-                      "bake_s": bake_s, **per_frame_cost(basis, V, handles, demo_motion(V, handles, 60))}
-        print(f"   {name}: step {runs[name]['step_ms']['median']:.2f} ms, map {runs[name]['map_ms']['median']:.2f} ms",
-              flush=True)
+        runs[name] = {
+            "vertices": len(V),
+            "dimension": basis.dimension,
+            "ghost": len(basis.ghost_vertices),
+            "bake_s": bake_s,
+            **per_frame_cost(basis, V, handles, demo_motion(V, handles, 60)),
+        }
+        print(
+            f"   {name}: step {runs[name]['step_ms']['median']:.2f} ms, map {runs[name]['map_ms']['median']:.2f} ms",
+            flush=True,
+        )
     return runs
 
 
@@ -115,7 +164,12 @@ def stress_run(basis, V, handles, frames, still):
     non_finite, farthest, step_ms, euler, removed, evaluations = 0, 0.0, [], 0, 0.0, []
     start = time.perf_counter()
     for _ in range(frames):
-        T = rigid(rng.normal(size=3), rng.uniform(0, np.radians(150)), centre, rng.normal(scale=length / 3, size=3))
+        T = rigid(
+            rng.normal(size=3),
+            rng.uniform(0, np.radians(150)),
+            centre,
+            rng.normal(scale=length / 3, size=3),
+        )
         X = sim.step([np.eye(4), T])
         non_finite += int(not (np.isfinite(X).all() and np.isfinite(sim.energy())))
         farthest = max(farthest, float(np.abs(X - V.mean(axis=0)).max() / diagonal))
@@ -134,22 +188,36 @@ def stress_run(basis, V, handles, frames, still):
     solver = mdc.ReducedSolver(basis, handles, pull=PULL)
     solver.set_transforms([np.eye(4), T])
     solved = solver.solve(max_iterations=1000, tolerance=1e-12)
-    return {"vertices": len(V), "frames": frames, "still_frames": still, "damping": damping,
-            "non_finite_frames": non_finite, "farthest_vertex_diagonals": farthest,
-            "moving_s": moving_s, "step_ms_median": float(np.median(step_ms)), "step_ms_max": float(max(step_ms)),
-            "evaluations_median": float(np.median(evaluations)), "evaluations_max": int(max(evaluations)),
-            "implicit_euler_substeps": euler, "energy_removed": removed,
-            "energy_at_stop": energies[0], "energy_at_end": energies[-1],
-            "largest_energy_increase_still": float(increases.max()),
-            "pose_converged": solved["converged"],
-            "settled_distance_diagonals": float(np.abs(X - solver.positions()).max() / diagonal)}
+    return {
+        "vertices": len(V),
+        "frames": frames,
+        "still_frames": still,
+        "damping": damping,
+        "non_finite_frames": non_finite,
+        "farthest_vertex_diagonals": farthest,
+        "moving_s": moving_s,
+        "step_ms_median": float(np.median(step_ms)),
+        "step_ms_max": float(max(step_ms)),
+        "evaluations_median": float(np.median(evaluations)),
+        "evaluations_max": int(max(evaluations)),
+        "implicit_euler_substeps": euler,
+        "energy_removed": removed,
+        "energy_at_stop": energies[0],
+        "energy_at_end": energies[-1],
+        "largest_energy_increase_still": float(increases.max()),
+        "pose_converged": solved["converged"],
+        "settled_distance_diagonals": float(np.abs(X - solver.positions()).max() / diagonal),
+    }
 
 
 def stress(quick):
     name = "dragon_vrip_res4" if quick else "dragon_vrip_res3"
     V, F = mdc.read_mesh(MESHES / f"{name}.ply.gz")
     basis = mdc.bake(V, F)
-    return {"mesh": name, **stress_run(basis, V, tail_and_head(V), *((100, 150) if quick else (1000, 300)))}
+    return {
+        "mesh": name,
+        **stress_run(basis, V, tail_and_head(V), *((100, 150) if quick else (1000, 300))),
+    }
 
 
 def proxy(quick):
@@ -162,9 +230,14 @@ def proxy(quick):
     basis = mdc.bake(V, F, **sizes)
     bake_s = time.perf_counter() - start
     handles = tail_and_head(V)
-    return {"vertices": len(V), "proxy_vertices": basis.num_basis_vertices, "dimension": basis.dimension,
-            "bake_s": bake_s, **per_frame_cost(basis, V, handles, demo_motion(V, handles, 30)),
-            "stress": stress_run(basis, V, handles, *((100, 150) if quick else (1000, 300)))}
+    return {
+        "vertices": len(V),
+        "proxy_vertices": basis.num_basis_vertices,
+        "dimension": basis.dimension,
+        "bake_s": bake_s,
+        **per_frame_cost(basis, V, handles, demo_motion(V, handles, 30)),
+        "stress": stress_run(basis, V, handles, *((100, 150) if quick else (1000, 300))),
+    }
 
 
 def tolerance(quick):
@@ -187,18 +260,39 @@ def tolerance(quick):
     for tol in (1e-12, 1e-10, 1e-9, 1e-8, 1e-7, 1e-6):
         X, iterations = frames(tol)
         distance = max(np.abs(x - r).max() for x, r in zip(X, reference)) / diagonal
-        rows.append({"tolerance": tol, "iterations_median": float(np.median(iterations)),
-                     "iterations_moving": float(np.mean(iterations[:12])),
-                     "iterations_still": float(np.mean(iterations[-24:])), "largest_distance_diagonals": float(distance)})
-    return {"mesh": "dragon_vrip_res4", "vertices": len(V), "frames": len(moves), "reference_tolerance": 1e-14,
-            "rows": rows}
+        rows.append(
+            {
+                "tolerance": tol,
+                "iterations_median": float(np.median(iterations)),
+                "iterations_moving": float(np.mean(iterations[:12])),
+                "iterations_still": float(np.mean(iterations[-24:])),
+                "largest_distance_diagonals": float(distance),
+            }
+        )
+    return {
+        "mesh": "dragon_vrip_res4",
+        "vertices": len(V),
+        "frames": len(moves),
+        "reference_tolerance": 1e-14,
+        "rows": rows,
+    }
 
 
 def run(quick=False):
     figures = {}
-    for name, part in (("bar", bar), ("tolerance", tolerance), ("cost", cost), ("stress", stress), ("proxy", proxy)):
+    for name, part in (
+        ("bar", bar),
+        ("tolerance", tolerance),
+        ("cost", cost),
+        ("stress", stress),
+        ("proxy", proxy),
+    ):
         start = time.perf_counter()
         figures[name] = part(quick)
         print(f"   {name}: {time.perf_counter() - start:.0f} s", flush=True)
-    parameters = {"defaults": {name: o.default for name, o in mdc.SIMULATION_OPTIONS.items()}, "bar_bake": BAR, "amplitude": AMPLITUDE}
+    parameters = {
+        "defaults": {name: o.default for name, o in mdc.SIMULATION_OPTIONS.items()},
+        "bar_bake": BAR,
+        "amplitude": AMPLITUDE,
+    }
     return parameters, figures

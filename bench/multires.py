@@ -6,6 +6,7 @@ positions), and the converged pose under the end-pull handles against the 100k d
 on the vertices the two meshes share (RMS relative to the bounding-box diagonal).
 Targets (issue 15, printed, not asserted): bake 30 s, 4 GB, 200 MB stored, 16 ms per update, 1% RMS.
 """
+
 import json
 import textwrap
 
@@ -74,13 +75,26 @@ def run(quick=False):
         outcome = bake_in_fresh_process(name, levels, proxy)
         outcome["proxy"] = proxy
         bakes.append(outcome)
-        print(f"   multires ({name} subdivided {levels}x, proxy {proxy}): {json.dumps(outcome)}", flush=True)
+        print(
+            f"   multires ({name} subdivided {levels}x, proxy {proxy}): {json.dumps(outcome)}",
+            flush=True,
+        )
         if outcome["ok"]:
-            print(f"   bake {outcome['seconds']:.1f} s (target {TARGETS['seconds']:.0f}), peak {outcome['peak_gb']:.2f} GB "
-                  f"(target {TARGETS['peak_gb']:.0f}), stored {outcome['stored_mb']:.0f} MB (target "
-                  f"{TARGETS['stored_mb']:.0f}; dense {outcome['dense_mb']:.0f}), update {outcome['update_ms']:.1f} ms "
-                  f"(target {TARGETS['update_ms']:.0f}), RMS against the unsubdivided mesh's own bake {100 * outcome['rms']:.3f}% "
-                  f"(target {100 * TARGETS['rms']:.0f}%)", flush=True)
-    parameters = {"mesh": name, "subdivisions": levels, "proxies": list(proxies), "modes": 20,
-                  "derivatives": 47, "ghost": 1000, "targets": TARGETS}
+            print(
+                f"   bake {outcome['seconds']:.1f} s (target {TARGETS['seconds']:.0f}), peak {outcome['peak_gb']:.2f} GB "
+                f"(target {TARGETS['peak_gb']:.0f}), stored {outcome['stored_mb']:.0f} MB (target "
+                f"{TARGETS['stored_mb']:.0f}; dense {outcome['dense_mb']:.0f}), update {outcome['update_ms']:.1f} ms "
+                f"(target {TARGETS['update_ms']:.0f}), RMS against the unsubdivided mesh's own bake {100 * outcome['rms']:.3f}% "
+                f"(target {100 * TARGETS['rms']:.0f}%)",
+                flush=True,
+            )
+    parameters = {
+        "mesh": name,
+        "subdivisions": levels,
+        "proxies": list(proxies),
+        "modes": 20,
+        "derivatives": 47,
+        "ghost": 1000,
+        "targets": TARGETS,
+    }
     return parameters, {"bakes": bakes}

@@ -24,6 +24,7 @@ evaluation of the same mesh without the display, its vertex positions written (a
 on another object): the floor of what the display costs. The load average (1, 5, 15 min) before and
 after the run.
 """
+
 import argparse
 import json
 import math
@@ -41,21 +42,34 @@ sys.path.insert(0, str(ROOT / "bench"))
 import blender_pose  # noqa: E402 (found through the line above; its meshes and handles)
 from headless import enable_addon  # noqa: E402 (blender_pose put blender_scripts/ on the path)
 
-
 #: Rounds of the timed frames (timed_frames): each figure is a frame's least over them.
 ROUNDS = 3
 
 
 def arguments():
-    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    argv = sys.argv[sys.argv.index("--") + 1 :] if "--" in sys.argv else []
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("--output", required=True)
-    parser.add_argument("--frames", type=int, default=250, help="frames of the animation cached and exported")
-    parser.add_argument("--timed", type=int, default=40, help="frames timed for each per-frame figure")
-    parser.add_argument("--subdivide", type=int, default=0, help="midpoint subdivisions of the 100k dragon "
-                                                                 "(2: 1.6M vertices, baked on a proxy)")
-    parser.add_argument("--no-sizes", action="store_true", help="skip the .blend sizes (dense meshes)")
-    parser.add_argument("--quick", action="store_true", help="dragon_vrip_res4 and a small basis (smoke test)")
+    parser.add_argument(
+        "--frames", type=int, default=250, help="frames of the animation cached and exported"
+    )
+    parser.add_argument(
+        "--timed", type=int, default=40, help="frames timed for each per-frame figure"
+    )
+    parser.add_argument(
+        "--subdivide",
+        type=int,
+        default=0,
+        help="midpoint subdivisions of the 100k dragon (2: 1.6M vertices, baked on a proxy)",
+    )
+    parser.add_argument(
+        "--no-sizes", action="store_true", help="skip the .blend sizes (dense meshes)"
+    )
+    parser.add_argument(
+        "--quick", action="store_true", help="dragon_vrip_res4 and a small basis (smoke test)"
+    )
     return parser.parse_args(argv)
 
 
@@ -75,10 +89,14 @@ def playback_handler(name):
     """The add-on's playback handler in bpy.app.handlers.`name`: the frame change's, and those Blender
     calls when the timeline starts or stops playing (Blender 4+), which headless frame changes do not
     call."""
-    return next(h for h in getattr(bpy.app.handlers, name) if h.__module__.endswith(".playback.timeline"))
+    return next(
+        h for h in getattr(bpy.app.handlers, name) if h.__module__.endswith(".playback.timeline")
+    )
 
 
-def timed_frames(obj, scene, timeline, frame_cache, frames, stepping=False, rounds=ROUNDS, playing=True):
+def timed_frames(
+    obj, scene, timeline, frame_cache, frames, stepping=False, rounds=ROUNDS, playing=True
+):
     """Handler, map and evaluation milliseconds over `frames`, each reached by scene.frame_set as
     the timeline reaches it, played (`playing`: between the calls of the add-on's playback handlers,
     the display reading a stand-in) or stepped through while still (the display's attribute):
@@ -103,7 +121,10 @@ def timed_frames(obj, scene, timeline, frame_cache, frames, stepping=False, roun
     add_on_handler = playback_handler("frame_change_post")
     handlers.insert(list(handlers).index(add_on_handler), before)
     handlers.insert(list(handlers).index(add_on_handler) + 1, after)
-    figures = {name: np.full((rounds, len(frames)), np.inf) for name in ("handler", "map", "evaluate", "step")}
+    figures = {
+        name: np.full((rounds, len(frames)), np.inf)
+        for name in ("handler", "map", "evaluate", "step")
+    }
     iterations = []
     if playing:
         playback_handler("animation_playback_pre")(scene, None)
@@ -131,11 +152,19 @@ def timed_frames(obj, scene, timeline, frame_cache, frames, stepping=False, roun
         if playing:
             playback_handler("animation_playback_post")(scene, None)
     least = {name: float(np.median(values.min(axis=0))) for name, values in figures.items()}
-    result = {"handler_ms": least["handler"], "map_ms": least["map"], "evaluate_ms": least["evaluate"],
-              "frames": len(frames), "rounds": rounds,
-              # For comparison, the medians over every round's frames, a neighbour's load included.
-              "every_round": {name + "_ms": float(np.median(values)) for name, values in figures.items()
-                              if stepping or name != "step"}}
+    result = {
+        "handler_ms": least["handler"],
+        "map_ms": least["map"],
+        "evaluate_ms": least["evaluate"],
+        "frames": len(frames),
+        "rounds": rounds,
+        # For comparison, the medians over every round's frames, a neighbour's load included.
+        "every_round": {
+            name + "_ms": float(np.median(values))
+            for name, values in figures.items()
+            if stepping or name != "step"
+        },
+    }
     if stepping:
         result.update(step_ms=least["step"], iterations=float(np.median(iterations)))
     return result
@@ -192,7 +221,9 @@ def main():
     obj, vertices, moving = blender_pose.posed_dragon(name, args.subdivide)
     settings = obj.modal_deform
     # The paper's 67 dimensions, as the pose benchmarks (blender_pose.py) bake them.
-    settings.modes, settings.derivatives, settings.ghost = (12, 12, 300) if args.quick else (15, 52, 1000)
+    settings.modes, settings.derivatives, settings.ghost = (
+        (12, 12, 300) if args.quick else (15, 52, 1000)
+    )
     start = time.perf_counter()
     assert bpy.ops.modal_deform.bake() == {"FINISHED"}
     bake_seconds = time.perf_counter() - start
@@ -202,9 +233,16 @@ def main():
     scene.frame_start, scene.frame_end = 1, frames
     animate(moving.controller, frames)
     load_before = os.getloadavg()
-    results = {"blender": bpy.app.version_string, "mesh": name, "subdivide": args.subdivide, "vertices": vertices,
-               "dimension": settings.status.dimension, "proxy_vertices": settings.status.proxy_vertices,
-               "bake_seconds": bake_seconds, "frames": frames}
+    results = {
+        "blender": bpy.app.version_string,
+        "mesh": name,
+        "subdivide": args.subdivide,
+        "vertices": vertices,
+        "dimension": settings.status.dimension,
+        "proxy_vertices": settings.status.proxy_vertices,
+        "bake_seconds": bake_seconds,
+        "frames": frames,
+    }
 
     # The static animation: baked into the cache, then read back frame by frame.
     start = time.perf_counter()
@@ -216,25 +254,34 @@ def main():
         if not args.no_sizes:
             results["blend_with_cache_bytes"] = saved_size(folder, "cache.blend")
             pc2 = os.path.join(folder, "dragon.pc2")
-            assert bpy.ops.modal_deform.export_mesh_cache(filepath=pc2, file_format="PC2") == {"FINISHED"}
+            assert bpy.ops.modal_deform.export_mesh_cache(filepath=pc2, file_format="PC2") == {
+                "FINISHED"
+            }
             results["pc2_bytes"] = os.path.getsize(pc2)
 
         # Secondary motion: each frame simulated live from the one before, then read back.
         settings.dynamics.enabled = True
         timeline.set_frame(scene, 1)
         timeline.show(obj, scene)
-        results["dynamic_step"] = timed_frames(obj, scene, timeline, frame_cache, timed, stepping=True)
-        results["dynamic_step_still"] = timed_frames(obj, scene, timeline, frame_cache, timed, stepping=True,
-                                                     playing=False)
+        results["dynamic_step"] = timed_frames(
+            obj, scene, timeline, frame_cache, timed, stepping=True
+        )
+        results["dynamic_step_still"] = timed_frames(
+            obj, scene, timeline, frame_cache, timed, stepping=True, playing=False
+        )
         results["dynamic_read"] = timed_frames(obj, scene, timeline, frame_cache, timed)
-        results["dynamic_cache_bytes_per_frame"] = frame_cache.get(obj).nbytes() / len(frame_cache.get(obj))
+        results["dynamic_cache_bytes_per_frame"] = frame_cache.get(obj).nbytes() / len(
+            frame_cache.get(obj)
+        )
         results["dynamic_jump"] = jump_forward(obj, scene, timeline, frame_cache, len(timed))
         results["without_display"] = without_display(obj, timeline, frame_cache, timed)
 
         if not args.no_sizes:
             # The static animation as a shape key per frame, as Bake Animation wrote it before the cache.
             settings.dynamics.enabled = False
-            assert bpy.ops.modal_deform.bake_animation(frame_start=1, frame_end=frames) == {"FINISHED"}
+            assert bpy.ops.modal_deform.bake_animation(frame_start=1, frame_end=frames) == {
+                "FINISHED"
+            }
             start = time.perf_counter()
             assert bpy.ops.modal_deform.export_shape_keys() == {"FINISHED"}
             results["shape_keys_export_seconds"] = time.perf_counter() - start

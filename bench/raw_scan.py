@@ -3,6 +3,7 @@ midpoint-subdivided once, about 405k vertices, with every kind of scan damage) b
 paper's 67 dimensions (20 modes + 47 derivatives, 1k ghost), each seed in a fresh process: wall
 time, peak resident memory, what the bake found. Targets (issue 15): at most 60 s within 4 GB.
 """
+
 import json
 import textwrap
 
@@ -51,10 +52,23 @@ def run(quick=False):
         outcome = bake_in_fresh_process(name, levels, seed)
         outcome["seed"] = seed
         bakes.append(outcome)
-        print(f"   raw scan ({name}, {levels} subdivision, seed {seed}): {json.dumps(outcome)}", flush=True)
+        print(
+            f"   raw scan ({name}, {levels} subdivision, seed {seed}): {json.dumps(outcome)}",
+            flush=True,
+        )
         if outcome["ok"]:
-            print(f"   bake {outcome['seconds']:.1f} s (target {TARGET_SECONDS:.0f} s), peak "
-                  f"{outcome['peak_gb']:.2f} GB (target {TARGET_GB:.0f} GB)", flush=True)
-    parameters = {"mesh": name, "subdivisions": levels, "seeds": list(SEEDS), "modes": 20, "derivatives": 47,
-                  "ghost": 1000, "targets": {"seconds": TARGET_SECONDS, "peak_gb": TARGET_GB}}
+            print(
+                f"   bake {outcome['seconds']:.1f} s (target {TARGET_SECONDS:.0f} s), peak "
+                f"{outcome['peak_gb']:.2f} GB (target {TARGET_GB:.0f} GB)",
+                flush=True,
+            )
+    parameters = {
+        "mesh": name,
+        "subdivisions": levels,
+        "seeds": list(SEEDS),
+        "modes": 20,
+        "derivatives": 47,
+        "ghost": 1000,
+        "targets": {"seconds": TARGET_SECONDS, "peak_gb": TARGET_GB},
+    }
     return parameters, {"bakes": bakes}

@@ -13,14 +13,15 @@ holds (the stored basis fields, q and positions, the full solve's positions and 
 `compare` prints each array that differs in any bit and exits 1 if one does; timings (seconds,
 ms) are not compared.
 """
+
 import argparse
 import pathlib
 import sys
 
 import numpy as np
+import shapes
 
 import modal_deform.core as mdc
-import shapes
 
 # Stats that measure time, not behaviour.
 _TIMES = {"seconds", "ms"}
@@ -59,11 +60,13 @@ def _reduced_pose(basis, V):
 
 def cases():
     """{case name: function returning {array name: array}}."""
+
     def default_bake(name):
         def run():
             V, F = _mesh(name)
             basis = mdc.bake(V, F)
             return {**_basis_arrays(basis), **_reduced_pose(basis, V)}
+
         return run
 
     def painted():
@@ -92,9 +95,15 @@ def cases():
         arrays.update({"refine.positions": X, **_stats_arrays("refine", stats)})
         return arrays
 
-    return {"bunny": default_bake("bunny"), "dragon_res4": default_bake("dragon_res4"),
-            "dragon_res3": default_bake("dragon_res3"), "dragon_res4_painted": painted,
-            "dragon_res4_region": region, "dragon_res4_proxy": proxy, "dragon_res4_full_refine": full_and_refine}
+    return {
+        "bunny": default_bake("bunny"),
+        "dragon_res4": default_bake("dragon_res4"),
+        "dragon_res3": default_bake("dragon_res3"),
+        "dragon_res4_painted": painted,
+        "dragon_res4_region": region,
+        "dragon_res4_proxy": proxy,
+        "dragon_res4_full_refine": full_and_refine,
+    }
 
 
 def main():
@@ -116,11 +125,17 @@ def main():
             continue
         stored = dict(np.load(path))
         changed = sorted(set(stored) ^ set(arrays))
-        changed += [key for key in sorted(set(stored) & set(arrays))
-                    if stored[key].dtype != arrays[key].dtype or stored[key].shape != np.shape(arrays[key])
-                    or stored[key].tobytes() != np.asarray(arrays[key], stored[key].dtype).tobytes()]
+        changed += [
+            key
+            for key in sorted(set(stored) & set(arrays))
+            if stored[key].dtype != arrays[key].dtype
+            or stored[key].shape != np.shape(arrays[key])
+            or stored[key].tobytes() != np.asarray(arrays[key], stored[key].dtype).tobytes()
+        ]
         differ = differ or bool(changed)
-        print(f"{name}: {'identical' if not changed else 'DIFFERS in ' + ', '.join(changed)} ({len(stored)} arrays)")
+        print(
+            f"{name}: {'identical' if not changed else 'DIFFERS in ' + ', '.join(changed)} ({len(stored)} arrays)"
+        )
     sys.exit(1 if differ else 0)
 
 

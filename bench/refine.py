@@ -19,6 +19,7 @@ dragon converges at 30 and 90 degrees; Refine converges at 23k within 15 s and a
     PYTHONPATH=python_addon:bench /usr/bin/python3 bench/refine.py [--quick] [--meshes dragon_res3 ...]
         [--poses "dragon_res2=turn 30" ...] [--record]
 """
+
 import argparse
 import json
 import os
@@ -26,18 +27,20 @@ import shlex
 import sys
 import time
 
-import numpy as np
-
 import common
-import modal_deform.core as mdc
+import numpy as np
 import shapes
 from support import raw_scans
+
+import modal_deform.core as mdc
 
 STIFFNESS = 100.0
 TURNS = (30, 90, 170)
 BEND = 90
-TARGETS = {"refine_seconds": {"dragon_res3": 15.0, "dragon_res2": 60.0},
-           "from_rest_converges": {"dragon_res3": (30, 90)}}
+TARGETS = {
+    "refine_seconds": {"dragon_res3": 15.0, "dragon_res2": 60.0},
+    "from_rest_converges": {"dragon_res3": (30, 90)},
+}
 MESHES = ("dragon_res3", "raw_dragon_res3", "dragon_res2")
 CRUSHED_BELOW = 0.05  # of a face's rest area
 
@@ -83,24 +86,48 @@ def refine(basis, F, rest_areas, handles, transforms):
     start = time.perf_counter()
     X, stats = solver.refine(F)
     stats["wall_seconds"] = time.perf_counter() - start
-    stats.update(reduced_seconds=reduced_seconds, reduced_iterations=reduced["iterations"],
-                 reduced_converged=reduced["converged"], reduced_ghost_objective=reduced["energy"],
-                 gap=stats["initial_energy"] - stats["energy"], rms=common.rms_error(reduced_X, X),
-                 crushed_at_start=crushed_faces(rest_areas, reduced_X, F),
-                 crushed_at_end=crushed_faces(rest_areas, X, F))
+    stats.update(
+        reduced_seconds=reduced_seconds,
+        reduced_iterations=reduced["iterations"],
+        reduced_converged=reduced["converged"],
+        reduced_ghost_objective=reduced["energy"],
+        gap=stats["initial_energy"] - stats["energy"],
+        rms=common.rms_error(reduced_X, X),
+        crushed_at_start=crushed_faces(rest_areas, reduced_X, F),
+        crushed_at_end=crushed_faces(rest_areas, X, F),
+    )
     return stats
 
 
 def row(stats):
-    keys = ("steps", "iterations", "factorizations", "seconds", "wall_seconds", "energy", "initial_energy",
-            "converged", "stalled", "gradient_norm", "gradient_scale", "gap", "rms", "reduced_seconds",
-            "reduced_iterations", "reduced_converged", "relaxed_vertices", "crushed_at_start", "crushed_at_end")
+    keys = (
+        "steps",
+        "iterations",
+        "factorizations",
+        "seconds",
+        "wall_seconds",
+        "energy",
+        "initial_energy",
+        "converged",
+        "stalled",
+        "gradient_norm",
+        "gradient_scale",
+        "gap",
+        "rms",
+        "reduced_seconds",
+        "reduced_iterations",
+        "reduced_converged",
+        "relaxed_vertices",
+        "crushed_at_start",
+        "crushed_at_end",
+    )
     history = stats["history"]
     return {k: stats[k] for k in keys if k in stats} | {
         "exact_iterations": sum(it["model"] == "exact" for it in history),
         "guarded_steps": sum(it["guarded"] for it in history),
         "line_search_failures": sum(it["step"] == 0 for it in history),
-        "load_average": os.getloadavg()[0]}
+        "load_average": os.getloadavg()[0],
+    }
 
 
 def run(quick=False, meshes=MESHES, poses_of=None):
@@ -113,8 +140,13 @@ def run(quick=False, meshes=MESHES, poses_of=None):
         rest_areas = face_areas(V, F)
         if poses_of and name in poses_of:
             named_poses = {pose: t for pose, t in named_poses.items() if pose in poses_of[name]}
-        entry = {"vertices": len(V), "faces": len(F), "handle_vertices": [len(h) for h in handles],
-                 "from_rest": {}, "refine": {}}
+        entry = {
+            "vertices": len(V),
+            "faces": len(F),
+            "handle_vertices": [len(h) for h in handles],
+            "from_rest": {},
+            "refine": {},
+        }
         start = time.perf_counter()
         basis = mdc.bake(V, F, modes=15, derivatives=52, ghost=1000)
         entry["bake_seconds"] = time.perf_counter() - start
@@ -128,19 +160,36 @@ def run(quick=False, meshes=MESHES, poses_of=None):
             entry["from_rest"][pose] = row(from_rest(V, F, rest_areas, handles, transforms))
             print(name, "from rest", pose, json.dumps(entry["from_rest"][pose]), flush=True)
         figures[name] = entry
-    parameters = {"stiffness": STIFFNESS, "turns": TURNS, "bend": BEND, "basis": "15 modes + 52 derivatives, 1k ghost",
-                  "tolerance": 1e-8, "targets": TARGETS, "meshes": list(meshes)}
+    parameters = {
+        "stiffness": STIFFNESS,
+        "turns": TURNS,
+        "bend": BEND,
+        "basis": "15 modes + 52 derivatives, 1k ghost",
+        "tolerance": 1e-8,
+        "targets": TARGETS,
+        "meshes": list(meshes),
+    }
     return parameters, figures
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("--quick", action="store_true", help="the 5k dragon only")
     parser.add_argument("--meshes", nargs="+", default=MESHES, choices=MESHES + ("dragon_res4",))
-    parser.add_argument("--poses", nargs="+", metavar="MESH=POSE", default=[],
-                        help='only these poses of a mesh, e.g. "dragon_res2=turn 30" (a mesh not named runs all)')
-    parser.add_argument("--record", action="store_true",
-                        help="write bench/results/refine.json (as make bench does) instead of printing the figures")
+    parser.add_argument(
+        "--poses",
+        nargs="+",
+        metavar="MESH=POSE",
+        default=[],
+        help='only these poses of a mesh, e.g. "dragon_res2=turn 30" (a mesh not named runs all)',
+    )
+    parser.add_argument(
+        "--record",
+        action="store_true",
+        help="write bench/results/refine.json (as make bench does) instead of printing the figures",
+    )
     args = parser.parse_args()
     poses_of = {}
     for item in args.poses:
@@ -149,8 +198,12 @@ def main():
     start = time.perf_counter()
     parameters, figures = run(args.quick, tuple(args.meshes), poses_of)
     if args.record:
-        command = "PYTHONPATH=python_addon:bench /usr/bin/python3 " + shlex.join(["bench/refine.py"] + sys.argv[1:])
-        print(f"wrote {common.write('refine', command, parameters, figures, time.perf_counter() - start)}")
+        command = "PYTHONPATH=python_addon:bench /usr/bin/python3 " + shlex.join(
+            ["bench/refine.py"] + sys.argv[1:]
+        )
+        print(
+            f"wrote {common.write('refine', command, parameters, figures, time.perf_counter() - start)}"
+        )
     else:
         json.dump({"parameters": parameters, "figures": figures}, sys.stdout, indent=1)
 

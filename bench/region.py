@@ -7,15 +7,16 @@ end, which rises to the head); the two bakes in turn in one process; medians of 
 the stages, and what each basis spends its dimensions on. Each region's pose is checked for the
 vertices outside: they must not move at all.
 """
+
 import statistics
 import time
 
-import numpy as np
-
-import modal_deform.core as mdc
 import common  # noqa: F401 (puts the test-support package on sys.path)
+import numpy as np
 from support import SHARED_MESHES
 from support.subdivision import midpoint_subdivide
+
+import modal_deform.core as mdc
 
 RUNS = {"dense": 3, "proxy": 2}
 SIZES = {"modes": 15, "derivatives": 52, "ghost": 1000}
@@ -45,19 +46,47 @@ def whole_and_region(V, F, runs, proxy):
             start = time.perf_counter()
             basis = mdc.bake(V, F, **SIZES, **proxy, region=region if kind == "region" else None)
             seconds = time.perf_counter() - start
-            done[kind].append({"seconds": seconds, "stages": basis.timings, "dimension": basis.dimension,
-                               "num_rigid": basis.num_rigid, "num_floppy": basis.num_floppy,
-                               "ghost_vertices": len(basis.ghost_vertices),
-                               "proxy_vertices": basis.num_basis_vertices if basis.on_proxy else 0})
-            print(f"   {len(V)} vertices, run {index + 1}, {kind}: {seconds:.1f} s, {basis.dimension} dimensions",
-                  flush=True)
-    summary = {kind: {"seconds": statistics.median(r["seconds"] for r in rs),
-                      "stages": {k: statistics.median(r["stages"].get(k, 0.0) for r in rs) for k in rs[0]["stages"]},
-                      **{k: rs[0][k] for k in ("dimension", "num_rigid", "num_floppy", "ghost_vertices",
-                                                "proxy_vertices")}}
-               for kind, rs in done.items()}
-    return {"vertices": len(V), "region_vertices": len(region), "runs": done, "summary": summary,
-            "outside_max_displacement": pose_outside_moves(basis, V, region)}
+            done[kind].append(
+                {
+                    "seconds": seconds,
+                    "stages": basis.timings,
+                    "dimension": basis.dimension,
+                    "num_rigid": basis.num_rigid,
+                    "num_floppy": basis.num_floppy,
+                    "ghost_vertices": len(basis.ghost_vertices),
+                    "proxy_vertices": basis.num_basis_vertices if basis.on_proxy else 0,
+                }
+            )
+            print(
+                f"   {len(V)} vertices, run {index + 1}, {kind}: {seconds:.1f} s, {basis.dimension} dimensions",
+                flush=True,
+            )
+    summary = {
+        kind: {
+            "seconds": statistics.median(r["seconds"] for r in rs),
+            "stages": {
+                k: statistics.median(r["stages"].get(k, 0.0) for r in rs) for k in rs[0]["stages"]
+            },
+            **{
+                k: rs[0][k]
+                for k in (
+                    "dimension",
+                    "num_rigid",
+                    "num_floppy",
+                    "ghost_vertices",
+                    "proxy_vertices",
+                )
+            },
+        }
+        for kind, rs in done.items()
+    }
+    return {
+        "vertices": len(V),
+        "region_vertices": len(region),
+        "runs": done,
+        "summary": summary,
+        "outside_max_displacement": pose_outside_moves(basis, V, region),
+    }
 
 
 def run(quick=False):
@@ -67,7 +96,14 @@ def run(quick=False):
     for _ in range(2):
         V, F = midpoint_subdivide(V, F)
     # The quick run's proxies are scaled down with its mesh (5k vertices subdivided: 80k).
-    proxy = {"proxy": 5000, "proxy_above": 10000} if quick else {"proxy": mdc.BAKE_OPTIONS["proxy"].default, "proxy_above": mdc.BAKE_OPTIONS["proxy_above"].default}
+    proxy = (
+        {"proxy": 5000, "proxy_above": 10000}
+        if quick
+        else {
+            "proxy": mdc.BAKE_OPTIONS["proxy"].default,
+            "proxy_above": mdc.BAKE_OPTIONS["proxy_above"].default,
+        }
+    )
     on_proxy = whole_and_region(V, F, 1 if quick else RUNS["proxy"], proxy)
     parameters = {"mesh": name, "head_fraction": HEAD, **SIZES, **proxy}
     return parameters, {"dense": dense, "on_proxy": on_proxy}

@@ -48,6 +48,7 @@ Experiments (each writes bench/results/<name>.json: machine, commit, command, pa
 --quick runs tiny sizes (the smoke test): results go to bench/results/tmp/, the report is not
 written. The report alone is regenerated from the JSON with --report-only (or bench/report.py).
 """
+
 import argparse
 import importlib
 import json
@@ -61,15 +62,33 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import common  # noqa: E402
 import report  # noqa: E402
 
-PYTHON_EXPERIMENTS = ("table1", "accuracy", "convergence", "taylor", "bake_limit", "bake_busy", "raw_scan", "multires",
-                      "strong_poses", "refine", "region", "dynamics")
-EXPERIMENTS = ("native",) + PYTHON_EXPERIMENTS + ("blender", "bpy_pose", "viewport_frames", "playback", "renders")
+PYTHON_EXPERIMENTS = (
+    "table1",
+    "accuracy",
+    "convergence",
+    "taylor",
+    "bake_limit",
+    "bake_busy",
+    "raw_scan",
+    "multires",
+    "strong_poses",
+    "refine",
+    "region",
+    "dynamics",
+)
+EXPERIMENTS = (
+    ("native",)
+    + PYTHON_EXPERIMENTS
+    + ("blender", "bpy_pose", "viewport_frames", "playback", "renders")
+)
 NATIVE_IN_TABLE1 = "BM_Bake|BM_BfgsIteration|BM_Positions"
 BLENDER = ["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python"]
 
 
 def command(name):
-    return f"make bench  (alone: PYTHONPATH=python_addon /usr/bin/python3 bench/run.py --only {name})"
+    return (
+        f"make bench  (alone: PYTHONPATH=python_addon /usr/bin/python3 bench/run.py --only {name})"
+    )
 
 
 def native(quick):
@@ -77,12 +96,21 @@ def native(quick):
     with tempfile.TemporaryDirectory() as folder:
         out = pathlib.Path(folder) / "native.json"
         # The dragon's bake, BFGS iterations and positions are measured by table1 at the same sizes.
-        arguments = [str(binary), f"--benchmark_out={out}", "--benchmark_out_format=json",
-                     "--benchmark_filter=BM_Shells|BM_LumpedMass" if quick else f"--benchmark_filter=-{NATIVE_IN_TABLE1}"]
+        arguments = [
+            str(binary),
+            f"--benchmark_out={out}",
+            "--benchmark_out_format=json",
+            "--benchmark_filter=BM_Shells|BM_LumpedMass"
+            if quick
+            else f"--benchmark_filter=-{NATIVE_IN_TABLE1}",
+        ]
         subprocess.run(arguments, check=True)
         raw = json.loads(out.read_text())
-    return {"binary": str(binary.relative_to(common.ROOT)), "filter": arguments[3:],
-            "context": raw["context"]}, {"benchmarks": raw["benchmarks"]}
+    return {
+        "binary": str(binary.relative_to(common.ROOT)),
+        "filter": arguments[3:],
+        "context": raw["context"],
+    }, {"benchmarks": raw["benchmarks"]}
 
 
 def blender(quick):
@@ -92,12 +120,22 @@ def blender(quick):
         extra = ["--updates", "3", "--quick"] if quick else []
         # The comparison on the accuracy experiment's meshes when they are there (make bench runs it first).
         shapes = ["--shapes", str(common.MESHES)] if common.MESHES.is_dir() else []
-        subprocess.run(BLENDER + [str(pose), "--", "--output", str(out), *shapes, *extra], check=True, cwd=common.ROOT)
+        subprocess.run(
+            BLENDER + [str(pose), "--", "--output", str(out), *shapes, *extra],
+            check=True,
+            cwd=common.ROOT,
+        )
         raw = json.loads(out.read_text())
-        if not quick:  # the dragon subdivided twice (1.6M vertices), baked on a proxy: pose updates only
+        if (
+            not quick
+        ):  # the dragon subdivided twice (1.6M vertices), baked on a proxy: pose updates only
             dense = pathlib.Path(folder) / "blender_dense.json"
-            subprocess.run(BLENDER + [str(pose), "--", "--output", str(dense), "--subdivide", "2", "--updates", "15"],
-                           check=True, cwd=common.ROOT)
+            subprocess.run(
+                BLENDER
+                + [str(pose), "--", "--output", str(dense), "--subdivide", "2", "--updates", "15"],
+                check=True,
+                cwd=common.ROOT,
+            )
             raw["dense"] = json.loads(dense.read_text())
     return raw.pop("parameters"), raw
 
@@ -105,7 +143,12 @@ def blender(quick):
 #: The bpy_pose experiment's meshes: blender_pose.py's arguments for the dragon (100k vertices),
 #: subdivided once (400k), twice (1.6M), and twice with as many edges split as it has vertices
 #: (3.2M; the process peaks at about 6 GB, the bake's).
-DENSE_DRAGONS = (["--subdivide", "0"], ["--subdivide", "1"], ["--subdivide", "2"], ["--subdivide", "2", "--double"])
+DENSE_DRAGONS = (
+    ["--subdivide", "0"],
+    ["--subdivide", "1"],
+    ["--subdivide", "2"],
+    ["--subdivide", "2", "--double"],
+)
 
 
 def bpy_pose(quick):
@@ -117,9 +160,20 @@ def bpy_pose(quick):
         for version in common.BPY_VERSIONS:
             for i, size in enumerate(sizes):
                 out = pathlib.Path(folder) / f"bpy-{version}-{i}.json"
-                common.in_bpy(version, common.ROOT / "bench" / "blender_pose.py",
-                       ["--output", str(out), "--pose-only", *size,
-                        "--updates", "3" if quick else "15", *(["--quick"] if quick else [])], folder)
+                common.in_bpy(
+                    version,
+                    common.ROOT / "bench" / "blender_pose.py",
+                    [
+                        "--output",
+                        str(out),
+                        "--pose-only",
+                        *size,
+                        "--updates",
+                        "3" if quick else "15",
+                        *(["--quick"] if quick else []),
+                    ],
+                    folder,
+                )
                 runs.append(json.loads(out.read_text()))
     return {"blenders": common.BPY_VERSIONS, "sizes": sizes}, {"runs": runs}
 
@@ -127,14 +181,33 @@ def bpy_pose(quick):
 def viewport_frames(quick):
     """The viewport's frame while posing, at 100k and 1.6M vertices (quick: 100k on a small basis)."""
     runs = []
-    sizes = [["--modes", "8", "--derivatives", "8", "--proxy-above", "50000", "--proxy", "10000"]] if quick else \
-        [["--subdivide", "0"], ["--subdivide", "2"]]
+    sizes = (
+        [["--modes", "8", "--derivatives", "8", "--proxy-above", "50000", "--proxy", "10000"]]
+        if quick
+        else [["--subdivide", "0"], ["--subdivide", "2"]]
+    )
     with tempfile.TemporaryDirectory() as folder:
         for i, size in enumerate(sizes):
             out = pathlib.Path(folder) / f"frames-{i}.json"
-            subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x800x24", "blender", "--factory-startup", "--python",
-                            str(common.ROOT / "bench" / "viewport_frames.py"), "--", str(out), "--updates",
-                            "2" if quick else "3", *size], check=True, cwd=common.ROOT)
+            subprocess.run(
+                [
+                    "xvfb-run",
+                    "-a",
+                    "-s",
+                    "-screen 0 1280x800x24",
+                    "blender",
+                    "--factory-startup",
+                    "--python",
+                    str(common.ROOT / "bench" / "viewport_frames.py"),
+                    "--",
+                    str(out),
+                    "--updates",
+                    "2" if quick else "3",
+                    *size,
+                ],
+                check=True,
+                cwd=common.ROOT,
+            )
             run = json.loads(out.read_text())
             if not run["ok"]:
                 raise RuntimeError("\n".join(run["log"]))
@@ -151,26 +224,43 @@ def playback(quick):
         for version in common.BPY_VERSIONS:
             for i, size in enumerate(sizes):
                 out = pathlib.Path(folder) / f"playback-{version}-{i}.json"
-                common.in_bpy(version, common.ROOT / "bench" / "playback.py",
-                              ["--output", str(out), *size, *(["--quick"] if quick else [])], folder)
+                common.in_bpy(
+                    version,
+                    common.ROOT / "bench" / "playback.py",
+                    ["--output", str(out), *size, *(["--quick"] if quick else [])],
+                    folder,
+                )
                 runs.append(json.loads(out.read_text()))
     return {"blenders": common.BPY_VERSIONS, "sizes": sizes}, {"runs": runs}
 
 
 def renders(quick):
     folder = common.RESULTS / "renders" if quick else common.ROOT / "docs" / "figures"
-    arguments = ["--meshes", str(common.MESHES), "--output", str(folder)] + (["--samples", "4", "--width", "160"] if quick else [])
-    subprocess.run(BLENDER + [str(common.ROOT / "blender_scripts" / "render_figures.py"), "--", *arguments],
-                   check=True, cwd=common.ROOT)
+    arguments = ["--meshes", str(common.MESHES), "--output", str(folder)] + (
+        ["--samples", "4", "--width", "160"] if quick else []
+    )
+    subprocess.run(
+        BLENDER + [str(common.ROOT / "blender_scripts" / "render_figures.py"), "--", *arguments],
+        check=True,
+        cwd=common.ROOT,
+    )
     images = sorted(str(p.relative_to(common.ROOT)) for p in folder.glob("render_*.png"))
-    return {"meshes": "accuracy experiment, bench/results/tmp/meshes", "arguments": arguments}, {"images": images}
+    return {"meshes": "accuracy experiment, bench/results/tmp/meshes", "arguments": arguments}, {
+        "images": images
+    }
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true", help="tiny sizes, results in bench/results/tmp/, no report")
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument(
+        "--quick", action="store_true", help="tiny sizes, results in bench/results/tmp/, no report"
+    )
     parser.add_argument("--only", nargs="+", choices=EXPERIMENTS, help="run only these experiments")
-    parser.add_argument("--report-only", action="store_true", help="write docs/benchmarks.md from the JSON and stop")
+    parser.add_argument(
+        "--report-only", action="store_true", help="write docs/benchmarks.md from the JSON and stop"
+    )
     args = parser.parse_args()
     if args.quick:
         common.RESULTS = common.RESULTS / "tmp"
@@ -183,8 +273,13 @@ def main():
                 parameters, figures = importlib.import_module(name).run(quick=args.quick)
             else:
                 parameters, figures = globals()[name](args.quick)
-            path = common.write(name, command(name), parameters, figures, time.perf_counter() - start)
-            print(f"   {time.perf_counter() - start:.0f} s -> {path.relative_to(common.ROOT)}", flush=True)
+            path = common.write(
+                name, command(name), parameters, figures, time.perf_counter() - start
+            )
+            print(
+                f"   {time.perf_counter() - start:.0f} s -> {path.relative_to(common.ROOT)}",
+                flush=True,
+            )
         print(f"all experiments: {time.perf_counter() - start_all:.0f} s", flush=True)
     if not args.quick:
         print(f"wrote {report.write().relative_to(common.ROOT)}")

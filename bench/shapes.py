@@ -16,6 +16,7 @@ pose come from the test-support package (tests/support), which this module puts 
         for frame in range(1, pose.frames + 1):
             transforms = pose.at(frame / pose.frames)   # one 4x4 per handle in shape.handles
 """
+
 import dataclasses
 import pathlib
 import sys
@@ -25,7 +26,8 @@ import numpy as np
 import modal_deform.core as mdc
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests"))
-from support import SCAN_FILES as _SCAN_FILES, SHARED_MESHES  # noqa: E402,F401
+from support import SCAN_FILES as _SCAN_FILES  # noqa: E402,F401
+from support import SHARED_MESHES
 from support.poses import Pose, end_handles, end_pull, rigid_transform, translation  # noqa: E402,F401
 
 #: Generated shapes and the shared scans, in the order tables list them.
@@ -37,6 +39,7 @@ SCANS = ("bunny", "dragon_res4", "dragon_res3", "dragon_res2")
 class Shape:
     """A mesh (V (n, 3), F (m, 3)), its handles (list of vertex index arrays), its poses, and the
     direction renders look from (towards the shape)."""
+
     name: str
     V: np.ndarray
     F: np.ndarray
@@ -63,8 +66,13 @@ def rod_end(length, axis, bend, twist):
 def _rod_poses(length, axis, poses):
     """Rod poses: the near end held, the far end bent/twisted/shifted per (name, description,
     bend, twist, shift, frames)."""
+
     def motion(bend, twist, shift):
-        return lambda t: [np.eye(4), translation((0, t * shift, 0)) @ rod_end(length, axis, t * bend, t * twist)]
+        return lambda t: [
+            np.eye(4),
+            translation((0, t * shift, 0)) @ rod_end(length, axis, t * bend, t * twist),
+        ]
+
     return tuple(Pose(name, text, motion(b, w, s), frames) for name, text, b, w, s, frames in poses)
 
 
@@ -80,7 +88,9 @@ def bumpy_plane(n=199):
         def at(t):
             T = translation((0, 0, t * height)) @ rigid_transform((0, 1, 0), t * tilt, centre)
             return [np.eye(4), T @ rigid_transform((0, 0, 1), t * turn, centre)]
+
         return at
+
     deg = np.pi / 180
     poses = (
         Pose("lift", "middle lifted by 3 (30% of the width)", lift(3), 3),
@@ -101,13 +111,17 @@ def cylinder(around=64, along=80):
     end rings as handles."""
     V, F = mdc.testing.cylinder(around, along, 1.25, 10.0)
     deg = np.pi / 180
-    poses = _rod_poses(10.0, (0, 0), (
-        ("lift", "far ring shifted sideways by 2.5", 0, 0, 2.5, 3),
-        ("bend", "bent by 60 deg", 60 * deg, 0, 0, 2),
-        ("twist", "twisted by 90 deg", 0, 90 * deg, 0, 3),
-        ("bend_twist", "bent by 60 and twisted by 90 deg", 60 * deg, 90 * deg, 0, 6),
-        ("bend_large", "bent by 120 deg", 120 * deg, 0, 0, 6),
-    ))
+    poses = _rod_poses(
+        10.0,
+        (0, 0),
+        (
+            ("lift", "far ring shifted sideways by 2.5", 0, 0, 2.5, 3),
+            ("bend", "bent by 60 deg", 60 * deg, 0, 0, 2),
+            ("twist", "twisted by 90 deg", 0, 90 * deg, 0, 3),
+            ("bend_twist", "bent by 60 and twisted by 90 deg", 60 * deg, 90 * deg, 0, 6),
+            ("bend_large", "bent by 120 deg", 120 * deg, 0, 0, 6),
+        ),
+    )
     return Shape("cylinder", V, F, _rod_handles(V, 10.0), poses, view=(1.0, -0.4, -0.35))
 
 
@@ -115,14 +129,18 @@ def bar(nx=12, nz=120):
     """Closed 1 x 1 x 10 box (about 6k vertices by default), its end faces as handles."""
     V, F = mdc.testing.bar(nx, nx, nz, 1.0, 1.0, 10.0)
     deg = np.pi / 180
-    poses = _rod_poses(10.0, (0.5, 0.5), (
-        ("lift", "far end shifted sideways by 2", 0, 0, 2.0, 3),
-        ("bend", "bent by 90 deg", 90 * deg, 0, 0, 6),
-        ("bend_60", "bent by 60 deg", 60 * deg, 0, 0, 4),
-        ("twist", "twisted by 90 deg", 0, 90 * deg, 0, 6),
-        ("bend_large", "bent by 180 deg", 180 * deg, 0, 0, 6),
-        ("twist_large", "twisted by 180 deg (the reference buckles)", 0, 180 * deg, 0, 6),
-    ))
+    poses = _rod_poses(
+        10.0,
+        (0.5, 0.5),
+        (
+            ("lift", "far end shifted sideways by 2", 0, 0, 2.0, 3),
+            ("bend", "bent by 90 deg", 90 * deg, 0, 0, 6),
+            ("bend_60", "bent by 60 deg", 60 * deg, 0, 0, 4),
+            ("twist", "twisted by 90 deg", 0, 90 * deg, 0, 6),
+            ("bend_large", "bent by 180 deg", 180 * deg, 0, 0, 6),
+            ("twist_large", "twisted by 180 deg (the reference buckles)", 0, 180 * deg, 0, 6),
+        ),
+    )
     return Shape("bar", V, F, _rod_handles(V, 10.0), poses, view=(1.0, -0.35, -0.3))
 
 
@@ -134,12 +152,29 @@ def end_turns(V, turns=(30, 90, 170), bend=90):
     shift = 0.09 * length * side + 0.045 * length * up_axis
 
     def motion(axis, degrees, moved):
-        return lambda t: [np.eye(4), rigid_transform(axis, t * np.radians(degrees), centre, t * moved)]
-    poses = tuple(Pose(f"turn_{d}", f"far end turned by {d} deg about the long axis and moved", motion(along, d, shift),
-                       max(2, round(d / 15))) for d in turns)
+        return lambda t: [
+            np.eye(4),
+            rigid_transform(axis, t * np.radians(degrees), centre, t * moved),
+        ]
+
+    poses = tuple(
+        Pose(
+            f"turn_{d}",
+            f"far end turned by {d} deg about the long axis and moved",
+            motion(along, d, shift),
+            max(2, round(d / 15)),
+        )
+        for d in turns
+    )
     if bend:
-        poses += (Pose(f"bend_{bend}", f"far end turned by {bend} deg about the up axis",
-                       motion(up_axis, bend, np.zeros(3)), max(2, round(bend / 15))),)
+        poses += (
+            Pose(
+                f"bend_{bend}",
+                f"far end turned by {bend} deg about the up axis",
+                motion(up_axis, bend, np.zeros(3)),
+                max(2, round(bend / 15)),
+            ),
+        )
     return handles, poses
 
 

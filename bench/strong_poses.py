@@ -12,10 +12,19 @@ the bounding-box diagonal, on the vertices the meshes share; targets 1% at 30 an
 at 170), and at 30 and 90 degrees the full objective of the 100k dragon at both poses against its
 minimum: solve_full converged from the lower of the two poses (Refine; from rest it took over 40 minutes).
 """
+
 import json
 import textwrap
 
-from support.strong_poses import POSES, STEP_DEGREES, STIFFNESS, difference_error, ends, follow, transforms  # noqa: F401
+from support.strong_poses import (  # noqa: F401
+    POSES,
+    STEP_DEGREES,
+    STIFFNESS,
+    difference_error,
+    ends,
+    follow,
+    transforms,
+)
 
 TARGETS = {30: 0.01, 90: 0.01, 170: 0.02}
 
@@ -97,18 +106,35 @@ def sizes(quick):
 
 def child_code(quick):
     from common import ROOT
+
     name, levels, proxy, angles, full_angles = sizes(quick)
-    return _CHILD.format(bench=str(ROOT / "bench"), name=name, levels=levels, proxy=proxy, angles=angles,
-                         full_angles=full_angles)
+    return _CHILD.format(
+        bench=str(ROOT / "bench"),
+        name=name,
+        levels=levels,
+        proxy=proxy,
+        angles=angles,
+        full_angles=full_angles,
+    )
 
 
 def run(quick=False):
     from common import json_from_fresh_process
+
     name, levels, _, angles, full_angles = sizes(quick)
     code = child_code(quick)
     outcome = json_from_fresh_process(code)
     print(f"   strong_poses: {json.dumps(outcome)}", flush=True)
-    parameters = {"mesh": name, "subdivisions": levels, "modes": 20, "derivatives": 47, "ghost": 1000,
-                  "stiffness": STIFFNESS, "poses": list(POSES), "turns": list(angles), "full_turns": list(full_angles),
-                  "targets": {str(k): v for k, v in TARGETS.items()}}
+    parameters = {
+        "mesh": name,
+        "subdivisions": levels,
+        "modes": 20,
+        "derivatives": 47,
+        "ghost": 1000,
+        "stiffness": STIFFNESS,
+        "poses": list(POSES),
+        "turns": list(angles),
+        "full_turns": list(full_angles),
+        "targets": {str(k): v for k, v in TARGETS.items()},
+    }
     return parameters, outcome

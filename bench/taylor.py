@@ -10,12 +10,13 @@ minimum on the fine mesh), evaluated (paper Fig. 9)
 
 Each curve's objective minimum on the line (bounded scalar minimisation) is reported and marked.
 """
+
 import numpy as np
 import scipy.optimize
-
-import modal_deform.core as mdc
 import shapes
 from table1 import with_ghost
+
+import modal_deform.core as mdc
 
 SHAPE, POSE = "bumpy_plane", "bend"
 DIMENSION = (20, 47)
@@ -31,8 +32,9 @@ def objective_along(basis, shape, transforms, direction):
 
 
 def minimum(f):
-    found = scipy.optimize.minimize_scalar(f, bounds=(LINE[0], LINE[-1]), method="bounded",
-                                           options={"xatol": 1e-6})
+    found = scipy.optimize.minimize_scalar(
+        f, bounds=(LINE[0], LINE[-1]), method="bounded", options={"xatol": 1e-6}
+    )
     return {"t": float(found.x), "value": float(found.fun)}
 
 
@@ -54,21 +56,33 @@ def run(quick=False):
     v = s * (np.asarray(basis.vectors, np.float64) @ direction)
     # The handle term is quadratic in t: exact from three samples of objective minus energy.
     samples = np.array([-1.0, 0.0, 1.0])
-    handle_term = np.poly1d(np.polyfit(samples, [objectives["fine mesh"](t) - energy.value(rest + t * v)
-                                                 for t in samples], 2))
+    handle_term = np.poly1d(
+        np.polyfit(
+            samples, [objectives["fine mesh"](t) - energy.value(rest + t * v) for t in samples], 2
+        )
+    )
     second = 0.5 * v @ (energy.hessian(rest) @ v)
     third = energy.third(rest, v, v) @ v / 6
     objectives["Taylor, 2nd order"] = lambda t: second * t**2 + handle_term(t)
     objectives["Taylor, 3rd order"] = lambda t: second * t**2 + third * t**3 + handle_term(t)
     for ghost in ghosts:
         coarse = with_ghost(basis, shape.F, ghost)
-        objectives[f"ghost {len(coarse.ghost_vertices)}"] = objective_along(coarse, shape, transforms, direction)
+        objectives[f"ghost {len(coarse.ghost_vertices)}"] = objective_along(
+            coarse, shape, transforms, direction
+        )
     curves = {name: np.array([f(t) for t in LINE]) for name, f in objectives.items()}
     energies = {name: c - handle_term(LINE) for name, c in curves.items()}
     minima = {name: minimum(f) for name, f in objectives.items()}
     for name, m in minima.items():
         print(f"  {name}: objective minimum {m['value']:.5g} at t = {m['t']:.4f}", flush=True)
-    parameters = {"shape": SHAPE, "vertices": len(shape.V), "pose": POSE, "modes_derivatives": DIMENSION,
-                  "dimension": basis.dimension, "ghosts": ghosts, "stiffness": mdc.solve.STIFFNESS,
-                  "line": "q(t) = t q*, q* the converged reduced pose on the fine mesh"}
+    parameters = {
+        "shape": SHAPE,
+        "vertices": len(shape.V),
+        "pose": POSE,
+        "modes_derivatives": DIMENSION,
+        "dimension": basis.dimension,
+        "ghosts": ghosts,
+        "stiffness": mdc.solve.STIFFNESS,
+        "line": "q(t) = t q*, q* the converged reduced pose on the fine mesh",
+    }
     return parameters, {"t": LINE, "objective": curves, "energy": energies, "minima": minima}

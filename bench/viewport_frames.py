@@ -11,6 +11,7 @@ with the options), a handle moved every frame. A frame is the pose update of ben
 buffers, drawing). Each display (vertex positions, stand-in, shape key) in turn, A B C A B C; medians, ms.
 Writes OUTPUT.json ({"ok", "log", "vertices", "displays": {display: {step: ms}}}) and quits.
 """
+
 import argparse
 import json
 import pathlib
@@ -24,14 +25,18 @@ sys.path.insert(0, str(ROOT / "bench"))
 import blender_pose  # noqa: E402 (found through the line above; blender_pose puts blender_scripts on the path)
 from headless import enable_addon  # noqa: E402
 
-argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+argv = sys.argv[sys.argv.index("--") + 1 :] if "--" in sys.argv else []
+parser = argparse.ArgumentParser(
+    description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+)
 parser.add_argument("output")
 parser.add_argument("--subdivide", type=int, default=0)
 parser.add_argument("--updates", type=int, default=15, help="frames per display and round")
 parser.add_argument("--modes", type=int, default=16)
 parser.add_argument("--derivatives", type=int, default=45)
-parser.add_argument("--proxy-above", type=int, help="the object's Proxy Above (default: the add-on's)")
+parser.add_argument(
+    "--proxy-above", type=int, help="the object's Proxy Above (default: the add-on's)"
+)
 parser.add_argument("--proxy", type=int, help="the object's Proxy Size (default: the add-on's)")
 args = parser.parse_args(argv)
 bpy.context.preferences.view.show_splash = False
@@ -64,9 +69,13 @@ def measure():
         figures = blender_pose.time_displays(obj, moving.controller, args.updates, draw=draw)
     for f in figures.values():
         f["frame"] = f["update"] + f["draw"]
-    return {"vertices": vertices, "dimension": settings.status.dimension,
-            "proxy_vertices": settings.status.proxy_vertices, "blender": bpy.app.version_string,
-            "displays": figures}
+    return {
+        "vertices": vertices,
+        "dimension": settings.status.dimension,
+        "proxy_vertices": settings.status.proxy_vertices,
+        "blender": bpy.app.version_string,
+        "displays": figures,
+    }
 
 
 def run():
@@ -74,8 +83,10 @@ def run():
     try:
         result.update(measure(), ok=True)
         for display, f in result["displays"].items():
-            result["log"].append(f"{result['vertices']} vertices, {display}: frame {f['frame']:.1f} ms = ours "
-                                 f"{f['tick']:.1f} + Blender's evaluation {f['evaluate']:.1f} + drawing {f['draw']:.1f}")
+            result["log"].append(
+                f"{result['vertices']} vertices, {display}: frame {f['frame']:.1f} ms = ours "
+                f"{f['tick']:.1f} + Blender's evaluation {f['evaluate']:.1f} + drawing {f['draw']:.1f}"
+            )
     except Exception:
         result["log"].append(traceback.format_exc())
     print("\n".join(result["log"]), flush=True)

@@ -6,6 +6,7 @@
 Options left out keep the object's settings (Sidebar > Modal Deform > Basis). Exits with code 1
 and the reason when the bake fails.
 """
+
 import pathlib
 import sys
 
@@ -33,8 +34,10 @@ def main():
             setattr(settings, name, getattr(args, name))
     headless.run(bpy.ops.modal_deform.bake)
     status = settings.status
-    print(f"baked {obj.name}: {status.dimension} dimensions, ghost {status.ghost_vertices} vertices, "
-          f"{status.seconds:.1f} s")
+    print(
+        f"baked {obj.name}: {status.dimension} dimensions, ghost {status.ghost_vertices} vertices, "
+        f"{status.seconds:.1f} s"
+    )
     headless.save(args.output)
 
 

@@ -19,6 +19,7 @@ pose: select the mesh, Sidebar > Modal Deform > Pose, then move the
 Empties with G/R. Prints the bake time, the time per interactive update and how much each result
 stretches the surface.
 """
+
 import argparse
 import importlib
 import math
@@ -35,7 +36,6 @@ import demo_dynamics  # noqa: E402
 from headless import add_handle, bind_laplacian_deform, enable_addon, evaluated_positions  # noqa: E402
 from rendering import render, side_by_side, stage  # noqa: E402
 
-
 #: The pose: the top of the head turned about the vertical and then bent sideways (degrees).
 TURN, BEND = 45, 45
 #: The top of the head (the moved handle): Suzanne's vertices above this height (she spans -1 to 1).
@@ -43,16 +43,31 @@ TOP = 0.6
 
 
 def arguments():
-    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    argv = sys.argv[sys.argv.index("--") + 1 :] if "--" in sys.argv else []
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("--output", default="out", help="folder for demo.png and demo.blend")
-    parser.add_argument("--subdivisions", type=int, default=3, help="Catmull-Clark levels (3: ~31k vertices)")
+    parser.add_argument(
+        "--subdivisions", type=int, default=3, help="Catmull-Clark levels (3: ~31k vertices)"
+    )
     parser.add_argument("--samples", type=int, default=16, help="Cycles samples per pixel")
-    parser.add_argument("--turn", type=float, default=TURN, help="the top of the head turned about the vertical, degrees")
+    parser.add_argument(
+        "--turn",
+        type=float,
+        default=TURN,
+        help="the top of the head turned about the vertical, degrees",
+    )
     parser.add_argument("--bend", type=float, default=BEND, help="then bent sideways, degrees")
-    parser.add_argument("--width", type=int, default=800, help="width of each of the three pictures, pixels")
-    parser.add_argument("--dynamics-subdivisions", type=int, default=2,
-                        help="Catmull-Clark levels of the secondary motion's Suzanne (2: ~8k vertices)")
+    parser.add_argument(
+        "--width", type=int, default=800, help="width of each of the three pictures, pixels"
+    )
+    parser.add_argument(
+        "--dynamics-subdivisions",
+        type=int,
+        default=2,
+        help="Catmull-Clark levels of the secondary motion's Suzanne (2: ~8k vertices)",
+    )
     return parser.parse_args(argv)
 
 
@@ -136,8 +151,12 @@ def curled_finger(mdc, name, painted, x):
     curl = Matrix()
     for low, high in reversed(knuckles):
         pivot = obj.matrix_world @ Vector((x, 0.0, (low + high) / 2))
-        curl = Matrix.Translation(pivot) @ Matrix.Rotation(math.radians(60), 4, "Y") @ \
-            Matrix.Translation(-pivot) @ curl
+        curl = (
+            Matrix.Translation(pivot)
+            @ Matrix.Rotation(math.radians(60), 4, "Y")
+            @ Matrix.Translation(-pivot)
+            @ curl
+        )
     tip.controller.matrix_world = curl @ tip.controller.matrix_world
     bpy.context.view_layer.update()
     assert bpy.ops.modal_deform.solve() == {"FINISHED"}
@@ -159,7 +178,9 @@ def pulled_ear(suzanne, V):
     bpy.context.view_layer.objects.active = ear
     assert bpy.ops.modal_deform.bake() == {"FINISHED"}
     tip = add_handle(ear, V[:, 0] > 1.25)
-    tip.controller.matrix_world = Matrix.Translation((0.15, 0.0, 0.35)) @ tip.controller.matrix_world
+    tip.controller.matrix_world = (
+        Matrix.Translation((0.15, 0.0, 0.35)) @ tip.controller.matrix_world
+    )
     bpy.context.view_layer.update()
     assert bpy.ops.modal_deform.solve() == {"FINISHED"}
     return ear
@@ -168,15 +189,20 @@ def pulled_ear(suzanne, V):
 def painted_row(mdc, posing, suzanne, V, output):
     """The second row (issue 24): the uniform finger, the painted finger, Suzanne's pulled ear,
     each alone in the row's stage. Returns their pixels left to right."""
-    objects = [curled_finger(mdc, "Uniform finger", False, 0.0), curled_finger(mdc, "Painted finger", True, 0.0),
-               pulled_ear(suzanne, V)]
+    objects = [
+        curled_finger(mdc, "Uniform finger", False, 0.0),
+        curled_finger(mdc, "Painted finger", True, 0.0),
+        pulled_ear(suzanne, V),
+    ]
     ear = objects[2].data
     posed = np.empty(3 * len(ear.vertices), np.float32)
     ear.shape_keys.key_blocks[posing.POSE_KEY].data.foreach_get("co", posed)
     outside = V[:, 0] <= 0.75
-    print(f"Region: the ear's tip moved by {np.abs(posed.reshape(-1, 3) - V).max():.2f}; the "
-          f"{int(outside.sum())} vertices outside the ear moved by "
-          f"{np.abs(posed.reshape(-1, 3)[outside] - V[outside]).max():g}")
+    print(
+        f"Region: the ear's tip moved by {np.abs(posed.reshape(-1, 3) - V).max():.2f}; the "
+        f"{int(outside.sum())} vertices outside the ear moved by "
+        f"{np.abs(posed.reshape(-1, 3)[outside] - V[outside]).max():g}"
+    )
     pictures = []
     for shown in objects:
         for obj in objects + [suzanne]:
@@ -194,8 +220,10 @@ def painted_row(mdc, posing, suzanne, V, output):
 def main():
     args = arguments()
     addon = enable_addon().__name__
-    posing, displays, mesh_io, mdc = (importlib.import_module(f"{addon}.{name}")
-                                      for name in ("posing", "pose.displays", "mesh_io", "core"))
+    posing, displays, mesh_io, mdc = (
+        importlib.import_module(f"{addon}.{name}")
+        for name in ("posing", "pose.displays", "mesh_io", "core")
+    )
     output = pathlib.Path(args.output).resolve()
     output.mkdir(parents=True, exist_ok=True)
 
@@ -208,23 +236,29 @@ def main():
     start = time.perf_counter()
     assert bpy.ops.modal_deform.bake() == {"FINISHED"}
     status = suzanne.modal_deform.status
-    print(f"bake: {time.perf_counter() - start:.1f} s ({status.dimension} dimensions, ghost {status.ghost_vertices} "
-          f"vertices)")
+    print(
+        f"bake: {time.perf_counter() - start:.1f} s ({status.dimension} dimensions, ghost {status.ghost_vertices} "
+        f"vertices)"
+    )
 
     # Handles: the top of the head, turned about the vertical and bent sideways about the head's
     # centre; the chin, held where it is (its Empty is not moved).
     top, chin = V[:, 2] > TOP, (V[:, 2] < -0.55) & (V[:, 1] < -0.3)
     head = add_handle(suzanne, top)
     add_handle(suzanne, chin)
-    turn = Matrix.Rotation(math.radians(args.bend), 4, "Y") @ Matrix.Rotation(math.radians(args.turn), 4, "Z")
+    turn = Matrix.Rotation(math.radians(args.bend), 4, "Y") @ Matrix.Rotation(
+        math.radians(args.turn), 4, "Z"
+    )
     centre = suzanne.matrix_world.translation
     transform = Matrix.Translation(centre) @ turn @ Matrix.Translation(-centre)
     head.controller.matrix_world = transform @ head.controller.matrix_world
     bpy.context.view_layer.update()
 
     times = interactive_updates(posing, displays, suzanne, 30)
-    print(f"interactive pose: {np.median(times):.1f} ms per update (median of {len(times)}; first {times[0]:.1f} ms; "
-          f"budget {suzanne.modal_deform.budget:.0f} ms for the solver)")
+    print(
+        f"interactive pose: {np.median(times):.1f} ms per update (median of {len(times)}; first {times[0]:.1f} ms; "
+        f"budget {suzanne.modal_deform.budget:.0f} ms for the solver)"
+    )
     assert bpy.ops.modal_deform.solve() == {"FINISHED"}
 
     # Laplacian Deform gets the same handles. Each connected component needs an anchor of its own:
@@ -235,12 +269,22 @@ def main():
     key = suzanne.data.shape_keys.key_blocks[posing.POSE_KEY]
     posed = np.empty(V.size, np.float32)
     key.data.foreach_get("co", posed)
-    for name, X in (("Modal Deform", posed.reshape(-1, 3)), ("Laplacian Deform", evaluated_positions(laplacian))):
+    for name, X in (
+        ("Modal Deform", posed.reshape(-1, 3)),
+        ("Laplacian Deform", evaluated_positions(laplacian)),
+    ):
         mean, largest = edge_strain(suzanne.data, V, X)
-        print(f"{name}: edges stretched or squashed by {100 * mean:.1f}% on average, at most {100 * largest:.0f}%")
+        print(
+            f"{name}: edges stretched or squashed by {100 * mean:.1f}% on average, at most {100 * largest:.0f}%"
+        )
 
-    stage(suzanne.matrix_world.translation + Vector((0.1, 0.0, 0.05)), eye=(1.0, -6.0, 0.8), lens=70,
-          samples=args.samples, resolution=(args.width, args.width * 3 // 4))
+    stage(
+        suzanne.matrix_world.translation + Vector((0.1, 0.0, 0.05)),
+        eye=(1.0, -6.0, 0.8),
+        lens=70,
+        samples=args.samples,
+        resolution=(args.width, args.width * 3 // 4),
+    )
     start = time.perf_counter()
     laplacian.hide_render = True
     key.value = 0.0
@@ -253,10 +297,17 @@ def main():
     bpy.data.objects.remove(laplacian)
     bpy.data.objects.remove(hook)
     below = painted_row(mdc, posing, suzanne, V, output)
-    side_by_side([np.concatenate([row[i] for row in (below, [rest, ours, theirs])], axis=0) for i in range(3)],
-                 output / "demo.png")
-    print(f"rendered {output / 'demo.png'} (rest, Modal Deform, Laplacian Deform; the uniform and the painted "
-          f"finger, the ear) in {time.perf_counter() - start:.1f} s")
+    side_by_side(
+        [
+            np.concatenate([row[i] for row in (below, [rest, ours, theirs])], axis=0)
+            for i in range(3)
+        ],
+        output / "demo.png",
+    )
+    print(
+        f"rendered {output / 'demo.png'} (rest, Modal Deform, Laplacian Deform; the uniform and the painted "
+        f"finger, the ear) in {time.perf_counter() - start:.1f} s"
+    )
 
     bpy.context.view_layer.objects.active = suzanne
     for obj in bpy.context.view_layer.objects:
@@ -265,8 +316,12 @@ def main():
     print(f"wrote {output / 'demo.blend'}")
 
     start = time.perf_counter()
-    modules = (importlib.import_module(f"{addon}.{name}") for name in ("playback.frame_cache", "posing"))
-    strip = demo_dynamics.secondary_motion(tuple(modules), output, args.dynamics_subdivisions, args.width // 2)
+    modules = (
+        importlib.import_module(f"{addon}.{name}") for name in ("playback.frame_cache", "posing")
+    )
+    strip = demo_dynamics.secondary_motion(
+        tuple(modules), output, args.dynamics_subdivisions, args.width // 2
+    )
     print(f"rendered {strip} (secondary motion) in {time.perf_counter() - start:.1f} s")
 
 

@@ -5,11 +5,11 @@ into the cache) and rendered as a strip of frames.
 
 Called by demo.py after its stage (camera, light, Cycles) is set up; run inside Blender.
 """
+
 import math
 
 import bpy
 import numpy as np
-
 from headless import add_handle, evaluated_positions
 from rendering import render, side_by_side
 
@@ -69,10 +69,14 @@ def secondary_motion(addon, output, levels, width):
         along.append(np.dot(X[ears].ravel() - V[ears].ravel(), way) / np.dot(way, way))
         if frame in STRIP:
             pictures.append(render(output / f"demo_dynamics_{frame:02d}.png"))
-    print(f"the ears' way from rest (0) to where they settle (1), frames 1 to {max(STRIP)}: "
-          + " ".join(f"{a:.2f}" for a in along))
+    print(
+        f"the ears' way from rest (0) to where they settle (1), frames 1 to {max(STRIP)}: "
+        + " ".join(f"{a:.2f}" for a in along)
+    )
     cache = frame_cache.get(suzanne)
-    print(f"secondary motion: {len(V)} vertices, {len(cache)} frames cached in {cache.nbytes() / 1024:.1f} KB")
+    print(
+        f"secondary motion: {len(V)} vertices, {len(cache)} frames cached in {cache.nbytes() / 1024:.1f} KB"
+    )
     bpy.data.objects.remove(controller)
     bpy.data.objects.remove(suzanne)
     for obj in shown:

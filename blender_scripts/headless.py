@@ -1,5 +1,6 @@
 """What the headless scripts share: their arguments after "--", the object they work on, saving, handles
 made as an artist makes them, and Blender's Laplacian Deform to compare with."""
+
 import argparse
 import importlib
 import pathlib
@@ -17,21 +18,26 @@ ADDON_PARENT = pathlib.Path(__file__).resolve().parents[1] / "python_addon"
 def argument_parser(doc):
     """A parser for the arguments after Blender's own (``blender -b ... --python script.py -- ...``),
     with the --object and --output every script takes."""
-    parser = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=doc, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("--object", required=True, help="name of the mesh object")
     parser.add_argument("--output", help="save here instead of over the opened file")
     return parser
 
 
 def parse(parser):
-    return parser.parse_args(sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else [])
+    return parser.parse_args(sys.argv[sys.argv.index("--") + 1 :] if "--" in sys.argv else [])
 
 
 def enable_addon():
     """Enable Modal Deform and return its package: the extension Blender installed (4.2+, module
     bl_ext.<repository>.modal_deform) if there is one, else the add-on of this source tree."""
-    installed = sorted(m.__name__ for m in addon_utils.modules()
-                       if m.__name__.startswith("bl_ext.") and m.__name__.endswith(".modal_deform"))
+    installed = sorted(
+        m.__name__
+        for m in addon_utils.modules()
+        if m.__name__.startswith("bl_ext.") and m.__name__.endswith(".modal_deform")
+    )
     if installed:
         name = installed[0]
     else:

@@ -7,6 +7,7 @@ With --frames the controllers' animation is solved frame by frame into the per-f
 the file (Bake Animation; with Dynamics on, simulated); without, the current frame into the
 "Modal Deform" shape key (Solve).
 """
+
 import pathlib
 import sys
 
@@ -18,11 +19,17 @@ import headless  # noqa: E402 (found through the line above)
 
 def main():
     parser = headless.argument_parser(__doc__)
-    parser.add_argument("--frames", type=int, nargs=2, metavar=("START", "END"), help="bake this frame range")
+    parser.add_argument(
+        "--frames", type=int, nargs=2, metavar=("START", "END"), help="bake this frame range"
+    )
     args = headless.parse(parser)
     headless.active_mesh_object(args.object)
     if args.frames:
-        headless.run(bpy.ops.modal_deform.bake_animation, frame_start=args.frames[0], frame_end=args.frames[1])
+        headless.run(
+            bpy.ops.modal_deform.bake_animation,
+            frame_start=args.frames[0],
+            frame_end=args.frames[1],
+        )
     else:
         headless.run(bpy.ops.modal_deform.solve)
     headless.save(args.output)

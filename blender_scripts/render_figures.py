@@ -8,6 +8,7 @@ along) and posed positions (n, 3) under any of the keys "full", "derivatives", "
 "laplacian"; it becomes OUTPUT/render_<name>.png: the rest mesh, then those present in that
 order, left to right, one colour each, all seen by the same camera (framing every variant).
 """
+
 import argparse
 import math
 import pathlib
@@ -23,17 +24,26 @@ from rendering import render, side_by_side, stage  # noqa: E402
 
 #: Variant: RGB base colour (white for the rest shape, grey for the reference, blue for ours,
 #: orange for linear modes, red for Laplacian Deform).
-VARIANTS = {"rest": (0.9, 0.9, 0.9), "full": (0.6, 0.6, 0.6), "derivatives": (0.25, 0.45, 0.8), "linear": (0.85, 0.5, 0.15),
-            "laplacian": (0.75, 0.2, 0.2)}
+VARIANTS = {
+    "rest": (0.9, 0.9, 0.9),
+    "full": (0.6, 0.6, 0.6),
+    "derivatives": (0.25, 0.45, 0.8),
+    "linear": (0.85, 0.5, 0.15),
+    "laplacian": (0.75, 0.2, 0.2),
+}
 
 
 def arguments():
-    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    argv = sys.argv[sys.argv.index("--") + 1 :] if "--" in sys.argv else []
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("--meshes", required=True, help="folder of .npz meshes")
     parser.add_argument("--output", required=True, help="folder for render_<name>.png")
     parser.add_argument("--samples", type=int, default=16, help="Cycles samples per pixel")
-    parser.add_argument("--width", type=int, default=300, help="pixels per variant; the height is the same")
+    parser.add_argument(
+        "--width", type=int, default=300, help="pixels per variant; the height is the same"
+    )
     return parser.parse_args(argv)
 
 
@@ -62,7 +72,9 @@ def framing(points, view, lens, aspect):
     centre = 0.5 * (points.min(axis=0) + points.max(axis=0))
     radius = np.linalg.norm(points - centre, axis=1).max()
     half_angle = math.atan(18.0 / lens) * min(1.0, aspect)  # the 36 mm sensor's narrower half-width
-    distance = 0.95 * radius / math.sin(half_angle)  # the bounding sphere is loose: 0.95 still frames
+    distance = (
+        0.95 * radius / math.sin(half_angle)
+    )  # the bounding sphere is loose: 0.95 still frames
     view = np.asarray(view, float) / np.linalg.norm(view)
     return Vector(centre), Vector(centre - distance * view)
 
@@ -76,7 +88,9 @@ def main():
         present = [v for v in VARIANTS if v in data]
         clear_scene()
         size = (args.width, args.width)
-        target, eye = framing(np.concatenate([data[v] for v in present]), data["view"], 50, size[0] / size[1])
+        target, eye = framing(
+            np.concatenate([data[v] for v in present]), data["view"], 50, size[0] / size[1]
+        )
         stage(target, tuple(eye), lens=50, samples=args.samples, resolution=size)
         images = []
         with tempfile.TemporaryDirectory() as folder:

@@ -3,6 +3,7 @@
 
 Run inside Blender (imports bpy); the scripts put this folder on sys.path.
 """
+
 import bpy
 import numpy as np
 from mathutils import Vector

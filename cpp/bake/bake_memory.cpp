@@ -40,7 +40,8 @@ std::string gigabytes(double bytes) {
 }
 
 #ifdef _WIN32
-// Physical memory not in use (what /proc/meminfo's MemAvailable is on Linux); infinity when unknown.
+// Physical memory not in use (what /proc/meminfo's MemAvailable is on Linux); infinity when
+// unknown.
 double system_available() {
   MEMORYSTATUSEX status{};
   status.dwLength = sizeof status;
@@ -81,17 +82,20 @@ double address_space_left() {
 
 }  // namespace
 
-BakeMemory estimate_bake_memory(Eigen::Index vertices, Eigen::Index simulated, double stiffness_nonzeros,
-                                double factor_bytes, int modes, int derivatives) {
+BakeMemory estimate_bake_memory(Eigen::Index vertices, Eigen::Index simulated,
+                                double stiffness_nonzeros, double factor_bytes, int modes,
+                                int derivatives) {
   BakeMemory need;
   need.mesh = kMeshBytesPerVertex * static_cast<double>(vertices);
   need.stiffness = kStiffnessBytesPerEntry * stiffness_nonzeros;
   need.factor = factor_bytes;
   const double column = 8.0 * 3 * static_cast<double>(simulated);
   const double kept = modes + 6.0;  // modes, a few zero modes
-  const double widest = std::max(kLanczosColumnsPerMode * (modes + 6.0), kDerivativeBlocks * derivatives);
+  const double widest =
+      std::max(kLanczosColumnsPerMode * (modes + 6.0), kDerivativeBlocks * derivatives);
   // The assembly holds U on the simulated and on all vertices, in double and in float.
-  const double assembly = 8.0 * 3 * static_cast<double>(simulated + vertices) + 4.0 * 3 * static_cast<double>(vertices);
+  const double assembly =
+      8.0 * 3 * static_cast<double>(simulated + vertices) + 4.0 * 3 * static_cast<double>(vertices);
   need.vectors = std::max(column * (kept + widest), assembly * (modes + derivatives + 6.0));
   return need;
 }
@@ -100,12 +104,13 @@ double available_memory() { return std::min(system_available(), address_space_le
 
 void require_memory(const BakeMemory& need, double available) {
   if (need.total() <= available) return;
-  throw OutOfMemory(message("bake: not enough memory: the bake needs about ", gigabytes(need.total()), " (factor of K ",
-                            gigabytes(need.factor), " from CHOLMOD's analysis, stiffness matrix ",
-                            gigabytes(need.stiffness), ", basis vectors ", gigabytes(need.vectors), ", mesh ",
-                            gigabytes(need.mesh), ") but only ", gigabytes(available),
-                            " is available (free memory, or the process's address-space limit); close other "
-                            "programs, bake fewer modes and derivatives, or decimate the mesh"));
+  throw OutOfMemory(message(
+      "bake: not enough memory: the bake needs about ", gigabytes(need.total()), " (factor of K ",
+      gigabytes(need.factor), " from CHOLMOD's analysis, stiffness matrix ",
+      gigabytes(need.stiffness), ", basis vectors ", gigabytes(need.vectors), ", mesh ",
+      gigabytes(need.mesh), ") but only ", gigabytes(available),
+      " is available (free memory, or the process's address-space limit); close other "
+      "programs, bake fewer modes and derivatives, or decimate the mesh"));
 }
 
 }  // namespace modal_deform

@@ -21,8 +21,9 @@ struct BakeMemory {
 // The peak of a bake of a mesh of `vertices` vertices, `simulated` of them simulated, with a
 // stiffness matrix of `stiffness_nonzeros` entries whose factor takes `factor_bytes`
 // (CholmodLLT::factor_bytes after analyze), `modes` modes asked for and `derivatives`.
-BakeMemory estimate_bake_memory(Eigen::Index vertices, Eigen::Index simulated, double stiffness_nonzeros,
-                                double factor_bytes, int modes, int derivatives);
+BakeMemory estimate_bake_memory(Eigen::Index vertices, Eigen::Index simulated,
+                                double stiffness_nonzeros, double factor_bytes, int modes,
+                                int derivatives);
 
 // Bytes this process can still allocate: the smaller of the system's available memory
 // (MemAvailable) and the address-space limit (ulimit -v) less what the process has mapped;

@@ -48,7 +48,7 @@ Basis rest_state(const VerticesRef& V, const FacesRef& F, const BakeOptions& opt
 
 // Stages 2 to 8 of the mesh V (whose `part` moves) on its rest state `basis`; errors name V's
 // vertices by `name`.
-Basis bake_stages(const VerticesRef& V, const MovingPart& part, const BakeOptions& options, Basis basis,
-                  const VertexName& name, Progress& progress);
+Basis bake_stages(const VerticesRef& V, const MovingPart& part, const BakeOptions& options,
+                  Basis basis, const VertexName& name, Progress& progress);
 
 }  // namespace modal_deform

@@ -22,8 +22,9 @@ class GhostInBackground {
           fraction_ = fraction;
           return !stop_.load();
         }),
-        ghost_(std::async(std::launch::async,
-                          [&V, &F, &mass, target, this] { return ghost_mesh(V, F, mass, target, &progress_); })) {}
+        ghost_(std::async(std::launch::async, [&V, &F, &mass, target, this] {
+          return ghost_mesh(V, F, mass, target, &progress_);
+        })) {}
   // When the bake stops early, cancels the ghost and waits, so nothing outlives the bake.
   ~GhostInBackground() {
     stop_ = true;

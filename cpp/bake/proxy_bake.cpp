@@ -10,8 +10,8 @@
 
 namespace modal_deform {
 
-Basis bake_on_proxy(const VerticesRef& V, const MovingPart& part, const BakeOptions& options, Basis fine,
-                    Progress& progress) {
+Basis bake_on_proxy(const VerticesRef& V, const MovingPart& part, const BakeOptions& options,
+                    Basis fine, Progress& progress) {
   Basis timed;  // the proxy stage's time, until the proxy's basis exists
   Progress as_proxy([&progress](const std::string&, double fraction) {
     progress.report(stages::kProxy, fraction);
@@ -22,12 +22,13 @@ Basis bake_on_proxy(const VerticesRef& V, const MovingPart& part, const BakeOpti
   });
   // The proxy's elements carry the fine paint's means (restrict_to_ghost).
   BakeOptions on_proxy = options;
-  on_proxy.material.paint = restrict_to_ghost(proxy.map, static_cast<int>(proxy.V.rows()), part.mass,
-                                              part.paint(options.material.paint));
+  on_proxy.material.paint = restrict_to_ghost(proxy.map, static_cast<int>(proxy.V.rows()),
+                                              part.mass, part.paint(options.material.paint));
   on_proxy.region = part.proxy_region(proxy);
   Basis basis = rest_state(proxy.V, proxy.F, on_proxy, fine.scale);
   basis.timings = timed.timings;
-  // A proxy vertex's index means nothing to the artist: errors name the nearest of its fine vertices.
+  // A proxy vertex's index means nothing to the artist: errors name the nearest of its fine
+  // vertices.
   const VertexName fine_vertex = [&](int p) {
     return message(vertex_at(V, part.mesh_vertex(nearest_fine_vertex(proxy, part.V, p))),
                    ", the nearest of the mesh's vertices to the proxy's vertex ", p);

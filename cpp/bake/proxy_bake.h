@@ -11,7 +11,7 @@
 namespace modal_deform {
 
 // The basis of (V, `part` of it moving) on its proxy, from the mesh's rest state `fine`.
-Basis bake_on_proxy(const VerticesRef& V, const MovingPart& part, const BakeOptions& options, Basis fine,
-                    Progress& progress);
+Basis bake_on_proxy(const VerticesRef& V, const MovingPart& part, const BakeOptions& options,
+                    Basis fine, Progress& progress);
 
 }  // namespace modal_deform

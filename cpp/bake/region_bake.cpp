@@ -10,7 +10,8 @@ Attachment region_attachment(const RegionMesh& region, Eigen::Index num_vertices
   Attachment attachment;
   attachment.simulated.assign(region.vertices.begin(), region.vertices.begin() + region.num_free);
   attachment.submesh_index = Eigen::VectorXi::Constant(num_vertices, -1);
-  for (int s = 0; s < region.num_free; ++s) attachment.submesh_index[region.vertices[static_cast<size_t>(s)]] = s;
+  for (int s = 0; s < region.num_free; ++s)
+    attachment.submesh_index[region.vertices[static_cast<size_t>(s)]] = s;
   attachment.faces = region.faces;
   attachment.component = Eigen::VectorXi::Zero(region.num_free);
   return attachment;
@@ -18,17 +19,20 @@ Attachment region_attachment(const RegionMesh& region, Eigen::Index num_vertices
 
 }  // namespace
 
-MovingPart::MovingPart(const VerticesRef& mesh_V, const FacesRef& mesh_F, const VectorRef& mesh_mass,
-                       const Eigen::VectorXi& region)
+MovingPart::MovingPart(const VerticesRef& mesh_V, const FacesRef& mesh_F,
+                       const VectorRef& mesh_mass, const Eigen::VectorXi& region)
     : mesh_vertices_(mesh_V.rows()),
       region_(region.size() > 0 ? region_mesh(mesh_F, mesh_mass, region) : RegionMesh()),
       submesh_V_(mesh_V(region_.vertices, Eigen::all)),
-      mass_(is_region() ? Eigen::VectorXd(mesh_mass(region_.vertices)) : Eigen::VectorXd(mesh_mass)),
+      mass_(is_region() ? Eigen::VectorXd(mesh_mass(region_.vertices))
+                        : Eigen::VectorXd(mesh_mass)),
       V(is_region() ? VerticesRef(submesh_V_) : mesh_V),
       F(is_region() ? FacesRef(region_.faces) : mesh_F),
       mass(mass_) {}
 
-int MovingPart::num_free() const { return is_region() ? region_.num_free : static_cast<int>(V.rows()); }
+int MovingPart::num_free() const {
+  return is_region() ? region_.num_free : static_cast<int>(V.rows());
+}
 
 Attachment MovingPart::attachment() const {
   return is_region() ? region_attachment(region_, mesh_vertices_) : attach(V, F);
@@ -65,7 +69,8 @@ Eigen::VectorXi MovingPart::proxy_region(const Ghost& proxy) const {
   std::vector<int> vertices;
   for (size_t p = 0; p < free.size(); ++p)
     if (free[p]) vertices.push_back(static_cast<int>(p));
-  return Eigen::Map<const Eigen::VectorXi>(vertices.data(), static_cast<Eigen::Index>(vertices.size()));
+  return Eigen::Map<const Eigen::VectorXi>(vertices.data(),
+                                           static_cast<Eigen::Index>(vertices.size()));
 }
 
 Eigen::MatrixXd MovingPart::ghost_vectors(const Ghost& ghost, const Eigen::MatrixXd& U) const {
@@ -73,7 +78,8 @@ Eigen::MatrixXd MovingPart::ghost_vectors(const Ghost& ghost, const Eigen::Matri
   const std::vector<int>& sub = region_.vertices;
   Eigen::MatrixXd rows(3 * static_cast<Eigen::Index>(sub.size()), U.cols());
   for (size_t i = 0; i < sub.size(); ++i)
-    rows.middleRows<3>(3 * static_cast<Eigen::Index>(i)) = U.middleRows<3>(3 * static_cast<Eigen::Index>(sub[i]));
+    rows.middleRows<3>(3 * static_cast<Eigen::Index>(i)) =
+        U.middleRows<3>(3 * static_cast<Eigen::Index>(sub[i]));
   return restrict_to_ghost(ghost, mass, rows);
 }
 

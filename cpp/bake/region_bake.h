@@ -22,7 +22,8 @@ class MovingPart {
  public:
   // The mesh (V, F) with its lumped `mass`; `region` its vertex indices that may move (any order;
   // empty: the whole mesh), with region_mesh's errors. V and F must outlive the part.
-  MovingPart(const VerticesRef& V, const FacesRef& F, const VectorRef& mass, const Eigen::VectorXi& region);
+  MovingPart(const VerticesRef& V, const FacesRef& F, const VectorRef& mass,
+             const Eigen::VectorXi& region);
   MovingPart(const MovingPart&) = delete;
   MovingPart& operator=(const MovingPart&) = delete;
 
@@ -30,7 +31,9 @@ class MovingPart {
   // The vertices that may move: the mesh's, or the region's free ones.
   int num_free() const;
   // Submesh vertex s as a vertex of the mesh.
-  int mesh_vertex(int s) const { return is_region() ? region_.vertices[static_cast<size_t>(s)] : s; }
+  int mesh_vertex(int s) const {
+    return is_region() ? region_.vertices[static_cast<size_t>(s)] : s;
+  }
 
   // Step 2: which vertices are simulated (the region's free ones, none attached) and which follow
   // them (attach).

@@ -7,10 +7,10 @@
 #include <type_traits>
 #include <utility>
 
+#include "bake/bake.h"
 #include "bindings/bindings.h"
 #include "bindings/named_fields.h"
 #include "bindings/python_progress.h"
-#include "bake/bake.h"
 #include "util/bake_stages.h"
 
 namespace py = pybind11;
@@ -33,7 +33,8 @@ struct StoredLayout<T, std::enable_if_t<std::is_base_of_v<Eigen::EigenBase<T>, T
   using Scalar = typename T::Scalar;
   static constexpr bool vector = T::IsVectorAtCompileTime;
   static constexpr int ndim = vector ? 1 : 2;
-  static constexpr int columns = vector || T::ColsAtCompileTime == Eigen::Dynamic ? 0 : T::ColsAtCompileTime;
+  static constexpr int columns =
+      vector || T::ColsAtCompileTime == Eigen::Dynamic ? 0 : T::ColsAtCompileTime;
   static constexpr bool fortran = !vector && !T::IsRowMajor;
 };
 
@@ -91,12 +92,14 @@ void bind_bake(py::module_& m) {
   for (size_t i = 0; i < kBakeStages.size(); ++i) stages[i] = kBakeStages[i];
   m.attr("BAKE_STAGES") = stages;
 
-  m.attr("BAKE_OPTIONS") = option_table<BakeOptions>([](auto visit) { for_each_bake_option(visit); });
+  m.attr("BAKE_OPTIONS") =
+      option_table<BakeOptions>([](auto visit) { for_each_bake_option(visit); });
   m.def(
       "bake",
-      [](const VerticesRef& V, const FacesRef& F, const py::object& progress, const py::kwargs& keywords) {
-        const auto options =
-            from_keywords<BakeOptions>(keywords, [](auto visit) { for_each_bake_option(visit); }, "bake");
+      [](const VerticesRef& V, const FacesRef& F, const py::object& progress,
+         const py::kwargs& keywords) {
+        const auto options = from_keywords<BakeOptions>(
+            keywords, [](auto visit) { for_each_bake_option(visit); }, "bake");
         Progress reporter(python_progress(progress));
         py::gil_scoped_release release;
         return bake(V, F, options, reporter);

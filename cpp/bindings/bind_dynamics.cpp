@@ -19,16 +19,19 @@ void bind_dynamics(py::module_& m) {
   const auto simulation_options = [](auto visit) { for_each_simulation_option(visit); };
   m.attr("SIMULATION_OPTIONS") = option_table<SimulationOptions>(simulation_options);
   py::class_<ReducedDynamics>(m, "Simulation")
-      .def(py::init([simulation_options](const Basis& basis, const std::vector<Eigen::VectorXi>& handles,
+      .def(py::init([simulation_options](const Basis& basis,
+                                         const std::vector<Eigen::VectorXi>& handles,
                                          const VectorRef& weights, const std::string& energy,
                                          const py::kwargs& keywords) {
              const SimulationOptions options =
                  from_keywords<SimulationOptions>(keywords, simulation_options, "Simulation");
              const EnergyKind kind = energy_kind(energy);
              py::gil_scoped_release release;
-             return std::make_unique<ReducedDynamics>(basis, to_handles(handles), weights, options, kind);
+             return std::make_unique<ReducedDynamics>(basis, to_handles(handles), weights, options,
+                                                      kind);
            }),
-           py::arg("basis"), py::arg("handles"), py::arg("weights"), py::arg("energy"), py::keep_alive<1, 2>())
+           py::arg("basis"), py::arg("handles"), py::arg("weights"), py::arg("energy"),
+           py::keep_alive<1, 2>())
       .def(
           "step",
           [](ReducedDynamics& simulation, const Transforms& transforms) {
@@ -40,7 +43,8 @@ void bind_dynamics(py::module_& m) {
             return to_dict(stats, [](auto visit) { for_each_simulation_stat(visit); });
           },
           py::arg("transforms"))
-      .def("set_state", &ReducedDynamics::set_state, py::arg("q"), py::arg("v"), py::arg("transforms"))
+      .def("set_state", &ReducedDynamics::set_state, py::arg("q"), py::arg("v"),
+           py::arg("transforms"))
       .def("forget", &ReducedDynamics::forget)
       .def_property_readonly("remembered_frames", &ReducedDynamics::remembered_frames)
       .def_property_readonly("memory_frames", &ReducedDynamics::memory_frames)
@@ -56,7 +60,8 @@ void bind_dynamics(py::module_& m) {
       .def_property_readonly("dimension", &ReducedDynamics::dimension)
       .def_property_readonly("num_handles", &ReducedDynamics::num_handles)
       .def_property_readonly("mass_scale", &ReducedDynamics::mass_scale)
-      .def_property_readonly("lowest_mode", [](const ReducedDynamics& s) { return Eigen::VectorXd(s.lowest_mode()); });
+      .def_property_readonly(
+          "lowest_mode", [](const ReducedDynamics& s) { return Eigen::VectorXd(s.lowest_mode()); });
 }
 
 }  // namespace modal_deform

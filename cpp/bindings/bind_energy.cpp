@@ -33,18 +33,21 @@ void bind_energy(py::module_& m) {
 
   // Each energy adds its class here, deriving from Energy.
 
-  py::class_<Arap, Energy>(m, "Arap")
-      .def(py::init<const VerticesRef&, const FacesRef&>(), py::arg("V"), py::arg("F"), release);
+  py::class_<Arap, Energy>(m, "Arap").def(py::init<const VerticesRef&, const FacesRef&>(),
+                                          py::arg("V"), py::arg("F"), release);
   const auto material_options = [](auto visit) { for_each_material_field(visit); };
   m.attr("MATERIAL_OPTIONS") = option_table<Material>(material_options);
   py::class_<DiscreteShells, Energy>(m, "DiscreteShells")
-      .def(py::init([material_options](const VerticesRef& V, const FacesRef& F, const py::kwargs& keywords) {
-             const Material material = from_keywords<Material>(keywords, material_options, "DiscreteShells");
+      .def(py::init([material_options](const VerticesRef& V, const FacesRef& F,
+                                       const py::kwargs& keywords) {
+             const Material material =
+                 from_keywords<Material>(keywords, material_options, "DiscreteShells");
              py::gil_scoped_release unlocked;
              return DiscreteShells(V, F, material.bending, material.membrane, material.paint);
            }),
            py::arg("V"), py::arg("F"))
-      .def("third_batch", &DiscreteShells::third_batch, py::arg("x"), py::arg("Phi"), py::arg("pairs"), release)
+      .def("third_batch", &DiscreteShells::third_batch, py::arg("x"), py::arg("Phi"),
+           py::arg("pairs"), release)
       .def_property_readonly("term_counts", [](const DiscreteShells& energy) {
         const auto counts = energy.term_counts();
         return py::dict(py::arg("edges") = counts.edges, py::arg("triangles") = counts.triangles,

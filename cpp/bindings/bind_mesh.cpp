@@ -13,7 +13,9 @@ namespace py = pybind11;
 namespace modal_deform {
 namespace {
 
-py::tuple as_tuple(TriangleMesh mesh) { return py::make_tuple(std::move(mesh.V), std::move(mesh.F)); }
+py::tuple as_tuple(TriangleMesh mesh) {
+  return py::make_tuple(std::move(mesh.V), std::move(mesh.F));
+}
 
 py::dict report_to_dict(const MeshReport& report) {
   py::dict out;
@@ -27,15 +29,18 @@ py::dict report_to_dict(const MeshReport& report) {
                                         static_cast<Eigen::Index>(report.vertex_component.size()))
           .eval();
   for (const auto& finding : report.findings)
-    out[finding.name.c_str()] = py::dict(py::arg("count") = finding.count, py::arg("first") = finding.examples);
+    out[finding.name.c_str()] =
+        py::dict(py::arg("count") = finding.count, py::arg("first") = finding.examples);
   return out;
 }
 
 }  // namespace
 
 void bind_mesh(py::module_& m) {
-  m.def("check", [](const VerticesRef& V, const FacesRef& F) { return report_to_dict(check_mesh(V, F)); },
-        py::arg("V"), py::arg("F"));
+  m.def(
+      "check",
+      [](const VerticesRef& V, const FacesRef& F) { return report_to_dict(check_mesh(V, F)); },
+      py::arg("V"), py::arg("F"));
   m.def(
       "mass",
       [](const VerticesRef& V, const FacesRef& F) {

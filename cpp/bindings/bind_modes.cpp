@@ -22,19 +22,20 @@ void bind_modes(py::module_& m) {
         VibrationModes modes = vibration_modes(K, mass, count, Z);
         return std::make_pair(std::move(modes.eigenvalues), std::move(modes.modes));
       },
-      py::arg("K"), py::arg("mass"), py::arg("count"), py::arg("Z"), py::call_guard<py::gil_scoped_release>());
+      py::arg("K"), py::arg("mass"), py::arg("count"), py::arg("Z"),
+      py::call_guard<py::gil_scoped_release>());
   m.def(
       "rigid_motions",
-      [](const VerticesRef& V, const Eigen::Ref<const Eigen::VectorXi>& labels, const VectorRef& mass) {
-        return rigid_motions(V, labels, mass);
-      },
+      [](const VerticesRef& V, const Eigen::Ref<const Eigen::VectorXi>& labels,
+         const VectorRef& mass) { return rigid_motions(V, labels, mass); },
       py::arg("V"), py::arg("labels"), py::arg("mass"), py::call_guard<py::gil_scoped_release>());
   m.def(
       "solve_in_range",
       [](const SparseMatrix& K, const VectorRef& mass, const MatrixRef& Z, const MatrixRef& B) {
         return solve_in_range(K, mass, Z, B);
       },
-      py::arg("K"), py::arg("mass"), py::arg("Z"), py::arg("B"), py::call_guard<py::gil_scoped_release>());
+      py::arg("K"), py::arg("mass"), py::arg("Z"), py::arg("B"),
+      py::call_guard<py::gil_scoped_release>());
 }
 
 }  // namespace modal_deform

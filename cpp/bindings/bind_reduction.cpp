@@ -28,7 +28,9 @@ void bind_reduction(py::module_& m) {
   m.def(
       "restrict_to_ghost",
       [](const Eigen::Ref<const Eigen::VectorXi>& map, int num_ghost, const VectorRef& mass,
-         const Eigen::Ref<const Eigen::MatrixXd>& U) { return restrict_to_ghost(map, num_ghost, mass, U); },
+         const Eigen::Ref<const Eigen::MatrixXd>& U) {
+        return restrict_to_ghost(map, num_ghost, mass, U);
+      },
       py::arg("ghost_map"), py::arg("num_ghost"), py::arg("mass"), py::arg("U"),
       py::call_guard<py::gil_scoped_release>());
 }

@@ -28,16 +28,23 @@ pybind11::object to_python(const T& value) {
   return pybind11::cast(value);
 }
 inline pybind11::object to_python(EnergyKind kind) { return pybind11::str(energy_name(kind)); }
-inline pybind11::object to_python(HessianModel model) { return pybind11::str(hessian_model_name(model)); }
+inline pybind11::object to_python(HessianModel model) {
+  return pybind11::str(hessian_model_name(model));
+}
 
 // What a value of type T is called in messages and in the exported tables.
 template <typename T>
 const char* kind_name() {
-  if constexpr (std::is_same_v<T, bool>) return "bool";
-  else if constexpr (std::is_integral_v<T>) return "int";
-  else if constexpr (std::is_floating_point_v<T>) return "float";
-  else if constexpr (std::is_same_v<T, EnergyKind>) return "energy";
-  else return "array";
+  if constexpr (std::is_same_v<T, bool>)
+    return "bool";
+  else if constexpr (std::is_integral_v<T>)
+    return "int";
+  else if constexpr (std::is_floating_point_v<T>)
+    return "float";
+  else if constexpr (std::is_same_v<T, EnergyKind>)
+    return "energy";
+  else
+    return "array";
 }
 
 // An array option's value: None is an empty array.
@@ -56,7 +63,8 @@ void from_python(pybind11::handle value, T& field, const char* name) {
   }
   if constexpr (std::is_same_v<T, EnergyKind>) {
     if (!pybind11::isinstance<pybind11::str>(value))
-      throw InputError(message(name, ": expected \"shells\" or \"arap\", got ", pybind11::repr(value).cast<std::string>()));
+      throw InputError(message(name, ": expected \"shells\" or \"arap\", got ",
+                               pybind11::repr(value).cast<std::string>()));
     field = energy_kind(value.cast<std::string>());
     return;
   } else {
@@ -64,8 +72,10 @@ void from_python(pybind11::handle value, T& field, const char* name) {
     const std::string type = pybind11::str(value.get_type().attr("__name__"));
     const bool flag = type == "bool" || type == "bool_";
     bool fits = true;
-    if constexpr (std::is_same_v<T, bool>) fits = flag;
-    else if constexpr (std::is_arithmetic_v<T>) fits = !flag && !pybind11::isinstance<pybind11::str>(value);
+    if constexpr (std::is_same_v<T, bool>)
+      fits = flag;
+    else if constexpr (std::is_arithmetic_v<T>)
+      fits = !flag && !pybind11::isinstance<pybind11::str>(value);
     try {
       if (fits) {
         field = value.cast<T>();
@@ -74,11 +84,12 @@ void from_python(pybind11::handle value, T& field, const char* name) {
     } catch (const pybind11::cast_error&) {
     } catch (const pybind11::error_already_set&) {
     }
-    const std::string expected = std::is_same_v<T, bool>          ? "True or False"
-                                 : std::is_integral_v<T>          ? "an integer"
-                                 : std::is_floating_point_v<T>    ? "a number"
-                                                                  : "an array of numbers, or None";
-    throw InputError(message(name, ": expected ", expected, ", got ", pybind11::repr(value).cast<std::string>()));
+    const std::string expected = std::is_same_v<T, bool>       ? "True or False"
+                                 : std::is_integral_v<T>       ? "an integer"
+                                 : std::is_floating_point_v<T> ? "a number"
+                                                               : "an array of numbers, or None";
+    throw InputError(message(name, ": expected ", expected, ", got ",
+                             pybind11::repr(value).cast<std::string>()));
   }
 }
 
@@ -98,7 +109,8 @@ pybind11::dict option_record(const Option& option, const T& default_value) {
   if constexpr (kIsArray<T>) value = pybind11::none();
   return pybind11::dict(pybind11::arg("name") = option.name, pybind11::arg("default") = value,
                         pybind11::arg("kind") = kind_name<T>(), pybind11::arg("doc") = option.doc,
-                        pybind11::arg("min") = option.range.min, pybind11::arg("max") = option.range.max,
+                        pybind11::arg("min") = option.range.min,
+                        pybind11::arg("max") = option.range.max,
                         pybind11::arg("min_open") = option.range.min_open,
                         pybind11::arg("max_open") = option.range.max_open);
 }
@@ -108,7 +120,9 @@ template <typename Options, typename ForEach>
 pybind11::list option_table(ForEach for_each) {
   const Options defaults{};
   pybind11::list table;
-  for_each([&](const Option& option, auto field) { table.append(option_record(option, field(defaults))); });
+  for_each([&](const Option& option, auto field) {
+    table.append(option_record(option, field(defaults)));
+  });
   return table;
 }
 

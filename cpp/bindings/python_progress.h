@@ -16,10 +16,11 @@ namespace modal_deform {
 // prints does not stop the work; an exception raised by the callback propagates as itself.
 inline ProgressCallback python_progress(const pybind11::object& callback) {
   if (callback.is_none()) return {};
-  const std::shared_ptr<pybind11::object> held(new pybind11::object(callback), [](pybind11::object* object) {
-    pybind11::gil_scoped_acquire gil;
-    delete object;
-  });
+  const std::shared_ptr<pybind11::object> held(new pybind11::object(callback),
+                                               [](pybind11::object* object) {
+                                                 pybind11::gil_scoped_acquire gil;
+                                                 delete object;
+                                               });
   return [held](const std::string& stage, double fraction) {
     pybind11::gil_scoped_acquire gil;
     const pybind11::object answer = (*held)(stage, fraction);

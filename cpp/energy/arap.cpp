@@ -36,7 +36,8 @@ struct CellRotation {
 };
 
 CellRotation best_rotation(const Eigen::Matrix3d& S) {
-  const Eigen::JacobiSVD<Eigen::Matrix3d, Eigen::NoQRPreconditioner> svd(S, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::JacobiSVD<Eigen::Matrix3d, Eigen::NoQRPreconditioner> svd(
+      S, Eigen::ComputeFullU | Eigen::ComputeFullV);
   CellRotation fit{Eigen::Matrix3d(), svd.matrixU(), svd.singularValues()};
   if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0) {
     fit.U.col(2) = -fit.U.col(2);
@@ -84,7 +85,10 @@ Arap::Arap(const VerticesRef& V, const FacesRef& F)
     for (int e = cell_offsets_[i]; e < cell_offsets_[i + 1]; ++e) {
       const int j = cell_neighbors_[e];
       const int* begin = &cell_neighbors_[cell_offsets_[j]];
-      cell_twins_[e] = cell_offsets_[j] + static_cast<int>(std::find(begin, begin + (cell_offsets_[j + 1] - cell_offsets_[j]), i) - begin);
+      cell_twins_[e] =
+          cell_offsets_[j] +
+          static_cast<int>(std::find(begin, begin + (cell_offsets_[j + 1] - cell_offsets_[j]), i) -
+                           begin);
     }
 
   // Cell i's rotation couples every pair of {i} ∪ N(i); vertex k meets the cells of {k} ∪ N(k).
@@ -94,7 +98,8 @@ Arap::Arap(const VerticesRef& V, const FacesRef& F)
     coupled.assign(1, k);
     auto add_cell = [&](int i) {
       coupled.push_back(i);
-      coupled.insert(coupled.end(), cell_neighbors_.begin() + cell_offsets_[i], cell_neighbors_.begin() + cell_offsets_[i + 1]);
+      coupled.insert(coupled.end(), cell_neighbors_.begin() + cell_offsets_[i],
+                     cell_neighbors_.begin() + cell_offsets_[i + 1]);
     };
     add_cell(k);
     for (int e = cell_offsets_[k]; e < cell_offsets_[k + 1]; ++e) add_cell(cell_neighbors_[e]);
@@ -131,7 +136,8 @@ double Arap::value(const VectorRef& x) const {
   require_positions(x, 3 * num_vertices_, "X");
   double energy = 0;
 #pragma omp parallel for schedule(static) reduction(+ : energy) if (parallel_)
-  for (int i = 0; i < num_vertices_; ++i) energy += cell_energy(i, x, best_rotation(covariance(i, x)).rotation);
+  for (int i = 0; i < num_vertices_; ++i)
+    energy += cell_energy(i, x, best_rotation(covariance(i, x)).rotation);
   return energy;
 }
 
@@ -171,10 +177,11 @@ double Arap::value_and_gradient(const VectorRef& x, Eigen::Ref<Eigen::VectorXd> 
 //   f_ωx_j  = 2 w_j [ē_j]× R_iᵀ =: G_j,   f_ωx_i = −Σ_j G_j
 //   f_ωω    = 2 (tr P · I − P) = 2 U diag(Σs − s_k) Uᵀ    (from exp's second-order term ½[ω]×²)
 // The reduced energy min_ω f has the Hessian f_xx − f_xω f_ωω⁻¹ f_ωx (implicit function theorem);
-// f_ωω's eigenvalues 2(σ2 ± σ3), 2(σ1 ± σ3), 2(σ1 + σ2) are ≥ 0 at the optimum, and f_ωω is singular when
-// the cell's edges are collinear (a free spin: f_ωx has no part along it, the pseudo-inverse is
-// exact) or when σ2 = σ3 after a reflection fix (the best rotation jumps: E has a kink there).
-// With K = f_ωω⁺ = ½ U diag(μ) Uᵀ, H_p = diag(√(μ/2)) Uᵀ G_p gives f_pω K f_ωq = H_pᵀ H_q.
+// f_ωω's eigenvalues 2(σ2 ± σ3), 2(σ1 ± σ3), 2(σ1 + σ2) are ≥ 0 at the optimum, and f_ωω is
+// singular when the cell's edges are collinear (a free spin: f_ωx has no part along it, the
+// pseudo-inverse is exact) or when σ2 = σ3 after a reflection fix (the best rotation jumps: E has a
+// kink there). With K = f_ωω⁺ = ½ U diag(μ) Uᵀ, H_p = diag(√(μ/2)) Uᵀ G_p gives f_pω K f_ωq = H_pᵀ
+// H_q.
 void Arap::rotation_factors(int i, const VectorRef& x, Eigen::Matrix3d* out) const {
   const CellRotation fit = best_rotation(covariance(i, x));
   const Eigen::Vector3d& s = fit.signed_singular_values;
@@ -186,14 +193,16 @@ void Arap::rotation_factors(int i, const VectorRef& x, Eigen::Matrix3d* out) con
                  (rest_.segment<3>(3 * i) - rest_.segment<3>(3 * cell_neighbors_[e])).squaredNorm();
   const double cutoff = kSingularRotationRatio * std::max(eigenvalues.maxCoeff(), 2 * rest_size);
   Eigen::Vector3d scale;
-  for (int k = 0; k < 3; ++k) scale[k] = eigenvalues[k] > cutoff ? std::sqrt(1.0 / eigenvalues[k]) : 0.0;
+  for (int k = 0; k < 3; ++k)
+    scale[k] = eigenvalues[k] > cutoff ? std::sqrt(1.0 / eigenvalues[k]) : 0.0;
   const Eigen::Matrix3d scaled_Ut = scale.asDiagonal() * fit.U.transpose();
   out[0].setZero();
   for (int e = cell_offsets_[i]; e < cell_offsets_[i + 1]; ++e) {
     const int j = cell_neighbors_[e];
     const Eigen::Vector3d rest_edge = rest_.segment<3>(3 * i) - rest_.segment<3>(3 * j);
     Eigen::Matrix3d& factor = out[1 + e - cell_offsets_[i]];
-    factor.noalias() = scaled_Ut * (2 * cell_weights_[e] * cross_matrix(rest_edge) * fit.rotation.transpose());
+    factor.noalias() =
+        scaled_Ut * (2 * cell_weights_[e] * cross_matrix(rest_edge) * fit.rotation.transpose());
     out[0] -= factor;
   }
 }
@@ -264,7 +273,8 @@ SparseMatrix Arap::hessian(const VectorRef& x) const {
 
 Eigen::VectorXd Arap::third(const VectorRef&, const VectorRef&, const VectorRef&) const {
   throw InputError(
-      "Arap: the ARAP energy has no third derivative here; modal derivatives need the shells energy "
+      "Arap: the ARAP energy has no third derivative here; modal derivatives need the shells "
+      "energy "
       "(energy=\"shells\")");
 }
 

@@ -1,7 +1,8 @@
 // The as-rigid-as-possible energy (Sorkine & Alexa 2007, "As-Rigid-As-Possible Surface Modeling"),
 // the alternative objective of the solvers (the paper's Fig. 3 poses ARAP in a shells basis).
 //
-//   E(x) = Σ_i min_{R_i ∈ SO(3)} Σ_{j ∈ N(i)} w_ij ‖(x_i − x_j) − R_i (x̄_i − x̄_j)‖²   (S&A eq. 3, 7)
+//   E(x) = Σ_i min_{R_i ∈ SO(3)} Σ_{j ∈ N(i)} w_ij ‖(x_i − x_j) − R_i (x̄_i − x̄_j)‖²   (S&A eq. 3,
+//   7)
 //
 // with one cell per vertex (its one-ring of edges) and cotangent weights of the rest mesh,
 // w_ij = ½ (cot α_ij + cot β_ij), clamped to w_ij ≥ 0 so that E ≥ 0 with its minimum at rest
@@ -29,7 +30,8 @@ class Arap final : public Energy {
   // x: 3n positions. Throws InputError naming the first non-finite coordinate or a wrong length.
   double value(const VectorRef& x) const override;
   // E(x) and ∇E(x) (3n, length) with each R_i at its optimum.
-  double value_and_gradient(const VectorRef& x, Eigen::Ref<Eigen::VectorXd> gradient) const override;
+  double value_and_gradient(const VectorRef& x,
+                            Eigen::Ref<Eigen::VectorXd> gradient) const override;
   // The exact Hessian of E with optimal rotations (3n by 3n, dimensionless, both triangles;
   // symmetric up to rounding). Each cell couples its whole one-ring, so the pattern is the 2-ring.
   // Positive semi-definite at rest, with 6 zero eigenvalues per connected component; away from

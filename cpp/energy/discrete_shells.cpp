@@ -33,7 +33,9 @@ constexpr double kCollapse = kDegenerateAreaRatio;
 
 // Rest stiffness w ‖∇s‖² of a bending or area term on equilateral triangles (per unit α or β):
 // a hinge of edge ē, w = 2√3, ‖∇θ‖² = 16 / (3 ē²); a triangle, w ‖∇A‖² = Σ ē² / (4 Ā) = √3.
-double equilateral_hinge_stiffness(double edge_squared) { return 32 / (std::sqrt(3.0) * edge_squared); }
+double equilateral_hinge_stiffness(double edge_squared) {
+  return 32 / (std::sqrt(3.0) * edge_squared);
+}
 constexpr double kEquilateralTriangleStiffness = 1.7320508075688772;
 
 template <typename Term>
@@ -67,11 +69,13 @@ bool differentiable(const EdgeTerm& term, double length) { return length > term.
 bool differentiable(const TriangleTerm& term, double norm) { return norm > term.collapsed_norm; }
 
 Response respond(const EdgeTerm& term, const EdgeLength::Frame<double>& frame) {
-  return quadratic(EdgeLength::measure(frame), term.rest_length, term.weight, differentiable(term, frame.length));
+  return quadratic(EdgeLength::measure(frame), term.rest_length, term.weight,
+                   differentiable(term, frame.length));
 }
 
 Response respond(const TriangleTerm& term, const TriangleArea::Frame<double>& frame) {
-  return quadratic(TriangleArea::measure(frame), term.rest_area, term.weight, differentiable(term, frame.norm));
+  return quadratic(TriangleArea::measure(frame), term.rest_area, term.weight,
+                   differentiable(term, frame.norm));
 }
 
 // The hinge fade (header): φ(t) and φ'(t) for t = ‖n‖² / ‖n̄‖², the quintic smoothstep in
@@ -95,7 +99,8 @@ Fade<T> fade(const T& t) {
 constexpr double kCollapsedNormRatio = kCollapse * kCollapse;
 
 bool hinge_collapsed(const HingeTerm& term, double n1n1, double n2n2) {
-  return n1n1 <= kCollapsedNormRatio * term.rest_n1n1 || n2n2 <= kCollapsedNormRatio * term.rest_n2n2;
+  return n1n1 <= kCollapsedNormRatio * term.rest_n1n1 ||
+         n2n2 <= kCollapsedNormRatio * term.rest_n2n2;
 }
 
 bool hinge_faded(const HingeTerm& term, double n1n1, double n2n2) {
@@ -106,10 +111,11 @@ bool hinge_faded(const HingeTerm& term, double n1n1, double n2n2) {
 // w sin δ, its derivative in θ, from cos θ and sin θ (any scalar T) and the rest's cos θ̄, sin θ̄
 // and w (doubles, or lanes as T is).
 template <typename T, typename C>
-std::array<T, 2> bending_and_slope(const T& cos_theta, const T& sin_theta, const C& cos_rest, const C& sin_rest,
-                                   const C& weight) {
+std::array<T, 2> bending_and_slope(const T& cos_theta, const T& sin_theta, const C& cos_rest,
+                                   const C& sin_rest, const C& weight) {
   const T dc = cos_theta - T(cos_rest), ds = sin_theta - T(sin_rest);
-  return {(dc * dc + ds * ds) * (0.5 * weight), (sin_theta * cos_rest - cos_theta * sin_rest) * weight};
+  return {(dc * dc + ds * ds) * (0.5 * weight),
+          (sin_theta * cos_rest - cos_theta * sin_rest) * weight};
 }
 
 template <typename T>
@@ -124,7 +130,8 @@ std::array<T, 2> bending_and_slope(const HingeTerm& term, const DihedralAngle::F
 template <typename T>
 void faded_hinge_gradient(const HingeTerm& term, const DihedralAngle::Frame<T>& f, T* g) {
   const auto [bending, slope] = bending_and_slope(term, f);
-  const Fade<T> fade1 = fade(f.n1n1 * (1 / term.rest_n1n1)), fade2 = fade(f.n2n2 * (1 / term.rest_n2n2));
+  const Fade<T> fade1 = fade(f.n1n1 * (1 / term.rest_n1n1)),
+                fade2 = fade(f.n2n2 * (1 / term.rest_n2n2));
   DihedralAngle::gradient(f, g);
   const T along_theta = fade1.value * fade2.value * slope;
   const T c1 = bending * fade1.slope * fade2.value * (2 / term.rest_n1n1);
@@ -145,7 +152,8 @@ void faded_hinge_gradient(const HingeTerm& term, const DihedralAngle::Frame<T>& 
 // the term where neither triangle is crushed (hinge_faded false).
 Response unfaded_respond(const HingeTerm& term, const DihedralAngle::Frame<double>& frame) {
   const auto [cos_theta, sin_theta] = DihedralAngle::measure(frame);
-  const auto [bending, slope] = bending_and_slope(cos_theta, sin_theta, term.cos_rest, term.sin_rest, term.weight);
+  const auto [bending, slope] =
+      bending_and_slope(cos_theta, sin_theta, term.cos_rest, term.sin_rest, term.weight);
   const double cos_delta = cos_theta * term.cos_rest + sin_theta * term.sin_rest;
   return {bending, slope, term.weight * cos_delta, -slope, true};
 }
@@ -154,7 +162,8 @@ Response unfaded_respond(const HingeTerm& term, const DihedralAngle::Frame<doubl
 Response respond(const HingeTerm& term, const DihedralAngle::Frame<double>& frame) {
   if (hinge_collapsed(term, frame.n1n1, frame.n2n2)) return {};
   if (hinge_faded(term, frame.n1n1, frame.n2n2)) {
-    const double faded = bending_and_slope(term, frame)[0] * fade(frame.n1n1 / term.rest_n1n1).value *
+    const double faded = bending_and_slope(term, frame)[0] *
+                         fade(frame.n1n1 / term.rest_n1n1).value *
                          fade(frame.n2n2 / term.rest_n2n2).value;
     return {faded, 1.0, 0.0, 0.0, true, true};
   }
@@ -163,7 +172,8 @@ Response respond(const HingeTerm& term, const DihedralAngle::Frame<double>& fram
 
 // ∇s at `frame`: the element quantity's, or a faded hinge's whole term's (Response::faded).
 template <typename Term, typename T>
-void gradient_of(const Term& term, bool faded, const typename Term::Quantity::template Frame<T>& frame, T* g) {
+void gradient_of(const Term& term, bool faded,
+                 const typename Term::Quantity::template Frame<T>& frame, T* g) {
   if constexpr (std::is_same_v<Term, HingeTerm>) {
     if (faded) return faded_hinge_gradient(term, frame, g);
   }
@@ -260,7 +270,7 @@ using TermLanes = Lanes<kLanes>;
 
 // A field of kLanes consecutive terms, side by side.
 template <typename Term>
-TermLanes lanes_of(const Term* terms, double Term::*field) {
+TermLanes lanes_of(const Term* terms, double Term::* field) {
   TermLanes lanes;
   for (int l = 0; l < kLanes; ++l) lanes[l] = terms[l].*field;
   return lanes;
@@ -268,25 +278,30 @@ TermLanes lanes_of(const Term* terms, double Term::*field) {
 
 // w f(s) and w f'(s) of kLanes terms in their usual state (in_usual_state): an edge or a triangle
 // not collapsed, a hinge not faded.
-std::array<TermLanes, 2> usual_value_and_slope(const EdgeTerm* terms, const EdgeLength::Frame<TermLanes>& frame) {
+std::array<TermLanes, 2> usual_value_and_slope(const EdgeTerm* terms,
+                                               const EdgeLength::Frame<TermLanes>& frame) {
   return quadratic_and_slope(EdgeLength::measure(frame), lanes_of(terms, &EdgeTerm::rest_length),
                              lanes_of(terms, &EdgeTerm::weight));
 }
 std::array<TermLanes, 2> usual_value_and_slope(const TriangleTerm* terms,
                                                const TriangleArea::Frame<TermLanes>& frame) {
-  return quadratic_and_slope(TriangleArea::measure(frame), lanes_of(terms, &TriangleTerm::rest_area),
+  return quadratic_and_slope(TriangleArea::measure(frame),
+                             lanes_of(terms, &TriangleTerm::rest_area),
                              lanes_of(terms, &TriangleTerm::weight));
 }
-std::array<TermLanes, 2> usual_value_and_slope(const HingeTerm* terms, const DihedralAngle::Frame<TermLanes>& frame) {
+std::array<TermLanes, 2> usual_value_and_slope(const HingeTerm* terms,
+                                               const DihedralAngle::Frame<TermLanes>& frame) {
   const auto [cos_theta, sin_theta] = DihedralAngle::measure(frame);
   return bending_and_slope(cos_theta, sin_theta, lanes_of(terms, &HingeTerm::cos_rest),
-                           lanes_of(terms, &HingeTerm::sin_rest), lanes_of(terms, &HingeTerm::weight));
+                           lanes_of(terms, &HingeTerm::sin_rest),
+                           lanes_of(terms, &HingeTerm::weight));
 }
 
 bool in_usual_state(const EdgeTerm& term, const EdgeLength::Frame<TermLanes>& frame, int lane) {
   return differentiable(term, frame.length[lane]);
 }
-bool in_usual_state(const TriangleTerm& term, const TriangleArea::Frame<TermLanes>& frame, int lane) {
+bool in_usual_state(const TriangleTerm& term, const TriangleArea::Frame<TermLanes>& frame,
+                    int lane) {
   return differentiable(term, frame.norm[lane]);
 }
 bool in_usual_state(const HingeTerm& term, const DihedralAngle::Frame<TermLanes>& frame, int lane) {
@@ -302,7 +317,8 @@ constexpr int kChunk = 16 * kLanes;
 // frames, usual values, slopes and gradients at once (lanes.h), then added to `out` term by term;
 // a term not in its usual state and the last terms go through add_gradient.
 template <typename Term>
-void add_gradients_in_lanes(const std::vector<Term>& terms, const double* x, double* out, double& energy) {
+void add_gradients_in_lanes(const std::vector<Term>& terms, const double* x, double* out,
+                            double& energy) {
   constexpr int K = kVerticesOf<Term>, N = kDofsOf<Term>, kGroups = kChunk / kLanes;
   const AllVertices all;
   const size_t count = terms.size(), whole = count - count % kLanes;
@@ -357,7 +373,8 @@ void visit_part(const shells::TermSet<Term>& set, int part, Visit& visit) {
 // ∇s and ∇²s (N by N, symmetrised, row-major) at r (s as gradient_of takes it): the gradient
 // evaluated on dual numbers with one direction per coordinate.
 template <typename Term, int N = kDofsOf<Term>>
-void second_derivatives(const Term& term, bool faded, const double* r, double* gradient, double* hessian) {
+void second_derivatives(const Term& term, bool faded, const double* r, double* gradient,
+                        double* hessian) {
   using D = Dual<double, N>;
   D rd[N], g[N];
   for (int i = 0; i < N; ++i) {
@@ -374,8 +391,8 @@ void second_derivatives(const Term& term, bool faded, const double* r, double* g
 // ∇s, ∇²s u, ∇²s w and ∇³s(u, w) at r: the gradient evaluated on hyper-dual numbers
 // r + ε1 u + ε2 w, read off at 1, ε2, ε1 and ε1ε2.
 template <typename Term, int N = kDofsOf<Term>>
-void third_derivatives(const Term& term, bool faded, const double* r, const double* u, const double* w,
-                       double* gradient, double* hu, double* hw, double* tuw) {
+void third_derivatives(const Term& term, bool faded, const double* r, const double* u,
+                       const double* w, double* gradient, double* hu, double* hw, double* tuw) {
   using H = Dual<Dual<double, 1>, 1>;
   H rh[N], g[N];
   for (int i = 0; i < N; ++i) {
@@ -395,11 +412,12 @@ void third_derivatives(const Term& term, bool faded, const double* r, const doub
 // ∇³(w f(s))(u, w) in relative coordinates (the formula in the header); tuw = ∇³s(u, w) is
 // only read when f' ≠ 0.
 template <int N>
-void third_of_term(const Response& q, const double* gradient, const double* hu, const double* hw, const double* u,
-                   const double* w, const double* tuw, double* out) {
+void third_of_term(const Response& q, const double* gradient, const double* hu, const double* hw,
+                   const double* u, const double* w, const double* tuw, double* out) {
   const double su = dot<N>(gradient, u), sw = dot<N>(gradient, w);
   const double along_gradient = q.d3f * su * sw + q.d2f * dot<N>(u, hw);
-  for (int i = 0; i < N; ++i) out[i] = along_gradient * gradient[i] + q.d2f * (su * hw[i] + sw * hu[i]);
+  for (int i = 0; i < N; ++i)
+    out[i] = along_gradient * gradient[i] + q.d2f * (su * hw[i] + sw * hu[i]);
   if (q.df != 0)
     for (int i = 0; i < N; ++i) out[i] += q.df * tuw[i];
 }
@@ -449,7 +467,8 @@ BlockCoefficients block_coefficients(const Response& q, bool semidefinite) {
 // positive semidefinite matrices when k.project, expanded to the 3K by 3K Hessian over the term's
 // vertices (row-major). ∇²s is only read when k.df ≠ 0.
 template <int K>
-void term_hessian(const BlockCoefficients& k, const double* gradient, const double* hessian, double* full) {
+void term_hessian(const BlockCoefficients& k, const double* gradient, const double* hessian,
+                  double* full) {
   constexpr int N = 3 * (K - 1), M = 3 * K;
   // Written so that the result is exactly symmetric (the assembled Hessian then is too).
   for (int i = 0; i < N; ++i)
@@ -472,25 +491,29 @@ void term_hessian(const BlockCoefficients& k, const double* gradient, const doub
       full[c * M + j] = -sum;
     }
   for (int c = 0; c < 3; ++c)
-    for (int d = 0; d < c; ++d) full[c * M + d] = full[d * M + c] = 0.5 * (full[c * M + d] + full[d * M + c]);
+    for (int d = 0; d < c; ++d)
+      full[c * M + d] = full[d * M + c] = 0.5 * (full[c * M + d] + full[d * M + c]);
 }
-
 
 template <typename Term>
 void add_vertex_pairs(const std::vector<Term>& terms, std::vector<std::array<int, 2>>& pairs) {
   for (const Term& term : terms)
     for (int p = 0; p < kVerticesOf<Term>; ++p)
       for (int q = p + 1; q < kVerticesOf<Term>; ++q)
-        if (term.vertices[p] != term.vertices[q]) pairs.push_back({term.vertices[p], term.vertices[q]});
+        if (term.vertices[p] != term.vertices[q])
+          pairs.push_back({term.vertices[p], term.vertices[q]});
 }
 
 template <typename Term>
-void finish_set(shells::TermSet<Term>& set, const BlockSparsity& sparsity, const VertexPartition& partition) {
+void finish_set(shells::TermSet<Term>& set, const BlockSparsity& sparsity,
+                const VertexPartition& partition) {
   constexpr int K = kVerticesOf<Term>;
   // In the order of their smallest vertex, so that sweeps move through the outputs in order: a
   // stable counting sort, linear (a comparison sort found each term's smallest vertex again for
   // every comparison).
-  const auto smallest = [](const Term& term) { return *std::min_element(term.vertices.begin(), term.vertices.end()); };
+  const auto smallest = [](const Term& term) {
+    return *std::min_element(term.vertices.begin(), term.vertices.end());
+  };
   std::vector<int> start(static_cast<size_t>(sparsity.num_vertices()) + 1, 0);
   for (const Term& term : set.terms) ++start[smallest(term) + 1];
   std::partial_sum(start.begin(), start.end(), start.begin());
@@ -504,7 +527,8 @@ void finish_set(shells::TermSet<Term>& set, const BlockSparsity& sparsity, const
     for (size_t e = chunk * kChunk; e < std::min(set.terms.size(), (chunk + 1) * kChunk); ++e)
       for (int p = 0; p < K; ++p)
         for (int q = 0; q < K; ++q)
-          set.block_offsets[e][p * K + q] = sparsity.offset(set.terms[e].vertices[p], set.terms[e].vertices[q]);
+          set.block_offsets[e][p * K + q] =
+              sparsity.offset(set.terms[e].vertices[p], set.terms[e].vertices[q]);
   });
   if (partition.parts() > 1) set.by_part = elements_by_part(partition, set.terms);
 }
@@ -516,8 +540,8 @@ void DiscreteShells::for_each_term(int part, Visit&& visit) const {
   for_each_set([&](const auto& set) { visit_part(set, part, visit); });
 }
 
-DiscreteShells::DiscreteShells(const VerticesRef& V, const FacesRef& F, double bending, double membrane,
-                               const StiffnessPaint& paint) {
+DiscreteShells::DiscreteShells(const VerticesRef& V, const FacesRef& F, double bending,
+                               double membrane, const StiffnessPaint& paint) {
   validate_mesh(V, F);
   require_weight(bending, "bending");
   require_weight(membrane, "membrane");
@@ -531,8 +555,9 @@ DiscreteShells::DiscreteShells(const VerticesRef& V, const FacesRef& F, double b
   const double tiny = kCollapse * bounding_box_extent(V);
   std::vector<char> degenerate(F.rows());
   for (int f = 0; f < F.rows(); ++f)
-    degenerate[f] = is_degenerate_face(V, F, f) || ((V.row(F(f, 1)) - V.row(F(f, 0))).norm() <= tiny &&
-                                                    (V.row(F(f, 2)) - V.row(F(f, 0))).norm() <= tiny);
+    degenerate[f] =
+        is_degenerate_face(V, F, f) || ((V.row(F(f, 1)) - V.row(F(f, 0))).norm() <= tiny &&
+                                        (V.row(F(f, 2)) - V.row(F(f, 0))).norm() <= tiny);
 
   // The rest quantities come from the same code as the deformed ones, so at rest s = s̄ exactly.
   for (const auto& [a, b] : topology.edges) {
@@ -571,8 +596,9 @@ DiscreteShells::DiscreteShells(const VerticesRef& V, const FacesRef& F, double b
     term.cos_rest = cos_rest;
     term.sin_rest = sin_rest;
     const double bend = paint.factor(term.vertices) * bending;
-    term.weight = bounded_weight(3 * bend * frame.aa / (area[hinge.faces[0]] + area[hinge.faces[1]]),
-                                 squared_gradient_norm<HingeTerm>(frame), bend * equilateral_hinge_stiffness(frame.aa));
+    term.weight = bounded_weight(
+        3 * bend * frame.aa / (area[hinge.faces[0]] + area[hinge.faces[1]]),
+        squared_gradient_norm<HingeTerm>(frame), bend * equilateral_hinge_stiffness(frame.aa));
     term.rest_n1n1 = frame.n1n1;
     term.rest_n2n2 = frame.n2n2;
     hinges_.terms.push_back(term);
@@ -587,7 +613,8 @@ DiscreteShells::DiscreteShells(const VerticesRef& V, const FacesRef& F, double b
   });
   sparsity_ = BlockSparsity(n, pairs);
   const size_t num_terms = edges_.terms.size() + triangles_.terms.size() + hinges_.terms.size();
-  partition_ = balanced_partition(work, num_terms >= kParallelElements ? std::max(1, omp_get_max_threads()) : 1);
+  partition_ = balanced_partition(
+      work, num_terms >= kParallelElements ? std::max(1, omp_get_max_threads()) : 1);
   finish_set(edges_, sparsity_, partition_);
   finish_set(triangles_, sparsity_, partition_);
   finish_set(hinges_, sparsity_, partition_);
@@ -613,10 +640,12 @@ double DiscreteShells::value(const VectorRef& x) const {
   return energy;
 }
 
-double DiscreteShells::value_and_gradient(const VectorRef& x, Eigen::Ref<Eigen::VectorXd> gradient) const {
+double DiscreteShells::value_and_gradient(const VectorRef& x,
+                                          Eigen::Ref<Eigen::VectorXd> gradient) const {
   require_positions(x, rest_.size(), "X");
   if (gradient.size() != rest_.size())
-    throw InputError(message("gradient: expected ", rest_.size(), " values, got ", gradient.size()));
+    throw InputError(
+        message("gradient: expected ", rest_.size(), " values, got ", gradient.size()));
   double energy = 0;
   if (!parallel()) {  // the reduced solver's ghost, for instance
     gradient.setZero();
@@ -687,7 +716,8 @@ void DiscreteShells::hessian_into(const VectorRef& x, bool projected, SparseMatr
   }
 }
 
-Eigen::VectorXd DiscreteShells::third(const VectorRef& x, const VectorRef& u, const VectorRef& w) const {
+Eigen::VectorXd DiscreteShells::third(const VectorRef& x, const VectorRef& u,
+                                      const VectorRef& w) const {
   require_positions(x, rest_.size(), "X");
   require_positions(u, rest_.size(), "U");
   require_positions(w, rest_.size(), "W");
@@ -714,7 +744,8 @@ Eigen::VectorXd DiscreteShells::third(const VectorRef& x, const VectorRef& u, co
   return out;
 }
 
-RowMatrixXd DiscreteShells::third_batch(const VectorRef& x, const Eigen::Ref<const Eigen::MatrixXd>& Phi,
+RowMatrixXd DiscreteShells::third_batch(const VectorRef& x,
+                                        const Eigen::Ref<const Eigen::MatrixXd>& Phi,
                                         const std::vector<std::array<int, 2>>& pairs) const {
   require_positions(x, rest_.size(), "X");
   if (Phi.rows() != rest_.size())
@@ -729,7 +760,8 @@ RowMatrixXd DiscreteShells::third_batch(const VectorRef& x, const Eigen::Ref<con
   for (size_t p = 0; p < pairs.size(); ++p)
     for (int column : pairs[p]) {
       if (column < 0 || column >= Phi.cols())
-        throw InputError(message("pairs[", p, "]: column ", column, " outside [0, ", Phi.cols(), ")"));
+        throw InputError(
+            message("pairs[", p, "]: column ", column, " outside [0, ", Phi.cols(), ")"));
       if (slot[column] < 0) {
         slot[column] = static_cast<int>(used.size());
         used.push_back(column);
@@ -768,7 +800,8 @@ RowMatrixXd DiscreteShells::third_batch(const VectorRef& x, const Eigen::Ref<con
         double tuw[N], local[N];
         if (q.df != 0) {  // away from rest: ∇³s(Φ_i, Φ_j) too
           double unused_g[N], unused_hu[N], unused_hw[N];
-          third_derivatives(term, q.faded, r, &phi[N * i], &phi[N * j], unused_g, unused_hu, unused_hw, tuw);
+          third_derivatives(term, q.faded, r, &phi[N * i], &phi[N * j], unused_g, unused_hu,
+                            unused_hw, tuw);
         }
         third_of_term<N>(q, g, &h_phi[N * i], &h_phi[N * j], &phi[N * i], &phi[N * j], tuw, local);
         to_vertices<K>(local, &full[3 * K * p]);

@@ -77,15 +77,16 @@ class DiscreteShells final : public Energy {
   // V: #V by 3 rest positions; F: #F by 3 triangles; bending (α) and membrane (β) weights,
   // finite and ≥ 0, each element's multiplied by its factor of `paint` (stiffness_paint.h).
   // Throws InputError for an unusable mesh (validate_mesh), a bad weight or paint.
-  DiscreteShells(const VerticesRef& V, const FacesRef& F, double bending = 1.0, double membrane = 1.0,
-                 const StiffnessPaint& paint = {});
+  DiscreteShells(const VerticesRef& V, const FacesRef& F, double bending = 1.0,
+                 double membrane = 1.0, const StiffnessPaint& paint = {});
 
   int num_vertices() const override { return static_cast<int>(rest_.size() / 3); }
   const Eigen::VectorXd& rest() const override { return rest_; }
 
   // x, u, w: 3n. Throws InputError for a wrong length or a non-finite entry (naming it).
   double value(const VectorRef& x) const override;
-  double value_and_gradient(const VectorRef& x, Eigen::Ref<Eigen::VectorXd> gradient) const override;
+  double value_and_gradient(const VectorRef& x,
+                            Eigen::Ref<Eigen::VectorXd> gradient) const override;
   // Exactly symmetric; its pattern (vertex blocks of every vertex pair sharing a term, and all
   // diagonal blocks) is the same at every x.
   SparseMatrix hessian(const VectorRef& x) const override;
@@ -123,8 +124,12 @@ class DiscreteShells final : public Energy {
   template <typename Visit>
   void for_each_term(int part, Visit&& visit) const;
   const shells::TermSet<shells::EdgeTerm>& set_of(const shells::EdgeTerm&) const { return edges_; }
-  const shells::TermSet<shells::TriangleTerm>& set_of(const shells::TriangleTerm&) const { return triangles_; }
-  const shells::TermSet<shells::HingeTerm>& set_of(const shells::HingeTerm&) const { return hinges_; }
+  const shells::TermSet<shells::TriangleTerm>& set_of(const shells::TriangleTerm&) const {
+    return triangles_;
+  }
+  const shells::TermSet<shells::HingeTerm>& set_of(const shells::HingeTerm&) const {
+    return hinges_;
+  }
   bool parallel() const { return partition_.parts() > 1; }
 
   Eigen::VectorXd rest_;

@@ -15,8 +15,8 @@ namespace modal_deform {
 
 template <typename T, int N>
 struct Dual {
-  T v{};                  // value
-  std::array<T, N> d{};   // derivative along each direction
+  T v{};                 // value
+  std::array<T, N> d{};  // derivative along each direction
 
   Dual() = default;
   explicit Dual(double value) : v(value) {}

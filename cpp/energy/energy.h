@@ -20,7 +20,8 @@ class Energy {
   // E(x).
   virtual double value(const VectorRef& x) const = 0;
   // E(x), with ∇E(x) written into `gradient` (3n).
-  virtual double value_and_gradient(const VectorRef& x, Eigen::Ref<Eigen::VectorXd> gradient) const = 0;
+  virtual double value_and_gradient(const VectorRef& x,
+                                    Eigen::Ref<Eigen::VectorXd> gradient) const = 0;
   // ∇²E(x): symmetric 3n by 3n, both triangles stored.
   virtual SparseMatrix hessian(const VectorRef& x) const = 0;
   // A positive semidefinite stand-in for ∇²E(x), element by element: each element's Hessian
@@ -35,7 +36,8 @@ class Energy {
     H = projected ? projected_hessian(x) : hessian(x);
   }
   // ∇³E(x)(u, w) (3n): the Hessian's derivative along u, applied to w.
-  virtual Eigen::VectorXd third(const VectorRef& x, const VectorRef& u, const VectorRef& w) const = 0;
+  virtual Eigen::VectorXd third(const VectorRef& x, const VectorRef& u,
+                                const VectorRef& w) const = 0;
 };
 
 }  // namespace modal_deform

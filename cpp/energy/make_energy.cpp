@@ -16,15 +16,17 @@ const char* energy_name(EnergyKind kind) { return kind == EnergyKind::kArap ? "a
 
 void require_paintable(EnergyKind kind, const StiffnessPaint& paint) {
   if (kind == EnergyKind::kArap && !paint.uniform())
-    throw InputError("stiffness_weights: the ARAP energy has no painted stiffness (its energy is per vertex "
-                     "neighbourhood, not per element); use the shells energy, or no stiffness weights");
+    throw InputError(
+        "stiffness_weights: the ARAP energy has no painted stiffness (its energy is per vertex "
+        "neighbourhood, not per element); use the shells energy, or no stiffness weights");
 }
 
 std::unique_ptr<Energy> make_energy(EnergyKind kind, const VerticesRef& V, const FacesRef& F,
                                     const Material& material) {
   require_paintable(kind, material.paint);
   if (kind == EnergyKind::kArap) return std::make_unique<Arap>(V, F);
-  return std::make_unique<DiscreteShells>(V, F, material.bending, material.membrane, material.paint);
+  return std::make_unique<DiscreteShells>(V, F, material.bending, material.membrane,
+                                          material.paint);
 }
 
 }  // namespace modal_deform

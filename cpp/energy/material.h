@@ -20,21 +20,26 @@ struct Material {
 // m -> m.member, const when m is.
 template <typename Visit>
 void for_each_material_field(Visit&& visit) {
-  visit(Option{"bending", "How much the surface resists bending (the weight α of the shells energy).",
-               closed(0, kMaxWeight)},
-        [](auto& m) -> auto& { return m.bending; });
+  visit(
+      Option{"bending", "How much the surface resists bending (the weight α of the shells energy).",
+             closed(0, kMaxWeight)},
+      [](auto& m) -> auto& { return m.bending; });
   visit(Option{"membrane",
-               "How much the surface resists stretching and squashing (the weight β of the shells energy).",
+               "How much the surface resists stretching and squashing (the weight β of the shells "
+               "energy).",
                closed(0, kMaxWeight)},
         [](auto& m) -> auto& { return m.membrane; });
   visit(Option{"stiffness_weights",
-               "Stiffness painted per vertex, as Cloth takes it from a vertex group: (n,) weights in [0, 1], "
-               "or None for a uniform material. Each element's bending and membrane weights are multiplied by "
+               "Stiffness painted per vertex, as Cloth takes it from a vertex group: (n,) weights "
+               "in [0, 1], "
+               "or None for a uniform material. Each element's bending and membrane weights are "
+               "multiplied by "
                "1 + (max_stiffness - 1) times the mean weight of its vertices."},
         [](auto& m) -> auto& { return m.paint.weights; });
-  visit(Option{"max_stiffness", "How many times stiffer than the material a painted weight of 1 is.",
-               closed(1, kMaxStiffness)},
-        [](auto& m) -> auto& { return m.paint.max_stiffness; });
+  visit(
+      Option{"max_stiffness", "How many times stiffer than the material a painted weight of 1 is.",
+             closed(1, kMaxStiffness)},
+      [](auto& m) -> auto& { return m.paint.max_stiffness; });
 }
 
 // The material fields of options that hold a Material `material`, as fields of the options:

@@ -92,7 +92,8 @@ struct TriangleArea {
   template <typename T>
   static void gradient(const Frame<T>& f, T* g) {
     const T half_inverse_norm = T(0.5) / f.norm;
-    const Vec3<T> u{f.n[0] * half_inverse_norm, f.n[1] * half_inverse_norm, f.n[2] * half_inverse_norm};
+    const Vec3<T> u{f.n[0] * half_inverse_norm, f.n[1] * half_inverse_norm,
+                    f.n[2] * half_inverse_norm};
     const Vec3<T> ga = cross(f.b, u), gb = cross(u, f.a);
     for (int i = 0; i < 3; ++i) {
       g[i] = ga[i];

@@ -50,13 +50,15 @@ inline VertexPartition balanced_partition(const std::vector<int>& work, int part
 // For each part, the indices of the elements with a vertex it owns, ascending. Element: any type
 // with a `vertices` array of vertex indices.
 template <typename Element>
-std::vector<std::vector<int>> elements_by_part(const VertexPartition& partition, const std::vector<Element>& elements) {
+std::vector<std::vector<int>> elements_by_part(const VertexPartition& partition,
+                                               const std::vector<Element>& elements) {
   std::vector<std::vector<int>> lists(partition.parts());
   for (int e = 0; e < static_cast<int>(elements.size()); ++e) {
     const auto& vertices = elements[e].vertices;
     for (int part = 0; part < partition.parts(); ++part) {
       const VertexPartition::Range range = partition.range(part);
-      if (std::any_of(vertices.begin(), vertices.end(), [range](int v) { return range.contains(v); }))
+      if (std::any_of(vertices.begin(), vertices.end(),
+                      [range](int v) { return range.contains(v); }))
         lists[part].push_back(e);
     }
   }

@@ -44,7 +44,9 @@ const OpenBlasThreads& openblas_threads() {
   static const OpenBlasThreads found = [] {
     OpenBlasThreads threads;
     Dl_info info{};
-    if (dladdr(reinterpret_cast<void*>(&cholmod_factorize), &info) == 0 || info.dli_fname == nullptr) return threads;
+    if (dladdr(reinterpret_cast<void*>(&cholmod_factorize), &info) == 0 ||
+        info.dli_fname == nullptr)
+      return threads;
     void* cholmod = dlopen(info.dli_fname, RTLD_LAZY | RTLD_NOLOAD);
     if (cholmod == nullptr) return threads;
     threads.get = reinterpret_cast<int (*)()>(dlsym(cholmod, "openblas_get_num_threads"));

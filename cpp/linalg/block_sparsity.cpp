@@ -56,7 +56,8 @@ BlockSparsity::BlockSparsity(int num_vertices, const std::vector<std::array<int,
 int BlockSparsity::offset(int a, int b) const {
   const auto first = rows_.begin() + begin_[b], last = rows_.begin() + begin_[b + 1];
   const auto it = std::lower_bound(first, last, a);
-  if (it == last || *it != a) throw std::logic_error(message("BlockSparsity: no block (", a, ", ", b, ")"));
+  if (it == last || *it != a)
+    throw std::logic_error(message("BlockSparsity: no block (", a, ", ", b, ")"));
   return 9 * begin_[b] + 3 * static_cast<int>(it - first);
 }
 

@@ -43,8 +43,9 @@ class BlockSparsity {
   void zero_columns(SparseMatrix& matrix, int first_vertex, int last_vertex) const;
 
  private:
-  std::vector<int> begin_;  // #V + 1: the blocks of vertex column b are rows_[begin_[b] .. begin_[b + 1])
-  std::vector<int> rows_;   // row vertex of each block, sorted within a column
+  std::vector<int>
+      begin_;  // #V + 1: the blocks of vertex column b are rows_[begin_[b] .. begin_[b + 1])
+  std::vector<int> rows_;  // row vertex of each block, sorted within a column
 };
 
 }  // namespace modal_deform

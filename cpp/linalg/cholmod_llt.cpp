@@ -53,18 +53,22 @@ class SerialOpenMP {
 // The lower triangle of A plus diag(shift), with every diagonal entry stored (an unreferenced
 // vertex has none in A, but still needs a pivot).
 SparseMatrix lower_with_diagonal(const SparseMatrix& A, const VectorRef* shift) {
-  if (A.rows() != A.cols()) throw InputError(message("A: expected a square matrix, got ", A.rows(), " by ", A.cols()));
+  if (A.rows() != A.cols())
+    throw InputError(message("A: expected a square matrix, got ", A.rows(), " by ", A.cols()));
   const int n = static_cast<int>(A.rows());
-  if (shift && shift->size() != n) throw InputError(message("shift: expected ", n, " values, got ", shift->size()));
+  if (shift && shift->size() != n)
+    throw InputError(message("shift: expected ", n, " values, got ", shift->size()));
   std::vector<int> count(n, 0);
   for (int j = 0; j < n; ++j) {
     int previous = -1;
     bool has_diagonal = false;
     for (SparseMatrix::InnerIterator it(A, j); it; ++it) {
       const int i = static_cast<int>(it.row());
-      if (i <= previous) throw InputError(message("A: row indices of column ", j, " are not sorted or repeat"));
+      if (i <= previous)
+        throw InputError(message("A: row indices of column ", j, " are not sorted or repeat"));
       previous = i;
-      if (!std::isfinite(it.value())) throw InputError(message("A(", i, ", ", j, ") is not finite"));
+      if (!std::isfinite(it.value()))
+        throw InputError(message("A(", i, ", ", j, ") is not finite"));
       if (i >= j) ++count[j];
       has_diagonal |= i == j;
     }
@@ -188,8 +192,10 @@ struct CholmodLLT::Cholmod {
   }
 };
 
-CholmodLLT::CholmodLLT(int dofs_per_node) : cholmod_(std::make_unique<Cholmod>()), dofs_per_node_(dofs_per_node) {
-  if (dofs_per_node < 1) throw InputError(message("dofs_per_node: expected 1 or more, got ", dofs_per_node));
+CholmodLLT::CholmodLLT(int dofs_per_node)
+    : cholmod_(std::make_unique<Cholmod>()), dofs_per_node_(dofs_per_node) {
+  if (dofs_per_node < 1)
+    throw InputError(message("dofs_per_node: expected 1 or more, got ", dofs_per_node));
 }
 
 CholmodLLT::~CholmodLLT() = default;
@@ -224,16 +230,20 @@ void CholmodLLT::analyze_lower() {
   SparseMatrix graph = node_graph(lower_, b);
   cholmod_sparse graph_view = Cholmod::view(graph, false);
   std::vector<int> node_order(static_cast<size_t>(n / b)), order(static_cast<size_t>(n));
-  cholmod_->check(cholmod_metis(&graph_view, nullptr, 0, 1, node_order.data(), &cholmod_->common) != 0,
-                  "METIS ordering");
+  cholmod_->check(
+      cholmod_metis(&graph_view, nullptr, 0, 1, node_order.data(), &cholmod_->common) != 0,
+      "METIS ordering");
   for (int k = 0; k < n / b; ++k)
-    for (int r = 0; r < b; ++r) order[static_cast<size_t>(b * k + r)] = b * node_order[static_cast<size_t>(k)] + r;
+    for (int r = 0; r < b; ++r)
+      order[static_cast<size_t>(b * k + r)] = b * node_order[static_cast<size_t>(k)] + r;
   cholmod_sparse view = Cholmod::view(lower_);
   cholmod_->factor = cholmod_analyze_p(&view, order.data(), nullptr, 0, &cholmod_->common);
   cholmod_->check(cholmod_->factor != nullptr, "analyze");
 }
 
-void CholmodLLT::factorize(const SparseMatrix& A) { factorize_lower(lower_with_diagonal(A, nullptr), kSingularRcond); }
+void CholmodLLT::factorize(const SparseMatrix& A) {
+  factorize_lower(lower_with_diagonal(A, nullptr), kSingularRcond);
+}
 
 void CholmodLLT::factorize(const SparseMatrix& A, const VectorRef& shift, double min_rcond) {
   factorize_lower(lower_with_diagonal(A, &shift), min_rcond);
@@ -255,15 +265,16 @@ void CholmodLLT::factorize_lower(SparseMatrix lower, double min_rcond) {
     const int pivot = static_cast<int>(L->minor);
     const int row = static_cast<const int*>(L->Perm)[pivot];
     failed_row_ = row;
-    throw NumericalError(message("the matrix is not positive definite: the Cholesky factorisation breaks down at row ",
-                                 row, " (pivot ", pivot + 1, " of ", rows(), " in CHOLMOD's ordering)"));
+    throw NumericalError(message(
+        "the matrix is not positive definite: the Cholesky factorisation breaks down at row ", row,
+        " (pivot ", pivot + 1, " of ", rows(), " in CHOLMOD's ordering)"));
   }
   cholmod_->check(ok != 0, "factorize");
   rcond_ = cholmod_rcond(L, &cholmod_->common);
   if (!(rcond_ >= min_rcond))
-    throw NumericalError(
-        message("the matrix is singular to working precision (CHOLMOD's reciprocal condition estimate ", rcond_,
-                "): its solutions would be rounding noise"));
+    throw NumericalError(message(
+        "the matrix is singular to working precision (CHOLMOD's reciprocal condition estimate ",
+        rcond_, "): its solutions would be rounding noise"));
   factorized_ = true;
 }
 
@@ -275,13 +286,16 @@ Eigen::MatrixXd CholmodLLT::solve(const Eigen::Ref<const Eigen::MatrixXd>& B) {
 
 void CholmodLLT::solve(const Eigen::Ref<const Eigen::MatrixXd>& B, Eigen::Ref<Eigen::MatrixXd> X) {
   if (X.rows() != B.rows() || X.cols() != B.cols())
-    throw InputError(message("X: expected ", B.rows(), " by ", B.cols(), ", got ", X.rows(), " by ", X.cols()));
+    throw InputError(
+        message("X: expected ", B.rows(), " by ", B.cols(), ", got ", X.rows(), " by ", X.cols()));
   X = solve_in_workspace(B);
 }
 
 CholmodLLT::Solution CholmodLLT::solve_in_workspace(const Eigen::Ref<const Eigen::MatrixXd>& B) {
-  if (!factorized_) throw std::logic_error("CholmodLLT::solve: no successful factorisation to solve with");
-  if (B.rows() != rows()) throw InputError(message("B: expected ", rows(), " rows, got ", B.rows()));
+  if (!factorized_)
+    throw std::logic_error("CholmodLLT::solve: no successful factorisation to solve with");
+  if (B.rows() != rows())
+    throw InputError(message("B: expected ", rows(), " rows, got ", B.rows()));
   if (B.cols() == 0) return Solution(nullptr, B.rows(), 0, Eigen::OuterStride<>(B.rows()));
   cholmod_dense rhs{};
   rhs.nrow = static_cast<size_t>(B.rows());
@@ -293,8 +307,8 @@ CholmodLLT::Solution CholmodLLT::solve_in_workspace(const Eigen::Ref<const Eigen
   rhs.dtype = CHOLMOD_DOUBLE;
   Cholmod& c = *cholmod_;
   const BlasThreadLimit blas_threads;
-  const int ok =
-      cholmod_solve2(CHOLMOD_A, c.factor, &rhs, nullptr, &c.solution, nullptr, &c.work_y, &c.work_e, &c.common);
+  const int ok = cholmod_solve2(CHOLMOD_A, c.factor, &rhs, nullptr, &c.solution, nullptr, &c.work_y,
+                                &c.work_e, &c.common);
   c.check(ok != 0, "solve");
   return Solution(static_cast<const double*>(c.solution->x), B.rows(), B.cols(),
                   Eigen::OuterStride<>(static_cast<Eigen::Index>(c.solution->d)));

@@ -30,7 +30,8 @@ void for_row_blocks(Eigen::Index rows, Work&& work) {
 
 // Σ over the blocks of term(first, count), each an r by c matrix, added in block order.
 template <typename Term>
-Eigen::MatrixXd sum_over_row_blocks(Eigen::Index rows, Eigen::Index r, Eigen::Index c, Term&& term) {
+Eigen::MatrixXd sum_over_row_blocks(Eigen::Index rows, Eigen::Index r, Eigen::Index c,
+                                    Term&& term) {
   std::vector<Eigen::MatrixXd> partial(static_cast<size_t>(row_blocks(rows)));
   for_row_blocks(rows, [&](Eigen::Index first, Eigen::Index count) {
     partial[static_cast<size_t>(first / kRowBlock)].noalias() = term(first, count);
@@ -43,21 +44,25 @@ Eigen::MatrixXd sum_over_row_blocks(Eigen::Index rows, Eigen::Index r, Eigen::In
 // Aᵀ B (a by b) for A (n by a) and B (n by b).
 inline Eigen::MatrixXd inner_product(const Eigen::Ref<const Eigen::MatrixXd>& A,
                                      const Eigen::Ref<const Eigen::MatrixXd>& B) {
-  return sum_over_row_blocks(A.rows(), A.cols(), B.cols(), [&](Eigen::Index first, Eigen::Index count) {
-    return A.middleRows(first, count).transpose() * B.middleRows(first, count);
-  });
+  return sum_over_row_blocks(
+      A.rows(), A.cols(), B.cols(), [&](Eigen::Index first, Eigen::Index count) {
+        return A.middleRows(first, count).transpose() * B.middleRows(first, count);
+      });
 }
 
 // Aᵀ diag(d) B (a by b) for A (n by a), d (n) and B (n by b).
 inline Eigen::MatrixXd inner_product(const Eigen::Ref<const Eigen::MatrixXd>& A, const VectorRef& d,
                                      const Eigen::Ref<const Eigen::MatrixXd>& B) {
-  return sum_over_row_blocks(A.rows(), A.cols(), B.cols(), [&](Eigen::Index first, Eigen::Index count) {
-    return A.middleRows(first, count).transpose() * (d.segment(first, count).asDiagonal() * B.middleRows(first, count));
-  });
+  return sum_over_row_blocks(
+      A.rows(), A.cols(), B.cols(), [&](Eigen::Index first, Eigen::Index count) {
+        return A.middleRows(first, count).transpose() *
+               (d.segment(first, count).asDiagonal() * B.middleRows(first, count));
+      });
 }
 
 // A C (n by c) for A (n by a) and C (a by c).
-inline Eigen::MatrixXd dense_product(const Eigen::Ref<const Eigen::MatrixXd>& A, const Eigen::MatrixXd& C) {
+inline Eigen::MatrixXd dense_product(const Eigen::Ref<const Eigen::MatrixXd>& A,
+                                     const Eigen::MatrixXd& C) {
   Eigen::MatrixXd X(A.rows(), C.cols());
   for_row_blocks(A.rows(), [&](Eigen::Index first, Eigen::Index count) {
     X.middleRows(first, count).noalias() = A.middleRows(first, count) * C;
@@ -66,7 +71,8 @@ inline Eigen::MatrixXd dense_product(const Eigen::Ref<const Eigen::MatrixXd>& A,
 }
 
 // X += A C for X (n by c), A (n by a) and C (a by c).
-inline void add_dense_product(Eigen::Ref<Eigen::MatrixXd> X, const Eigen::Ref<const Eigen::MatrixXd>& A,
+inline void add_dense_product(Eigen::Ref<Eigen::MatrixXd> X,
+                              const Eigen::Ref<const Eigen::MatrixXd>& A,
                               const Eigen::MatrixXd& C) {
   for_row_blocks(X.rows(), [&](Eigen::Index first, Eigen::Index count) {
     X.middleRows(first, count).noalias() += A.middleRows(first, count) * C;

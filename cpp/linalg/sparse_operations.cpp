@@ -25,7 +25,8 @@ void add_product(const SparseMatrix& A, const Eigen::Ref<const Eigen::MatrixXd>&
     RowMajorMatrix rows, product;  // reused from task to task
 #pragma omp for schedule(dynamic)
     for (Eigen::Index task = 0; task < tasks; ++task) {
-      const Eigen::Index first = task * kProductColumns, width = std::min(kProductColumns, X.cols() - first);
+      const Eigen::Index first = task * kProductColumns,
+                         width = std::min(kProductColumns, X.cols() - first);
       rows = X.middleCols(first, width);
       product.noalias() = A * rows;
       out.middleCols(first, width) += scale * product;

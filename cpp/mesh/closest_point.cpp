@@ -6,8 +6,8 @@ namespace modal_deform {
 
 // Projecting p onto the triangle's plane (normal equations of p − a ≈ s (b − a) + t (c − a))
 // answers when the projection falls inside; otherwise the closest point lies on an edge.
-Eigen::Vector3d closest_point_barycentric(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                                          const Eigen::Vector3d& c) {
+Eigen::Vector3d closest_point_barycentric(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                          const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
   const Eigen::Vector3d e1 = b - a, e2 = c - a, d = p - a;
   const double g11 = e1.squaredNorm(), g12 = e1.dot(e2), g22 = e2.squaredNorm();
   const double determinant = g11 * g22 - g12 * g12;  // g11 g22 sin²θ

@@ -19,6 +19,7 @@ constexpr double kMaxCotangent = 1e3;
 // V: #V by 3 rest positions; F: #F by 3 faces; topology: build_topology(V, F).
 // Returns the #edges weights in the order of topology.edges, dimensionless; negative where the
 // opposite angles sum to more than 180 degrees (non-Delaunay edges).
-Eigen::VectorXd cotangent_weights(const VerticesRef& V, const FacesRef& F, const MeshTopology& topology);
+Eigen::VectorXd cotangent_weights(const VerticesRef& V, const FacesRef& F,
+                                  const MeshTopology& topology);
 
 }  // namespace modal_deform

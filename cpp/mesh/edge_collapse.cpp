@@ -40,8 +40,9 @@ class Quadric {
   // w (n·p + d)² for the plane n·p + d = 0, n of unit length.
   static Quadric plane(const Eigen::Vector3d& n, double d, double w) {
     Quadric q;
-    q.c_ = {w * n.x() * n.x(), w * n.x() * n.y(), w * n.x() * n.z(), w * n.y() * n.y(), w * n.y() * n.z(),
-            w * n.z() * n.z(), w * d * n.x(),     w * d * n.y(),     w * d * n.z(),     w * d * d};
+    q.c_ = {w * n.x() * n.x(), w * n.x() * n.y(), w * n.x() * n.z(), w * n.y() * n.y(),
+            w * n.y() * n.z(), w * n.z() * n.z(), w * d * n.x(),     w * d * n.y(),
+            w * d * n.z(),     w * d * d};
     return q;
   }
 
@@ -52,8 +53,8 @@ class Quadric {
 
   double operator()(const Eigen::Vector3d& p) const {
     const double x = p.x(), y = p.y(), z = p.z();
-    return x * (c_[0] * x + 2 * (c_[1] * y + c_[2] * z + c_[6])) + y * (c_[3] * y + 2 * (c_[4] * z + c_[7])) +
-           z * (c_[5] * z + 2 * c_[8]) + c_[9];
+    return x * (c_[0] * x + 2 * (c_[1] * y + c_[2] * z + c_[6])) +
+           y * (c_[3] * y + 2 * (c_[4] * z + c_[7])) + z * (c_[5] * z + 2 * c_[8]) + c_[9];
   }
 
  private:
@@ -82,7 +83,8 @@ struct TriangleShape {
   bool degenerate;         // the test of is_degenerate_face
 };
 
-TriangleShape triangle_shape(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+TriangleShape triangle_shape(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                             const Eigen::Vector3d& c) {
   TriangleShape shape;
   shape.normal = (b - a).cross(c - a);
   const double ab = (b - a).squaredNorm(), bc = (c - b).squaredNorm(), ca = (a - c).squaredNorm();
@@ -107,17 +109,22 @@ struct Candidate {
 
 class Simplifier {
  public:
-  Simplifier(const VerticesRef& V, const FacesRef& F, const VectorRef& mass, std::vector<char> sides);
+  Simplifier(const VerticesRef& V, const FacesRef& F, const VectorRef& mass,
+             std::vector<char> sides);
   void simplify(int target, Progress* progress);
   EdgeCollapse result();
 
  private:
-  bool has_vertex(int f, int x) const { return faces_(f, 0) == x || faces_(f, 1) == x || faces_(f, 2) == x; }
+  bool has_vertex(int f, int x) const {
+    return faces_(f, 0) == x || faces_(f, 1) == x || faces_(f, 2) == x;
+  }
   bool same_side(int x, int y) const { return sides_.empty() || sides_[x] == sides_[y]; }
   bool keeps_the_sides(int u, int v) const;
   bool find_cancelled_faces(int u, int v);
   bool is_double_sheet(int u, int v, int p, int q) const;
-  bool is_cancelled(int f) const { return std::find(cancelled_.begin(), cancelled_.end(), f) != cancelled_.end(); }
+  bool is_cancelled(int f) const {
+    return std::find(cancelled_.begin(), cancelled_.end(), f) != cancelled_.end();
+  }
   const std::vector<int>& live_faces(int x);
   void tally_neighbours(int x, std::vector<Neighbour>& out);
   void add_boundary_quadrics();
@@ -133,12 +140,14 @@ class Simplifier {
 
   RowMatrixX3i faces_;  // the kept input faces; a collapse of v into u renames v to u
   std::vector<char> face_alive_;
-  std::vector<Eigen::Vector3d> input_normals_;   // unit normal of each kept input face, 0 if degenerate
-  std::vector<std::vector<int>> vertex_faces_;   // faces around each vertex; dead ones dropped lazily
+  std::vector<Eigen::Vector3d>
+      input_normals_;  // unit normal of each kept input face, 0 if degenerate
+  std::vector<std::vector<int>>
+      vertex_faces_;  // faces around each vertex; dead ones dropped lazily
   std::vector<Cluster> clusters_;
-  std::vector<Eigen::Vector3d> position_;        // centroid of each live cluster
-  std::vector<int> version_;                     // bumped whenever a vertex's cluster grows
-  std::vector<int> merged_into_;                 // -1 for a live vertex or one no face uses
+  std::vector<Eigen::Vector3d> position_;  // centroid of each live cluster
+  std::vector<int> version_;               // bumped whenever a vertex's cluster grows
+  std::vector<int> merged_into_;           // -1 for a live vertex or one no face uses
   std::vector<char> alive_;
   std::vector<char> sides_;  // empty: one side
   int num_alive_ = 0;
@@ -149,7 +158,8 @@ class Simplifier {
   std::vector<Candidate> candidates_;
 };
 
-Simplifier::Simplifier(const VerticesRef& V, const FacesRef& F, const VectorRef& mass, std::vector<char> sides)
+Simplifier::Simplifier(const VerticesRef& V, const FacesRef& F, const VectorRef& mass,
+                       std::vector<char> sides)
     : sides_(std::move(sides)) {
   const int n = static_cast<int>(V.rows());
   // Faces on the same three vertices: oppositely oriented copies cancel in pairs (together they
@@ -159,7 +169,9 @@ Simplifier::Simplifier(const VerticesRef& V, const FacesRef& F, const VectorRef&
     std::array<int, 3> key;  // the vertices in increasing order
     int orientation;         // +1 when the face runs through key cyclically, -1 otherwise
     int face;
-    bool operator<(const Copy& other) const { return std::tie(key, face) < std::tie(other.key, other.face); }
+    bool operator<(const Copy& other) const {
+      return std::tie(key, face) < std::tie(other.key, other.face);
+    }
   };
   std::vector<Copy> copies;
   copies.reserve(F.rows());
@@ -174,7 +186,8 @@ Simplifier::Simplifier(const VerticesRef& V, const FacesRef& F, const VectorRef&
   std::vector<int> kept;
   for (size_t begin = 0, end; begin < copies.size(); begin = end) {
     int net = 0;
-    for (end = begin; end < copies.size() && copies[end].key == copies[begin].key; ++end) net += copies[end].orientation;
+    for (end = begin; end < copies.size() && copies[end].key == copies[begin].key; ++end)
+      net += copies[end].orientation;
     for (size_t i = begin; i < end && net != 0; ++i)
       if (copies[i].orientation * net > 0) {
         kept.push_back(copies[i].face);
@@ -185,7 +198,9 @@ Simplifier::Simplifier(const VerticesRef& V, const FacesRef& F, const VectorRef&
 
   const int num_faces = static_cast<int>(kept.size());
   if (num_faces == 0)
-    throw InputError("F: no triangle is left once faces with repeated vertices and oppositely oriented copies go");
+    throw InputError(
+        "F: no triangle is left once faces with repeated vertices and oppositely oriented copies "
+        "go");
   faces_.resize(num_faces, 3);
   for (int f = 0; f < num_faces; ++f) faces_.row(f) = F.row(kept[f]);
   face_alive_.assign(num_faces, 1);
@@ -213,7 +228,8 @@ Simplifier::Simplifier(const VerticesRef& V, const FacesRef& F, const VectorRef&
     const TriangleShape shape = triangle_shape(a, position_[faces_(f, 1)], position_[faces_(f, 2)]);
     input_normals_[f] = shape.degenerate ? Eigen::Vector3d::Zero() : shape.normal.normalized();
     if (shape.degenerate) continue;
-    const Quadric plane = Quadric::plane(input_normals_[f], -input_normals_[f].dot(a), 0.5 * shape.normal.norm());
+    const Quadric plane =
+        Quadric::plane(input_normals_[f], -input_normals_[f].dot(a), 0.5 * shape.normal.norm());
     for (int k = 0; k < 3; ++k) clusters_[faces_(f, k)].quadric += plane;
   }
   add_boundary_quadrics();
@@ -227,7 +243,8 @@ Simplifier::Simplifier(const VerticesRef& V, const FacesRef& F, const VectorRef&
 
 const std::vector<int>& Simplifier::live_faces(int x) {
   auto& faces = vertex_faces_[x];
-  faces.erase(std::remove_if(faces.begin(), faces.end(), [this](int f) { return !face_alive_[f]; }), faces.end());
+  faces.erase(std::remove_if(faces.begin(), faces.end(), [this](int f) { return !face_alive_[f]; }),
+              faces.end());
   return faces;
 }
 
@@ -237,7 +254,8 @@ void Simplifier::tally_neighbours(int x, std::vector<Neighbour>& out) {
     for (int k = 0; k < 3; ++k) {
       const int w = faces_(f, k);
       if (w == x) continue;
-      auto it = std::find_if(out.begin(), out.end(), [w](const Neighbour& s) { return s.vertex == w; });
+      auto it =
+          std::find_if(out.begin(), out.end(), [w](const Neighbour& s) { return s.vertex == w; });
       if (it == out.end())
         out.push_back({w, 1, f});
       else
@@ -254,7 +272,8 @@ void Simplifier::add_boundary_quadrics() {
       if (s.faces != 1 || s.vertex < x || input_normals_[s.face].squaredNorm() == 0) continue;
       const Eigen::Vector3d edge = position_[s.vertex] - position_[x];
       const Eigen::Vector3d normal = edge.cross(input_normals_[s.face]).normalized();
-      const Quadric plane = Quadric::plane(normal, -normal.dot(position_[x]), kBoundaryWeight * edge.squaredNorm());
+      const Quadric plane =
+          Quadric::plane(normal, -normal.dot(position_[x]), kBoundaryWeight * edge.squaredNorm());
       clusters_[x].quadric += plane;
       clusters_[s.vertex].quadric += plane;
     }
@@ -266,7 +285,8 @@ double Simplifier::cost(int u, int v) const {
   const Eigen::Vector3d p = merged_centroid(a, b);
   const double quadric_error = std::max(0.0, a.quadric(p) + b.quadric(p));
   const double mass = a.mass + b.mass;
-  const double ward = mass > 0 ? a.mass * b.mass / mass * (position_[u] - position_[v]).squaredNorm() : 0.0;
+  const double ward =
+      mass > 0 ? a.mass * b.mass / mass * (position_[u] - position_[v]).squaredNorm() : 0.0;
   return quadric_error + kCompactnessWeight * ward;
 }
 
@@ -274,13 +294,15 @@ void Simplifier::add_candidates(int x, bool higher_only, std::vector<Candidate>&
   tally_neighbours(x, around_u_);
   degenerate_faces_.clear();
   for (int f : vertex_faces_[x])
-    if (triangle_shape(position_[faces_(f, 0)], position_[faces_(f, 1)], position_[faces_(f, 2)]).degenerate)
+    if (triangle_shape(position_[faces_(f, 0)], position_[faces_(f, 1)], position_[faces_(f, 2)])
+            .degenerate)
       degenerate_faces_.push_back(f);
   for (const Neighbour& s : around_u_) {
     if ((higher_only && s.vertex < x) || !same_side(x, s.vertex)) continue;
     const bool on_degenerate_face = std::any_of(degenerate_faces_.begin(), degenerate_faces_.end(),
                                                 [&](int f) { return has_vertex(f, s.vertex); });
-    out.push_back({on_degenerate_face ? -1.0 : cost(x, s.vertex), x, s.vertex, version_[x], version_[s.vertex]});
+    out.push_back({on_degenerate_face ? -1.0 : cost(x, s.vertex), x, s.vertex, version_[x],
+                   version_[s.vertex]});
   }
 }
 
@@ -308,7 +330,8 @@ bool Simplifier::face_stays_sound(int f, int u, int v, const Eigen::Vector3d& p)
   const double max_turn_cosine = std::cos(kMaxNormalTurnDegrees * kPi / 180.0);
   // A needle's normal turns with any small move of its vertices: only sound faces must not turn.
   if (!old_shape.degenerate && old_shape.quality >= kMinFaceQuality &&
-      new_shape.normal.dot(old_shape.normal) < max_turn_cosine * new_shape.normal.norm() * old_shape.normal.norm())
+      new_shape.normal.dot(old_shape.normal) <
+          max_turn_cosine * new_shape.normal.norm() * old_shape.normal.norm())
     return false;
   // Turning in small steps must not add up to a flip against the input.
   return new_shape.normal.dot(input_normals_[f]) > 0 || input_normals_[f].squaredNorm() == 0;
@@ -348,7 +371,8 @@ int Simplifier::try_collapse(int u, int v) {
   tally_neighbours(u, around_u_);
   tally_neighbours(v, around_v_);
   auto on_boundary = [](const std::vector<Neighbour>& around) {
-    return std::any_of(around.begin(), around.end(), [](const Neighbour& s) { return s.faces == 1; });
+    return std::any_of(around.begin(), around.end(),
+                       [](const Neighbour& s) { return s.faces == 1; });
   };
   const bool u_boundary = on_boundary(around_u_);
   if (u_boundary != on_boundary(around_v_) || (u_boundary && shared_.size() != 1)) return -1;
@@ -373,7 +397,8 @@ int Simplifier::try_collapse(int u, int v) {
   // worse than the worst face around u and v before, the faces the collapse removes included. A
   // rule per face locked islands of small clusters among large ones for good: merging one into a
   // neighbour removes the needles between them but makes its other faces a little thinner.
-  if (star_quality(u, v, p, true) < std::min(kMinFaceQuality, star_quality(u, v, p, false))) return -1;
+  if (star_quality(u, v, p, true) < std::min(kMinFaceQuality, star_quality(u, v, p, false)))
+    return -1;
   collapse(u, v, p);
   return u;
 }
@@ -387,9 +412,10 @@ bool Simplifier::is_double_sheet(int u, int v, int p, int q) const {
   const Eigen::Vector3d &x = position_[u], &y = position_[v], &a = position_[p], &b = position_[q];
   const Eigen::Vector3d edge = b - a;
   if (edge.cross(x - a).dot(edge.cross(y - a)) <= 0) return false;
-  const double longest = std::max({(x - y).norm(), (x - a).norm(), (x - b).norm(), (y - a).norm(), (y - b).norm(),
-                                   edge.norm()});
-  return std::abs((y - x).dot((a - x).cross(b - x))) <= kSheetThickness * longest * longest * longest;
+  const double longest = std::max({(x - y).norm(), (x - a).norm(), (x - b).norm(), (y - a).norm(),
+                                   (y - b).norm(), edge.norm()});
+  return std::abs((y - x).dot((a - x).cross(b - x))) <=
+         kSheetThickness * longest * longest * longest;
 }
 
 // A face of v that the collapse lays on a face of u (the same three vertices once v is u): when
@@ -426,12 +452,14 @@ bool Simplifier::keeps_the_sides(int u, int v) const {
   if (sides_.empty()) return true;
   if (!same_side(u, v)) return false;
   const auto next_to_other_side = [this](int x, const std::vector<Neighbour>& around) {
-    return std::any_of(around.begin(), around.end(), [&](const Neighbour& s) { return !same_side(x, s.vertex); });
+    return std::any_of(around.begin(), around.end(),
+                       [&](const Neighbour& s) { return !same_side(x, s.vertex); });
   };
   const bool u_next = next_to_other_side(u, around_u_);
   if (u_next != next_to_other_side(v, around_v_)) return false;
   return !u_next || std::any_of(shared_.begin(), shared_.end(), [&](int f) {
-    return !same_side(u, faces_(f, 0)) || !same_side(u, faces_(f, 1)) || !same_side(u, faces_(f, 2));
+    return !same_side(u, faces_(f, 0)) || !same_side(u, faces_(f, 1)) ||
+           !same_side(u, faces_(f, 2));
   });
 }
 
@@ -481,7 +509,8 @@ void Simplifier::collapse_in_rounds(int until, const std::function<void()>& repo
     round.clear();
     for (int x = 0; x < static_cast<int>(alive_.size()); ++x)
       if (alive_[x]) add_candidates(x, true, round);
-    std::sort(round.begin(), round.end(), [](const Candidate& a, const Candidate& b) { return a.cost < b.cost; });
+    std::sort(round.begin(), round.end(),
+              [](const Candidate& a, const Candidate& b) { return a.cost < b.cost; });
     int collapses = 0;
     for (size_t i = 0; i < round.size() / 2 && num_alive_ > until; ++i) {
       const Candidate& c = round[i];
@@ -505,7 +534,8 @@ void Simplifier::simplify(int target, Progress* progress) {
     if (progress && ++pops % kReportInterval == 0)
       progress->report(stages::kGhost, double(start - num_alive_) / double(start - target));
   };
-  collapse_in_rounds(target < num_alive_ / kRoundsAbove ? kRoundsAbove * target : num_alive_, report);
+  collapse_in_rounds(target < num_alive_ / kRoundsAbove ? kRoundsAbove * target : num_alive_,
+                     report);
   seed();
   int collapses_in_pass = 0;
   while (num_alive_ > target) {
@@ -520,7 +550,9 @@ void Simplifier::simplify(int target, Progress* progress) {
     const Candidate c = heap_.top();
     heap_.pop();
     report();
-    if (!alive_[c.u] || !alive_[c.v] || version_[c.u] != c.version_u || version_[c.v] != c.version_v) continue;
+    if (!alive_[c.u] || !alive_[c.v] || version_[c.u] != c.version_u ||
+        version_[c.v] != c.version_v)
+      continue;
     const int kept = try_collapse(c.u, c.v);
     if (kept < 0) continue;
     ++collapses_in_pass;
@@ -561,21 +593,25 @@ EdgeCollapse Simplifier::result() {
 
 }  // namespace
 
-EdgeCollapse collapse_edges(const VerticesRef& V, const FacesRef& F, const VectorRef& mass, int target,
-                            Progress* progress, const std::vector<char>& sides) {
+EdgeCollapse collapse_edges(const VerticesRef& V, const FacesRef& F, const VectorRef& mass,
+                            int target, Progress* progress, const std::vector<char>& sides) {
   validate_mesh(V, F);
-  if (target < 4) throw InputError(message("target: a ghost needs at least 4 vertices, got ", target));
+  if (target < 4)
+    throw InputError(message("target: a ghost needs at least 4 vertices, got ", target));
   if (mass.size() != V.rows())
-    throw InputError(message("mass: expected ", V.rows(), " values (one per vertex), got ", mass.size()));
+    throw InputError(
+        message("mass: expected ", V.rows(), " values (one per vertex), got ", mass.size()));
   for (Eigen::Index i = 0; i < mass.size(); ++i)
     if (!std::isfinite(mass[i]) || mass[i] < 0)
       throw InputError(message("mass[", i, "]: expected a finite value >= 0, got ", mass[i]));
   if (!sides.empty() && static_cast<Eigen::Index>(sides.size()) != V.rows())
-    throw InputError(message("sides: expected ", V.rows(), " values (one per vertex), got ", sides.size()));
+    throw InputError(
+        message("sides: expected ", V.rows(), " values (one per vertex), got ", sides.size()));
 
   if (target >= V.rows()) {
     if (progress) progress->report(stages::kGhost, 1.0);
-    EdgeCollapse identity{V, F, Eigen::VectorXi::LinSpaced(V.rows(), 0, static_cast<int>(V.rows()) - 1)};
+    EdgeCollapse identity{V, F,
+                          Eigen::VectorXi::LinSpaced(V.rows(), 0, static_cast<int>(V.rows()) - 1)};
     return identity;
   }
   Simplifier simplifier(V, F, mass, sides);

@@ -38,12 +38,14 @@ struct EdgeCollapse {
 // collapse is left (the result says how many were reached). `mass` (#V, length², e.g.
 // lumped_mass) weights the centroids. Faces with repeated indices are dropped first, and faces
 // on the same three vertices cancel by orientation (one copy of a surplus orientation stays), in
-// the input and as collapses make them; vertices left without a face belong to no cluster. A target of at least #V gives (V, F) unchanged, each vertex
-// its own cluster. `sides` (#V, or empty for one side) splits the vertices into sides that stay
-// apart (see above). Reports progress as stage "ghost"; throws Cancelled when told to stop and
-// InputError for bad input (see validate_mesh; target < 4; mass or sides of the wrong size, mass
-// negative or not finite; no triangle left once faces cancel).
-EdgeCollapse collapse_edges(const VerticesRef& V, const FacesRef& F, const VectorRef& mass, int target,
-                            Progress* progress = nullptr, const std::vector<char>& sides = {});
+// the input and as collapses make them; vertices left without a face belong to no cluster. A target
+// of at least #V gives (V, F) unchanged, each vertex its own cluster. `sides` (#V, or empty for one
+// side) splits the vertices into sides that stay apart (see above). Reports progress as stage
+// "ghost"; throws Cancelled when told to stop and InputError for bad input (see validate_mesh;
+// target < 4; mass or sides of the wrong size, mass negative or not finite; no triangle left once
+// faces cancel).
+EdgeCollapse collapse_edges(const VerticesRef& V, const FacesRef& F, const VectorRef& mass,
+                            int target, Progress* progress = nullptr,
+                            const std::vector<char>& sides = {});
 
 }  // namespace modal_deform

@@ -15,8 +15,9 @@ void require_vertices(const VerticesRef& V, const char* name) {
   require_positions(flatten(V), 3 * V.rows(), name);
   const double extent = bounding_box_extent(V);
   if (!(extent >= kMinExtent))
-    throw InputError(message(name, ": the mesh's extent (the longest side of its bounding box) is ", extent,
-                             "; the core needs at least ", kMinExtent, ": scale the mesh up"));
+    throw InputError(message(name, ": the mesh's extent (the longest side of its bounding box) is ",
+                             extent, "; the core needs at least ", kMinExtent,
+                             ": scale the mesh up"));
 }
 
 void validate_mesh(const VerticesRef& V, const FacesRef& F) {
@@ -26,8 +27,8 @@ void validate_mesh(const VerticesRef& V, const FacesRef& F) {
   for (Eigen::Index f = 0; f < F.rows(); ++f)
     for (int k = 0; k < 3; ++k)
       if (F(f, k) < 0 || F(f, k) >= V.rows())
-        throw InputError(message("F[", f, "]: face ", f, " refers to vertex ", F(f, k), ", outside [0, ",
-                                 V.rows(), ")"));
+        throw InputError(message("F[", f, "]: face ", f, " refers to vertex ", F(f, k),
+                                 ", outside [0, ", V.rows(), ")"));
 }
 
 double face_shape_ratio(const VerticesRef& V, const FacesRef& F, int f) {
@@ -55,7 +56,8 @@ std::vector<int> duplicate_faces(const FacesRef& F) {
   std::sort(keys.begin(), keys.end());
   std::vector<int> copies;
   for (size_t i = 1; i < keys.size(); ++i)
-    if (std::equal(keys[i].begin(), keys[i].begin() + 3, keys[i - 1].begin())) copies.push_back(keys[i][3]);
+    if (std::equal(keys[i].begin(), keys[i].begin() + 3, keys[i - 1].begin()))
+      copies.push_back(keys[i][3]);
   std::sort(copies.begin(), copies.end());
   return copies;
 }
@@ -76,8 +78,8 @@ MeshReport check_mesh(const VerticesRef& V, const FacesRef& F) {
 
   auto add = [&report](const std::string& name, const std::vector<int>& indices) {
     MeshReport::Finding finding{name, static_cast<int>(indices.size()), {}};
-    finding.examples.assign(indices.begin(),
-                            indices.begin() + std::min<size_t>(indices.size(), MeshReport::kExamples));
+    finding.examples.assign(
+        indices.begin(), indices.begin() + std::min<size_t>(indices.size(), MeshReport::kExamples));
     report.findings.push_back(std::move(finding));
   };
 

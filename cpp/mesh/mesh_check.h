@@ -42,14 +42,14 @@ std::vector<int> duplicate_faces(const FacesRef& F);
 struct MeshReport {
   static constexpr int kExamples = 10;
   struct Finding {
-    std::string name;          // e.g. "nonmanifold_edges"
+    std::string name;  // e.g. "nonmanifold_edges"
     int count = 0;
     std::vector<int> examples;  // first offending indices (vertices, faces or edges as named)
   };
   int num_vertices = 0, num_faces = 0, num_edges = 0, num_components = 0;
-  std::vector<int> component_sizes;  // vertices per component, largest first
+  std::vector<int> component_sizes;   // vertices per component, largest first
   std::vector<int> vertex_component;  // per vertex: its component, -1 when in no face
-  std::vector<Finding> findings;     // boundary_edges, nonmanifold_edges, ... in a fixed order
+  std::vector<Finding> findings;      // boundary_edges, nonmanifold_edges, ... in a fixed order
 };
 
 // Validates (V, F) and reports its boundary edges, non-manifold edges and vertices, unreferenced

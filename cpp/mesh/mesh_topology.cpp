@@ -80,14 +80,15 @@ void collect_edges(const FacesRef& F, MeshTopology& topology) {
     for (size_t i = run_begin[r]; i < run_begin[r + 1]; ++i) {
       const int f = sides[i].second / 3;
       topology.face_edges(f, sides[i].second % 3) = e;
-      topology.edge_faces[static_cast<size_t>(topology.edge_face_offsets[e]) + (i - run_begin[r])] = f;
+      topology.edge_faces[static_cast<size_t>(topology.edge_face_offsets[e]) + (i - run_begin[r])] =
+          f;
     }
   }
 }
 
 // Faces around a non-manifold edge, sorted by the angle of their opposite vertex about the edge.
-std::vector<int> faces_in_angular_order(const VerticesRef& V, const FacesRef& F, const MeshTopology& topology,
-                                        int edge) {
+std::vector<int> faces_in_angular_order(const VerticesRef& V, const FacesRef& F,
+                                        const MeshTopology& topology, int edge) {
   const auto [a, b] = topology.edges[edge];
   const Eigen::Vector3d axis = (V.row(b) - V.row(a)).transpose().normalized();
   std::vector<std::pair<double, int>> by_angle;
@@ -109,7 +110,9 @@ std::vector<int> faces_in_angular_order(const VerticesRef& V, const FacesRef& F,
 Hinge make_hinge(const FacesRef& F, const MeshTopology& topology, int edge, int face0, int face1) {
   auto [a, b] = topology.edges[edge];
   if (!runs_from(F, face0, a, b)) std::swap(a, b);
-  return Hinge{edge, {a, b, opposite_vertex(F, face0, a, b), opposite_vertex(F, face1, a, b)}, {face0, face1}};
+  return Hinge{edge,
+               {a, b, opposite_vertex(F, face0, a, b), opposite_vertex(F, face1, a, b)},
+               {face0, face1}};
 }
 
 void collect_hinges(const VerticesRef& V, const FacesRef& F, MeshTopology& topology) {
@@ -172,7 +175,9 @@ void collect_nonmanifold_vertices(const FacesRef& F, MeshTopology& topology) {
     const int* faces = vertex_faces.data() + offsets[v];
     const int count = offsets[v + 1] - offsets[v];
     if (count < 2) continue;
-    const auto local = [&](int face) { return static_cast<int>(std::find(faces, faces + count, face) - faces); };
+    const auto local = [&](int face) {
+      return static_cast<int>(std::find(faces, faces + count, face) - faces);
+    };
     UnionFind fans(count);
     for (int i = 0; i < count; ++i) {
       for (int k = 0; k < 3; ++k) {

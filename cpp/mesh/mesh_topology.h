@@ -27,7 +27,8 @@ struct MeshTopology {
   // Faces around edge e: edge_faces[edge_face_offsets[e] .. edge_face_offsets[e + 1]).
   std::vector<int> edge_face_offsets;
   std::vector<int> edge_faces;
-  // face_edges(f, k): the edge from F(f, k) to F(f, (k + 1) % 3); -1 for faces with repeated indices.
+  // face_edges(f, k): the edge from F(f, k) to F(f, (k + 1) % 3); -1 for faces with repeated
+  // indices.
   RowMatrixX3i face_edges;
   // Interior edges with their two faces. A non-manifold edge (k > 2 faces) gets one hinge per
   // pair of faces that are neighbours around it at rest (k hinges): the sheets meeting there bend
@@ -42,7 +43,9 @@ struct MeshTopology {
   std::vector<int> vertex_component;
   int num_components = 0;
 
-  int num_edge_faces(int edge) const { return edge_face_offsets[edge + 1] - edge_face_offsets[edge]; }
+  int num_edge_faces(int edge) const {
+    return edge_face_offsets[edge + 1] - edge_face_offsets[edge];
+  }
 };
 
 // Builds the topology of the triangle mesh (V, F). V (#V by 3) orders the faces around

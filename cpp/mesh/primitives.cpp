@@ -10,7 +10,6 @@
 namespace modal_deform {
 namespace {
 
-
 void require_positive(int count, const char* name) {
   if (count < 1) throw InputError(message(name, ": needs at least 1, got ", count));
 }
@@ -32,7 +31,8 @@ TriangleMesh grid(int nx, int ny, double width, double height) {
   std::vector<int> faces;
   for (int j = 0; j <= ny; ++j)
     for (int i = 0; i <= nx; ++i)
-      positions.insert(positions.end(), {width * (double(i) / nx - 0.5), height * (double(j) / ny - 0.5), 0.0});
+      positions.insert(positions.end(),
+                       {width * (double(i) / nx - 0.5), height * (double(j) / ny - 0.5), 0.0});
   auto at = [nx](int i, int j) { return j * (nx + 1) + i; };
   for (int j = 0; j < ny; ++j)
     for (int i = 0; i < nx; ++i)
@@ -87,7 +87,9 @@ TriangleMesh bar(int nx, int ny, int nz, double sx, double sy, double sz) {
   const std::array<double, 3> sizes{sx, sy, sz};
   // Lattice points on the surface of the box get consecutive indices.
   std::vector<int> index((nx + 1) * (ny + 1) * (nz + 1), -1);
-  auto lattice = [&](const std::array<int, 3>& p) { return (p[2] * (ny + 1) + p[1]) * (nx + 1) + p[0]; };
+  auto lattice = [&](const std::array<int, 3>& p) {
+    return (p[2] * (ny + 1) + p[1]) * (nx + 1) + p[0];
+  };
   std::vector<double> positions;
   auto vertex = [&](const std::array<int, 3>& p) {
     int& id = index[lattice(p)];

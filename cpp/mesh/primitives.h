@@ -15,7 +15,8 @@ TriangleMesh grid(int nx, int ny, double width, double height);
 
 // A square grid (n by n quads, side `size`) with `num_bumps` Gaussian bumps of height up to
 // `amplitude` at pseudo-random places fixed by `seed`.
-TriangleMesh bumpy_plane(int n, double size, int num_bumps, double amplitude, std::uint32_t seed = 1);
+TriangleMesh bumpy_plane(int n, double size, int num_bumps, double amplitude,
+                         std::uint32_t seed = 1);
 
 // An open tube along z from 0 to `length`: n_around quads around, n_along along.
 TriangleMesh cylinder(int n_around, int n_along, double radius, double length);

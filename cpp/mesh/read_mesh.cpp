@@ -14,7 +14,8 @@ namespace {
 // Line reader over plain or gzip files (zlib reads both).
 class LineReader {
  public:
-  explicit LineReader(const std::string& path) : path_(path), file_(gzopen(path.c_str(), "rb"), gzclose) {
+  explicit LineReader(const std::string& path)
+      : path_(path), file_(gzopen(path.c_str(), "rb"), gzclose) {
     if (!file_) throw InputError(message(path, ": cannot open the file"));
   }
   bool next(std::string& line) {
@@ -61,7 +62,8 @@ TriangleMesh read_obj(LineReader& reader) {
         const long index = std::strtol(corner.c_str(), nullptr, 10);  // "7/3/2" reads as 7
         const long count = static_cast<long>(positions.size() / 3);
         const long zero_based = index < 0 ? count + index : index - 1;
-        if (index == 0 || zero_based < 0 || zero_based >= count) reader.fail("face index out of range");
+        if (index == 0 || zero_based < 0 || zero_based >= count)
+          reader.fail("face index out of range");
         polygon.push_back(static_cast<int>(zero_based));
       }
       if (polygon.size() < 3) reader.fail("a face needs at least three vertices");
@@ -87,15 +89,18 @@ TriangleMesh read_ply(LineReader& reader) {
       in_vertex_element = word == "vertex";
       long count;
       if (!(in >> count) || count < 0) reader.fail("bad element count");
-      if (in_vertex_element) num_vertices = count;
-      else if (word == "face") num_faces = count;
+      if (in_vertex_element)
+        num_vertices = count;
+      else if (word == "face")
+        num_faces = count;
     } else if (word == "property" && in_vertex_element) {
       ++vertex_properties;
     } else if (word == "end_header") {
       break;
     }
   }
-  if (num_vertices < 0 || num_faces < 0 || vertex_properties < 3) reader.fail("missing vertex or face element");
+  if (num_vertices < 0 || num_faces < 0 || vertex_properties < 3)
+    reader.fail("missing vertex or face element");
   std::vector<double> positions;
   positions.reserve(3 * num_vertices);
   for (long v = 0; v < num_vertices; ++v) {
@@ -113,7 +118,8 @@ TriangleMesh read_ply(LineReader& reader) {
     if (!(in >> count) || count < 3) reader.fail("a face needs at least three vertices");
     polygon.clear();
     for (long k = 0; k < count; ++k) {
-      if (!(in >> index) || index < 0 || index >= num_vertices) reader.fail("face index out of range");
+      if (!(in >> index) || index < 0 || index >= num_vertices)
+        reader.fail("face index out of range");
       polygon.push_back(static_cast<int>(index));
     }
     add_polygon(polygon, faces);
@@ -122,7 +128,8 @@ TriangleMesh read_ply(LineReader& reader) {
 }
 
 bool ends_with(const std::string& text, const std::string& suffix) {
-  return text.size() >= suffix.size() && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
+  return text.size() >= suffix.size() &&
+         text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 }  // namespace

@@ -13,10 +13,13 @@ struct TriangleMesh {
 };
 
 // The mesh of flat buffers: positions (x0 y0 z0 x1 ...) and triangle indices (a0 b0 c0 a1 ...).
-inline TriangleMesh mesh_from_buffers(const std::vector<double>& positions, const std::vector<int>& faces) {
+inline TriangleMesh mesh_from_buffers(const std::vector<double>& positions,
+                                      const std::vector<int>& faces) {
   TriangleMesh mesh;
-  mesh.V = Eigen::Map<const RowMatrixX3d>(positions.data(), static_cast<Eigen::Index>(positions.size() / 3), 3);
-  mesh.F = Eigen::Map<const RowMatrixX3i>(faces.data(), static_cast<Eigen::Index>(faces.size() / 3), 3);
+  mesh.V = Eigen::Map<const RowMatrixX3d>(positions.data(),
+                                          static_cast<Eigen::Index>(positions.size() / 3), 3);
+  mesh.F =
+      Eigen::Map<const RowMatrixX3i>(faces.data(), static_cast<Eigen::Index>(faces.size() / 3), 3);
   return mesh;
 }
 

@@ -9,7 +9,9 @@ namespace modal_deform {
 
 class UnionFind {
  public:
-  explicit UnionFind(int n) : parent_(n), size_(n, 1), count_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
+  explicit UnionFind(int n) : parent_(n), size_(n, 1), count_(n) {
+    std::iota(parent_.begin(), parent_.end(), 0);
+  }
 
   int find(int x) {
     while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];

@@ -30,7 +30,8 @@ struct Kernel {
   std::vector<bool> decoupled;
 };
 
-Kernel checked_kernel(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z) {
+Kernel checked_kernel(const SparseMatrix& K, const VectorRef& mass,
+                      const Eigen::Ref<const Eigen::MatrixXd>& Z) {
   return {checked_kernel_basis(K, mass, Z), decoupled_dofs(K, mass)};
 }
 
@@ -50,30 +51,35 @@ std::vector<int> pins_for(const SparseMatrix& K, const Kernel& kernel) {
     // picks the DOFs (columns) that best pin down the component's kernel.
     std::vector<Eigen::Index> columns;
     for (Eigen::Index k = 0; k < kernel.Z.cols(); ++k)
-      if (std::any_of(dofs.begin(), dofs.end(), [&](int d) { return kernel.Z(d, k) != 0; })) columns.push_back(k);
+      if (std::any_of(dofs.begin(), dofs.end(), [&](int d) { return kernel.Z(d, k) != 0; }))
+        columns.push_back(k);
     if (columns.empty()) continue;
-    Eigen::MatrixXd rows_t(static_cast<Eigen::Index>(columns.size()), static_cast<Eigen::Index>(dofs.size()));
+    Eigen::MatrixXd rows_t(static_cast<Eigen::Index>(columns.size()),
+                           static_cast<Eigen::Index>(dofs.size()));
     for (size_t a = 0; a < columns.size(); ++a)
       for (size_t b = 0; b < dofs.size(); ++b) rows_t(a, b) = kernel.Z(dofs[b], columns[a]);
     Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(rows_t);
     qr.setThreshold(kRankThreshold);
-    for (Eigen::Index r = 0; r < qr.rank(); ++r) pins.push_back(dofs[qr.colsPermutation().indices()[r]]);
+    for (Eigen::Index r = 0; r < qr.rank(); ++r)
+      pins.push_back(dofs[qr.colsPermutation().indices()[r]]);
   }
   if (static_cast<Eigen::Index>(pins.size()) != kernel.Z.cols())
-    throw InputError(message("Z: its ", kernel.Z.cols(), " columns do not split over the connected components of K ",
-                             "(their ranks per component add up to ", pins.size(), "); Z must span the kernel of K"));
+    throw InputError(message(
+        "Z: its ", kernel.Z.cols(), " columns do not split over the connected components of K ",
+        "(their ranks per component add up to ", pins.size(), "); Z must span the kernel of K"));
   std::sort(pins.begin(), pins.end());
   return pins;
 }
 
 void check_right_hand_sides(const SparseMatrix& K, const Eigen::Ref<const Eigen::MatrixXd>& B) {
-  if (B.rows() != K.rows()) throw InputError(message("B: expected ", K.rows(), " rows, got ", B.rows()));
+  if (B.rows() != K.rows())
+    throw InputError(message("B: expected ", K.rows(), " rows, got ", B.rows()));
   if (!B.allFinite()) throw InputError("B: has an entry that is not finite");
 }
 
 Eigen::MatrixXd solve_with_pins(const SparseMatrix& K, const VectorRef& mass, const Kernel& kernel,
-                                const Eigen::Ref<const Eigen::MatrixXd>& B, const std::vector<int>& pins,
-                                Progress* progress) {
+                                const Eigen::Ref<const Eigen::MatrixXd>& B,
+                                const std::vector<int>& pins, Progress* progress) {
   const Eigen::Index n = K.rows();
   if (progress) progress->report(stages::kDerivativeSolves, 0.0);
 
@@ -91,8 +97,9 @@ Eigen::MatrixXd solve_with_pins(const SparseMatrix& K, const VectorRef& mass, co
   try {
     llt.factorize(K, pin_stiffness);
   } catch (const NumericalError& e) {
-    throw NumericalError(message("solve_in_range: K with its kernel pinned cannot be factored; does Z span the whole ",
-                                 "kernel of K? ", e.what()));
+    throw NumericalError(message(
+        "solve_in_range: K with its kernel pinned cannot be factored; does Z span the whole ",
+        "kernel of K? ", e.what()));
   }
   return solve_in_range_by_blocks(
       K, dof_masses(mass), kernel.Z, kernel.decoupled, Eigen::MatrixXd(B),
@@ -107,7 +114,8 @@ Eigen::MatrixXd solve_with_pins(const SparseMatrix& K, const VectorRef& mass, co
 
 // Each block is copied out of B before its solution goes in, so Ψ needs no memory of its own. The
 // blocks reuse their buffers: at 100k vertices each is 113 MB, and fresh memory costs page faults.
-Eigen::MatrixXd solve_in_range_by_blocks(const SparseMatrix& K, const Eigen::VectorXd& m, const Eigen::MatrixXd& Z,
+Eigen::MatrixXd solve_in_range_by_blocks(const SparseMatrix& K, const Eigen::VectorXd& m,
+                                         const Eigen::MatrixXd& Z,
                                          const std::vector<bool>& decoupled, Eigen::MatrixXd B,
                                          const BlockSolve& solve, Progress* progress) {
   check_right_hand_sides(K, B);
@@ -131,7 +139,9 @@ Eigen::MatrixXd solve_in_range_by_blocks(const SparseMatrix& K, const Eigen::Vec
     });
     if (Z.cols()) add_dense_product(PB, Z, -gram.solve(inner_product(Z, PB)));
     const std::function<void(double)> report = [&](double part) {
-      if (progress) progress->report(stages::kDerivativeSolves, (static_cast<double>(first) + part * width) / B.cols());
+      if (progress)
+        progress->report(stages::kDerivativeSolves,
+                         (static_cast<double>(first) + part * width) / B.cols());
     };
     auto X = Psi.middleCols(first, width);
     const Eigen::VectorXd rhs_norms = PB.colwise().norm();
@@ -143,14 +153,16 @@ Eigen::MatrixXd solve_in_range_by_blocks(const SparseMatrix& K, const Eigen::Vec
     for (Eigen::Index j = 0; j < width; ++j) {
       const double bound = kResidualTolerance * (norm_K * X.col(j).norm() + rhs_norms[j]);
       if (!(PB.col(j).norm() <= bound))
-        throw NumericalError(message("solve_in_range: column ", first + j, " has residual ", PB.col(j).norm(),
-                                     ", above ", bound, "; does Z span the kernel of K?"));
+        throw NumericalError(message("solve_in_range: column ", first + j, " has residual ",
+                                     PB.col(j).norm(), ", above ", bound,
+                                     "; does Z span the kernel of K?"));
     }
   }
   return std::move(Psi);
 }
 
-std::vector<std::array<int, 2>> derivative_pairs(const std::vector<std::vector<int>>& components, int count) {
+std::vector<std::array<int, 2>> derivative_pairs(const std::vector<std::vector<int>>& components,
+                                                 int count) {
   const auto share_a_component = [](const std::vector<int>& a, const std::vector<int>& b) {
     for (size_t i = 0, j = 0; i < a.size() && j < b.size();) {
       if (a[i] == b[j]) return true;
@@ -166,23 +178,26 @@ std::vector<std::array<int, 2>> derivative_pairs(const std::vector<std::vector<i
       if (share_a_component(components[static_cast<size_t>(i)], components[static_cast<size_t>(j)]))
         pairs.push_back({i, j});
   if (static_cast<int>(pairs.size()) < count)
-    throw InputError(message("derivatives: ", count, " asked for, but the ", k,
-                             " modes that have derivatives (all but the translations and zero modes) give only ",
-                             pairs.size(), " pairs; ask for more modes or fewer derivatives"));
+    throw InputError(
+        message("derivatives: ", count, " asked for, but the ", k,
+                " modes that have derivatives (all but the translations and zero modes) give only ",
+                pairs.size(), " pairs; ask for more modes or fewer derivatives"));
   return pairs;
 }
 
 std::vector<std::vector<int>> components_moved(const Eigen::Ref<const Eigen::MatrixXd>& Phi,
                                                const Eigen::Ref<const Eigen::VectorXi>& component) {
   if (Phi.rows() != 3 * component.size())
-    throw InputError(message("Phi: expected ", 3 * component.size(), " rows (3 per labelled vertex), got ", Phi.rows()));
+    throw InputError(message("Phi: expected ", 3 * component.size(),
+                             " rows (3 per labelled vertex), got ", Phi.rows()));
   if (component.size() > 0 && component.minCoeff() < 0)
     throw InputError(message("component: expected labels >= 0, got ", component.minCoeff()));
   const int c = component.size() > 0 ? component.maxCoeff() + 1 : 0;
   std::vector<std::vector<int>> moved(static_cast<size_t>(Phi.cols()));
   for (Eigen::Index col = 0; col < Phi.cols(); ++col) {
     Eigen::VectorXd norm = Eigen::VectorXd::Zero(c);
-    for (Eigen::Index v = 0; v < component.size(); ++v) norm[component[v]] += Phi.col(col).segment<3>(3 * v).squaredNorm();
+    for (Eigen::Index v = 0; v < component.size(); ++v)
+      norm[component[v]] += Phi.col(col).segment<3>(3 * v).squaredNorm();
     const double total = norm.sum();
     for (int k = 0; k < c; ++k)
       if (norm[k] > 1e-12 * total) moved[static_cast<size_t>(col)].push_back(k);
@@ -190,7 +205,8 @@ std::vector<std::vector<int>> components_moved(const Eigen::Ref<const Eigen::Mat
   return moved;
 }
 
-Eigen::MatrixXd solve_in_range(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z,
+Eigen::MatrixXd solve_in_range(const SparseMatrix& K, const VectorRef& mass,
+                               const Eigen::Ref<const Eigen::MatrixXd>& Z,
                                const Eigen::Ref<const Eigen::MatrixXd>& B, Progress* progress) {
   const Kernel kernel = checked_kernel(K, mass, Z);
   return solve_with_pins(K, mass, kernel, B, pins_for(K, kernel), progress);

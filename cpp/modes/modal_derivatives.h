@@ -22,7 +22,8 @@ namespace modal_deform {
 // two components) are left out: the energy couples the vertices of one component only, so their
 // derivative is zero. components[i]: the components mode i moves, ascending (components_moved).
 // Throws InputError naming "derivatives" when count is negative or exceeds the pairs there are.
-std::vector<std::array<int, 2>> derivative_pairs(const std::vector<std::vector<int>>& components, int count);
+std::vector<std::array<int, 2>> derivative_pairs(const std::vector<std::vector<int>>& components,
+                                                 int count);
 
 // The components each column of Phi (3n by k, interleaved) moves: those holding more than 1e-12
 // of its squared norm. component: n labels in [0, c). Throws InputError for mismatched sizes or a
@@ -42,8 +43,10 @@ std::vector<std::vector<int>> components_moved(const Eigen::Ref<const Eigen::Mat
 // get zero rows. Throws InputError for inconsistent input (Z not M-orthonormal, not in the kernel
 // or not split over the components of K) and NumericalError when the pinned matrix is singular
 // (Z misses part of the kernel) or a solution fails its residual check.
-Eigen::MatrixXd solve_in_range(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& Z,
-                               const Eigen::Ref<const Eigen::MatrixXd>& B, Progress* progress = nullptr);
+Eigen::MatrixXd solve_in_range(const SparseMatrix& K, const VectorRef& mass,
+                               const Eigen::Ref<const Eigen::MatrixXd>& Z,
+                               const Eigen::Ref<const Eigen::MatrixXd>& B,
+                               Progress* progress = nullptr);
 
 // What the solves in the range above share, for a caller with a solver of its own (ShiftedPencil):
 // Ψ written over B, block by block of at most 64 columns, each block's P B handed to
@@ -57,7 +60,8 @@ Eigen::MatrixXd solve_in_range(const SparseMatrix& K, const VectorRef& mass, con
 // a column fails the residual check.
 using BlockSolve = std::function<bool(Eigen::MatrixXd& PB, Eigen::Ref<Eigen::MatrixXd> X,
                                       const std::function<void(double part)>& report)>;
-Eigen::MatrixXd solve_in_range_by_blocks(const SparseMatrix& K, const Eigen::VectorXd& m, const Eigen::MatrixXd& Z,
+Eigen::MatrixXd solve_in_range_by_blocks(const SparseMatrix& K, const Eigen::VectorXd& m,
+                                         const Eigen::MatrixXd& Z,
                                          const std::vector<bool>& decoupled, Eigen::MatrixXd B,
                                          const BlockSolve& solve, Progress* progress);
 

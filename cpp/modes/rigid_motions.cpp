@@ -21,16 +21,21 @@ Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& r) {
 
 }  // namespace
 
-Eigen::MatrixXd rigid_motions(const VerticesRef& V, const Eigen::Ref<const Eigen::VectorXi>& component,
+Eigen::MatrixXd rigid_motions(const VerticesRef& V,
+                              const Eigen::Ref<const Eigen::VectorXi>& component,
                               const VectorRef& mass) {
   const Eigen::Index n = V.rows();
-  if (component.size() != n) throw InputError(message("labels: expected ", n, " values, got ", component.size()));
-  if (mass.size() != n) throw InputError(message("mass: expected ", n, " values, got ", mass.size()));
+  if (component.size() != n)
+    throw InputError(message("labels: expected ", n, " values, got ", component.size()));
+  if (mass.size() != n)
+    throw InputError(message("mass: expected ", n, " values, got ", mass.size()));
   for (Eigen::Index i = 0; i < n; ++i) {
     if (!V.row(i).allFinite()) throw InputError(message("V[", i, "] is not finite"));
     if (!(std::isfinite(mass[i]) && mass[i] >= 0))
-      throw InputError(message("mass[", i, "] = ", mass[i], ": expected a finite non-negative mass"));
-    if (component[i] < -1) throw InputError(message("labels[", i, "] = ", component[i], ": expected -1 or more"));
+      throw InputError(
+          message("mass[", i, "] = ", mass[i], ": expected a finite non-negative mass"));
+    if (component[i] < -1)
+      throw InputError(message("labels[", i, "] = ", component[i], ": expected -1 or more"));
   }
   const int c = n ? component.maxCoeff() + 1 : 0;
 
@@ -47,7 +52,8 @@ Eigen::MatrixXd rigid_motions(const VerticesRef& V, const Eigen::Ref<const Eigen
   }
   for (size_t k = 0; k < total.size(); ++k) {
     if (size[k] == 0) throw InputError(message("labels: component ", k, " has no vertices"));
-    if (!(total[k] > 0)) throw InputError(message("mass: component ", k, " has no mass; label its vertices -1"));
+    if (!(total[k] > 0))
+      throw InputError(message("mass: component ", k, " has no mass; label its vertices -1"));
     centroid[k] /= total[k];
   }
   std::vector<Eigen::Matrix3d> inertia(static_cast<size_t>(c), Eigen::Matrix3d::Zero());

@@ -19,7 +19,8 @@ constexpr int kRigidMotions = kTranslations + kRotations;
 // rotations in ascending order of their moment of inertia. Throws InputError for a label outside
 // [-1, c), a component without vertices or without mass, or one whose massive vertices lie on a
 // line (it has no third rotation).
-Eigen::MatrixXd rigid_motions(const VerticesRef& V, const Eigen::Ref<const Eigen::VectorXi>& component,
+Eigen::MatrixXd rigid_motions(const VerticesRef& V,
+                              const Eigen::Ref<const Eigen::VectorXi>& component,
                               const VectorRef& mass);
 
 }  // namespace modal_deform

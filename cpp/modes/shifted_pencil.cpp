@@ -79,9 +79,13 @@ constexpr int kMaxRefinementSteps = 6;
 class ShiftInvert {
  public:
   // factor: of K − σM; expected_solves: for the bar.
-  ShiftInvert(CholmodLLT& factor, const Eigen::VectorXd& dof_mass, const Eigen::MatrixXd& Z, Progress* progress,
-              int expected_solves)
-      : factor_(factor), dof_mass_(dof_mass), Z_(Z), progress_(progress), expected_solves_(expected_solves) {}
+  ShiftInvert(CholmodLLT& factor, const Eigen::VectorXd& dof_mass, const Eigen::MatrixXd& Z,
+              Progress* progress, int expected_solves)
+      : factor_(factor),
+        dof_mass_(dof_mass),
+        Z_(Z),
+        progress_(progress),
+        expected_solves_(expected_solves) {}
 
   // T X: one block solve of X's columns.
   Eigen::MatrixXd apply(const Eigen::Ref<const Eigen::MatrixXd>& X) {
@@ -89,7 +93,9 @@ class ShiftInvert {
     if (Z_.cols()) add_dense_product(Y, Z_, -inner_product(Z_, dof_mass_, Y));
     solves_ += static_cast<int>(X.cols());
     // The bar approaches 1 without reaching it: the number of solves is not known in advance.
-    if (progress_) progress_->report(stages::kModes, 1.0 - std::exp(-static_cast<double>(solves_) / expected_solves_));
+    if (progress_)
+      progress_->report(stages::kModes,
+                        1.0 - std::exp(-static_cast<double>(solves_) / expected_solves_));
     return Y;
   }
 
@@ -113,8 +119,8 @@ class BlockLanczos {
   // dimension: of the space T acts on (DOFs with mass less the deflated kernel); max_columns:
   // Lanczos vectors allowed, at most that; zero_nu: the ν above which a pair is a zero mode that
   // the caller deflates (infinity when it does not).
-  BlockLanczos(ShiftInvert& T, const Eigen::VectorXd& m, Eigen::Index dimension, Eigen::Index max_columns,
-               double zero_nu)
+  BlockLanczos(ShiftInvert& T, const Eigen::VectorXd& m, Eigen::Index dimension,
+               Eigen::Index max_columns, double zero_nu)
       : T_(T),
         m_(m),
         dimension_(dimension),
@@ -140,9 +146,11 @@ class BlockLanczos {
       H_.block(0, first, last, last - first) = orthogonalize(W, last);
       const Eigen::MatrixXd next = orthonormal_coefficients(W);  // W before = W after · next
       // Ritz pairs of the space so far: T Q = Q H + W next Eᵀ over its last block.
-      const Eigen::MatrixXd H = 0.5 * (H_.topLeftCorner(last, last) + H_.topLeftCorner(last, last).transpose());
+      const Eigen::MatrixXd H =
+          0.5 * (H_.topLeftCorner(last, last) + H_.topLeftCorner(last, last).transpose());
       Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> ritz(H);
-      if (ritz.info() != Eigen::Success) throw NumericalError("vibration modes: the Ritz step failed");
+      if (ritz.info() != Eigen::Success)
+        throw NumericalError("vibration modes: the Ritz step failed");
       const Eigen::Index added = std::min<Eigen::Index>(next.rows(), Q_.cols() - last);
       if (last >= count) {
         const Eigen::MatrixXd S = ritz.eigenvectors().rowwise().reverse().leftCols(count);
@@ -156,8 +164,8 @@ class BlockLanczos {
           return dense_product(Q_.leftCols(last), S);
       }
       if (added == 0)
-        throw NumericalError(message("vibration modes: the eigensolver did not converge within ", last,
-                                     " Lanczos vectors (", T_.solves(), " solves)"));
+        throw NumericalError(message("vibration modes: the eigensolver did not converge within ",
+                                     last, " Lanczos vectors (", T_.solves(), " solves)"));
       H_.block(last, first, added, last - first) = next.topRows(added);
       append(W.leftCols(added));
     }
@@ -182,7 +190,8 @@ class BlockLanczos {
     }
     worst_.push_back((estimate.array() / tolerance).maxCoeff());
     const size_t blocks = worst_.size();
-    return blocks > kStalledBlocks && worst_[blocks - 1] > 0.5 * worst_[blocks - 1 - kStalledBlocks];
+    return blocks > kStalledBlocks &&
+           worst_[blocks - 1] > 0.5 * worst_[blocks - 1 - kStalledBlocks];
   }
 
   // W −= Q Qᵀ M W over the first `columns` of Q; returns the coefficients removed. W = T Q_j lies
@@ -211,7 +220,8 @@ class BlockLanczos {
   }
 
   Eigen::MatrixXd orthonormal_pass(Eigen::MatrixXd& W) const {
-    if (W.cols() == 0) return Eigen::MatrixXd(0, 0);  // Eigen's eigensolver fails on an empty matrix
+    if (W.cols() == 0)
+      return Eigen::MatrixXd(0, 0);  // Eigen's eigensolver fails on an empty matrix
     const Eigen::MatrixXd gram = inner_product(W, m_, W);
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(gram);
     const double floor = kDependentNorm * kDependentNorm * gram.diagonal().maxCoeff();
@@ -261,8 +271,10 @@ Eigen::VectorXd inverse_mass_norms(const Eigen::MatrixXd& R, const Eigen::Vector
 // error up to about k ε Σ|K_dj||φ_j| (Higham's γ_k), k the nonzeros per row. Modes on a scan's
 // stiff small parts (needles, flaps at non-manifold edges) have |K||φ| far above tr K / tr M, so
 // their residuals stop at this level rather than at kRoundingFloor's, which assumes an even mesh.
-Eigen::VectorXd rounding_levels(const SparseMatrix& K, const Eigen::MatrixXd& modes, const Eigen::VectorXd& m) {
-  const Eigen::MatrixXd magnitudes = modes.cwiseAbs().transpose();  // count by 3n: a DOF's values contiguous
+Eigen::VectorXd rounding_levels(const SparseMatrix& K, const Eigen::MatrixXd& modes,
+                                const Eigen::VectorXd& m) {
+  const Eigen::MatrixXd magnitudes =
+      modes.cwiseAbs().transpose();  // count by 3n: a DOF's values contiguous
   Eigen::MatrixXd products = Eigen::MatrixXd::Zero(magnitudes.rows(), magnitudes.cols());
   // Row d of |K||φ| from column d of K, K being symmetric: each is summed on one thread.
   for_row_blocks(K.outerSize(), [&](Eigen::Index first, Eigen::Index count) {
@@ -271,7 +283,8 @@ Eigen::VectorXd rounding_levels(const SparseMatrix& K, const Eigen::MatrixXd& mo
         products.col(d) += std::abs(it.value()) * magnitudes.col(it.row());
   });
   const double terms_per_row = static_cast<double>(K.nonZeros()) / static_cast<double>(K.rows());
-  return terms_per_row * std::numeric_limits<double>::epsilon() * inverse_mass_norms(products.transpose(), m);
+  return terms_per_row * std::numeric_limits<double>::epsilon() *
+         inverse_mass_norms(products.transpose(), m);
 }
 
 }  // namespace
@@ -279,24 +292,27 @@ Eigen::VectorXd rounding_levels(const SparseMatrix& K, const Eigen::MatrixXd& mo
 void require_accurate(const VibrationModes& modes, int first, int last) {
   for (int i = first; i < last; ++i)
     if (!(modes.residuals[i] <= modes.tolerances[i]))
-      throw NumericalError(message("vibration modes: mode ", i, " (eigenvalue ", modes.eigenvalues[i],
-                                   ") has residual ", modes.residuals[i], ", above the tolerance ",
-                                   modes.tolerances[i]));
+      throw NumericalError(message("vibration modes: mode ", i, " (eigenvalue ",
+                                   modes.eigenvalues[i], ") has residual ", modes.residuals[i],
+                                   ", above the tolerance ", modes.tolerances[i]));
 }
 
-ShiftedPencil::ShiftedPencil(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& kernel,
-                             double shift)
+ShiftedPencil::ShiftedPencil(const SparseMatrix& K, const VectorRef& mass,
+                             const Eigen::Ref<const Eigen::MatrixXd>& kernel, double shift)
     : K_(K), requested_shift_(shift), kernel_(checked_kernel_basis(K, mass, kernel)) {
   if (!(shift <= 0 && std::isfinite(shift)))
-    throw InputError(message("shift: expected a finite sigma < 0, or 0 to choose one, got ", shift));
+    throw InputError(
+        message("shift: expected a finite sigma < 0, or 0 to choose one, got ", shift));
   const double trace_K = K.diagonal().sum();
-  if (!(trace_K > 0)) throw InputError("K: no positive diagonal entry; there is no stiffness to take modes of");
+  if (!(trace_K > 0))
+    throw InputError("K: no positive diagonal entry; there is no stiffness to take modes of");
   dof_mass_ = dof_masses(mass);
   scale_ = trace_K / dof_mass_.sum();
   // DOFs outside the problem get a stiffness so that K − σM stays definite.
   decoupled_ = decoupled_dofs(K, mass);
   const auto n = static_cast<int>(K.rows());
-  const int num_decoupled = static_cast<int>(std::count(decoupled_.begin(), decoupled_.end(), true));
+  const int num_decoupled =
+      static_cast<int>(std::count(decoupled_.begin(), decoupled_.end(), true));
   decoupled_stiffness_ = Eigen::VectorXd::Zero(n);
   for (int d = 0; d < n; ++d)
     if (decoupled_[static_cast<size_t>(d)]) decoupled_stiffness_[d] = trace_K / (n - num_decoupled);
@@ -311,9 +327,10 @@ void ShiftedPencil::factor_with_shift(double sigma) {
     factor_.factorize(K_, decoupled_stiffness_ - sigma * dof_mass_, 0.0);
   } catch (const OutOfMemory& e) {
     const double bytes = factor_.factor_bytes();  // 0 when the analysis itself ran out
-    throw OutOfMemory(message("vibration modes: not enough memory to factor K - sigma M (", K_.rows(), " rows",
-                              bytes > 0 ? message(", a factor of ", bytes / 1e9, " GB") : std::string(),
-                              "): ", e.what()));
+    throw OutOfMemory(
+        message("vibration modes: not enough memory to factor K - sigma M (", K_.rows(), " rows",
+                bytes > 0 ? message(", a factor of ", bytes / 1e9, " GB") : std::string(),
+                "): ", e.what()));
   } catch (const NumericalError& e) {
     throw NumericalError(message("vibration modes: K - sigma M with sigma = ", sigma,
                                  " cannot be factored; is K positive semidefinite? ", e.what()));
@@ -323,17 +340,21 @@ void ShiftedPencil::factor_with_shift(double sigma) {
 
 VibrationModes ShiftedPencil::lowest_modes(int count, Progress* progress, double zero_modes_below) {
   if (!(zero_modes_below >= 0 && std::isfinite(zero_modes_below)))
-    throw InputError(message("zero_modes_below: expected a finite bound >= 0, got ", zero_modes_below));
+    throw InputError(
+        message("zero_modes_below: expected a finite bound >= 0, got ", zero_modes_below));
   const Eigen::VectorXd& m = dof_mass_;
   const auto n = static_cast<int>(m.size());
   const int free = static_cast<int>((m.array() > 0).count() - kernel_.cols());
   if (count < 1 || count >= free)
     throw InputError(message("count: expected 1 to ", free - 1,
-                             " modes (DOFs with mass, less the deflated kernel, less 1), got ", count));
-  const double sigma = requested_shift_ < 0 ? requested_shift_
-                                            : -(kernel_.cols() ? kDeflatedShiftFraction : kShiftFraction) * scale_;
+                             " modes (DOFs with mass, less the deflated kernel, less 1), got ",
+                             count));
+  const double sigma = requested_shift_ < 0
+                           ? requested_shift_
+                           : -(kernel_.cols() ? kDeflatedShiftFraction : kShiftFraction) * scale_;
   const int width = std::min(free, kBlockWidth);
-  const Eigen::Index max_columns = std::min(free, std::max(kMaxColumnsPerMode * count, kMinColumns) + width);
+  const Eigen::Index max_columns =
+      std::min(free, std::max(kMaxColumnsPerMode * count, kMinColumns) + width);
   if (progress) progress->report(stages::kModes, 0.0);
   if (sigma != factored_shift_) factor_with_shift(sigma);
 
@@ -344,8 +365,8 @@ VibrationModes ShiftedPencil::lowest_modes(int count, Progress* progress, double
   Eigen::MatrixXd R(n, width);
   for (Eigen::Index j = 0; j < width; ++j)
     for (int d = 0; d < n; ++d) R(d, j) = uniform(random);
-  const double zero_nu =
-      zero_modes_below > 0 ? 1 / (zero_modes_below - sigma) : std::numeric_limits<double>::infinity();
+  const double zero_nu = zero_modes_below > 0 ? 1 / (zero_modes_below - sigma)
+                                              : std::numeric_limits<double>::infinity();
   BlockLanczos lanczos(T, m, free, max_columns, zero_nu);
   const Eigen::MatrixXd ritz_vectors = lanczos.run(R, count);
 
@@ -356,22 +377,24 @@ VibrationModes ShiftedPencil::lowest_modes(int count, Progress* progress, double
   const Eigen::MatrixXd KY = multiply(K_, Y);
   const Eigen::MatrixXd reduced_K = inner_product(Y, KY);
   const Eigen::MatrixXd reduced_M = inner_product(Y, m, Y);
-  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> ritz(0.5 * (reduced_K + reduced_K.transpose()),
-                                                                 0.5 * (reduced_M + reduced_M.transpose()));
-  if (ritz.info() != Eigen::Success) throw NumericalError("vibration modes: the Rayleigh-Ritz step failed");
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> ritz(
+      0.5 * (reduced_K + reduced_K.transpose()), 0.5 * (reduced_M + reduced_M.transpose()));
+  if (ritz.info() != Eigen::Success)
+    throw NumericalError("vibration modes: the Rayleigh-Ritz step failed");
 
   VibrationModes result;
-  result.eigenvalues = ritz.eigenvalues();  // ascending
+  result.eigenvalues = ritz.eigenvalues();               // ascending
   result.modes = dense_product(Y, ritz.eigenvectors());  // M-orthonormal
   Eigen::MatrixXd residual = dense_product(KY, ritz.eigenvectors());
   for_row_blocks(residual.rows(), [&](Eigen::Index first, Eigen::Index rows) {
-    residual.middleRows(first, rows) -= m.segment(first, rows).asDiagonal() *
-                                        (result.modes.middleRows(first, rows) * result.eigenvalues.asDiagonal());
+    residual.middleRows(first, rows) -=
+        m.segment(first, rows).asDiagonal() *
+        (result.modes.middleRows(first, rows) * result.eigenvalues.asDiagonal());
   });
   result.residuals = inverse_mass_norms(residual, m);
   const double largest = result.eigenvalues[count - 1];
-  result.tolerances = kResidualTolerance * (result.eigenvalues.array().abs() + largest) + kRoundingFloor * scale_ +
-                      rounding_levels(K_, result.modes, m).array();
+  result.tolerances = kResidualTolerance * (result.eigenvalues.array().abs() + largest) +
+                      kRoundingFloor * scale_ + rounding_levels(K_, result.modes, m).array();
   result.shift = sigma;
   result.solves = T.solves();
 
@@ -381,7 +404,8 @@ VibrationModes ShiftedPencil::lowest_modes(int count, Progress* progress, double
   known_eigenvalues_ = result.eigenvalues(within);
   known_modes_ = result.modes(Eigen::all, within);
   deflatable_ = 0;
-  while (deflatable_ < static_cast<Eigen::Index>(within.size()) && within[static_cast<size_t>(deflatable_)] == deflatable_)
+  while (deflatable_ < static_cast<Eigen::Index>(within.size()) &&
+         within[static_cast<size_t>(deflatable_)] == deflatable_)
     ++deflatable_;
   if (progress) progress->report(stages::kModes, 1.0);
   return result;
@@ -407,7 +431,8 @@ FlexibleModes ShiftedPencil::flexible_modes(int flexible, double zero, Progress*
     require_accurate(modes, 0, found);
     if (found == 0) require_accurate(modes, 0, wanted);  // nothing to deflate: no second try
     deflate(found);
-    zero_values.insert(zero_values.end(), modes.eigenvalues.data(), modes.eigenvalues.data() + found);
+    zero_values.insert(zero_values.end(), modes.eigenvalues.data(),
+                       modes.eigenvalues.data() + found);
     if (within.segment(found, wanted - found).all() && count - found >= flexible) {
       FlexibleModes result;
       result.num_zero = static_cast<int>(zero_values.size());
@@ -423,8 +448,8 @@ FlexibleModes ShiftedPencil::flexible_modes(int flexible, double zero, Progress*
 
 void ShiftedPencil::deflate(int count) {
   if (count < 0 || count > deflatable_)
-    throw InputError(message("deflate: ", count, " modes asked for, but the last lowest_modes has ", deflatable_,
-                             " lowest modes within their tolerance left to deflate"));
+    throw InputError(message("deflate: ", count, " modes asked for, but the last lowest_modes has ",
+                             deflatable_, " lowest modes within their tolerance left to deflate"));
   const Eigen::Index kept = known_modes_.cols() - count;
   kernel_.conservativeResize(Eigen::NoChange, kernel_.cols() + count);
   kernel_.rightCols(count) = known_modes_.leftCols(count);
@@ -436,9 +461,12 @@ void ShiftedPencil::deflate(int count) {
 Eigen::MatrixXd ShiftedPencil::solve_in_range(Eigen::MatrixXd B, Progress* progress) {
   const Stopwatch stopwatch(timings_.solves);
   if (known_eigenvalues_.size() == 0)
-    throw InputError("solve_in_range: no eigenpair known to correct the shifted solves; call lowest_modes first");
+    throw InputError(
+        "solve_in_range: no eigenpair known to correct the shifted solves; call lowest_modes "
+        "first");
   if (!(known_eigenvalues_.array() > 0).all())
-    throw InputError(message("solve_in_range: the eigenpairs found include eigenvalue ", known_eigenvalues_.minCoeff(),
+    throw InputError(message("solve_in_range: the eigenpairs found include eigenvalue ",
+                             known_eigenvalues_.minCoeff(),
                              ", not above 0: deflate the zero modes first"));
   if (progress) progress->report(stages::kDerivativeSolves, 0.0);
   const Eigen::Index n = K_.rows();
@@ -449,12 +477,15 @@ Eigen::MatrixXd ShiftedPencil::solve_in_range(Eigen::MatrixXd B, Progress* progr
   // (K − σM)⁻¹ = Σ φφᵀ/(λ − σ) over the M-orthonormal eigenpairs, K⁺ = Σ φφᵀ/λ on the range.
   // The known pairs get the difference −σ/(λ(λ − σ)) added; on the others the error of each step
   // is the fraction −σ/(λ − σ), at most `contraction`.
-  const Eigen::VectorXd correction = (-sigma) * (eigenvalues.array() * (eigenvalues.array() - sigma)).inverse();
+  const Eigen::VectorXd correction =
+      (-sigma) * (eigenvalues.array() * (eigenvalues.array() - sigma)).inverse();
   const double contraction = -sigma / (eigenvalues.maxCoeff() - sigma);
-  const int steps = static_cast<int>(std::ceil(std::log(kRefinementTolerance) / std::log(contraction)));
+  const int steps =
+      static_cast<int>(std::ceil(std::log(kRefinementTolerance) / std::log(contraction)));
   if (steps > kMaxRefinementSteps)
-    throw NumericalError(message("solve_in_range: sigma = ", sigma, " is too far below the largest eigenvalue known, ",
-                                 eigenvalues.maxCoeff(), ": ", steps, " refinement steps would be needed"));
+    throw NumericalError(message(
+        "solve_in_range: sigma = ", sigma, " is too far below the largest eigenvalue known, ",
+        eigenvalues.maxCoeff(), ": ", steps, " refinement steps would be needed"));
   // One step: X += (K − σM)⁻¹ R less its kernel part, corrected on the known pairs by w. What it
   // leaves of R needs no product with K: K (K − σM)⁻¹ R = R + σM (K − σM)⁻¹ R, K Z = 0 and
   // K Φ = M Φ Λ, so R − K X = −σ M (K − σM)⁻¹ R − M Φ Λ w, which overwrites R: after the last
@@ -484,7 +515,8 @@ Eigen::MatrixXd ShiftedPencil::solve_in_range(Eigen::MatrixXd B, Progress* progr
   };
   return solve_in_range_by_blocks(
       K_, m, kernel_, decoupled_, std::move(B),
-      [&](Eigen::MatrixXd& PB, Eigen::Ref<Eigen::MatrixXd> X, const std::function<void(double)>& report) {
+      [&](Eigen::MatrixXd& PB, Eigen::Ref<Eigen::MatrixXd> X,
+          const std::function<void(double)>& report) {
         X.setZero();
         for (int k = 0; k < steps; ++k) {
           if (k > 0) report(static_cast<double>(k) / steps);

@@ -51,8 +51,8 @@ class ShiftedPencil {
   // flexible modes. shift: σ < 0, or 0 to take it from the scale of the problem (tr K / tr M) and
   // whether a kernel is deflated. K is kept by reference: it must outlive the pencil. Throws
   // InputError for bad K, mass, kernel or shift.
-  ShiftedPencil(const SparseMatrix& K, const VectorRef& mass, const Eigen::Ref<const Eigen::MatrixXd>& kernel,
-                double shift = 0);
+  ShiftedPencil(const SparseMatrix& K, const VectorRef& mass,
+                const Eigen::Ref<const Eigen::MatrixXd>& kernel, double shift = 0);
 
   // CHOLMOD's ordering of K now rather than at the first factorisation, so that factor_bytes()
   // is known before memory is spent on the factor. Throws OutOfMemory.
@@ -115,13 +115,13 @@ class ShiftedPencil {
   void factor_with_shift(double sigma);
 
   const SparseMatrix& K_;
-  Eigen::VectorXd dof_mass_;          // the diagonal of M (3n)
-  std::vector<bool> decoupled_;       // DOFs outside the problem (decoupled_dofs)
+  Eigen::VectorXd dof_mass_;             // the diagonal of M (3n)
+  std::vector<bool> decoupled_;          // DOFs outside the problem (decoupled_dofs)
   Eigen::VectorXd decoupled_stiffness_;  // added to them so that K − σM stays definite
-  double scale_;                      // tr K / tr M, a mass-weighted mean of the spectrum
-  double requested_shift_;            // the σ given, or 0
+  double scale_;                         // tr K / tr M, a mass-weighted mean of the spectrum
+  double requested_shift_;               // the σ given, or 0
   Eigen::MatrixXd kernel_;
-  CholmodLLT factor_{3};              // orders vertices, 3 DOFs each
+  CholmodLLT factor_{3};  // orders vertices, 3 DOFs each
   double factored_shift_ = 0;
   // The eigenpairs of the last lowest_modes within their tolerance and not deflated: solve_in_range
   // corrects them; the first deflatable_ of them are its lowest modes.

@@ -32,16 +32,19 @@ void validate_stiffness_and_mass(const SparseMatrix& K, const VectorRef& mass) {
   if (n == 0) throw InputError("mass: no vertices");
   for (Eigen::Index i = 0; i < n; ++i)
     if (!(std::isfinite(mass[i]) && mass[i] >= 0))
-      throw InputError(message("mass[", i, "] = ", mass[i], ": expected a finite non-negative mass"));
+      throw InputError(
+          message("mass[", i, "] = ", mass[i], ": expected a finite non-negative mass"));
   if (K.rows() != 3 * n || K.cols() != 3 * n)
-    throw InputError(
-        message("K: expected ", 3 * n, " by ", 3 * n, " (3 per vertex), got ", K.rows(), " by ", K.cols()));
+    throw InputError(message("K: expected ", 3 * n, " by ", 3 * n, " (3 per vertex), got ",
+                             K.rows(), " by ", K.cols()));
   double largest = 0;
   for (int j = 0; j < K.outerSize(); ++j) {
     int previous = -1;
     for (SparseMatrix::InnerIterator it(K, j); it; ++it) {
-      if (!std::isfinite(it.value())) throw InputError(message("K(", it.row(), ", ", j, ") is not finite"));
-      if (it.row() <= previous) throw InputError(message("K: row indices of column ", j, " are not sorted or repeat"));
+      if (!std::isfinite(it.value()))
+        throw InputError(message("K(", it.row(), ", ", j, ") is not finite"));
+      if (it.row() <= previous)
+        throw InputError(message("K: row indices of column ", j, " are not sorted or repeat"));
       previous = static_cast<int>(it.row());
       largest = std::max(largest, std::abs(it.value()));
     }
@@ -55,11 +58,13 @@ void validate_stiffness_and_mass(const SparseMatrix& K, const VectorRef& mass) {
   const int* rows = K.innerIndexPtr();
   const double* values = K.valuePtr();
   const auto asymmetric = [&](int i, int j, double value, double partner) {
-    return InputError(message("K is not symmetric: K(", i, ", ", j, ") = ", value, " but K(", j, ", ", i, ") = ",
-                              partner));
+    return InputError(message("K is not symmetric: K(", i, ", ", j, ") = ", value, " but K(", j,
+                              ", ", i, ") = ", partner));
   };
-  std::vector<int> unpaired(static_cast<size_t>(K.outerSize()));  // per column, its first entry not yet paired
-  for (int c = 0; c < K.outerSize(); ++c) unpaired[static_cast<size_t>(c)] = column_range(K, c).first;
+  std::vector<int> unpaired(
+      static_cast<size_t>(K.outerSize()));  // per column, its first entry not yet paired
+  for (int c = 0; c < K.outerSize(); ++c)
+    unpaired[static_cast<size_t>(c)] = column_range(K, c).first;
   // Checks the entries of column c above the diagonal with rows below `row` and moves past them.
   const auto check_unpaired = [&](int c, int row) {
     int& p = unpaired[static_cast<size_t>(c)];
@@ -81,7 +86,9 @@ void validate_stiffness_and_mass(const SparseMatrix& K, const VectorRef& mass) {
   for (int c = 0; c < K.outerSize(); ++c) check_unpaired(c, c);
 }
 
-Eigen::VectorXd dof_masses(const VectorRef& mass) { return mass.replicate(1, 3).transpose().reshaped(); }
+Eigen::VectorXd dof_masses(const VectorRef& mass) {
+  return mass.replicate(1, 3).transpose().reshaped();
+}
 
 std::vector<bool> decoupled_dofs(const SparseMatrix& K, const VectorRef& mass) {
   std::vector<bool> decoupled(static_cast<size_t>(K.cols()));
@@ -96,7 +103,8 @@ std::vector<bool> decoupled_dofs(const SparseMatrix& K, const VectorRef& mass) {
 Eigen::MatrixXd checked_kernel_basis(const SparseMatrix& K, const VectorRef& mass,
                                      const Eigen::Ref<const Eigen::MatrixXd>& Z) {
   validate_stiffness_and_mass(K, mass);
-  if (Z.rows() != K.rows()) throw InputError(message("Z: expected ", K.rows(), " rows, got ", Z.rows()));
+  if (Z.rows() != K.rows())
+    throw InputError(message("Z: expected ", K.rows(), " rows, got ", Z.rows()));
   if (!Z.allFinite()) throw InputError("Z: has an entry that is not finite");
   Eigen::MatrixXd basis = Z;
   const std::vector<bool> decoupled = decoupled_dofs(K, mass);
@@ -105,14 +113,17 @@ Eigen::MatrixXd checked_kernel_basis(const SparseMatrix& K, const VectorRef& mas
   const Eigen::MatrixXd gram = basis.transpose() * (dof_masses(mass).asDiagonal() * basis);
   Eigen::Index i = 0, j = 0;
   if (Z.cols() &&
-      (gram - Eigen::MatrixXd::Identity(Z.cols(), Z.cols())).cwiseAbs().maxCoeff(&i, &j) > kOrthonormalTolerance)
-    throw InputError(message("Z: expected M-orthonormal columns, but (Z^T M Z)(", i, ", ", j, ") = ", gram(i, j)));
+      (gram - Eigen::MatrixXd::Identity(Z.cols(), Z.cols())).cwiseAbs().maxCoeff(&i, &j) >
+          kOrthonormalTolerance)
+    throw InputError(message("Z: expected M-orthonormal columns, but (Z^T M Z)(", i, ", ", j,
+                             ") = ", gram(i, j)));
   const Eigen::MatrixXd KZ = multiply(K, basis);
   const double norm_K = norm_1(K);
   for (Eigen::Index k = 0; k < Z.cols(); ++k) {
     const double relative = KZ.col(k).norm() / (norm_K * basis.col(k).norm());
     if (relative > kKernelTolerance)
-      throw InputError(message("Z: column ", k, " is not in the kernel of K (|K z| / (|K| |z|) = ", relative, ")"));
+      throw InputError(message("Z: column ", k,
+                               " is not in the kernel of K (|K z| / (|K| |z|) = ", relative, ")"));
   }
   return basis;
 }

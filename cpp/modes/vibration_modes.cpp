@@ -2,7 +2,8 @@
 
 namespace modal_deform {
 
-VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int count, Progress* progress) {
+VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int count,
+                               Progress* progress) {
   return vibration_modes(K, mass, count, Eigen::MatrixXd(K.rows(), 0), progress);
 }
 

@@ -14,11 +14,13 @@ namespace modal_deform {
 // ShiftedPencil::lowest_modes with σ < 0 from the scale of the problem, then require_accurate.
 // Reports ("modes", fraction) to `progress`, which may cancel. Throws InputError for bad input,
 // NumericalError when the eigensolver does not converge or a mode's residual is too large.
-VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int count, Progress* progress = nullptr);
-
-// The `count` lowest eigenpairs with modes M-orthogonal to the columns of Z (3n by z, M-orthonormal,
-// in the kernel of K: rigid_motions for a rigid-invariant energy), deflated.
 VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int count,
-                               const Eigen::Ref<const Eigen::MatrixXd>& Z, Progress* progress = nullptr);
+                               Progress* progress = nullptr);
+
+// The `count` lowest eigenpairs with modes M-orthogonal to the columns of Z (3n by z,
+// M-orthonormal, in the kernel of K: rigid_motions for a rigid-invariant energy), deflated.
+VibrationModes vibration_modes(const SparseMatrix& K, const VectorRef& mass, int count,
+                               const Eigen::Ref<const Eigen::MatrixXd>& Z,
+                               Progress* progress = nullptr);
 
 }  // namespace modal_deform

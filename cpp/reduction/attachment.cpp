@@ -49,13 +49,15 @@ class VertexGrid {
 
   // The vertices within r of c, ascending.
   std::vector<int> within(const Eigen::RowVector3d& c, double r) const {
-    const Eigen::Array3i from = cell(c.transpose().array() - r), to = cell(c.transpose().array() + r);
+    const Eigen::Array3i from = cell(c.transpose().array() - r),
+                         to = cell(c.transpose().array() + r);
     std::vector<int> found;
     for (int i = from[0]; i <= to[0]; ++i)
       for (int j = from[1]; j <= to[1]; ++j)
         for (int k = from[2]; k <= to[2]; ++k) {
           const long here = key({i, j, k});
-          const auto first = std::lower_bound(sorted_.begin(), sorted_.end(), std::pair<long, int>{here, -1});
+          const auto first =
+              std::lower_bound(sorted_.begin(), sorted_.end(), std::pair<long, int>{here, -1});
           for (auto it = first; it != sorted_.end() && it->first == here; ++it)
             if ((P_.row(it->second) - c).norm() <= r) found.push_back(it->second);
         }
@@ -67,7 +69,9 @@ class VertexGrid {
   Eigen::Array3i cell(const Eigen::Array3d& p) const {
     return ((p - low_) / size_).floor().cast<int>().max(0).min(cells_ - 1);
   }
-  long key(const Eigen::Array3i& c) const { return (static_cast<long>(c[0]) * cells_ + c[1]) * cells_ + c[2]; }
+  long key(const Eigen::Array3i& c) const {
+    return (static_cast<long>(c[0]) * cells_ + c[1]) * cells_ + c[2];
+  }
 
   const RowMatrixX3d& P_;
   Eigen::Array3d low_;
@@ -119,7 +123,8 @@ Attachment::Follower follow(const VerticesRef& V, const RowMatrixX3d& P, const V
     flat = axes.eigenvalues()[0] < kMinThickness * kMinThickness * axes.eigenvalues()[2];
     const bool everything = static_cast<int>(follower.anchors.size()) == S;
     if (collinear && everything)
-      throw NumericalError(message("attachment: the simulated vertices around attached vertex ", group.vertices[0],
+      throw NumericalError(message("attachment: the simulated vertices around attached vertex ",
+                                   group.vertices[0],
                                    " are collinear; no affine motion can be fitted to them"));
     if (!collinear && (!flat || everything)) break;
     reach *= 2;
@@ -130,14 +135,16 @@ Attachment::Follower follow(const VerticesRef& V, const RowMatrixX3d& P, const V
   // (all three, or the plane's two): [t; A e] = Σ_k G⁻¹ w_k [1; y_k·e] u_k. So t = Σ alpha_k u_k
   // and A = Σ_k u_k beta_kᵀ on those directions; on a flat region A n = −Σ_i e_i (n·A e_i), the
   // skew completion (what a linearised rotation of the plane does to its normal).
-  const Eigen::MatrixXd directions = flat ? Eigen::MatrixXd(axes.eigenvectors().rightCols(2)) : Eigen::MatrixXd::Identity(3, 3);
+  const Eigen::MatrixXd directions =
+      flat ? Eigen::MatrixXd(axes.eigenvectors().rightCols(2)) : Eigen::MatrixXd::Identity(3, 3);
   follower.normal = flat ? Eigen::Vector3d(axes.eigenvectors().col(0)) : Eigen::Vector3d::Zero();
   const auto K = static_cast<Eigen::Index>(follower.anchors.size());
   Eigen::MatrixXd design(1 + directions.cols(), K);  // column k: [1; y_k·e]
   design.row(0).setOnes();
   design.bottomRows(directions.cols()) = directions.transpose() * centred.transpose();
   const Eigen::MatrixXd gram = design * w.asDiagonal() * design.transpose();
-  const Eigen::MatrixXd solved = gram.ldlt().solve(design * w.asDiagonal());  // column k: G⁻¹ w_k [1; y_k·e]
+  const Eigen::MatrixXd solved =
+      gram.ldlt().solve(design * w.asDiagonal());  // column k: G⁻¹ w_k [1; y_k·e]
   follower.offsets.resize(static_cast<Eigen::Index>(group.vertices.size()), 3);
   for (size_t i = 0; i < group.vertices.size(); ++i)
     follower.offsets.row(static_cast<Eigen::Index>(i)) = V.row(group.vertices[i]) - mean;
@@ -177,7 +184,8 @@ Attachment attach(const VerticesRef& V, const FacesRef& F) {
   std::vector<char> sound(static_cast<size_t>(m), 1);
   for (int f : duplicate_faces(F)) sound[static_cast<size_t>(f)] = 0;
   for (int f = 0; f < m; ++f)
-    sound[static_cast<size_t>(f)] = sound[static_cast<size_t>(f)] && face_shape_ratio(V, F, f) > kMinSimulatedShape;
+    sound[static_cast<size_t>(f)] =
+        sound[static_cast<size_t>(f)] && face_shape_ratio(V, F, f) > kMinSimulatedShape;
   UnionFind pieces(m);
   join_across_edges(F, sound, pieces);
   std::vector<double> piece_area(static_cast<size_t>(m), 0.0);
@@ -185,13 +193,14 @@ Attachment attach(const VerticesRef& V, const FacesRef& F) {
     if (sound[static_cast<size_t>(f)]) piece_area[static_cast<size_t>(pieces.find(f))] += area[f];
   const double largest = *std::max_element(piece_area.begin(), piece_area.end());
   if (!(largest > 0))
-    throw InputError(message("F: every face is degenerate or a sliver (twice its area below ", kMinSimulatedShape,
-                             " of its longest edge squared) or a copy; the mesh has nothing to simulate"));
+    throw InputError(message(
+        "F: every face is degenerate or a sliver (twice its area below ", kMinSimulatedShape,
+        " of its longest edge squared) or a copy; the mesh has nothing to simulate"));
   const double threshold = kSimulatedAreaFraction * largest;
   std::vector<char> large(static_cast<size_t>(m), 0);  // a sound face of a simulated piece
   for (int f = 0; f < m; ++f)
-    large[static_cast<size_t>(f)] =
-        sound[static_cast<size_t>(f)] && piece_area[static_cast<size_t>(pieces.find(f))] >= threshold;
+    large[static_cast<size_t>(f)] = sound[static_cast<size_t>(f)] &&
+                                    piece_area[static_cast<size_t>(pieces.find(f))] >= threshold;
 
   // Vertices: simulated on a large piece's face, the large pieces that share a vertex one
   // component (pinned there: they share rigid motions, and turning about the pin is a zero mode);
@@ -243,32 +252,38 @@ Attachment attach(const VerticesRef& V, const FacesRef& F) {
       groups[static_cast<size_t>(group_of_root[root])].vertices.push_back(v);
     }
   }
-  result.component = Eigen::Map<const Eigen::VectorXi>(labels.data(), static_cast<Eigen::Index>(labels.size()));
+  result.component =
+      Eigen::Map<const Eigen::VectorXi>(labels.data(), static_cast<Eigen::Index>(labels.size()));
 
   std::vector<int> faces;
   for (int f = 0; f < m; ++f)
     if (large[static_cast<size_t>(f)])
       for (int k = 0; k < 3; ++k) faces.push_back(result.submesh_index[F(f, k)]);
-  result.faces = Eigen::Map<const RowMatrixX3i>(faces.data(), static_cast<Eigen::Index>(faces.size() / 3), 3);
+  result.faces =
+      Eigen::Map<const RowMatrixX3i>(faces.data(), static_cast<Eigen::Index>(faces.size() / 3), 3);
 
   RowMatrixX3d P(static_cast<Eigen::Index>(result.simulated.size()), 3);
-  for (size_t s = 0; s < result.simulated.size(); ++s) P.row(static_cast<Eigen::Index>(s)) = V.row(result.simulated[s]);
+  for (size_t s = 0; s < result.simulated.size(); ++s)
+    P.row(static_cast<Eigen::Index>(s)) = V.row(result.simulated[s]);
   const Eigen::VectorXd mass = lumped_mass(V, F)(result.simulated);
   const VertexGrid grid(P);
   for (const Group& group : groups) result.followers.push_back(follow(V, P, grid, mass, group));
   return result;
 }
 
-Eigen::MatrixXd extend_to_attached(const Attachment& attachment, const Eigen::Ref<const Eigen::MatrixXd>& U) {
+Eigen::MatrixXd extend_to_attached(const Attachment& attachment,
+                                   const Eigen::Ref<const Eigen::MatrixXd>& U) {
   const auto S = static_cast<Eigen::Index>(attachment.simulated.size());
   if (U.rows() != 3 * S)
-    throw InputError(message("U: expected ", 3 * S, " rows (3 per simulated vertex), got ", U.rows()));
+    throw InputError(
+        message("U: expected ", 3 * S, " rows (3 per simulated vertex), got ", U.rows()));
   const Eigen::Index n = attachment.submesh_index.size();
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(3 * n, U.cols());
 #pragma omp parallel for schedule(static)
   for (Eigen::Index j = 0; j < U.cols(); ++j) {
     for (Eigen::Index s = 0; s < S; ++s)
-      out.col(j).segment<3>(3 * attachment.simulated[static_cast<size_t>(s)]) = U.col(j).segment<3>(3 * s);
+      out.col(j).segment<3>(3 * attachment.simulated[static_cast<size_t>(s)]) =
+          U.col(j).segment<3>(3 * s);
     for (const Attachment::Follower& follower : attachment.followers) {
       // The fitted affine displacement t + A y of this column (header).
       Eigen::Vector3d t = Eigen::Vector3d::Zero(), turn = Eigen::Vector3d::Zero();

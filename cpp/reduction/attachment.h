@@ -61,6 +61,7 @@ Attachment attach(const VerticesRef& V, const FacesRef& F);
 // Fine vectors from submesh vectors: U (3#S by r, interleaved) to 3#V by r, simulated rows
 // copied, attached rows blended from their anchors, the rows of vertices neither simulated nor
 // attached (outside a region, region.h) zero.
-Eigen::MatrixXd extend_to_attached(const Attachment& attachment, const Eigen::Ref<const Eigen::MatrixXd>& U);
+Eigen::MatrixXd extend_to_attached(const Attachment& attachment,
+                                   const Eigen::Ref<const Eigen::MatrixXd>& U);
 
 }  // namespace modal_deform

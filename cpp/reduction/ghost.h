@@ -23,9 +23,10 @@ struct Ghost {
 // Simplifies (V #V by 3, F #F by 3) by edge collapse (see collapse_edges) to about `target`
 // vertices (fewer are not reached when no valid collapse is left; the result says how many).
 // `mass` (#V, length², lumped_mass) weights the means. Vertices left without a face (unreferenced,
-// or only on faces that cancelled) join the nearest ghost vertex. A target of at least #V gives the mesh itself with the identity map.
-// `sides` (#V or empty) keeps vertices of different sides apart (collapse_edges). Reports
-// stage "ghost"; throws Cancelled when told to stop, InputError for bad input.
+// or only on faces that cancelled) join the nearest ghost vertex. A target of at least #V gives the
+// mesh itself with the identity map. `sides` (#V or empty) keeps vertices of different sides apart
+// (collapse_edges). Reports stage "ghost"; throws Cancelled when told to stop, InputError for bad
+// input.
 Ghost ghost_mesh(const VerticesRef& V, const FacesRef& F, const VectorRef& mass, int target,
                  Progress* progress = nullptr, const std::vector<char>& sides = {});
 
@@ -39,7 +40,8 @@ int nearest_fine_vertex(const Ghost& ghost, const VerticesRef& fine_V, int g);
 // `map` (#V) sends fine vertices to ghost vertices in [0, num_ghost); every ghost vertex needs at
 // least one. Columns run in parallel.
 Eigen::MatrixXd restrict_to_ghost(const Eigen::Ref<const Eigen::VectorXi>& map, int num_ghost,
-                                  const VectorRef& fine_mass, const Eigen::Ref<const Eigen::MatrixXd>& U);
+                                  const VectorRef& fine_mass,
+                                  const Eigen::Ref<const Eigen::MatrixXd>& U);
 
 inline Eigen::MatrixXd restrict_to_ghost(const Ghost& ghost, const VectorRef& fine_mass,
                                          const Eigen::Ref<const Eigen::MatrixXd>& U) {

@@ -15,10 +15,14 @@ namespace {
 // and the faster its products (docs/measurements.md, "Choices in the core").
 constexpr Eigen::Index kBlockColumns = 80;
 // The squared M-norms of X's columns: the diagonal of Xᵀ M X without the rest of it.
-Eigen::VectorXd squared_m_norms(const Eigen::Ref<const Eigen::MatrixXd>& X, const VectorRef& dof_mass) {
-  return sum_over_row_blocks(X.rows(), 1, X.cols(), [&](Eigen::Index first, Eigen::Index count) {
-           return dof_mass.segment(first, count).transpose() * X.middleRows(first, count).cwiseAbs2();
-         }).transpose();
+Eigen::VectorXd squared_m_norms(const Eigen::Ref<const Eigen::MatrixXd>& X,
+                                const VectorRef& dof_mass) {
+  return sum_over_row_blocks(X.rows(), 1, X.cols(),
+                             [&](Eigen::Index first, Eigen::Index count) {
+                               return dof_mass.segment(first, count).transpose() *
+                                      X.middleRows(first, count).cwiseAbs2();
+                             })
+      .transpose();
 }
 
 // X ← X R⁻¹ for upper triangular R.
@@ -31,14 +35,16 @@ void solve_upper_on_the_right(Eigen::Ref<Eigen::MatrixXd> X, const Eigen::Matrix
 
 // Removes from X its components along the M-orthonormal columns Q (classical Gram–Schmidt; each
 // of the two passes does it once, which makes it twice, "twice is enough").
-void project_out(Eigen::Ref<Eigen::MatrixXd> X, const Eigen::Ref<const Eigen::MatrixXd>& Q, const VectorRef& dof_mass) {
+void project_out(Eigen::Ref<Eigen::MatrixXd> X, const Eigen::Ref<const Eigen::MatrixXd>& Q,
+                 const VectorRef& dof_mass) {
   if (Q.cols()) add_dense_product(X, Q, -inner_product(Q, dof_mass, X));
 }
 
 // Cholesky factor R (upper) of the Gram matrix G over the columns it keeps: column j is dropped
 // when its squared residual norm, G_jj less its components along the kept columns before it, is
 // at most floor[j]. Writes the kept indices into `kept`.
-Eigen::MatrixXd dropping_cholesky(const Eigen::MatrixXd& G, const Eigen::VectorXd& floor, std::vector<int>& kept) {
+Eigen::MatrixXd dropping_cholesky(const Eigen::MatrixXd& G, const Eigen::VectorXd& floor,
+                                  std::vector<int>& kept) {
   const Eigen::Index w = G.rows();
   Eigen::MatrixXd R = Eigen::MatrixXd::Zero(w, w);  // rows and columns of kept indices only
   kept.clear();
@@ -66,11 +72,14 @@ Eigen::MatrixXd dropping_cholesky(const Eigen::MatrixXd& G, const Eigen::VectorX
 
 }  // namespace
 
-std::vector<int> orthonormalize(Eigen::MatrixXd& U, const VectorRef& dof_mass, double tolerance, Progress* progress) {
+std::vector<int> orthonormalize(Eigen::MatrixXd& U, const VectorRef& dof_mass, double tolerance,
+                                Progress* progress) {
   if (dof_mass.size() != U.rows())
-    throw InputError(message("dof_mass: expected ", U.rows(), " values (one per row of U), got ", dof_mass.size()));
+    throw InputError(message("dof_mass: expected ", U.rows(), " values (one per row of U), got ",
+                             dof_mass.size()));
   if (!U.allFinite()) throw InputError("U: has an entry that is not finite");
-  if (!(tolerance >= 0 && tolerance < 1)) throw InputError(message("tolerance: expected [0, 1), got ", tolerance));
+  if (!(tolerance >= 0 && tolerance < 1))
+    throw InputError(message("tolerance: expected [0, 1), got ", tolerance));
   std::vector<int> kept_columns;
   Eigen::Index done = 0;  // columns of Q so far: U's leading columns
   if (progress) progress->report(stages::kOrthonormalisation, 0.0);
@@ -83,7 +92,8 @@ std::vector<int> orthonormalize(Eigen::MatrixXd& U, const VectorRef& dof_mass, d
     // at or before its own, so none is overwritten before it is read.
     auto X = U.middleCols(first, width);
     const auto Q = U.leftCols(done);
-    const Eigen::VectorXd floor = (tolerance * tolerance) * squared_m_norms(X, dof_mass);  // before projection
+    const Eigen::VectorXd floor =
+        (tolerance * tolerance) * squared_m_norms(X, dof_mass);  // before projection
     project_out(X, Q, dof_mass);
     std::vector<int> kept;
     const Eigen::MatrixXd R = dropping_cholesky(inner_product(X, dof_mass, X), floor, kept);
@@ -97,11 +107,13 @@ std::vector<int> orthonormalize(Eigen::MatrixXd& U, const VectorRef& dof_mass, d
     project_out(Y, Q, dof_mass);
     const Eigen::LLT<Eigen::MatrixXd> second(inner_product(Y, dof_mass, Y));
     if (second.info() != Eigen::Success)
-      throw NumericalError("orthonormalize: the second Cholesky-QR pass failed; the columns are too dependent");
+      throw NumericalError(
+          "orthonormalize: the second Cholesky-QR pass failed; the columns are too dependent");
     solve_upper_on_the_right(Y, Eigen::MatrixXd(second.matrixU()));
     done += Y.cols();
     for (int k : kept) kept_columns.push_back(static_cast<int>(first) + k);
-    if (progress) progress->report(stages::kOrthonormalisation, static_cast<double>(first + width) / U.cols());
+    if (progress)
+      progress->report(stages::kOrthonormalisation, static_cast<double>(first + width) / U.cols());
   }
   U.conservativeResize(Eigen::NoChange, done);
   return kept_columns;

@@ -25,7 +25,8 @@ constexpr double kDependentTolerance = 1e-6;
 // for 136 columns of the 100k dragon); the dense products run over row blocks in parallel.
 // Reports ("orthonormalisation", fraction) per block.
 // Throws InputError for a non-finite entry or a wrong dof_mass size.
-std::vector<int> orthonormalize(Eigen::MatrixXd& U, const VectorRef& dof_mass, double tolerance = kDependentTolerance,
+std::vector<int> orthonormalize(Eigen::MatrixXd& U, const VectorRef& dof_mass,
+                                double tolerance = kDependentTolerance,
                                 Progress* progress = nullptr);
 
 }  // namespace modal_deform

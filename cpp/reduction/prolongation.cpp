@@ -9,11 +9,13 @@
 
 namespace modal_deform {
 
-Prolongation prolongation_to_proxy(const VerticesRef& V, const VerticesRef& proxy_V, const FacesRef& proxy_F,
+Prolongation prolongation_to_proxy(const VerticesRef& V, const VerticesRef& proxy_V,
+                                   const FacesRef& proxy_F,
                                    const Eigen::Ref<const Eigen::VectorXi>& cluster) {
   const Eigen::Index n = V.rows(), p = proxy_V.rows();
   if (cluster.size() != n)
-    throw InputError(message("cluster: expected ", n, " entries (one per fine vertex), got ", cluster.size()));
+    throw InputError(
+        message("cluster: expected ", n, " entries (one per fine vertex), got ", cluster.size()));
   for (Eigen::Index i = 0; i < n; ++i)
     if (cluster[i] < 0 || cluster[i] >= p)
       throw InputError(message("cluster[", i, "] = ", cluster[i], " is outside [0, ", p, ")"));
@@ -24,7 +26,8 @@ Prolongation prolongation_to_proxy(const VerticesRef& V, const VerticesRef& prox
   for (Eigen::Index x = 0; x < p; ++x) first[x + 1] += first[x];
   std::vector<int> faces(static_cast<size_t>(first[p])), next(first.begin(), first.end() - 1);
   for (Eigen::Index f = 0; f < proxy_F.rows(); ++f)
-    for (int k = 0; k < 3; ++k) faces[static_cast<size_t>(next[proxy_F(f, k)]++)] = static_cast<int>(f);
+    for (int k = 0; k < 3; ++k)
+      faces[static_cast<size_t>(next[proxy_F(f, k)]++)] = static_cast<int>(f);
 
   Prolongation prolongation;
   prolongation.vertices.resize(n, 3);
@@ -56,8 +59,8 @@ Prolongation held_at_rest(Eigen::Index num_vertices) {
   return {RowMatrixX3i::Zero(num_vertices, 3), RowMatrixX3f::Zero(num_vertices, 3)};
 }
 
-void prolongate_positions(const Prolongation& prolongation, const float* rest, const float* proxy_displacement,
-                          float* out) {
+void prolongate_positions(const Prolongation& prolongation, const float* rest,
+                          const float* proxy_displacement, float* out) {
   const int* vertices = prolongation.vertices.data();
   const float* weights = prolongation.weights.data();
   for_row_blocks(prolongation.size(), [&](Eigen::Index first, Eigen::Index count) {

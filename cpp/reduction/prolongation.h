@@ -33,15 +33,17 @@ struct Prolongation {
 // (V #V by 3); `cluster` (#V, in [0, #P)) is the proxy vertex each fine vertex collapsed onto.
 // A fine vertex whose proxy vertex has no triangle takes that vertex alone (weights 1, 0, 0).
 // Runs in parallel over the fine vertices; throws InputError for a cluster index out of range.
-Prolongation prolongation_to_proxy(const VerticesRef& V, const VerticesRef& proxy_V, const FacesRef& proxy_F,
+Prolongation prolongation_to_proxy(const VerticesRef& V, const VerticesRef& proxy_V,
+                                   const FacesRef& proxy_F,
                                    const Eigen::Ref<const Eigen::VectorXi>& cluster);
 
 // #V rows that hold every fine vertex at rest (zero weights on proxy vertex 0).
 Prolongation held_at_rest(Eigen::Index num_vertices);
 
 // out_i = x̄_i + Σ_k w_ik d_{v_ik} for every fine vertex: `rest` (3#V, x̄), `proxy_displacement`
-// (3#P, d) and `out` (3#V), interleaved, in single precision. In parallel over blocks of fine vertices.
-void prolongate_positions(const Prolongation& prolongation, const float* rest, const float* proxy_displacement,
-                          float* out);
+// (3#P, d) and `out` (3#V), interleaved, in single precision. In parallel over blocks of fine
+// vertices.
+void prolongate_positions(const Prolongation& prolongation, const float* rest,
+                          const float* proxy_displacement, float* out);
 
 }  // namespace modal_deform

@@ -6,18 +6,21 @@
 
 namespace modal_deform {
 
-RegionMesh region_mesh(const FacesRef& F, const VectorRef& mass, const Eigen::Ref<const Eigen::VectorXi>& region) {
+RegionMesh region_mesh(const FacesRef& F, const VectorRef& mass,
+                       const Eigen::Ref<const Eigen::VectorXi>& region) {
   const Eigen::Index n = mass.size();
   // 1: in the region, 2: free (in the region, with mass), 3 and 4: clamped (below).
   std::vector<char> kind(static_cast<size_t>(n), 0);
   for (Eigen::Index i = 0; i < region.size(); ++i) {
     const int v = region[i];
-    if (v < 0 || v >= n) throw InputError(message("region[", i, "] = ", v, " is not a vertex (0 to ", n - 1, ")"));
+    if (v < 0 || v >= n)
+      throw InputError(message("region[", i, "] = ", v, " is not a vertex (0 to ", n - 1, ")"));
     if (kind[v]) throw InputError(message("region[", i, "] = ", v, " is there twice"));
     kind[v] = mass[v] > 0 ? 2 : 1;
   }
   if (region.size() == n)
-    throw InputError("region: it holds every vertex, so nothing is clamped; bake without a region instead");
+    throw InputError(
+        "region: it holds every vertex, so nothing is clamped; bake without a region instead");
   RegionMesh mesh;
   // The first ring (3): vertices on a face with a free vertex. The faces on them hold every term
   // that moves: a bending term spans the two faces of an edge, and a face with a free vertex
@@ -47,21 +50,26 @@ RegionMesh region_mesh(const FacesRef& F, const VectorRef& mass, const Eigen::Re
         if (free) ++mesh.num_free;
       }
   if (mesh.num_free == 0)
-    throw InputError("region: no vertex of it is left free (each lies on no face with area); paint the region on "
-                     "the surface");
+    throw InputError(
+        "region: no vertex of it is left free (each lies on no face with area); paint the region "
+        "on "
+        "the surface");
   mesh.faces.resize(static_cast<Eigen::Index>(faces.size()), 3);
   for (size_t i = 0; i < faces.size(); ++i)
     for (int k = 0; k < 3; ++k) mesh.faces(static_cast<Eigen::Index>(i), k) = local[F(faces[i], k)];
   return mesh;
 }
 
-void require_handles_in_region(const std::vector<std::vector<int>>& handles, const Eigen::VectorXi& region) {
+void require_handles_in_region(const std::vector<std::vector<int>>& handles,
+                               const Eigen::VectorXi& region) {
   if (region.size() == 0) return;
   for (size_t h = 0; h < handles.size(); ++h)
     for (int v : handles[h])
       if (!std::binary_search(region.data(), region.data() + region.size(), v))
-        throw InputError(message("handles[", h, "]: vertex ", v, " lies outside the basis's region, which alone "
-                                 "moves; keep handles inside the region, or bake a region that holds them"));
+        throw InputError(
+            message("handles[", h, "]: vertex ", v,
+                    " lies outside the basis's region, which alone "
+                    "moves; keep handles inside the region, or bake a region that holds them"));
 }
 
 }  // namespace modal_deform

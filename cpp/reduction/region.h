@@ -25,13 +25,15 @@ struct RegionMesh {
 };
 
 // The submesh of the region (fine vertex indices, any order) of the mesh (#V vertices, F #F by 3,
-// lumped `mass` #V), the region not empty. Throws InputError naming "region" for an index out of range
-// or repeated, a region holding every vertex (bake without one), or one with no vertex left free
-// (none with mass on a face).
-RegionMesh region_mesh(const FacesRef& F, const VectorRef& mass, const Eigen::Ref<const Eigen::VectorXi>& region);
+// lumped `mass` #V), the region not empty. Throws InputError naming "region" for an index out of
+// range or repeated, a region holding every vertex (bake without one), or one with no vertex left
+// free (none with mass on a face).
+RegionMesh region_mesh(const FacesRef& F, const VectorRef& mass,
+                       const Eigen::Ref<const Eigen::VectorXi>& region);
 
 // Throws InputError naming the handle and vertex when a handle vertex lies outside the region
 // (`region`: sorted fine indices; empty: the whole mesh).
-void require_handles_in_region(const std::vector<std::vector<int>>& handles, const Eigen::VectorXi& region);
+void require_handles_in_region(const std::vector<std::vector<int>>& handles,
+                               const Eigen::VectorXi& region);
 
 }  // namespace modal_deform

@@ -18,7 +18,8 @@ void Bfgs::start(const Eigen::VectorXd& x, const Eigen::MatrixXd& initial_invers
   const Eigen::Index n = x.size();
   if (initial_inverse_hessian.rows() != n || initial_inverse_hessian.cols() != n)
     throw InputError(message("initial_inverse_hessian: expected ", n, " by ", n, ", got ",
-                             initial_inverse_hessian.rows(), " by ", initial_inverse_hessian.cols()));
+                             initial_inverse_hessian.rows(), " by ",
+                             initial_inverse_hessian.cols()));
   x_ = x;
   H0_ = initial_inverse_hessian;
   H_ = H0_;
@@ -29,7 +30,8 @@ void Bfgs::start(const Eigen::VectorXd& x, const Eigen::MatrixXd& initial_invers
 }
 
 void Bfgs::move_to(const Eigen::VectorXd& x) {
-  if (x.size() != x_.size()) throw InputError(message("x: expected ", x_.size(), " values, got ", x.size()));
+  if (x.size() != x_.size())
+    throw InputError(message("x: expected ", x_.size(), " values, got ", x.size()));
   x_ = x;
   evaluated_ = converged_ = false;
 }
@@ -52,14 +54,16 @@ void Bfgs::objective_changed(double value_change, const VectorRef& gradient_chan
 
 void Bfgs::objective_changed() { evaluated_ = converged_ = false; }
 
-BfgsResult Bfgs::minimize(const Objective& objective, int max_iterations, double tolerance, double budget_ms,
-                          Finish finish) {
+BfgsResult Bfgs::minimize(const Objective& objective, int max_iterations, double tolerance,
+                          double budget_ms, Finish finish) {
   using Clock = std::chrono::steady_clock;
   const Clock::time_point start = Clock::now();
-  if (max_iterations < 0) throw InputError(message("max_iterations: expected at least 0, got ", max_iterations));
+  if (max_iterations < 0)
+    throw InputError(message("max_iterations: expected at least 0, got ", max_iterations));
   if (!(tolerance > 0 && tolerance < 1))
     throw InputError(message("tolerance: expected a value in (0, 1), got ", tolerance));
-  if (!(budget_ms > 0)) throw InputError(message("budget_ms: expected a time > 0 (or infinity), got ", budget_ms));
+  if (!(budget_ms > 0))
+    throw InputError(message("budget_ms: expected a time > 0 (or infinity), got ", budget_ms));
   const auto within_budget = [&] {
     return std::chrono::duration<double, std::milli>(Clock::now() - start).count() < budget_ms;
   };
@@ -67,11 +71,13 @@ BfgsResult Bfgs::minimize(const Objective& objective, int max_iterations, double
   if (!evaluated_) {
     value_ = objective(x_, gradient_);
     ++result.evaluations;
-    if (!std::isfinite(value_)) throw NumericalError("BFGS: the objective is not finite at the current point");
+    if (!std::isfinite(value_))
+      throw NumericalError("BFGS: the objective is not finite at the current point");
     evaluated_ = true;
   }
   const double sqrt_tolerance = std::sqrt(tolerance), cbrt_tolerance = std::cbrt(tolerance);
-  while (!converged_ && result.iterations < max_iterations && (result.iterations == 0 || within_budget())) {
+  while (!converged_ && result.iterations < max_iterations &&
+         (result.iterations == 0 || within_budget())) {
     if (gradient_.norm() <= tolerance * (1 + std::abs(value_))) {
       converged_ = true;
       break;
@@ -79,7 +85,8 @@ BfgsResult Bfgs::minimize(const Objective& objective, int max_iterations, double
     p_.noalias() = -H_ * gradient_;
     const double scale = 1 + std::abs(value_), model_decrease = -0.5 * gradient_.dot(p_);
     if (finish == Finish::kPredicted && model_decrease >= 0 && model_decrease < tolerance * scale &&
-        p_.norm() < sqrt_tolerance * (1 + x_.norm()) && gradient_.norm() <= cbrt_tolerance * scale) {
+        p_.norm() < sqrt_tolerance * (1 + x_.norm()) &&
+        gradient_.norm() <= cbrt_tolerance * scale) {
       x_ += p_;
       evaluated_ = false;
       converged_ = true;
@@ -88,13 +95,15 @@ BfgsResult Bfgs::minimize(const Objective& objective, int max_iterations, double
     }
     LineSearchResult search;
     if (gradient_.dot(p_) < 0) {
-      search = wolfe_line_search(objective, x_, value_, gradient_, p_, x_new_, value_new_, gradient_new_);
+      search = wolfe_line_search(objective, x_, value_, gradient_, p_, x_new_, value_new_,
+                                 gradient_new_);
       result.evaluations += search.evaluations;
     }
     if (search.step == 0) {
       ++result.line_search_failures;
       const double predicted_decrease = -gradient_.dot(p_);
-      if (predicted_decrease > 0 && predicted_decrease <= kUnresolvableDecrease * (1 + std::abs(value_))) {
+      if (predicted_decrease > 0 &&
+          predicted_decrease <= kUnresolvableDecrease * (1 + std::abs(value_))) {
         converged_ = true;
         break;
       }

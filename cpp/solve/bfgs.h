@@ -68,7 +68,8 @@ class Bfgs {
 
   const Eigen::VectorXd& x() const { return x_; }
   const Eigen::MatrixXd& inverse_hessian() const { return H_; }
-  // f and ∇f at x; valid after a minimize, unless it ended on a predicted step (Finish::kPredicted).
+  // f and ∇f at x; valid after a minimize, unless it ended on a predicted step
+  // (Finish::kPredicted).
   double value() const { return value_; }
   const Eigen::VectorXd& gradient() const { return gradient_; }
 

@@ -27,8 +27,9 @@ constexpr int kIterationsPerIntermediateStep = 20;
 constexpr double kExactHessianBelow = 1e-3;
 
 // The checks solve_full makes before any work; returns the handles' weights.
-Eigen::VectorXd checked_input(const VerticesRef& V, const FacesRef& F, const Handles& handles, const VectorRef& weights,
-                              const Transforms& transforms, double stiffness, const FullSolveOptions& options,
+Eigen::VectorXd checked_input(const VerticesRef& V, const FacesRef& F, const Handles& handles,
+                              const VectorRef& weights, const Transforms& transforms,
+                              double stiffness, const FullSolveOptions& options,
                               const RowMatrixX3d* initial) {
   validate_mesh(V, F);  // before the handles, which index into it
   const int n = static_cast<int>(V.rows());
@@ -39,16 +40,20 @@ Eigen::VectorXd checked_input(const VerticesRef& V, const FacesRef& F, const Han
   if (initial) require_positions(flatten(*initial), 3 * n, "initial");
   for (size_t i = 0; i < options.held.size(); ++i)
     if (options.held[i] < 0 || options.held[i] >= n)
-      throw InputError(message("held[", i, "] = ", options.held[i], " is not a vertex (0 to ", n - 1, ")"));
+      throw InputError(
+          message("held[", i, "] = ", options.held[i], " is not a vertex (0 to ", n - 1, ")"));
   return handle_weights;
 }
 
 // F and ∇F at y under the objective's current transforms.
-void evaluate(const PoseObjective& objective, NewtonPoint& point) { point.value = objective(point.y, point.gradient); }
+void evaluate(const PoseObjective& objective, NewtonPoint& point) {
+  point.value = objective(point.y, point.gradient);
+}
 
 // The predictor of a load step: the point moved on along the path the last load step took, by
 // `ratio` times that step, y_previous → y. Kept when F is lower there.
-void extrapolate(const PoseObjective& objective, double ratio, const Eigen::VectorXd& y_previous, NewtonPoint& point) {
+void extrapolate(const PoseObjective& objective, double ratio, const Eigen::VectorXd& y_previous,
+                 NewtonPoint& point) {
   NewtonPoint guess{point.y + ratio * (point.y - y_previous), 0, Eigen::VectorXd(point.y.size())};
   evaluate(objective, guess);
   if (guess.value < point.value) std::swap(point, guess);
@@ -59,25 +64,28 @@ constexpr double kLoadPathShare = 0.5;
 
 // Fraction of the work done for the progress bar: the load path first (when there is one), then
 // the final load's gradient decrease on a log scale.
-double fraction_done(double load, bool stepping, double gradient_norm, double scale, double tolerance) {
+double fraction_done(double load, bool stepping, double gradient_norm, double scale,
+                     double tolerance) {
   const double path = stepping ? kLoadPathShare * load : 0;
   if (load < 1) return path;
-  const double decrease = std::log(std::max(gradient_norm / scale, tolerance)) / std::log(tolerance);
+  const double decrease =
+      std::log(std::max(gradient_norm / scale, tolerance)) / std::log(tolerance);
   return path + (stepping ? 1 - kLoadPathShare : 1.0) * std::clamp(decrease, 0.0, 1.0);
 }
 
 }  // namespace
 
-FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handles& handles, const VectorRef& weights,
-                           const Transforms& transforms, double stiffness, const FullSolveOptions& options,
-                           const RowMatrixX3d* initial) {
+FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handles& handles,
+                           const VectorRef& weights, const Transforms& transforms, double stiffness,
+                           const FullSolveOptions& options, const RowMatrixX3d* initial) {
   const Eigen::VectorXd handle_weights =
       checked_input(V, F, handles, weights, transforms, stiffness, options, initial);
   const auto start = std::chrono::steady_clock::now();
   Progress progress(options.progress);
   progress.report("solve", 0);
 
-  PoseObjective objective(V, F, handles, handle_weights, stiffness, options.energy, options.material, options.held);
+  PoseObjective objective(V, F, handles, handle_weights, stiffness, options.energy,
+                          options.material, options.held);
   const LoadPath path(V, handles, transforms);
   ShiftedNewton newton(objective);
 
@@ -105,24 +113,25 @@ FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handle
     evaluate(objective, point);
     if (schedule.previous_increment() > 0) {
       Eigen::VectorXd y_load = point.y;
-      extrapolate(objective, (next - schedule.load()) / schedule.previous_increment(), y_previous, point);
+      extrapolate(objective, (next - schedule.load()) / schedule.previous_increment(), y_previous,
+                  point);
       y_previous.swap(y_load);
     } else if (schedule.stepping()) {
       y_previous = point.y;
     }
     const double target =
-        (final ? options.tolerance : std::max(options.tolerance, kIntermediateTolerance)) * result.gradient_scale;
+        (final ? options.tolerance : std::max(options.tolerance, kIntermediateTolerance)) *
+        result.gradient_scale;
     const int left = options.max_iterations - result.iterations;
     const int budget = final ? left : std::min(kIterationsPerIntermediateStep, left);
-    const int iterations = newton.minimize(point, target, budget, kExactHessianBelow * result.gradient_scale,
-                                           [&](const NewtonPoint& now) {
-                                             // ‖∇F‖ may rise for a step: the bar never goes back.
-                                             done = std::max(done, fraction_done(next, schedule.stepping(),
-                                                                                 now.gradient.norm(),
-                                                                                 result.gradient_scale,
-                                                                                 options.tolerance));
-                                             progress.report("solve", done);
-                                           });
+    const int iterations = newton.minimize(
+        point, target, budget, kExactHessianBelow * result.gradient_scale,
+        [&](const NewtonPoint& now) {
+          // ‖∇F‖ may rise for a step: the bar never goes back.
+          done = std::max(done, fraction_done(next, schedule.stepping(), now.gradient.norm(),
+                                              result.gradient_scale, options.tolerance));
+          progress.report("solve", done);
+        });
     result.iterations += iterations;
     ++result.steps;
     schedule.advance(next, iterations, point.gradient.norm() <= target);
@@ -134,7 +143,8 @@ FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handle
   result.converged = result.gradient_norm <= options.tolerance * result.gradient_scale;
   result.stalled = !result.converged && newton.stalled();
   result.history = newton.history();
-  result.positions = Eigen::Map<const RowMatrixX3d>(point.y.data(), V.rows(), 3) / objective.scale();
+  result.positions =
+      Eigen::Map<const RowMatrixX3d>(point.y.data(), V.rows(), 3) / objective.scale();
   // Held vertices are where they started to the last bit, not through the frame's scaling.
   const VerticesRef started_at = initial ? VerticesRef(*initial) : V;
   for (int v : options.held) result.positions.row(v) = started_at.row(v);

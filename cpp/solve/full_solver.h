@@ -22,7 +22,8 @@ namespace modal_deform {
 
 struct FullSolveOptions {
   EnergyKind energy = EnergyKind::kShells;
-  Material material = {};  // the shells weights and their painting (ignored by ARAP, which takes no paint)
+  Material material =
+      {};  // the shells weights and their painting (ignored by ARAP, which takes no paint)
   // In (0, 1): the factor by which ‖∇F‖ must drop below the larger of its values at rest and at
   // `initial` at the full load.
   double tolerance = 1e-8;
@@ -46,14 +47,17 @@ void for_each_full_solve_option(Visit&& visit) {
         [](auto& o) -> auto& { return o.energy; });
   for_each_material_option(visit);
   visit(Option{"tolerance",
-               "Stops when the gradient norm is below this fraction of its value at rest (or at `initial`, if "
+               "Stops when the gradient norm is below this fraction of its value at rest (or at "
+               "`initial`, if "
                "larger).",
                between_open(0, 1)},
         [](auto& o) -> auto& { return o.tolerance; });
-  visit(Option{"max_iterations", "Newton iterations at most, all load steps together.", at_least(0)},
-        [](auto& o) -> auto& { return o.max_iterations; });
+  visit(
+      Option{"max_iterations", "Newton iterations at most, all load steps together.", at_least(0)},
+      [](auto& o) -> auto& { return o.max_iterations; });
   visit(Option{"held",
-               "Vertex indices held exactly where the solve starts (at rest, or at `initial`), as a region bake's "
+               "Vertex indices held exactly where the solve starts (at rest, or at `initial`), as "
+               "a region bake's "
                "outside is; None holds none."},
         [](auto& o) -> auto& { return o.held; });
 }
@@ -99,8 +103,9 @@ void for_each_full_solve_stat(Visit&& visit) {
 // no shift makes the Hessian factorisable. Non-convergence (the iteration budget spent, or F no
 // longer decreasing at working precision) is reported in the result, not thrown. Runs
 // single-threaded but for CHOLMOD's BLAS and the energy's own threads.
-FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handles& handles, const VectorRef& weights,
-                           const Transforms& transforms, double stiffness, const FullSolveOptions& options = {},
+FullSolveResult solve_full(const VerticesRef& V, const FacesRef& F, const Handles& handles,
+                           const VectorRef& weights, const Transforms& transforms, double stiffness,
+                           const FullSolveOptions& options = {},
                            const RowMatrixX3d* initial = nullptr);
 
 }  // namespace modal_deform

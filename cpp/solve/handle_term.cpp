@@ -11,7 +11,8 @@
 
 namespace modal_deform {
 
-Eigen::VectorXd checked_handle_weights(const Handles& handles, const VectorRef& weights, int num_vertices) {
+Eigen::VectorXd checked_handle_weights(const Handles& handles, const VectorRef& weights,
+                                       int num_vertices) {
   const int count = static_cast<int>(handles.size());
   if (count == 0) throw InputError("handles: no handle given; posing needs at least one");
   std::vector<int> seen_in(num_vertices, -1);  // the last handle that listed each vertex
@@ -20,38 +21,45 @@ Eigen::VectorXd checked_handle_weights(const Handles& handles, const VectorRef& 
     for (size_t k = 0; k < handles[h].size(); ++k) {
       const int v = handles[h][k];
       if (v < 0 || v >= num_vertices)
-        throw InputError(message("handles[", h, "][", k, "] = ", v, " is outside [0, ", num_vertices, ")"));
+        throw InputError(
+            message("handles[", h, "][", k, "] = ", v, " is outside [0, ", num_vertices, ")"));
       if (seen_in[v] == h) throw InputError(message("handles[", h, "] lists vertex ", v, " twice"));
       seen_in[v] = h;
     }
   }
   if (weights.size() == 0) return Eigen::VectorXd::Ones(count);
   if (weights.size() != count)
-    throw InputError(message("weights: expected ", count, " values (one per handle), got ", weights.size()));
+    throw InputError(
+        message("weights: expected ", count, " values (one per handle), got ", weights.size()));
   for (int h = 0; h < count; ++h)
     if (!(weights[h] >= 0 && weights[h] <= kMaxWeight))
-      throw InputError(message("weights[", h, "] = ", weights[h], " is not a finite number in [0, ", kMaxWeight, "]"));
+      throw InputError(message("weights[", h, "] = ", weights[h], " is not a finite number in [0, ",
+                               kMaxWeight, "]"));
   return weights;
 }
 
 void check_transforms(const Transforms& transforms, int num_handles) {
   if (static_cast<int>(transforms.size()) != num_handles)
-    throw InputError(message("transforms: expected ", num_handles, " (one per handle), got ", transforms.size()));
+    throw InputError(message("transforms: expected ", num_handles, " (one per handle), got ",
+                             transforms.size()));
   for (int h = 0; h < num_handles; ++h) {
     const Eigen::Matrix4d& T = transforms[h];
     if (!T.allFinite()) throw InputError(message("transforms[", h, "] has non-finite entries"));
     if (T.row(3) != Eigen::RowVector4d(0, 0, 0, 1))
-      throw InputError(message("transforms[", h, "]: last row is (", T.row(3), "), expected (0 0 0 1)"));
+      throw InputError(
+          message("transforms[", h, "]: last row is (", T.row(3), "), expected (0 0 0 1)"));
     const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
     const double error = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
     if (error > 1e-5)
-      throw InputError(message("transforms[", h, "]: the 3 by 3 block is not a rotation (max |RᵀR - I| = ", error,
+      throw InputError(message("transforms[", h,
+                               "]: the 3 by 3 block is not a rotation (max |RᵀR - I| = ", error,
                                "; scaling and shear are not rigid)"));
-    if (R.determinant() < 0) throw InputError(message("transforms[", h, "]: the 3 by 3 block is a reflection"));
+    if (R.determinant() < 0)
+      throw InputError(message("transforms[", h, "]: the 3 by 3 block is a reflection"));
     // Targets beyond the coordinates the energies take would make the objective overflow.
     if (!positions_in_range(T.topRightCorner<3, 1>()))
-      throw InputError(message("transforms[", h, "]: the translation (", T(0, 3), ", ", T(1, 3), ", ", T(2, 3),
-                               ") is beyond ", kMaxCoordinate, " in a coordinate"));
+      throw InputError(message("transforms[", h, "]: the translation (", T(0, 3), ", ", T(1, 3),
+                               ", ", T(2, 3), ") is beyond ", kMaxCoordinate, " in a coordinate"));
   }
 }
 
@@ -75,7 +83,8 @@ HandleTerm::HandleTerm(const VerticesRef& rest, const VectorRef& mass, const Han
                        const VectorRef& weights, double coefficient) {
   for (size_t h = 0; h < handles.size(); ++h) {
     std::vector<Member>& members = members_.emplace_back();
-    for (int v : handles[h]) members.push_back({v, coefficient * weights[h] * mass[v], rest.row(v).transpose()});
+    for (int v : handles[h])
+      members.push_back({v, coefficient * weights[h] * mass[v], rest.row(v).transpose()});
     std::vector<Eigen::Vector3d>& targets = targets_.emplace_back();
     for (const Member& member : members) targets.push_back(member.rest);
   }
@@ -89,7 +98,8 @@ void HandleTerm::set_transforms(const Transforms& transforms) {
   }
 }
 
-double HandleTerm::add_value_and_gradient(const VectorRef& x, Eigen::Ref<Eigen::VectorXd> gradient) const {
+double HandleTerm::add_value_and_gradient(const VectorRef& x,
+                                          Eigen::Ref<Eigen::VectorXd> gradient) const {
   double value = 0;
   for (size_t h = 0; h < members_.size(); ++h)
     for (size_t k = 0; k < members_[h].size(); ++k) {
@@ -104,11 +114,13 @@ double HandleTerm::add_value_and_gradient(const VectorRef& x, Eigen::Ref<Eigen::
 Eigen::VectorXd HandleTerm::hessian_diagonal(int num_vertices) const {
   Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(3 * num_vertices);
   for (const std::vector<Member>& members : members_)
-    for (const Member& member : members) diagonal.segment<3>(3 * member.vertex).array() += 2 * member.weight;
+    for (const Member& member : members)
+      diagonal.segment<3>(3 * member.vertex).array() += 2 * member.weight;
   return diagonal;
 }
 
-ReducedHandleTerm::ReducedHandleTerm(const HandleTerm& term, const VertexRows& rows, Eigen::Index r) {
+ReducedHandleTerm::ReducedHandleTerm(const HandleTerm& term, const VertexRows& rows,
+                                     Eigen::Index r) {
   // A = Σ_i ω_i U_iᵀU_i with ω_i = Σ_{h∋i} c w_h m_i: rank updates with the gathered rows √ω_i U_i,
   // a block of vertices at a time (bounded memory for a handle of any size).
   std::map<int, double> omega;
@@ -139,7 +151,8 @@ ReducedHandleTerm::ReducedHandleTerm(const HandleTerm& term, const VertexRows& r
       handle.centroid += member.weight * member.rest;
     }
     // Without weight the term is zero and any centre will do.
-    handle.centroid = handle.mass > 0 ? Eigen::Vector3d(handle.centroid / handle.mass) : members.front().rest;
+    handle.centroid =
+        handle.mass > 0 ? Eigen::Vector3d(handle.centroid / handle.mass) : members.front().rest;
     handle.second_moment.setZero();
     handle.coefficients = Eigen::MatrixXd::Zero(r, 12);
     for (const HandleTerm::Member& member : members) {
@@ -148,7 +161,8 @@ ReducedHandleTerm::ReducedHandleTerm(const HandleTerm& term, const VertexRows& r
       const Eigen::Matrix<double, 3, Eigen::Dynamic> U_i = rows(member.vertex);
       for (int a = 0; a < 3; ++a) {
         const Eigen::VectorXd row = U_i.row(a).transpose();
-        for (int c = 0; c < 3; ++c) handle.coefficients.col(3 * a + c) += member.weight * offset[c] * row;
+        for (int c = 0; c < 3; ++c)
+          handle.coefficients.col(3 * a + c) += member.weight * offset[c] * row;
         handle.coefficients.col(9 + a) += member.weight * row;
       }
     }
@@ -174,7 +188,8 @@ void ReducedHandleTerm::set_transforms(const Transforms& transforms) {
   }
 }
 
-double ReducedHandleTerm::value_and_gradient(const VectorRef& q, Eigen::Ref<Eigen::VectorXd> gradient) const {
+double ReducedHandleTerm::value_and_gradient(const VectorRef& q,
+                                             Eigen::Ref<Eigen::VectorXd> gradient) const {
   gradient.noalias() = A_ * q;
   const double value = q.dot(gradient) + 2 * b_.dot(q) + e_;
   gradient = 2 * (gradient + b_);

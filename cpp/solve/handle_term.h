@@ -32,16 +32,19 @@ constexpr double kDefaultPull = 1000.0;
 
 // The pull μ as every table that takes it declares it (option.h); check_option(kPull, μ) refuses
 // a value out of range.
-inline constexpr Option kPull{"pull",
-                              "How hard the handles pull their vertices toward their targets (μ of the handle "
-                              "term): higher follows the controllers more exactly, lower lets the surface hold "
-                              "them back.",
-                              above_up_to(0, kMaxWeight)};
+inline constexpr Option kPull{
+    "pull",
+    "How hard the handles pull their vertices toward their targets (μ of the handle "
+    "term): higher follows the controllers more exactly, lower lets the surface hold "
+    "them back.",
+    above_up_to(0, kMaxWeight)};
 
 // Throws InputError naming the first problem: no handle, an empty handle, an index outside
 // [0, num_vertices), an index repeated within a handle, or weights (empty, or one per handle)
-// that are negative, not finite or above kMaxWeight (require_weight.h). Returns the weights, all 1 when `weights` is empty.
-Eigen::VectorXd checked_handle_weights(const Handles& handles, const VectorRef& weights, int num_vertices);
+// that are negative, not finite or above kMaxWeight (require_weight.h). Returns the weights, all 1
+// when `weights` is empty.
+Eigen::VectorXd checked_handle_weights(const Handles& handles, const VectorRef& weights,
+                                       int num_vertices);
 
 // Throws InputError naming the first transform that is not rigid: not finite, a last row other
 // than (0, 0, 0, 1), a rotation block R with max |RᵀR − I| > 1e-5, det R < 0 (a reflection), or
@@ -66,8 +69,8 @@ class HandleTerm {
 
   // rest: #V by 3 and mass: #V; coefficient: c. The handles must pass checked_handle_weights.
   // Transforms start at the identity.
-  HandleTerm(const VerticesRef& rest, const VectorRef& mass, const Handles& handles, const VectorRef& weights,
-             double coefficient);
+  HandleTerm(const VerticesRef& rest, const VectorRef& mass, const Handles& handles,
+             const VectorRef& weights, double coefficient);
 
   // One transform per handle (check_transforms first), in the units of `rest`.
   void set_transforms(const Transforms& transforms);
@@ -80,7 +83,7 @@ class HandleTerm {
   const std::vector<std::vector<Member>>& members() const { return members_; }
 
  private:
-  std::vector<std::vector<Member>> members_;     // per handle
+  std::vector<std::vector<Member>> members_;           // per handle
   std::vector<std::vector<Eigen::Vector3d>> targets_;  // per handle and member: T_h x̄_i
 };
 

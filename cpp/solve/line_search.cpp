@@ -39,8 +39,9 @@ double interpolate(const Sample& lo, const Sample& hi) {
 
 }  // namespace
 
-LineSearchResult wolfe_line_search(const Objective& objective, const Eigen::VectorXd& x, double value,
-                                   const Eigen::VectorXd& gradient, const Eigen::VectorXd& p, Eigen::VectorXd& x_new,
+LineSearchResult wolfe_line_search(const Objective& objective, const Eigen::VectorXd& x,
+                                   double value, const Eigen::VectorXd& gradient,
+                                   const Eigen::VectorXd& p, Eigen::VectorXd& x_new,
                                    double& value_new, Eigen::VectorXd& gradient_new,
                                    const WolfeConditions& conditions) {
   LineSearchResult result;
@@ -53,7 +54,8 @@ LineSearchResult wolfe_line_search(const Objective& objective, const Eigen::Vect
     value_new = objective(x_new, gradient_new);
     ++result.evaluations;
     last_step = step;
-    if (!std::isfinite(value_new)) return Sample{step, std::numeric_limits<double>::infinity(), std::nan("")};
+    if (!std::isfinite(value_new))
+      return Sample{step, std::numeric_limits<double>::infinity(), std::nan("")};
     return Sample{step, value_new, gradient_new.dot(p)};
   };
   Sample best{0, value, slope0};  // the lowest point satisfying sufficient decrease
@@ -120,11 +122,12 @@ LineSearchResult wolfe_line_search(const Objective& objective, const Eigen::Vect
   return result;
 }
 
-BacktrackingResult backtracking_line_search(const Objective& objective, const Eigen::VectorXd& x, double value,
-                                            const Eigen::VectorXd& gradient, const Eigen::VectorXd& p,
-                                            Eigen::VectorXd& x_new, double& value_new, Eigen::VectorXd& gradient_new,
-                                            double noise, double initial_step, double sufficient_decrease,
-                                            int max_halvings) {
+BacktrackingResult backtracking_line_search(const Objective& objective, const Eigen::VectorXd& x,
+                                            double value, const Eigen::VectorXd& gradient,
+                                            const Eigen::VectorXd& p, Eigen::VectorXd& x_new,
+                                            double& value_new, Eigen::VectorXd& gradient_new,
+                                            double noise, double initial_step,
+                                            double sufficient_decrease, int max_halvings) {
   BacktrackingResult result;
   const double slope = gradient.dot(p);
   if (slope < 0) {
@@ -139,8 +142,8 @@ BacktrackingResult backtracking_line_search(const Objective& objective, const Ei
         continue;
       }
       const bool decreased = value_new <= value + sufficient_decrease * step * slope;
-      const bool within_rounding =
-          -step * slope < noise && value_new <= value + noise && gradient_new.norm() < gradient_norm;
+      const bool within_rounding = -step * slope < noise && value_new <= value + noise &&
+                                   gradient_new.norm() < gradient_norm;
       if (decreased || within_rounding) {
         result.step = step;
         return result;

@@ -1,6 +1,6 @@
 // Line searches: one for the strong Wolfe conditions (Nocedal & Wright, Numerical Optimization, 2nd
-// ed., algorithms 3.5 and 3.6), used by BFGS, and Armijo backtracking, used by the full Newton solve
-// (whose step is long where its model is poor, not short).
+// ed., algorithms 3.5 and 3.6), used by BFGS, and Armijo backtracking, used by the full Newton
+// solve (whose step is long where its model is poor, not short).
 #pragma once
 
 #include <functional>
@@ -35,15 +35,16 @@ struct LineSearchResult {
 // when it was not the last one), with wolfe = false. On return x_new = x + αp, value_new and
 // gradient_new are f and ∇f there (x, value, gradient themselves when α = 0). x_new and
 // gradient_new must be sized like x; nothing is allocated.
-LineSearchResult wolfe_line_search(const Objective& objective, const Eigen::VectorXd& x, double value,
-                                   const Eigen::VectorXd& gradient, const Eigen::VectorXd& p, Eigen::VectorXd& x_new,
+LineSearchResult wolfe_line_search(const Objective& objective, const Eigen::VectorXd& x,
+                                   double value, const Eigen::VectorXd& gradient,
+                                   const Eigen::VectorXd& p, Eigen::VectorXd& x_new,
                                    double& value_new, Eigen::VectorXd& gradient_new,
                                    const WolfeConditions& conditions = {});
 
 struct BacktrackingResult {
-  double step = 0;      // α, 0 when no halving gave a decrease
-  int evaluations = 0;  // calls of the objective
-  int undefined = 0;    // trials rejected because f was +inf or NaN there (beyond its domain)
+  double step = 0;       // α, 0 when no halving gave a decrease
+  int evaluations = 0;   // calls of the objective
+  int undefined = 0;     // trials rejected because f was +inf or NaN there (beyond its domain)
   int insufficient = 0;  // trials rejected because f did not decrease enough
 };
 
@@ -59,10 +60,12 @@ constexpr double kUnresolvableDecrease = 1e-12;
 // than noise and ‖∇f‖ falls (it would otherwise stall on rounding). On return x_new, value_new and
 // gradient_new are the point taken and f, ∇f there (x, value, gradient themselves when α = 0);
 // x_new and gradient_new must be sized like x.
-BacktrackingResult backtracking_line_search(const Objective& objective, const Eigen::VectorXd& x, double value,
-                                            const Eigen::VectorXd& gradient, const Eigen::VectorXd& p,
-                                            Eigen::VectorXd& x_new, double& value_new, Eigen::VectorXd& gradient_new,
+BacktrackingResult backtracking_line_search(const Objective& objective, const Eigen::VectorXd& x,
+                                            double value, const Eigen::VectorXd& gradient,
+                                            const Eigen::VectorXd& p, Eigen::VectorXd& x_new,
+                                            double& value_new, Eigen::VectorXd& gradient_new,
                                             double noise = 0, double initial_step = 1,
-                                            double sufficient_decrease = 1e-4, int max_halvings = 40);
+                                            double sufficient_decrease = 1e-4,
+                                            int max_halvings = 40);
 
 }  // namespace modal_deform

@@ -24,9 +24,11 @@ LoadPath::LoadPath(const VerticesRef& V, const Handles& handles, const Transform
     c /= static_cast<double>(handles[h].size());
     centres_.push_back(c);
     const Eigen::AngleAxisd rotation(Eigen::Matrix3d(transforms[h].topLeftCorner<3, 3>()));
-    const double move = (transforms[h].topLeftCorner<3, 3>() * c + transforms[h].topRightCorner<3, 1>() - c).norm();
+    const double move =
+        (transforms[h].topLeftCorner<3, 3>() * c + transforms[h].topRightCorner<3, 1>() - c).norm();
     const double wanted = std::max(std::abs(rotation.angle()) / (kPi / 6), move / (0.1 * diagonal));
-    steps_ = std::max(steps_, static_cast<int>(std::ceil(std::min<double>(wanted - 1e-9, kMaxLoadSteps))));
+    steps_ = std::max(steps_,
+                      static_cast<int>(std::ceil(std::min<double>(wanted - 1e-9, kMaxLoadSteps))));
   }
 }
 
@@ -37,7 +39,8 @@ Transforms LoadPath::at(double t) const {
     const Eigen::Matrix4d& T = transforms_[h];
     const Eigen::Vector3d& c = centres_[h];
     const Eigen::AngleAxisd rotation(Eigen::Matrix3d(T.topLeftCorner<3, 3>()));
-    const Eigen::Matrix3d R = Eigen::AngleAxisd(t * rotation.angle(), rotation.axis()).toRotationMatrix();
+    const Eigen::Matrix3d R =
+        Eigen::AngleAxisd(t * rotation.angle(), rotation.axis()).toRotationMatrix();
     const Eigen::Vector3d moved = T.topLeftCorner<3, 3>() * c + T.topRightCorner<3, 1>();
     partial[h].setIdentity();
     partial[h].topLeftCorner<3, 3>() = R;

@@ -15,7 +15,8 @@ namespace {
 
 // The side of a triangle from vertex `from` to vertex `to`, in y (3#V): y_to − y_from.
 Eigen::Vector3d side(const Eigen::VectorXd& y, int from, int to) {
-  return y.segment<3>(3 * static_cast<Eigen::Index>(to)) - y.segment<3>(3 * static_cast<Eigen::Index>(from));
+  return y.segment<3>(3 * static_cast<Eigen::Index>(to)) -
+         y.segment<3>(3 * static_cast<Eigen::Index>(from));
 }
 
 }  // namespace
@@ -51,15 +52,17 @@ PoseObjective::PoseObjective(RowMatrixX3d rest, double scale, const FacesRef& F,
   // fixed diagonal: nothing moves them.
   constant_diagonal_ = handle_diagonal;
   for (int v = 0; v < n; ++v)
-    if (mass[v] == 0 && hessian_diagonal.segment<3>(3 * v).isZero(0) && handle_diagonal.segment<3>(3 * v).isZero(0))
+    if (mass[v] == 0 && hessian_diagonal.segment<3>(3 * v).isZero(0) &&
+        handle_diagonal.segment<3>(3 * v).isZero(0))
       constant_diagonal_.segment<3>(3 * v).setConstant(mean_mass);
   // The floor of the shift: a fraction of the median curvature per unit mass at rest (coordinates
-  // in no term left out). The median, not the mean: a raw scan's slivers have terms far stiffer than
-  // the rest, which would lift a mean, and τ sitting on a high floor damps every step
+  // in no term left out). The median, not the mean: a raw scan's slivers have terms far stiffer
+  // than the rest, which would lift a mean, and τ sitting on a high floor damps every step
   // (bench/results/refine.json, the raw-scan-like dragon).
   std::vector<double> curvature;
   for (Eigen::Index i = 0; i < mass_diagonal_.size(); ++i)
-    if (const double c = std::abs(hessian_diagonal[i] + handle_diagonal[i]) / mass_diagonal_[i]; c > 0)
+    if (const double c = std::abs(hessian_diagonal[i] + handle_diagonal[i]) / mass_diagonal_[i];
+        c > 0)
       curvature.push_back(c);
   const auto middle = curvature.begin() + static_cast<std::ptrdiff_t>(curvature.size() / 2);
   if (!curvature.empty()) std::nth_element(curvature.begin(), middle, curvature.end());
@@ -72,7 +75,8 @@ PoseObjective::PoseObjective(RowMatrixX3d rest, double scale, const FacesRef& F,
   }
 }
 
-PoseObjective PoseObjective::around(const std::vector<int>& free, std::vector<int>& vertices) const {
+PoseObjective PoseObjective::around(const std::vector<int>& free,
+                                    std::vector<int>& vertices) const {
   const int n = static_cast<int>(rest_.rows());
   std::vector<char> is_free(n, 0), near(n, 0);
   for (int v : free) is_free[v] = 1;
@@ -101,7 +105,8 @@ PoseObjective PoseObjective::around(const std::vector<int>& free, std::vector<in
   std::vector<int> held;
   Terms terms = terms_;
   const StiffnessPaint& paint = terms_.material.paint;
-  if (!paint.uniform()) terms.material.paint.weights.resize(static_cast<Eigen::Index>(vertices.size()));
+  if (!paint.uniform())
+    terms.material.paint.weights.resize(static_cast<Eigen::Index>(vertices.size()));
   for (size_t i = 0; i < vertices.size(); ++i) {
     const auto local = static_cast<Eigen::Index>(i);
     rest.row(local) = rest_.row(vertices[i]);
@@ -124,13 +129,16 @@ void PoseObjective::hessian_into(const Eigen::VectorXd& y, bool projected, Spars
   if (held_.empty()) return;
   for (int col = 0; col < H.outerSize(); ++col)
     for (SparseMatrix::InnerIterator entry(H, col); entry; ++entry)
-      if (held_[static_cast<size_t>(entry.row())] || held_[static_cast<size_t>(col)]) entry.valueRef() = 0;
+      if (held_[static_cast<size_t>(entry.row())] || held_[static_cast<size_t>(col)])
+        entry.valueRef() = 0;
 }
 
-bool PoseObjective::turns_a_triangle_over(const Eigen::VectorXd& y, const Eigen::VectorXd& y_new) const {
+bool PoseObjective::turns_a_triangle_over(const Eigen::VectorXd& y,
+                                          const Eigen::VectorXd& y_new) const {
   for (Eigen::Index f = 0; f < oriented_faces_.rows(); ++f) {
     const int a = oriented_faces_(f, 0), b = oriented_faces_(f, 1), c = oriented_faces_(f, 2);
-    if (side(y, a, b).cross(side(y, a, c)).dot(side(y_new, a, b).cross(side(y_new, a, c))) < 0) return true;
+    if (side(y, a, b).cross(side(y, a, c)).dot(side(y_new, a, b).cross(side(y_new, a, c))) < 0)
+      return true;
   }
   return false;
 }
@@ -139,10 +147,12 @@ double PoseObjective::step_to_turning(const Eigen::VectorXd& y, const Eigen::Vec
   double smallest = std::numeric_limits<double>::infinity();
   for (Eigen::Index f = 0; f < oriented_faces_.rows(); ++f) {
     const int a = oriented_faces_(f, 0), b = oriented_faces_(f, 1), c = oriented_faces_(f, 2);
-    const Eigen::Vector3d e1 = side(y, a, b), e2 = side(y, a, c), d1 = side(p, a, b), d2 = side(p, a, c);
+    const Eigen::Vector3d e1 = side(y, a, b), e2 = side(y, a, c), d1 = side(p, a, b),
+                          d2 = side(p, a, c);
     // n(α) = n + α (e1 × d2 + d1 × e2) + α² d1 × d2, so n·n(α) = c0 + c1 α + c2 α².
     const Eigen::Vector3d n = e1.cross(e2);
-    const double c0 = n.squaredNorm(), c1 = n.dot(e1.cross(d2) + d1.cross(e2)), c2 = n.dot(d1.cross(d2));
+    const double c0 = n.squaredNorm(), c1 = n.dot(e1.cross(d2) + d1.cross(e2)),
+                 c2 = n.dot(d1.cross(d2));
     if (c0 == 0) continue;  // collapsed already: not counted, as in turns_a_triangle_over
     double root = std::numeric_limits<double>::infinity();
     if (c2 == 0) {
@@ -169,7 +179,8 @@ void PoseObjective::set_transforms(Transforms transforms) {
 
 double PoseObjective::operator()(const Eigen::VectorXd& y, Eigen::VectorXd& gradient) const {
   if (!positions_in_range(y)) return std::numeric_limits<double>::infinity();
-  const double value = energy_->value_and_gradient(y, gradient) + handle_term_.add_value_and_gradient(y, gradient);
+  const double value =
+      energy_->value_and_gradient(y, gradient) + handle_term_.add_value_and_gradient(y, gradient);
   for (size_t i = 0; i < held_.size(); ++i)
     if (held_[i]) gradient[static_cast<Eigen::Index>(i)] = 0;
   return value;

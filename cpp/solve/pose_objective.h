@@ -21,8 +21,9 @@ class PoseObjective {
   // them.
   // `held` (vertex indices in range) stay where y puts them: their gradient and their Hessian rows
   // are zero.
-  PoseObjective(const VerticesRef& V, const FacesRef& F, const Handles& handles, const Eigen::VectorXd& weights,
-                double stiffness, EnergyKind energy, const Material& material, const std::vector<int>& held = {});
+  PoseObjective(const VerticesRef& V, const FacesRef& F, const Handles& handles,
+                const Eigen::VectorXd& weights, double stiffness, EnergyKind energy,
+                const Material& material, const std::vector<int>& held = {});
 
   // The same objective, up to a constant, as a function of the `free` vertices' coordinates (none
   // held) with every other vertex held: only the faces that touch a free vertex or a neighbour of
@@ -77,7 +78,8 @@ class PoseObjective {
     Material material;
   };
   // rest: #V by 3 in the normalised frame, scale the factor it was scaled by from mesh units.
-  PoseObjective(RowMatrixX3d rest, double scale, const FacesRef& F, Terms terms, const std::vector<int>& held);
+  PoseObjective(RowMatrixX3d rest, double scale, const FacesRef& F, Terms terms,
+                const std::vector<int>& held);
 
   Terms terms_;
   Transforms transforms_;  // normalised frame, as the handle term has them
@@ -89,7 +91,7 @@ class PoseObjective {
   double smallest_shift_ = 0;
   RowMatrixX3i faces_;
   RowMatrixX3i oriented_faces_;  // the faces not degenerate at rest: the ones that can turn over
-  std::vector<char> held_;  // per coordinate, empty when nothing is held
+  std::vector<char> held_;       // per coordinate, empty when nothing is held
 };
 
 }  // namespace modal_deform

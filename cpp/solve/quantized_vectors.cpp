@@ -26,8 +26,8 @@ float row_dot(const float* u, const float* q, Eigen::Index r) {
 #if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__) && defined(__ELF__)
 __attribute__((target_clones("arch=x86-64-v3", "default")))
 #endif
-void accumulate_columns(const std::int16_t* values, const float* scaled_q, Eigen::Index count, Eigen::Index r,
-                        float* sum) {
+void accumulate_columns(const std::int16_t* values, const float* scaled_q, Eigen::Index count,
+                        Eigen::Index r, float* sum) {
   for (Eigen::Index k = 0; k < count; ++k) sum[k] = 0;
   for (Eigen::Index j = 0; j < r; ++j) {
     const std::int16_t* column = values + j * count;
@@ -60,8 +60,8 @@ QuantizedVectors::QuantizedVectors(const RowMatrixXf& U)
   }
 }
 
-Eigen::Index QuantizedVectors::map(const RowMatrixXf& U, const Eigen::VectorXf& q, const float* rest,
-                                   double tolerance, float* out) const {
+Eigen::Index QuantizedVectors::map(const RowMatrixXf& U, const Eigen::VectorXf& q,
+                                   const float* rest, double tolerance, float* out) const {
   const Eigen::Index blocks = scales_.rows();
   const Eigen::VectorXd q_abs = q.cwiseAbs().cast<double>();
   Eigen::Index from_float32 = 0;
@@ -71,14 +71,17 @@ Eigen::Index QuantizedVectors::map(const RowMatrixXf& U, const Eigen::VectorXf& 
     float sum[kRowsPerBlock];
 #pragma omp for schedule(static)
     for (Eigen::Index block = 0; block < blocks; ++block) {
-      const Eigen::Index begin = block * kRowsPerBlock, end = std::min(rows_, begin + kRowsPerBlock);
+      const Eigen::Index begin = block * kRowsPerBlock,
+                         end = std::min(rows_, begin + kRowsPerBlock);
       const auto scale = scales_.row(block);
       if (scale.cast<double>().dot(q_abs) / (2.0 * kLargest) > tolerance) {  // the bound e_b(q)
-        for (Eigen::Index k = begin; k < end; ++k) sum[k - begin] = row_dot(U.data() + k * cols_, q.data(), cols_);
+        for (Eigen::Index k = begin; k < end; ++k)
+          sum[k - begin] = row_dot(U.data() + k * cols_, q.data(), cols_);
         ++from_float32;
       } else {
         scaled_q = scale.transpose().cwiseProduct(q) / kLargest;
-        accumulate_columns(values_.data() + begin * cols_, scaled_q.data(), end - begin, cols_, sum);
+        accumulate_columns(values_.data() + begin * cols_, scaled_q.data(), end - begin, cols_,
+                           sum);
       }
       for (Eigen::Index k = begin; k < end; ++k)
         out[k] = rest ? rest[k] + sum[k - begin] : sum[k - begin];

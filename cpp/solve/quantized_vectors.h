@@ -27,11 +27,12 @@ class QuantizedVectors {
   // U: rows by r, row-major. In parallel over the blocks.
   explicit QuantizedVectors(const RowMatrixXf& U);
 
-  // out[k] = rest[k] + (U q)[k] (rest null: U q alone) for every row k, each within `tolerance` (≥ 0,
-  // U's units) of the float32 map, U being the matrix this was made from; q has r entries.
-  // Returns the number of blocks mapped from float32. In parallel over blocks when there are many rows.
-  Eigen::Index map(const RowMatrixXf& U, const Eigen::VectorXf& q, const float* rest, double tolerance,
-                   float* out) const;
+  // out[k] = rest[k] + (U q)[k] (rest null: U q alone) for every row k, each within `tolerance` (≥
+  // 0, U's units) of the float32 map, U being the matrix this was made from; q has r entries.
+  // Returns the number of blocks mapped from float32. In parallel over blocks when there are many
+  // rows.
+  Eigen::Index map(const RowMatrixXf& U, const Eigen::VectorXf& q, const float* rest,
+                   double tolerance, float* out) const;
 
   Eigen::Index rows() const { return rows_; }
   Eigen::Index blocks() const { return scales_.rows(); }

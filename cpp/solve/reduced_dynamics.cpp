@@ -16,7 +16,6 @@
 namespace modal_deform {
 namespace {
 
-
 // An eigenvalue of the reduced rest Hessian below this fraction of the largest is a rigid motion's
 // or a mechanism's (numerically zero), not a flexible mode's.
 constexpr double kZeroEigenvalue = 1e-8;
@@ -32,23 +31,28 @@ const SimulationOptions& checked(const SimulationOptions& options) {
 }
 
 // The handles' weights; a free body has neither handles nor weights.
-Eigen::VectorXd checked_weights(const Handles& handles, const VectorRef& weights, int num_vertices) {
+Eigen::VectorXd checked_weights(const Handles& handles, const VectorRef& weights,
+                                int num_vertices) {
   if (!handles.empty()) return checked_handle_weights(handles, weights, num_vertices);
   if (weights.size() != 0)
-    throw InputError(message("weights: expected none (no handles: a free body), got ", weights.size()));
+    throw InputError(
+        message("weights: expected none (no handles: a free body), got ", weights.size()));
   return Eigen::VectorXd();
 }
 
 }  // namespace
 
-ReducedDynamics::ReducedDynamics(const Basis& basis, const Handles& handles, const VectorRef& weights,
-                                 const SimulationOptions& options, EnergyKind energy)
+ReducedDynamics::ReducedDynamics(const Basis& basis, const Handles& handles,
+                                 const VectorRef& weights, const SimulationOptions& options,
+                                 EnergyKind energy)
     : basis_(checked(basis)),
       options_(checked(options)),
       ghost_energy_(basis, energy),
-      handle_term_(HandleTerm(basis.rest, basis.mass, handles, checked_weights(handles, weights, basis.num_vertices()),
-                              options.pull * std::pow(basis.scale, 4)),
-                   [&basis](int v) { return basis.vertex_rows(v); }, basis.dimension()),
+      handle_term_(
+          HandleTerm(basis.rest, basis.mass, handles,
+                     checked_weights(handles, weights, basis.num_vertices()),
+                     options.pull * std::pow(basis.scale, 4)),
+          [&basis](int v) { return basis.vertex_rows(v); }, basis.dimension()),
       transforms_(handles.size(), Eigen::Matrix4d::Identity()),
       fine_positions_(basis) {
   require_handles_in_region(handles, basis.region);
@@ -62,20 +66,23 @@ ReducedDynamics::ReducedDynamics(const Basis& basis, const Handles& handles, con
   Eigen::MatrixXd K = ghost_energy_.rest_hessian();
   K = 0.5 * (K + K.transpose()).eval();
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(K);
-  if (eigen.info() != Eigen::Success) throw NumericalError("simulation: the reduced rest Hessian has no eigenvalues");
+  if (eigen.info() != Eigen::Success)
+    throw NumericalError("simulation: the reduced rest Hessian has no eigenvalues");
   const double largest = eigen.eigenvalues().maxCoeff();
   Eigen::Index lowest = 0;
   while (lowest < r && !(eigen.eigenvalues()[lowest] > kZeroEigenvalue * largest)) ++lowest;
   if (lowest == r || !(largest > 0))
-    throw InputError("basis: no flexible mode (every direction of the basis is a rigid motion or a mechanism); "
-                     "the period is that of the lowest flexible mode");
+    throw InputError(
+        "basis: no flexible mode (every direction of the basis is a rigid motion or a mechanism); "
+        "the period is that of the lowest flexible mode");
   const double lowest_eigenvalue = eigen.eigenvalues()[lowest];
   lowest_mode_ = eigen.eigenvectors().col(lowest);
 
   // The poles the artist asks for, and the model's that the midpoint rule maps onto them.
   h_ = 1.0 / (options.fps * options.substeps);
   const double omega = 2 * kPi * options.fps / options.period;
-  const std::complex<double> root = std::sqrt(std::complex<double>(options.damping * options.damping - 1, 0));
+  const std::complex<double> root =
+      std::sqrt(std::complex<double>(options.damping * options.damping - 1, 0));
   std::complex<double> product = 1, sum = 0;
   for (const double sign : {1.0, -1.0}) {
     const std::complex<double> pole = omega * (-options.damping + sign * root);
@@ -95,27 +102,34 @@ ReducedDynamics::ReducedDynamics(const Basis& basis, const Handles& handles, con
   set_state(Eigen::VectorXd::Zero(r), Eigen::VectorXd::Zero(r));
 }
 
-Eigen::MatrixXd ReducedDynamics::inverse_rest_hessian(const Eigen::MatrixXd& K, double potential_weight,
+Eigen::MatrixXd ReducedDynamics::inverse_rest_hessian(const Eigen::MatrixXd& K,
+                                                      double potential_weight,
                                                       double damping_weight) const {
   Eigen::MatrixXd H = (potential_weight * damping_weight) * (K + handle_term_.hessian());
   H.diagonal().array() += 1;
   H = 0.5 * (H + H.transpose()).eval();
   const Eigen::LLT<Eigen::MatrixXd> llt(H);
   if (llt.info() != Eigen::Success)
-    throw NumericalError("simulation: the incremental potential's Hessian at rest is not positive definite");
+    throw NumericalError(
+        "simulation: the incremental potential's Hessian at rest is not positive definite");
   Eigen::MatrixXd inverse = llt.solve(Eigen::MatrixXd::Identity(H.rows(), H.cols()));
   return 0.5 * (inverse + inverse.transpose());
 }
 
-void ReducedDynamics::positions_of(const Eigen::VectorXd& q, Eigen::Ref<Eigen::VectorXf> out) const {
-  if (q.size() != dimension()) throw InputError(message("q: expected ", dimension(), " reduced coordinates, got ", q.size()));
+void ReducedDynamics::positions_of(const Eigen::VectorXd& q,
+                                   Eigen::Ref<Eigen::VectorXf> out) const {
+  if (q.size() != dimension())
+    throw InputError(message("q: expected ", dimension(), " reduced coordinates, got ", q.size()));
   fine_positions_.write(q.cast<float>(), out);
 }
 
-void ReducedDynamics::set_state(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Transforms& transforms) {
+void ReducedDynamics::set_state(const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                                const Transforms& transforms) {
   const Eigen::Index r = dimension();
-  if (q.size() != r) throw InputError(message("q: expected ", r, " reduced coordinates, got ", q.size()));
-  if (v.size() != r) throw InputError(message("v: expected ", r, " reduced velocities, got ", v.size()));
+  if (q.size() != r)
+    throw InputError(message("q: expected ", r, " reduced coordinates, got ", q.size()));
+  if (v.size() != r)
+    throw InputError(message("v: expected ", r, " reduced velocities, got ", v.size()));
   if (!q.allFinite()) throw InputError("q: has non-finite entries");
   if (!v.allFinite() || !std::isfinite(0.5 * mass_scale_ * v.squaredNorm()))
     throw InputError("v: has non-finite entries, or a kinetic energy beyond double precision");
@@ -123,11 +137,13 @@ void ReducedDynamics::set_state(const Eigen::VectorXd& q, const Eigen::VectorXd&
   // The simulation's own state (playback sets each frame's cached state before stepping from it)
   // is kept: its energy and gradient were evaluated there, at these transforms, by the last step,
   // and BFGS's memory is the one that step left.
-  if (q_.size() == r && q == q_ && v == v_ && (transforms.empty() || transforms == transforms_)) return;
+  if (q_.size() == r && q == q_ && v == v_ && (transforms.empty() || transforms == transforms_))
+    return;
   Eigen::VectorXd gradient(r);
   const double elastic_energy = ghost_energy_.value_and_gradient(q, gradient);
   if (!std::isfinite(elastic_energy))
-    throw InputError(message("q: moves the mesh beyond the coordinates the energies take (", kMaxCoordinate, ")"));
+    throw InputError(message("q: moves the mesh beyond the coordinates the energies take (",
+                             kMaxCoordinate, ")"));
   if (!transforms.empty()) {
     transforms_ = transforms;
     handle_term_.set_transforms(transforms_);
@@ -148,12 +164,15 @@ double ReducedDynamics::incremental_potential(const Eigen::VectorXd& x, Eigen::V
 }
 
 double ReducedDynamics::incremental_potential(const Eigen::VectorXd& x, double elastic_energy,
-                                              const Eigen::VectorXd& elastic_gradient, Eigen::VectorXd& gradient) {
+                                              const Eigen::VectorXd& elastic_gradient,
+                                              Eigen::VectorXd& gradient) {
   const double handles = handle_term_.value_and_gradient(x, handle_gradient_);
   gradient = x - prediction_;
   const double inertia = 0.5 * gradient.squaredNorm();
-  gradient += potential_weight_ * (damping_weight_ * (elastic_gradient + handle_gradient_) - damping_pull_);
-  return inertia + potential_weight_ * (damping_weight_ * (elastic_energy + handles) - damping_pull_.dot(x));
+  gradient +=
+      potential_weight_ * (damping_weight_ * (elastic_gradient + handle_gradient_) - damping_pull_);
+  return inertia +
+         potential_weight_ * (damping_weight_ * (elastic_energy + handles) - damping_pull_.dot(x));
 }
 
 Transforms ReducedDynamics::interpolated(const Transforms& target, double a) const {
@@ -164,9 +183,12 @@ Transforms ReducedDynamics::interpolated(const Transforms& target, double a) con
     const Eigen::Matrix4d& to = target[h];
     const Eigen::Quaterniond rotation_from(Eigen::Matrix3d(from.topLeftCorner<3, 3>()));
     const Eigen::Quaterniond rotation_to(Eigen::Matrix3d(to.topLeftCorner<3, 3>()));
-    const Eigen::Matrix3d R = rotation_from.normalized().slerp(a, rotation_to.normalized()).toRotationMatrix();
-    const Eigen::Vector3d centre_from = from.topLeftCorner<3, 3>() * centres_[h] + from.topRightCorner<3, 1>();
-    const Eigen::Vector3d centre_to = to.topLeftCorner<3, 3>() * centres_[h] + to.topRightCorner<3, 1>();
+    const Eigen::Matrix3d R =
+        rotation_from.normalized().slerp(a, rotation_to.normalized()).toRotationMatrix();
+    const Eigen::Vector3d centre_from =
+        from.topLeftCorner<3, 3>() * centres_[h] + from.topRightCorner<3, 1>();
+    const Eigen::Vector3d centre_to =
+        to.topLeftCorner<3, 3>() * centres_[h] + to.topRightCorner<3, 1>();
     result[h].setIdentity();
     result[h].topLeftCorner<3, 3>() = R;
     result[h].topRightCorner<3, 1>() = (1 - a) * centre_from + a * centre_to - R * centres_[h];
@@ -190,7 +212,8 @@ SimulationStepStats ReducedDynamics::step(const Transforms& transforms) {
   transforms_ = transforms;
   fine_positions_.set(q_);
   ++remembered_frames_;
-  stats.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  stats.ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return stats;
 }
 
@@ -199,8 +222,9 @@ void ReducedDynamics::forget() {
   remembered_frames_ = 0;
 }
 
-void ReducedDynamics::minimize(Bfgs& bfgs, bool& started, const Eigen::MatrixXd& initial_inverse_hessian,
-                               Finish finish, SimulationStepStats& stats) {
+void ReducedDynamics::minimize(Bfgs& bfgs, bool& started,
+                               const Eigen::MatrixXd& initial_inverse_hessian, Finish finish,
+                               SimulationStepStats& stats) {
   // Φ changes from substep to substep by linear terms only: BFGS keeps what it learnt of its
   // curvature (the step's header comment says for how long).
   if (started)
@@ -214,7 +238,9 @@ void ReducedDynamics::minimize(Bfgs& bfgs, bool& started, const Eigen::MatrixXd&
   const double value = incremental_potential(q_, elastic_energy_, elastic_gradient_, gradient);
   bfgs.set_value_and_gradient(value, gradient);
   const BfgsResult result = bfgs.minimize(
-      [this](const Eigen::VectorXd& x, Eigen::VectorXd& gradient) { return incremental_potential(x, gradient); },
+      [this](const Eigen::VectorXd& x, Eigen::VectorXd& gradient) {
+        return incremental_potential(x, gradient);
+      },
       options_.max_iterations, options_.tolerance, std::numeric_limits<double>::infinity(), finish);
   stats.iterations += result.iterations;
   stats.evaluations += result.evaluations;
@@ -223,8 +249,8 @@ void ReducedDynamics::minimize(Bfgs& bfgs, bool& started, const Eigen::MatrixXd&
   stats.line_search_failures += result.line_search_failures;
 }
 
-void ReducedDynamics::substep(const Transforms& start, const Transforms& middle, const Transforms& end,
-                              SimulationStepStats& stats) {
+void ReducedDynamics::substep(const Transforms& start, const Transforms& middle,
+                              const Transforms& end, SimulationStepStats& stats) {
   ++stats.substeps;
   const double energy_before = energy();
   // The midpoint rule: Φ over the middle state.
@@ -248,12 +274,12 @@ void ReducedDynamics::substep(const Transforms& start, const Transforms& middle,
   double elastic_next = ghost_energy_.value_and_gradient(q_next, gradient_next);
   double potential_next = elastic_next + handle_term_.value_and_gradient(q_next, handle_gradient_);
   if (!(potential_next <= energy_before + work)) {
-    // The end state holds more energy than the step had (a non-quadratic energy's error, amplified by
-    // an unconverged minimisation in a violent motion): take the substep by implicit Euler instead,
-    // Φ_E(x) = ½‖x − q_n − h v_n‖² + (h²/ρ) V(x, t_{n+1}), undamped, from q_n. BFGS only decreases Φ_E
-    // (it ends at an evaluated point), so V(q_{n+1}, t_{n+1}) ≤ Φ_E(q_n) ρ/h² = ½ρ‖v_n‖² + V(q_n, t_{n+1}):
-    // within the energy the step had plus the handles' work at q_n, and the velocity check below
-    // holds the total there.
+    // The end state holds more energy than the step had (a non-quadratic energy's error, amplified
+    // by an unconverged minimisation in a violent motion): take the substep by implicit Euler
+    // instead, Φ_E(x) = ½‖x − q_n − h v_n‖² + (h²/ρ) V(x, t_{n+1}), undamped, from q_n. BFGS only
+    // decreases Φ_E (it ends at an evaluated point), so V(q_{n+1}, t_{n+1}) ≤ Φ_E(q_n) ρ/h² =
+    // ½ρ‖v_n‖² + V(q_n, t_{n+1}): within the energy the step had plus the handles' work at q_n, and
+    // the velocity check below holds the total there.
     ++stats.implicit_euler;
     prediction_ = q_ + h_ * v_;
     damping_pull_.setZero();

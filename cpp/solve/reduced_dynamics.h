@@ -12,7 +12,6 @@
 // Not thread-safe: one simulation per thread.
 #pragma once
 
-
 #include "basis/basis.h"
 #include "energy/make_energy.h"
 #include "solve/bfgs.h"
@@ -25,9 +24,9 @@ namespace modal_deform {
 struct SimulationOptions {
   double pull = kDefaultPull;  // μ of the handle term (handle_term.h)
   double period = 12.0;        // of the lowest flexible mode, in frames
-  double damping = 0.05;     // ζ of the lowest flexible mode, in [0, 1]
-  double fps = 24.0;         // frames per second
-  int substeps = 2;          // midpoint steps per frame
+  double damping = 0.05;       // ζ of the lowest flexible mode, in [0, 1]
+  double fps = 24.0;           // frames per second
+  int substeps = 2;            // midpoint steps per frame
   // BFGS per substep: at most this many iterations, and the stopping tolerance (bfgs.h), which
   // keeps the frames within the map's precision (FinePositions::kTolerance) of a tight solve's
   // (bench/results/dynamics.json, "tolerance").
@@ -49,19 +48,22 @@ template <typename Visit>
 void for_each_simulation_option(Visit&& visit) {
   visit(kPull, [](auto& o) -> auto& { return o.pull; });
   visit(Option{"period",
-               "Frames one swing of the lowest flexible mode takes (the slowest wobble): more make the mesh heavier "
+               "Frames one swing of the lowest flexible mode takes (the slowest wobble): more make "
+               "the mesh heavier "
                "and lazier, fewer make it snappier.",
                closed(kMinPeriodFrames, 1e6)},
         [](auto& o) -> auto& { return o.period; });
   visit(Option{"damping",
-               "Damping ratio of the lowest flexible mode, stiffer modes damped more: 0 swings on forever, 1 settles "
+               "Damping ratio of the lowest flexible mode, stiffer modes damped more: 0 swings on "
+               "forever, 1 settles "
                "without overshooting.",
                closed(0, 1)},
         [](auto& o) -> auto& { return o.damping; });
   visit(Option{"fps", "Frames per second: velocities are per second.", above_up_to(0, 1000)},
         [](auto& o) -> auto& { return o.fps; });
   visit(Option{"substeps",
-               "Midpoint steps per frame: more follow fast controllers more closely and cost more per frame.",
+               "Midpoint steps per frame: more follow fast controllers more closely and cost more "
+               "per frame.",
                closed(1, kMaxSubsteps)},
         [](auto& o) -> auto& { return o.substeps; });
   visit(Option{"max_iterations", "BFGS iterations per substep at most.", at_least(1)},
@@ -69,7 +71,8 @@ void for_each_simulation_option(Visit&& visit) {
   visit(Option{"tolerance", "BFGS's stopping tolerance per substep (bfgs.h).", between_open(0, 1)},
         [](auto& o) -> auto& { return o.tolerance; });
   visit(Option{"memory_frames",
-               "The most frames BFGS's memory of the curvature spans before it is forgotten (1: each frame learns "
+               "The most frames BFGS's memory of the curvature spans before it is forgotten (1: "
+               "each frame learns "
                "afresh).",
                at_least(1)},
         [](auto& o) -> auto& { return o.memory_frames; });
@@ -77,14 +80,14 @@ void for_each_simulation_option(Visit&& visit) {
 
 struct SimulationStepStats {
   int substeps = 0;
-  int iterations = 0;              // BFGS iterations, all substeps
-  int evaluations = 0;             // evaluations of Φ, all substeps
-  bool converged = true;           // every substep's minimisation converged (bfgs.h)
-  bool stalled = false;            // a substep's BFGS could not decrease Φ (its state was still taken)
+  int iterations = 0;     // BFGS iterations, all substeps
+  int evaluations = 0;    // evaluations of Φ, all substeps
+  bool converged = true;  // every substep's minimisation converged (bfgs.h)
+  bool stalled = false;   // a substep's BFGS could not decrease Φ (its state was still taken)
   int line_search_failures = 0;
-  int implicit_euler = 0;          // substeps the energy check took by implicit Euler instead
-  double energy_removed = 0;       // energy taken from the kinetic energy by the energy check
-  double ms = 0;                   // wall time of the step, milliseconds
+  int implicit_euler = 0;     // substeps the energy check took by implicit Euler instead
+  double energy_removed = 0;  // energy taken from the kinetic energy by the energy check
+  double ms = 0;              // wall time of the step, milliseconds
 };
 
 // The fields of SimulationStepStats by name (Simulation.stats in Python).
@@ -134,7 +137,8 @@ class ReducedDynamics {
   // (one per handle; empty keeps the current ones). Throws InputError for a wrong size, a
   // non-finite entry or a q whose ghost leaves the coordinates the energies take. Forgets BFGS's
   // memory unless the state is the simulation's own (the same q, v and transforms).
-  void set_state(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Transforms& transforms = {});
+  void set_state(const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                 const Transforms& transforms = {});
   const Eigen::VectorXd& q() const { return q_; }
   const Eigen::VectorXd& v() const { return v_; }
 
@@ -151,7 +155,7 @@ class ReducedDynamics {
 
   int dimension() const { return ghost_energy_.dimension(); }
   int num_handles() const { return static_cast<int>(centres_.size()); }
-  double mass_scale() const { return mass_scale_; }                   // ρ
+  double mass_scale() const { return mass_scale_; }                    // ρ
   const Eigen::VectorXd& lowest_mode() const { return lowest_mode_; }  // λ₁'s unit eigenvector of K
 
  private:
@@ -159,14 +163,15 @@ class ReducedDynamics {
   // (damping_weight V(x) − damping_pullᵀx), V = E + E_C.
   double incremental_potential(const Eigen::VectorXd& x, Eigen::VectorXd& gradient);
   // The same with E(x) and ∇E(x) given.
-  double incremental_potential(const Eigen::VectorXd& x, double elastic_energy, const Eigen::VectorXd& elastic_gradient,
-                               Eigen::VectorXd& gradient);
+  double incremental_potential(const Eigen::VectorXd& x, double elastic_energy,
+                               const Eigen::VectorXd& elastic_gradient, Eigen::VectorXd& gradient);
   // The inverse of I + potential_weight damping_weight (K + 2A): Φ's Hessian at rest.
-  Eigen::MatrixXd inverse_rest_hessian(const Eigen::MatrixXd& K, double potential_weight, double damping_weight) const;
+  Eigen::MatrixXd inverse_rest_hessian(const Eigen::MatrixXd& K, double potential_weight,
+                                       double damping_weight) const;
   // Minimises the current Φ with `bfgs` from q_n, ending as `finish` says (bfgs.h), adding to
   // `stats`; `started`: bfgs has minimised this scheme's Φ since the memory was last forgotten.
-  void minimize(Bfgs& bfgs, bool& started, const Eigen::MatrixXd& initial_inverse_hessian, Finish finish,
-                SimulationStepStats& stats);
+  void minimize(Bfgs& bfgs, bool& started, const Eigen::MatrixXd& initial_inverse_hessian,
+                Finish finish, SimulationStepStats& stats);
   // Transforms at fraction a of the way from start_ to target (per handle).
   Transforms interpolated(const Transforms& target, double a) const;
   void substep(const Transforms& start, const Transforms& middle, const Transforms& end,

@@ -10,7 +10,8 @@
 namespace modal_deform {
 
 GhostEnergy::GhostEnergy(const Basis& basis, EnergyKind energy)
-    : energy_(make_energy(energy, basis.scale * basis.ghost_vertices, basis.ghost_faces, ghost_material(basis))),
+    : energy_(make_energy(energy, basis.scale * basis.ghost_vertices, basis.ghost_faces,
+                          ghost_material(basis))),
       rest_(basis.scale * flatten(basis.ghost_vertices)),
       vectors_(basis.scale * basis.ghost_vectors),
       x_(rest_.size()),
@@ -53,7 +54,8 @@ FinePositions::FinePositions(const Basis& basis)
 void FinePositions::write(const Eigen::VectorXf& q, Eigen::Ref<Eigen::VectorXf> out) const {
   const Eigen::Index fine_rows = 3 * static_cast<Eigen::Index>(basis_.num_vertices());
   if (out.size() != fine_rows)
-    throw InputError(message("out: expected ", fine_rows, " values (3 per vertex), got ", out.size()));
+    throw InputError(
+        message("out: expected ", fine_rows, " values (3 per vertex), got ", out.size()));
   if (!basis_.on_proxy()) {
     quantized_vectors_.map(basis_.vectors, q, rest_.data(), tolerance_, out.data());
     return;

@@ -24,15 +24,16 @@ const Basis& checked(const Basis& basis) {
 
 }  // namespace
 
-ReducedSolver::ReducedSolver(const Basis& basis, const Handles& handles, const VectorRef& weights, double stiffness,
-                             EnergyKind energy, bool warm_start)
+ReducedSolver::ReducedSolver(const Basis& basis, const Handles& handles, const VectorRef& weights,
+                             double stiffness, EnergyKind energy, bool warm_start)
     : basis_(checked(basis)),
       num_handles_(static_cast<int>(handles.size())),
       ghost_energy_(basis, energy),
-      handle_term_(HandleTerm(basis.rest, basis.mass, handles,
-                              checked_handle_weights(handles, weights, basis.num_vertices()),
-                              checked_stiffness(stiffness) * std::pow(basis.scale, 4)),
-                   [&basis](int v) { return basis.vertex_rows(v); }, basis.dimension()) {
+      handle_term_(
+          HandleTerm(basis.rest, basis.mass, handles,
+                     checked_handle_weights(handles, weights, basis.num_vertices()),
+                     checked_stiffness(stiffness) * std::pow(basis.scale, 4)),
+          [&basis](int v) { return basis.vertex_rows(v); }, basis.dimension()) {
   require_handles_in_region(handles, basis.region);
   const Eigen::Index r = basis.dimension();
   if (warm_start) {
@@ -42,9 +43,11 @@ ReducedSolver::ReducedSolver(const Basis& basis, const Handles& handles, const V
     H.diagonal().array() += largest > 0 ? 1e-8 * largest : 1.0;
     const Eigen::LLT<Eigen::MatrixXd> llt(H);
     if (llt.info() != Eigen::Success)
-      throw NumericalError("reduced solver: the reduced Hessian at rest is not positive semidefinite");
+      throw NumericalError(
+          "reduced solver: the reduced Hessian at rest is not positive semidefinite");
     initial_inverse_hessian_ = llt.solve(Eigen::MatrixXd::Identity(r, r));
-    initial_inverse_hessian_ = 0.5 * (initial_inverse_hessian_ + initial_inverse_hessian_.transpose()).eval();
+    initial_inverse_hessian_ =
+        0.5 * (initial_inverse_hessian_ + initial_inverse_hessian_.transpose()).eval();
   } else {
     initial_inverse_hessian_ = Eigen::MatrixXd::Identity(r, r);
   }
@@ -71,7 +74,8 @@ ReducedSolveStats ReducedSolver::solve(const ReducedSolveOptions& options) {
 ReducedSolveStats ReducedSolver::solve(int max_iterations, double tolerance, double budget_ms) {
   const auto start = std::chrono::steady_clock::now();
   const BfgsResult result =
-      bfgs_.minimize([this](const Eigen::VectorXd& q, Eigen::VectorXd& gradient) { return objective(q, gradient); },
+      bfgs_.minimize([this](const Eigen::VectorXd& q,
+                            Eigen::VectorXd& gradient) { return objective(q, gradient); },
                      max_iterations, tolerance, budget_ms);
   ReducedSolveStats stats;
   stats.iterations = result.iterations;
@@ -81,7 +85,8 @@ ReducedSolveStats ReducedSolver::solve(int max_iterations, double tolerance, dou
   stats.line_search_failures = result.line_search_failures;
   stats.energy = bfgs_.value();
   stats.gradient_norm = bfgs_.gradient().norm();
-  stats.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  stats.ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return stats;
 }
 

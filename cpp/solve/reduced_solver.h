@@ -14,8 +14,8 @@
 #include <limits>
 #include <memory>
 
-#include "energy/make_energy.h"
 #include "basis/basis.h"
+#include "energy/make_energy.h"
 #include "solve/bfgs.h"
 #include "solve/handle_term.h"
 #include "solve/reduced_map.h"
@@ -23,14 +23,14 @@
 namespace modal_deform {
 
 struct ReducedSolveStats {
-  int iterations = 0;        // BFGS steps of this call
-  int evaluations = 0;       // evaluations of f and ∇f by this call
-  double energy = 0;         // f(q) at the end: deformation energy plus handle term
-  double gradient_norm = 0;  // ‖∇f(q)‖
-  bool converged = false;    // the stopping test holds (bfgs.h)
-  bool stalled = false;      // not converged, and no step decreases f (BfgsResult::stalled)
+  int iterations = 0;            // BFGS steps of this call
+  int evaluations = 0;           // evaluations of f and ∇f by this call
+  double energy = 0;             // f(q) at the end: deformation energy plus handle term
+  double gradient_norm = 0;      // ‖∇f(q)‖
+  bool converged = false;        // the stopping test holds (bfgs.h)
+  bool stalled = false;          // not converged, and no step decreases f (BfgsResult::stalled)
   int line_search_failures = 0;  // line searches of this call that found no decrease
-  double ms = 0;             // wall time of the call, milliseconds
+  double ms = 0;                 // wall time of the call, milliseconds
 };
 
 // The fields of ReducedSolveStats by name (the Python API's stats dict): visit(name, field) with
@@ -58,10 +58,14 @@ struct ReducedSolverOptions {
 template <typename Visit>
 void for_each_reduced_solver_option(Visit&& visit) {
   visit(kPull, [](auto& o) -> auto& { return o.pull; });
-  visit(Option{"energy", "The energy evaluated on the ghost: \"shells\" (with the basis's material) or \"arap\"."},
-        [](auto& o) -> auto& { return o.energy; });
+  visit(
+      Option{
+          "energy",
+          "The energy evaluated on the ghost: \"shells\" (with the basis's material) or \"arap\"."},
+      [](auto& o) -> auto& { return o.energy; });
   visit(Option{"warm_start",
-               "Start BFGS from the inverse of the reduced rest Hessian (the paper's warm start); False starts it "
+               "Start BFGS from the inverse of the reduced rest Hessian (the paper's warm start); "
+               "False starts it "
                "from the identity, for comparison."},
         [](auto& o) -> auto& { return o.warm_start; });
 }
@@ -77,10 +81,12 @@ template <typename Visit>
 void for_each_reduced_solve_option(Visit&& visit) {
   visit(Option{"max_iterations", "BFGS iterations at most.", at_least(0)},
         [](auto& o) -> auto& { return o.max_iterations; });
-  visit(Option{"tolerance", "ε of the Gill-Murray-Wright stopping test (paper eq. 14).", between_open(0, 1)},
+  visit(Option{"tolerance", "ε of the Gill-Murray-Wright stopping test (paper eq. 14).",
+               between_open(0, 1)},
         [](auto& o) -> auto& { return o.tolerance; });
   visit(Option{"budget_ms",
-               "No iteration begins once this many milliseconds have passed (the one under way is finished, so a "
+               "No iteration begins once this many milliseconds have passed (the one under way is "
+               "finished, so a "
                "call always progresses); None: no limit.",
                above_up_to(0, std::numeric_limits<double>::infinity())},
         [](auto& o) -> auto& { return o.budget_ms; });
@@ -90,11 +96,12 @@ class ReducedSolver {
  public:
   // basis: validated here (validate_basis); it must outlive the solver, which keeps a reference
   // to its fine arrays. handles, weights: see checked_handle_weights (fine vertex indices; empty
-  // weights mean 1), inside the basis's region if it has one (require_handles_in_region). stiffness: μ > 0. energy: evaluated on the ghost. warm_start false starts
-  // BFGS from the identity instead of the rest Hessian (for comparison). The solver starts at
-  // rest with identity transforms.
-  ReducedSolver(const Basis& basis, const Handles& handles, const VectorRef& weights, double stiffness,
-                EnergyKind energy = EnergyKind::kShells, bool warm_start = true);
+  // weights mean 1), inside the basis's region if it has one (require_handles_in_region).
+  // stiffness: μ > 0. energy: evaluated on the ghost. warm_start false starts BFGS from the
+  // identity instead of the rest Hessian (for comparison). The solver starts at rest with identity
+  // transforms.
+  ReducedSolver(const Basis& basis, const Handles& handles, const VectorRef& weights,
+                double stiffness, EnergyKind energy = EnergyKind::kShells, bool warm_start = true);
   // The same with the options of a table (checked).
   ReducedSolver(const Basis& basis, const Handles& handles, const VectorRef& weights,
                 const ReducedSolverOptions& options)

@@ -10,7 +10,8 @@ namespace {
 FullSolveOptions on_share(const FullSolveOptions& options, double begin, double width) {
   FullSolveOptions share = options;
   if (options.progress)
-    share.progress = [callback = options.progress, begin, width](const std::string& stage, double fraction) {
+    share.progress = [callback = options.progress, begin, width](const std::string& stage,
+                                                                 double fraction) {
       return callback(stage, begin + width * fraction);
     };
   return share;
@@ -18,9 +19,9 @@ FullSolveOptions on_share(const FullSolveOptions& options, double begin, double 
 
 }  // namespace
 
-RefineResult refine(const VerticesRef& V, const FacesRef& F, const Handles& handles, const VectorRef& weights,
-                    const Transforms& transforms, double stiffness, const FullSolveOptions& options,
-                    const RowMatrixX3d& initial) {
+RefineResult refine(const VerticesRef& V, const FacesRef& F, const Handles& handles,
+                    const VectorRef& weights, const Transforms& transforms, double stiffness,
+                    const FullSolveOptions& options, const RowMatrixX3d& initial) {
   RefineResult from_start{solve_full(V, F, handles, weights, transforms, stiffness,
                                      on_share(options, 0.0, kFromStartShare), &initial),
                           false};

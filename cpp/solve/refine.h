@@ -31,8 +31,8 @@ constexpr double kFromStartShare = 0.5;
 // progress bar ends at 1 whichever solves run. With the fallback, iterations, factorizations,
 // seconds and history count both solves, and initial_energy is F at `initial`, whichever answer
 // is returned.
-RefineResult refine(const VerticesRef& V, const FacesRef& F, const Handles& handles, const VectorRef& weights,
-                    const Transforms& transforms, double stiffness, const FullSolveOptions& options,
-                    const RowMatrixX3d& initial);
+RefineResult refine(const VerticesRef& V, const FacesRef& F, const Handles& handles,
+                    const VectorRef& weights, const Transforms& transforms, double stiffness,
+                    const FullSolveOptions& options, const RowMatrixX3d& initial);
 
 }  // namespace modal_deform

@@ -22,7 +22,8 @@ std::vector<int> stretched_vertices(const PoseObjective& objective, const Eigen:
       const int a = F(f, k), b = F(f, (k + 1) % 3);
       const double rest_length = (rest.row(a) - rest.row(b)).norm();
       // A zero-length rest edge (a raw scan's unwelded duplicate) has no term to stretch.
-      if (rest_length > 0 && (y.segment<3>(3 * a) - y.segment<3>(3 * b)).norm() > kStretchedBeyond * rest_length)
+      if (rest_length > 0 &&
+          (y.segment<3>(3 * a) - y.segment<3>(3 * b)).norm() > kStretchedBeyond * rest_length)
         stretched[a] = stretched[b] = 1;
     }
   std::vector<int> vertices;
@@ -39,7 +40,9 @@ int relax_stretched(const PoseObjective& objective, NewtonPoint& point) {
   std::vector<int> vertices;
   const PoseObjective local = objective.around(free, vertices);
   // Coordinates of the local objective's vertex i: the parent's vertex vertices[i].
-  auto at = [&](Eigen::VectorXd& y, size_t i) { return y.segment<3>(3 * static_cast<Eigen::Index>(i)); };
+  auto at = [&](Eigen::VectorXd& y, size_t i) {
+    return y.segment<3>(3 * static_cast<Eigen::Index>(i));
+  };
   const auto size = static_cast<Eigen::Index>(3 * vertices.size());
   NewtonPoint near{Eigen::VectorXd(size), 0, Eigen::VectorXd(size)};
   for (size_t i = 0; i < vertices.size(); ++i) at(near.y, i) = at(point.y, vertices[i]);

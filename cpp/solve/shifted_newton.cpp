@@ -13,7 +13,8 @@ namespace modal_deform {
 ShiftedNewton::ShiftedNewton(const PoseObjective& objective)
     : objective_(objective), llt_(3), shift_(objective.smallest_shift()) {
   const Eigen::Index size = objective.mass_diagonal().size();
-  for (Eigen::VectorXd* v : {&step_, &shifted_diagonal_, &residual_, &preconditioned_, &direction_, &product_})
+  for (Eigen::VectorXd* v :
+       {&step_, &shifted_diagonal_, &residual_, &preconditioned_, &direction_, &product_})
     v->resize(size);
   for (NewtonPoint* p : {&trial_, &extended_}) {
     p->y.resize(size);
@@ -27,8 +28,10 @@ int ShiftedNewton::minimize(NewtonPoint& point, double target, int budget, doubl
   previous_gradient_norm_ = 0;  // a new load: no forcing term from the last one's steps
   while (iterations < budget && stalled < kMaxStalledIterations && point.gradient.norm() > target) {
     const double gradient_norm = point.gradient.norm();
-    stalled = iterate(point, gradient_norm <= exact_below, forcing(gradient_norm, target, exact_below)) ? 0
-                                                                                                    : stalled + 1;
+    stalled =
+        iterate(point, gradient_norm <= exact_below, forcing(gradient_norm, target, exact_below))
+            ? 0
+            : stalled + 1;
     ++iterations;
     after_iteration(point);
   }
@@ -70,27 +73,35 @@ bool ShiftedNewton::iterate(NewtonPoint& point, bool near_minimum, double forcin
   }
   const double slope = point.gradient.dot(step_);
   product_.noalias() = hessian_ * step_;
-  const double curvature = step_.dot(product_) + step_.dot(objective_.constant_diagonal().cwiseProduct(step_));
+  const double curvature =
+      step_.dot(product_) + step_.dot(objective_.constant_diagonal().cwiseProduct(step_));
   const double noise = kUnresolvableDecrease * (1 + std::abs(point.value));
   // The first trial stops short of the first triangle's turning point (an interior point method's
   // fraction to the boundary): halving from 1 lands anywhere between half of it and all of it. No
   // trial of the search turns a triangle over, so only extend() checks for it.
-  const double initial_step = std::min(1.0, kToTurning * objective_.step_to_turning(point.y, step_));
+  const double initial_step =
+      std::min(1.0, kToTurning * objective_.step_to_turning(point.y, step_));
   const BacktrackingResult search =
-      backtracking_line_search(std::cref(objective_), point.y, point.value, point.gradient, step_, trial_.y,
-                               trial_.value, trial_.gradient, noise, initial_step);
+      backtracking_line_search(std::cref(objective_), point.y, point.value, point.gradient, step_,
+                               trial_.y, trial_.value, trial_.gradient, noise, initial_step);
   // Cut only by the guard: every longer trial turned a triangle over (or left F's domain), none
   // fell short of the decrease.
   const bool guarded = search.step > 0 && search.step < 1 && search.insufficient == 0;
-  const double ratio =
-      search.step > 0 ? (point.value - trial_.value) / predicted_decrease(search.step, slope, curvature) : 0;
-  NewtonIteration record{exact ? HessianModel::kExact : HessianModel::kProjected, shift_, search.step, guarded, ratio,
+  const double ratio = search.step > 0 ? (point.value - trial_.value) /
+                                             predicted_decrease(search.step, slope, curvature)
+                                       : 0;
+  NewtonIteration record{exact ? HessianModel::kExact : HessianModel::kProjected,
+                         shift_,
+                         search.step,
+                         guarded,
+                         ratio,
                          cg_iterations};
   update_shift(guarded ? 1 : search.step, ratio);
   if (search.step == 1 && ratio > kExtendAbove) {
     // A trial point beyond 1 that turns a triangle over counts as too far.
     record.step = extend(point, [&](const Eigen::VectorXd& trial, Eigen::VectorXd& trial_gradient) {
-      if (objective_.turns_a_triangle_over(point.y, trial)) return std::numeric_limits<double>::infinity();
+      if (objective_.turns_a_triangle_over(point.y, trial))
+        return std::numeric_limits<double>::infinity();
       return objective_(trial, trial_gradient);
     });
   }
@@ -125,7 +136,8 @@ double ShiftedNewton::predicted_decrease(double alpha, double slope, double curv
   return -alpha * slope - 0.5 * alpha * alpha * curvature;
 }
 
-int ShiftedNewton::solve_by_cg(const SparseMatrix& hessian, const Eigen::VectorXd& gradient, double forcing) {
+int ShiftedNewton::solve_by_cg(const SparseMatrix& hessian, const Eigen::VectorXd& gradient,
+                               double forcing) {
   // Preconditioned conjugate gradients (Nocedal & Wright, Numerical Optimization, algorithm 5.3)
   // on (H + C + τD) p = −∇F, with the residual r = −∇F − (H + C + τD) p.
   const double initial_norm = gradient.norm(), bound = forcing * initial_norm;
@@ -178,8 +190,8 @@ bool ShiftedNewton::try_factorize(const SparseMatrix& hessian) {
   factored_ = false;
   try {
     // Not refused for CHOLMOD's cheap condition estimate: ∇²F + τD with τ > 0 is definite when it
-    // factors, and on large scans the estimate is tiny for every τ near its floor; refusing it would
-    // hold τ above the floor, and the steps would creep.
+    // factors, and on large scans the estimate is tiny for every τ near its floor; refusing it
+    // would hold τ above the floor, and the steps would creep.
     set_shifted_diagonal();
     llt_.factorize(hessian, shifted_diagonal_, 0);
     factored_ = true;
@@ -191,7 +203,8 @@ bool ShiftedNewton::try_factorize(const SparseMatrix& hessian) {
 
 void ShiftedNewton::factorize_shifted(const SparseMatrix& hessian) {
   for (int attempt = 0; !try_factorize(hessian); ++attempt) {
-    if (attempt == 60) throw NumericalError("solve_full: no shift of the Hessian could be factored");
+    if (attempt == 60)
+      throw NumericalError("solve_full: no shift of the Hessian could be factored");
     failed_shift_ = std::max(failed_shift_, shift_);
     shift_ *= 10;
   }

@@ -37,8 +37,9 @@ inline const char* hessian_model_name(HessianModel model) {
 
 struct NewtonIteration {
   HessianModel model = HessianModel::kProjected;
-  double shift = 0;       // τ it was factored with
-  double step = 0;        // α taken (above 1: extended); 0: the line search found no decrease (the iterate stays)
+  double shift = 0;  // τ it was factored with
+  double step =
+      0;  // α taken (above 1: extended); 0: the line search found no decrease (the iterate stays)
   bool guarded = false;   // α < 1 only because longer steps turned a triangle over
   double ratio = 0;       // F's decrease over the model's at α
   int cg_iterations = 0;  // conjugate gradient iterations of the step; 0: solved with a new factor
@@ -102,9 +103,11 @@ class ShiftedNewton {
   // Conjugate gradient iterations (a solve with the factor and a product with the Hessian each)
   // before the matrix is factored instead.
   static constexpr int kMaxCgIterations = 12;
-  // The forcing terms' bound (Eisenstat & Walker's η_max): far from the minimum a loose step serves.
+  // The forcing terms' bound (Eisenstat & Walker's η_max): far from the minimum a loose step
+  // serves.
   static constexpr double kMaxForcing = 0.1;
-  // A full step that decreased F by more than this times the model's promise is extended (extend()).
+  // A full step that decreased F by more than this times the model's promise is extended
+  // (extend()).
   static constexpr double kExtendAbove = 1.5;
   static constexpr double kMaxExtension = 8;
   // The fraction of the way to the first triangle's turning point the line search starts at when
@@ -126,7 +129,8 @@ class ShiftedNewton {
   int solve_by_cg(const SparseMatrix& hessian, const Eigen::VectorXd& gradient, double forcing);
   // The relative residual the next Newton system is solved to by conjugate gradients.
   double forcing(double gradient_norm, double target, double exact_below) const;
-  // shifted_diagonal_ = C + τD at the current τ: the shift of both the factor and the system CG solves.
+  // shifted_diagonal_ = C + τD at the current τ: the shift of both the factor and the system CG
+  // solves.
   void set_shifted_diagonal();
   // Factors ∇²F + τD at the current τ; false (the matrix not definite) leaves τ as it is.
   bool try_factorize(const SparseMatrix& hessian);
@@ -151,7 +155,7 @@ class ShiftedNewton {
   // Iterations since the exact Hessian was last found not definite at τ.
   int since_exact_failed_ = kRetryExactAfter;
   bool factored_ = false;  // llt_ holds the factor of the last factorisation (it succeeded)
-  double previous_gradient_norm_ = 0;  // ‖∇F‖ before the last iteration, for the forcing term
+  double previous_gradient_norm_ = 0;        // ‖∇F‖ before the last iteration, for the forcing term
   Eigen::VectorXd step_, shifted_diagonal_;  // shifted_diagonal_: C + τD
   Eigen::VectorXd residual_, preconditioned_, direction_, product_;  // conjugate gradients' vectors
   NewtonPoint trial_, extended_;

@@ -23,9 +23,16 @@ inline constexpr const char* kOrthonormalisation = "orthonormalisation";
 inline constexpr const char* kAssembly = "assembly";
 inline constexpr const char* kProlongation = "prolongation";
 }  // namespace stages
-inline constexpr std::array<const char*, 11> kBakeStages = {
-    stages::kProxy,           stages::kAttachment,         stages::kHessian,  stages::kFactorisation,
-    stages::kGhost,           stages::kModes,              stages::kThirdDerivatives,
-    stages::kDerivativeSolves, stages::kOrthonormalisation, stages::kAssembly, stages::kProlongation};
+inline constexpr std::array<const char*, 11> kBakeStages = {stages::kProxy,
+                                                            stages::kAttachment,
+                                                            stages::kHessian,
+                                                            stages::kFactorisation,
+                                                            stages::kGhost,
+                                                            stages::kModes,
+                                                            stages::kThirdDerivatives,
+                                                            stages::kDerivativeSolves,
+                                                            stages::kOrthonormalisation,
+                                                            stages::kAssembly,
+                                                            stages::kProlongation};
 
 }  // namespace modal_deform

@@ -2,7 +2,8 @@
 //
 // InputError: the caller's data is wrong (becomes ValueError in Python); the message names the
 // argument and the first offending index. NumericalError: a solver failed on valid input
-// (becomes RuntimeError). OutOfMemory: not enough memory (becomes MemoryError). Cancelled: a progress callback asked to stop (becomes mdc.Cancelled).
+// (becomes RuntimeError). OutOfMemory: not enough memory (becomes MemoryError). Cancelled: a
+// progress callback asked to stop (becomes mdc.Cancelled).
 #pragma once
 
 #include <sstream>

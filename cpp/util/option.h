@@ -24,7 +24,9 @@ struct Range {
 };
 
 constexpr Range any_value() { return {}; }
-constexpr Range at_least(double min) { return {min, std::numeric_limits<double>::infinity(), false, false}; }
+constexpr Range at_least(double min) {
+  return {min, std::numeric_limits<double>::infinity(), false, false};
+}
 constexpr Range closed(double min, double max) { return {min, max, false, false}; }
 // (min, max]
 constexpr Range above_up_to(double min, double max) { return {min, max, true, false}; }
@@ -46,13 +48,13 @@ void check_option(const Option& option, const T& value) {
     const bool bounded_below = r.min > -std::numeric_limits<double>::infinity();
     const bool bounded_above = r.max < std::numeric_limits<double>::infinity();
     if (bounded_below && !bounded_above)
-      throw InputError(message(option.name, ": expected ", r.min_open ? "more than " : "at least ", r.min,
-                               ", got ", value));
+      throw InputError(message(option.name, ": expected ", r.min_open ? "more than " : "at least ",
+                               r.min, ", got ", value));
     if (!bounded_below && bounded_above)
-      throw InputError(message(option.name, ": expected ", r.max_open ? "less than " : "at most ", r.max,
-                               ", got ", value));
-    throw InputError(message(option.name, ": expected a value in ", r.min_open ? "(" : "[", r.min, ", ", r.max,
-                             r.max_open ? ")" : "]", ", got ", value));
+      throw InputError(message(option.name, ": expected ", r.max_open ? "less than " : "at most ",
+                               r.max, ", got ", value));
+    throw InputError(message(option.name, ": expected a value in ", r.min_open ? "(" : "[", r.min,
+                             ", ", r.max, r.max_open ? ")" : "]", ", got ", value));
   }
 }
 

@@ -22,16 +22,18 @@ inline bool positions_in_range(const Eigen::Ref<const Eigen::VectorXd>& y) {
 // kMaxCoordinate in magnitude; the message names the argument and the first offending vertex
 // ("X[7]: vertex 7 has a non-finite coordinate ...").
 inline void require_positions(const VectorRef& y, Eigen::Index size, const char* name) {
-  if (y.size() != size) throw InputError(message(name, ": expected ", size, " values, got ", y.size()));
+  if (y.size() != size)
+    throw InputError(message(name, ": expected ", size, " values, got ", y.size()));
   if (positions_in_range(y)) return;
   Eigen::Index v = 0;
   while (positions_in_range(y.segment<3>(3 * v))) ++v;
   const Eigen::Vector3d p = y.segment<3>(3 * v);
   if (!p.allFinite())
-    throw InputError(message(name, "[", v, "]: vertex ", v, " has a non-finite coordinate (", p[0], ", ", p[1], ", ",
-                             p[2], ")"));
-  throw InputError(message(name, "[", v, "]: vertex ", v, " has a coordinate too large (", p[0], ", ", p[1], ", ", p[2],
-                           "); the core takes magnitudes up to ", kMaxCoordinate, ": scale the mesh down"));
+    throw InputError(message(name, "[", v, "]: vertex ", v, " has a non-finite coordinate (", p[0],
+                             ", ", p[1], ", ", p[2], ")"));
+  throw InputError(message(name, "[", v, "]: vertex ", v, " has a coordinate too large (", p[0],
+                           ", ", p[1], ", ", p[2], "); the core takes magnitudes up to ",
+                           kMaxCoordinate, ": scale the mesh down"));
 }
 
 }  // namespace modal_deform

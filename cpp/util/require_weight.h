@@ -17,7 +17,8 @@ constexpr double kMaxWeight = 1e12;
 // Throws InputError unless weight is in [0, kMaxWeight] (NaN fails); the message names it.
 inline void require_weight(double weight, const char* name) {
   if (!(weight >= 0 && weight <= kMaxWeight))
-    throw InputError(message(name, ": expected a finite weight >= 0 and at most ", kMaxWeight, ", got ", weight));
+    throw InputError(message(name, ": expected a finite weight >= 0 and at most ", kMaxWeight,
+                             ", got ", weight));
 }
 
 }  // namespace modal_deform

@@ -5,6 +5,7 @@ This file only registers the Blender layer, once native_loader made the compiled
 imported inside register(). The interactive pose is in pose/, playback on the timeline in playback/.
 Every import is relative: installed as an extension the package is ``bl_ext.<repository>.modal_deform``.
 """
+
 import importlib
 
 from . import native_loader
@@ -22,8 +23,19 @@ bl_info = {
 native_loader.find_native()
 
 # The Blender modules in registration order (properties before what refers to them).
-_MODULES = ("properties", "storage", "playback.timeline", "ops_bake", "ops_handles", "pose.operators",
-            "pose.recovery", "playback.operators", "playback.bake_animation", "ops_preview", "ui")
+_MODULES = (
+    "properties",
+    "storage",
+    "playback.timeline",
+    "ops_bake",
+    "ops_handles",
+    "pose.operators",
+    "pose.recovery",
+    "playback.operators",
+    "playback.bake_animation",
+    "ops_preview",
+    "ui",
+)
 
 
 def _modules():

@@ -5,6 +5,7 @@ register(pairs) and unregister(pairs) from its own register() and unregister(). 
 persistent (kept when a file is loaded); names this Blender lacks (the playback handlers before
 Blender 4) are skipped; registering twice or unregistering what is not registered changes nothing.
 """
+
 import bpy
 
 

@@ -3,6 +3,7 @@ plays back and renders without the add-on. Frame f shows shape key "Modal Deform
 at f - 1 and f + 1, constant interpolation). The refined animation bake (jobs.AnimationJob) writes
 them, from its own solves or from the per-frame cache (playback/frame_cache.py).
 """
+
 import re
 
 from . import mesh_io, posing
@@ -38,6 +39,7 @@ def action_fcurves(animation_data):
     if hasattr(animation_data.action, "fcurves"):
         return animation_data.action.fcurves
     from bpy_extras import anim_utils
+
     channelbag = anim_utils.animdata_get_channelbag_for_assigned_slot(animation_data)
     return None if channelbag is None else channelbag.fcurves
 

@@ -6,6 +6,7 @@ controllers deforms nothing. Controllers may be scaled or sheared; only the rota
 decomposition) and the motion of the handle's centre are kept, as the solver takes rigid motions.
 A handle without a controller is pinned where it is.
 """
+
 import collections
 
 import numpy as np
@@ -30,7 +31,11 @@ def owner(obj):
     if obj.type == "MESH":
         return obj
     parent = obj.parent
-    if parent is not None and parent.type == "MESH" and any(h.controller == obj for h in parent.modal_deform.handles):
+    if (
+        parent is not None
+        and parent.type == "MESH"
+        and any(h.controller == obj for h in parent.modal_deform.handles)
+    ):
         return parent
     return None
 
@@ -60,7 +65,9 @@ def resolve(obj, scene, rest, region=None):
     """
     items = obj.modal_deform.handles
     if not items:
-        raise HandleError(f"'{obj.name}' has no handles: in Edit Mode select vertices and Add Handle")
+        raise HandleError(
+            f"'{obj.name}' has no handles: in Edit Mode select vertices and Add Handle"
+        )
     handles, warnings = [], []
     for item in items:
         label = f"handle '{item.name}'"
@@ -70,30 +77,51 @@ def resolve(obj, scene, rest, region=None):
         if indices is None:
             raise HandleError(f"{label}: vertex group '{item.vertex_group}' does not exist")
         if indices.size == 0:
-            raise HandleError(f"{label}: vertex group '{item.vertex_group}' has no vertices (none with a weight above 0)")
+            raise HandleError(
+                f"{label}: vertex group '{item.vertex_group}' has no vertices (none with a weight above 0)"
+            )
         if indices.size == len(rest):
-            raise HandleError(f"{label}: vertex group '{item.vertex_group}' holds every vertex, so nothing is left "
-                              f"to deform")
+            raise HandleError(
+                f"{label}: vertex group '{item.vertex_group}' holds every vertex, so nothing is left "
+                f"to deform"
+            )
         if region is not None and region.size:
             outside = indices[~np.isin(indices, region, assume_unique=True)]
             if outside.size:
-                raise HandleError(f"{label}: vertex group '{item.vertex_group}' has {outside.size} vertices outside "
-                                  f"the region the basis was baked with (vertex {outside[0]} first), which alone "
-                                  f"moves: keep the handle inside the region, or re-bake with a region that holds it")
+                raise HandleError(
+                    f"{label}: vertex group '{item.vertex_group}' has {outside.size} vertices outside "
+                    f"the region the basis was baked with (vertex {outside[0]} first), which alone "
+                    f"moves: keep the handle inside the region, or re-bake with a region that holds it"
+                )
         controller = item.controller
         if controller is not None and scene.objects.get(controller.name) != controller:
-            raise HandleError(f"{label}: controller '{controller.name}' is not in the scene (deleted?): assign "
-                              f"another or clear it to pin the handle")
+            raise HandleError(
+                f"{label}: controller '{controller.name}' is not in the scene (deleted?): assign "
+                f"another or clear it to pin the handle"
+            )
         if controller is None and item.bound_controller:
-            warnings.append(f"{label}: its controller '{item.bound_controller}' is gone, so the handle is pinned")
+            warnings.append(
+                f"{label}: its controller '{item.bound_controller}' is gone, so the handle is pinned"
+            )
         bind_inverse = Matrix(item.bind_matrix).inverted_safe()
-        handles.append(Handle(item.name, indices, item.weight, controller, bind_inverse, rest[indices].mean(axis=0)))
+        handles.append(
+            Handle(
+                item.name,
+                indices,
+                item.weight,
+                controller,
+                bind_inverse,
+                rest[indices].mean(axis=0),
+            )
+        )
     for i, a in enumerate(handles):
-        for b in handles[i + 1:]:
+        for b in handles[i + 1 :]:
             shared = np.intersect1d(a.indices, b.indices, assume_unique=True).size
             if shared:
-                warnings.append(f"handles '{a.name}' and '{b.name}' share {shared} vertices: they settle between "
-                                f"both targets by weight")
+                warnings.append(
+                    f"handles '{a.name}' and '{b.name}' share {shared} vertices: they settle between "
+                    f"both targets by weight"
+                )
     return handles, warnings
 
 
@@ -115,6 +143,7 @@ def add_controller(context, obj, name, centre, size):
     """An Empty of display size `size` at `centre` (obj's space), parented to obj so that moving obj
     carries it, like Ctrl+H > Hook to New Object."""
     import bpy
+
     empty = bpy.data.objects.new(name, None)
     empty.empty_display_type = "SPHERE"
     empty.empty_display_size = size

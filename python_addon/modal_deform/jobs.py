@@ -11,6 +11,7 @@ setting `written` when it changed the object.
 AnimationJob writes its frames as frame keys (frame_keys.py); refined, each frame starts from the
 previous frame's refined answer.
 """
+
 import threading
 import time
 
@@ -90,10 +91,16 @@ class BakeJob(_ThreadJob):
         self.vertex_groups = storage.groups(obj)
         region = self.vertex_groups.weights["region_group"]
         # The bake's numeric options are the settings' properties of the same names (properties.py).
-        self.options = {name: getattr(settings, name) for name, option in mdc.BAKE_OPTIONS.items()
-                        if option.kind in ("int", "float") and hasattr(settings, name)}
-        self.options.update(energy=self.energy.lower(), stiffness_weights=self.vertex_groups.weights["stiffness_group"],
-                            region=None if region is None else mesh_io.members(region))
+        self.options = {
+            name: getattr(settings, name)
+            for name, option in mdc.BAKE_OPTIONS.items()
+            if option.kind in ("int", "float") and hasattr(settings, name)
+        }
+        self.options.update(
+            energy=self.energy.lower(),
+            stiffness_weights=self.vertex_groups.weights["stiffness_group"],
+            region=None if region is None else mesh_io.members(region),
+        )
         if self.energy != "SHELLS":
             self.options["derivatives"] = 0
         self.stage, self.fraction = "starting", 0.0
@@ -121,15 +128,24 @@ class BakeJob(_ThreadJob):
             return unfinished
         obj = self._object_as_read()
         if obj is None:
-            return "WARNING", f"'{self.object_name}' changed during the bake: the result was discarded, bake again"
-        storage.store(obj, self.basis, self.fingerprint, self.vertex_groups, self.seconds, self.energy)
+            return (
+                "WARNING",
+                f"'{self.object_name}' changed during the bake: the result was discarded, bake again",
+            )
+        storage.store(
+            obj, self.basis, self.fingerprint, self.vertex_groups, self.seconds, self.energy
+        )
         self.written = True
         basis = self.basis
-        message = (f"Baked '{obj.name}' in {self.seconds:.1f} s: {basis.dimension} dimensions, ghost "
-                   f"{len(basis.ghost_vertices)} vertices")
+        message = (
+            f"Baked '{obj.name}' in {self.seconds:.1f} s: {basis.dimension} dimensions, ghost "
+            f"{len(basis.ghost_vertices)} vertices"
+        )
         if basis.num_floppy:
-            message += (f"; {basis.num_floppy} zero modes besides the rigid motions (large parts joined at a "
-                        f"single vertex) came on top of the modes")
+            message += (
+                f"; {basis.num_floppy} zero modes besides the rigid motions (large parts joined at a "
+                f"single vertex) came on top of the modes"
+            )
         return "INFO", message
 
 
@@ -145,8 +161,13 @@ class RefineJob(_ThreadJob):
 
     thread_name = "modal_deform refine"
 
-    def __init__(self, context, obj, tolerance=mdc.FULL_SOLVE_OPTIONS["tolerance"].default,
-                 max_iterations=mdc.FULL_SOLVE_OPTIONS["max_iterations"].default):
+    def __init__(
+        self,
+        context,
+        obj,
+        tolerance=mdc.FULL_SOLVE_OPTIONS["tolerance"].default,
+        max_iterations=mdc.FULL_SOLVE_OPTIONS["max_iterations"].default,
+    ):
         self.object_name = obj.name
         self.pose = posing.Pose(context, obj)
         self.pose.follow_controllers()
@@ -164,8 +185,12 @@ class RefineJob(_ThreadJob):
         return self.fraction if self.stage == "solve" else 0.0
 
     def _work(self):
-        self.X, self.stats = self.pose.solver.refine(self.F, tolerance=self.tolerance,
-                                                     max_iterations=self.max_iterations, progress=self._progress)
+        self.X, self.stats = self.pose.solver.refine(
+            self.F,
+            tolerance=self.tolerance,
+            max_iterations=self.max_iterations,
+            progress=self._progress,
+        )
 
     def finish(self):
         """Write the refined pose into the "Modal Deform" key (main thread). Returns (level, message)."""
@@ -174,13 +199,18 @@ class RefineJob(_ThreadJob):
             return unfinished
         obj = self._object_as_read()
         if obj is None:
-            return "WARNING", f"'{self.object_name}' changed during Refine: the result was discarded"
+            return (
+                "WARNING",
+                f"'{self.object_name}' changed during Refine: the result was discarded",
+            )
         mesh_io.write_shape_key(obj.data, posing.pose_key(obj)[0], self.X.astype(np.float32))
         self.written = True
         stats = self.stats
         outcome = "Refined" if stats["converged"] else "Refine did not converge"
-        message = (f"{outcome} in {self.seconds:.1f} s: {stats['iterations']} Newton iterations, objective "
-                   f"{stats['initial_energy']:.5g} -> {stats['energy']:.5g}")
+        message = (
+            f"{outcome} in {self.seconds:.1f} s: {stats['iterations']} Newton iterations, objective "
+            f"{stats['initial_energy']:.5g} -> {stats['energy']:.5g}"
+        )
         return ("INFO" if stats["converged"] else "WARNING"), message
 
 
@@ -275,7 +305,9 @@ class AnimationJob(FrameJob):
         obj = self.obj
         blocks = obj.data.shape_keys.key_blocks
         new_names = {name for _, name in self.created}
-        old = [b.name for b in blocks if frame_keys.is_frame_key(b.name) and b.name not in new_names]
+        old = [
+            b.name for b in blocks if frame_keys.is_frame_key(b.name) and b.name not in new_names
+        ]
         frame_keys.remove_keys(obj, old)
         pose_block = blocks.get(posing.POSE_KEY)
         if pose_block is not None:
@@ -286,7 +318,9 @@ class AnimationJob(FrameJob):
             frame_keys.show_on_its_frame(obj, block, frame)
         self.scene.frame_set(self.frame_before)
         self.written = True
-        message = f"{'Exported' if self.positions else 'Baked'} {len(self.frames)} frames into shape keys"
+        message = (
+            f"{'Exported' if self.positions else 'Baked'} {len(self.frames)} frames into shape keys"
+        )
         if self.unconverged:
             return "WARNING", f"{message}; {self.unconverged} did not converge"
         return "INFO", message
@@ -298,4 +332,3 @@ class AnimationJob(FrameJob):
         mesh_io.remove_shape_keys(self.obj, names)
         self.created = []
         self.scene.frame_set(self.frame_before)
-

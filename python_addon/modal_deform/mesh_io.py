@@ -3,6 +3,7 @@
 Positions are the base mesh's (``vertices.co``), the rest state every bake and pose starts from.
 Only an interactive pose writes them, and puts them back when it ends (pose.displays.PositionsDisplay).
 """
+
 import ctypes
 import sys
 
@@ -148,8 +149,10 @@ def shape_key_co(mesh, block):
     """
     count = len(block.data)
     if count != len(mesh.vertices) or block.id_data != mesh.shape_keys:
-        raise ValueError(f"shape key '{block.name}' has {count} points for {len(mesh.vertices)} vertices: "
-                         f"the mesh changed")
+        raise ValueError(
+            f"shape key '{block.name}' has {count} points for {len(mesh.vertices)} vertices: "
+            f"the mesh changed"
+        )
     return _float3_view(block.data)
 
 
@@ -158,9 +161,15 @@ def attribute_co(mesh, attribute):
     float32 view of Blender's own array, as shape_key_co gives a key's (checked against the mesh and
     read anew each time: use at once, never keep it)."""
     count = len(attribute.data)
-    if attribute.data_type != "FLOAT_VECTOR" or attribute.domain != "POINT" or count != len(mesh.vertices):
-        raise ValueError(f"attribute '{attribute.name}' is {attribute.data_type} on {count} "
-                         f"{attribute.domain.lower()}s, not a vector on each of the {len(mesh.vertices)} vertices")
+    if (
+        attribute.data_type != "FLOAT_VECTOR"
+        or attribute.domain != "POINT"
+        or count != len(mesh.vertices)
+    ):
+        raise ValueError(
+            f"attribute '{attribute.name}' is {attribute.data_type} on {count} "
+            f"{attribute.domain.lower()}s, not a vector on each of the {len(mesh.vertices)} vertices"
+        )
     return _float3_view(attribute.data)
 
 
@@ -189,6 +198,8 @@ def write_shape_key(mesh, block, co):
     co = np.asarray(co, np.float32).reshape(-1, 3)
     target = shape_key_co(mesh, block)
     if len(co) != len(target):
-        raise ValueError(f"shape key '{block.name}' has {len(target)} points for {len(co)} positions: the mesh changed")
+        raise ValueError(
+            f"shape key '{block.name}' has {len(target)} points for {len(co)} positions: the mesh changed"
+        )
     np.copyto(target, co)
     mesh.update()

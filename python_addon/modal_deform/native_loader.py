@@ -1,5 +1,6 @@
 """Makes the compiled core importable as ``<the add-on's package>._native`` (find_native), which the
 package's __init__ does first: ``core`` imports it, with or without Blender."""
+
 import contextlib
 import ctypes
 import importlib
@@ -48,6 +49,8 @@ def find_native():
             importlib.import_module(name)
             return
         if importlib.util.find_spec("modal_deform_native") is None:
-            raise ImportError(f"{__package__}: the compiled core is missing: no {name} (source tree: run `make build`) "
-                              "and no modal_deform_native (installed from the extension's wheel)")
+            raise ImportError(
+                f"{__package__}: the compiled core is missing: no {name} (source tree: run `make build`) "
+                "and no modal_deform_native (installed from the extension's wheel)"
+            )
         sys.modules[name] = importlib.import_module("modal_deform_native._native")

@@ -1,4 +1,5 @@
 """Bake: the basis of the active mesh, on a thread with progress and Esc (invoke) or at once (execute)."""
+
 import bpy
 
 from . import handles, storage
@@ -9,6 +10,7 @@ from .ops_common import JobOperator, mesh_poll
 class MODAL_DEFORM_OT_bake(JobOperator, bpy.types.Operator):
     """Compute the deformation basis of the mesh (vibration modes, modal derivatives, ghost) and keep it in \
 the file. Esc cancels"""
+
     bl_idname = "modal_deform.bake"
     bl_label = "Bake"
     bl_options = {"REGISTER", "UNDO"}
@@ -26,13 +28,16 @@ the file. Esc cancels"""
 
 class MODAL_DEFORM_OT_clear_basis(bpy.types.Operator):
     """Remove the baked basis from the object (posing needs a new bake)"""
+
     bl_idname = "modal_deform.clear_basis"
     bl_label = "Clear Basis"
     bl_options = {"REGISTER", "UNDO"}
 
     @classmethod
     def poll(cls, context):
-        return mesh_poll(cls, context) and handles.owner(context.object).modal_deform.basis is not None
+        return (
+            mesh_poll(cls, context) and handles.owner(context.object).modal_deform.basis is not None
+        )
 
     def execute(self, context):
         storage.clear(handles.owner(context.object))

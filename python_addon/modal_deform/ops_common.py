@@ -1,5 +1,6 @@
 """What the operators share: the poll of operators that act on a mesh (or a controller of one),
 and the errors they report to the artist instead of raising (playback's frame handler too)."""
+
 from . import handles, posing, storage
 
 #: Errors with a message for the artist: not baked or stale, a bad handle, a bad option.

@@ -1,4 +1,5 @@
 """Handle list operators: add from the selected vertices (Edit Mode) or a vertex group, remove."""
+
 import bmesh
 import bpy
 import numpy as np
@@ -14,6 +15,7 @@ def _mesh(context):
 class MODAL_DEFORM_OT_add_handle(bpy.types.Operator):
     """Add a handle. Edit Mode: a vertex group of the selected vertices with an Empty at their centre \
 that moves them (like Hook to New Object). Object Mode: a pinned handle on the active vertex group"""
+
     bl_idname = "modal_deform.add_handle"
     bl_label = "Add Handle"
     bl_options = {"REGISTER", "UNDO"}
@@ -34,14 +36,19 @@ that moves them (like Hook to New Object). Object Mode: a pinned handle on the a
             return self._from_selection(context, obj)
         group = obj.vertex_groups.active
         if group is None:
-            self.report({"ERROR"}, "No vertex group: select vertices in Edit Mode, or add a vertex group first")
+            self.report(
+                {"ERROR"},
+                "No vertex group: select vertices in Edit Mode, or add a vertex group first",
+            )
             return {"CANCELLED"}
         self._append(obj, group.name, None)
         return {"FINISHED"}
 
     def _from_selection(self, context, obj):
         bm = bmesh.from_edit_mesh(obj.data)
-        layer = bm.verts.layers.deform.verify()  # first: adding the layer invalidates vertex references
+        layer = (
+            bm.verts.layers.deform.verify()
+        )  # first: adding the layer invalidates vertex references
         selected = [v for v in bm.verts if v.select]
         if not selected:
             self.report({"ERROR"}, "No vertex selected: select the vertices the handle moves")
@@ -55,7 +62,9 @@ that moves them (like Hook to New Object). Object Mode: a pinned handle on the a
         empty = handles.add_controller(context, obj, f"{obj.name} {group.name}", centre, size)
         context.view_layer.update()  # the Empty's world matrix, which the bind reads
         self._append(obj, group.name, empty)
-        self.report({"INFO"}, f"Handle '{group.name}': {len(selected)} vertices, moved by '{empty.name}'")
+        self.report(
+            {"INFO"}, f"Handle '{group.name}': {len(selected)} vertices, moved by '{empty.name}'"
+        )
         return {"FINISHED"}
 
     @staticmethod
@@ -70,6 +79,7 @@ that moves them (like Hook to New Object). Object Mode: a pinned handle on the a
 
 class MODAL_DEFORM_OT_remove_handle(bpy.types.Operator):
     """Remove the active handle from the list (its vertex group and controller stay)"""
+
     bl_idname = "modal_deform.remove_handle"
     bl_label = "Remove Handle"
     bl_options = {"REGISTER", "UNDO"}
@@ -77,7 +87,9 @@ class MODAL_DEFORM_OT_remove_handle(bpy.types.Operator):
     @classmethod
     def poll(cls, context):
         obj = _mesh(context)
-        return obj is not None and 0 <= obj.modal_deform.active_handle < len(obj.modal_deform.handles)
+        return obj is not None and 0 <= obj.modal_deform.active_handle < len(
+            obj.modal_deform.handles
+        )
 
     def execute(self, context):
         settings = _mesh(context).modal_deform

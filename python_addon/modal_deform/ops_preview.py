@@ -1,4 +1,5 @@
 """Mode preview: the mesh displaced along one basis vector (the paper's Fig. 1/6), in a shape key of its own."""
+
 import bpy
 import numpy as np
 
@@ -51,6 +52,7 @@ def refresh(obj):
 
 class MODAL_DEFORM_OT_preview_mode(bpy.types.Operator):
     """Show or hide the mesh deformed along one basis vector, to judge a bake at a glance"""
+
     bl_idname = "modal_deform.preview_mode"
     bl_label = "Preview Mode"
     bl_options = {"REGISTER", "UNDO"}

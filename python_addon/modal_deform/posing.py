@@ -9,6 +9,7 @@ Where the interactive pose shows the pose while it runs is a display (pose/displ
 written mid-pose are repaired by pose/recovery.py. The interactive pose under way, the add-on's one
 piece of posing state, is `running` here.
 """
+
 import numpy as np
 
 from . import core as mdc
@@ -35,17 +36,25 @@ class Pose:
         settings = obj.modal_deform
         self.obj = obj
         self.basis = storage.ready_basis(obj)
-        self.handles, self.warnings = handles.resolve(obj, context.scene, self.basis.rest, self.basis.region)
-        self.solver = mdc.ReducedSolver(self.basis, [h.indices for h in self.handles], pull=settings.stiffness,
-                                        weights=[h.weight for h in self.handles],
-                                        energy=settings.status.energy.lower())
+        self.handles, self.warnings = handles.resolve(
+            obj, context.scene, self.basis.rest, self.basis.region
+        )
+        self.solver = mdc.ReducedSolver(
+            self.basis,
+            [h.indices for h in self.handles],
+            pull=settings.stiffness,
+            weights=[h.weight for h in self.handles],
+            energy=settings.status.energy.lower(),
+        )
         self._transforms = None
         self.stats = {"iterations": 0, "energy": 0.0, "converged": False, "stalled": False}
 
     def follow_controllers(self):
         """Give the solver the controllers' current placement; True when it changed."""
         transforms = handles.transforms(self.obj, self.handles)
-        if self._transforms is not None and all(np.array_equal(a, b) for a, b in zip(transforms, self._transforms)):
+        if self._transforms is not None and all(
+            np.array_equal(a, b) for a, b in zip(transforms, self._transforms)
+        ):
             return False
         self.solver.set_transforms(transforms)
         self._transforms = transforms
@@ -54,10 +63,16 @@ class Pose:
 
     def step(self, budget_ms):
         """BFGS iterations until converged or `budget_ms` milliseconds are spent (timed natively)."""
-        self.stats = self.solver.solve(max_iterations=MAX_ITERATIONS_PER_UPDATE, budget_ms=budget_ms)
+        self.stats = self.solver.solve(
+            max_iterations=MAX_ITERATIONS_PER_UPDATE, budget_ms=budget_ms
+        )
         return self.stats
 
-    def converge(self, max_iterations=CONVERGE_MAX_ITERATIONS, tolerance=mdc.SOLVE_OPTIONS["tolerance"].default):
+    def converge(
+        self,
+        max_iterations=CONVERGE_MAX_ITERATIONS,
+        tolerance=mdc.SOLVE_OPTIONS["tolerance"].default,
+    ):
         """Iterate until the stopping test holds (or max_iterations): the result a script wants."""
         stats = self.solver.solve(max_iterations=max_iterations, tolerance=tolerance)
         self.stats = stats
@@ -92,8 +107,10 @@ def header_text(stats, tick_ms):
     ended = state(stats)
     if ended == "stalled":
         ended = f"stalled: {STALLED_HINT}"
-    return (f"Modal Deform: {ended}, {stats['iterations']} iterations, energy {stats['energy']:.5g}, "
-            f"{tick_ms:.1f} ms per update")
+    return (
+        f"Modal Deform: {ended}, {stats['iterations']} iterations, energy {stats['energy']:.5g}, "
+        f"{tick_ms:.1f} ms per update"
+    )
 
 
 def pose_key(obj):
@@ -111,5 +128,7 @@ def is_posing(obj):
     checked for staleness (its positions may hold the pose)."""
     try:
         return running is not None and running.pose.obj == obj
-    except ReferenceError:  # the pose's object went away (undo, file loaded): it ends at its next event
+    except (
+        ReferenceError
+    ):  # the pose's object went away (undo, file loaded): it ends at its next event
         return False

@@ -16,6 +16,7 @@ Staleness: the vertex count, a hash of the faces' corners and a hash of the rest
 bake, compared with the mesh now; and the stiffness and region vertex groups with hashes of their
 weights (painting anew, choosing another group or deleting it makes the basis stale).
 """
+
 import collections
 import hashlib
 import time
@@ -24,8 +25,8 @@ import uuid
 import bpy
 import numpy as np
 
-from . import core as mdc
 from . import app_handlers, mesh_io
+from . import core as mdc
 
 PREFIX = ".Modal Deform "
 _SHAPES = "shapes"
@@ -64,8 +65,10 @@ def groups(obj):
             continue
         weights[setting] = mesh_io.group_weights(obj, name)
         if weights[setting] is None:
-            raise ValueError(f"'{obj.name}': the {purpose} vertex group '{name}' does not exist (deleted or "
-                             f"renamed?): choose another one or clear it")
+            raise ValueError(
+                f"'{obj.name}': the {purpose} vertex group '{name}' does not exist (deleted or "
+                f"renamed?): choose another one or clear it"
+            )
         hashes[setting] = _digest(weights[setting])
     return Groups(names, weights, hashes)
 
@@ -128,7 +131,9 @@ def store(obj, basis, mesh_fingerprint, vertex_groups, seconds, energy):
     in the .blend as obj's basis."""
     arrays = basis.to_arrays()
     block = bpy.data.palettes.new(PREFIX + obj.name)
-    block.use_fake_user = False  # palettes get one by default; this one lives as long as its objects
+    block.use_fake_user = (
+        False  # palettes get one by default; this one lives as long as its objects
+    )
     shapes = {}
     for name, a in arrays.items():
         if a.ndim == 0:
@@ -201,7 +206,9 @@ def load(obj):
             if name in shapes:
                 arrays[name] = np.frombuffer(value, dtype=value.typecode).reshape(shapes[name])
             else:
-                arrays[name] = np.array(value, dtype=np.int32 if isinstance(value, int) else np.float64)
+                arrays[name] = np.array(
+                    value, dtype=np.int32 if isinstance(value, int) else np.float64
+                )
         basis = mdc.Basis.from_arrays(arrays)
     except (KeyError, TypeError, ValueError, AttributeError) as error:
         raise NotReady(f"the basis stored for '{obj.name}' is damaged ({error}): re-bake") from None

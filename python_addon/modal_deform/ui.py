@@ -3,13 +3,13 @@ preview.
 
 Every label fits the sidebar at its default width: short property labels beside their fields
 (use_property_split), and sentences wrapped to the sidebar's width (wrapped_label)."""
+
 import textwrap
 
 import bpy
 
 from . import handles, ops_preview, posing, storage
 from .playback import frame_cache, timeline
-
 
 # Width of a character of the interface font at scale 1, in pixels, for wrapping text (a little above
 # the mean of Blender's font, so a wrapped line is never cut).
@@ -29,7 +29,9 @@ class MODAL_DEFORM_UL_handles(bpy.types.UIList):
     """A row per handle: "group → controller", the vertex group it moves and the controller that moves
     it, or "group (pinned)"."""
 
-    def draw_item(self, context, layout, data, item, icon, active_data, active_property, index=0, flt_flag=0):
+    def draw_item(
+        self, context, layout, data, item, icon, active_data, active_property, index=0, flt_flag=0
+    ):
         if item.controller is not None:
             layout.label(text=f"{item.vertex_group} \u2192 {item.controller.name}")
         else:
@@ -60,12 +62,16 @@ class VIEW3D_PT_modal_deform(_Panel, bpy.types.Panel):
         settings = obj.modal_deform
         layout = self.layout
         if settings.basis is None:
-            wrapped_label(layout, context, "Not baked: set up the basis below, then Bake", icon="INFO")
+            wrapped_label(
+                layout, context, "Not baked: set up the basis below, then Bake", icon="INFO"
+            )
             return
         reason = stale_reason(obj)
         if reason:
             layout.alert = True
-            wrapped_label(layout, context, f"Mesh changed since the bake ({reason}): re-bake", icon="ERROR")
+            wrapped_label(
+                layout, context, f"Mesh changed since the bake ({reason}): re-bake", icon="ERROR"
+            )
         else:
             layout.label(text="Ready to pose", icon="CHECKMARK")
 
@@ -110,22 +116,35 @@ class VIEW3D_PT_modal_deform_bake(_Panel, bpy.types.Panel):
         else:
             status = settings.status
             lines = box.column(align=True)
-            lines.label(text=f"{status.dimension} dimensions ({status.energy.title()})", icon="OUTLINER_DATA_LIGHTPROBE")
-            lines.label(text=f"{status.num_modes} modes, {status.num_derivatives} derivatives", icon="BLANK1")
+            lines.label(
+                text=f"{status.dimension} dimensions ({status.energy.title()})",
+                icon="OUTLINER_DATA_LIGHTPROBE",
+            )
+            lines.label(
+                text=f"{status.num_modes} modes, {status.num_derivatives} derivatives",
+                icon="BLANK1",
+            )
             lines.label(text=f"Ghost: {status.ghost_vertices:,} vertices", icon="BLANK1")
             if status.proxy_vertices:
                 lines.label(text=f"Proxy: {status.proxy_vertices:,} vertices", icon="BLANK1")
             lines.label(text=f"Baked {status.baked_at}", icon="TIME")
             lines.label(text=f"in {status.seconds:.1f} s", icon="BLANK1")
             if status.num_floppy:
-                wrapped_label(box, context, f"{status.num_floppy} floppy modes: parts joined at a vertex", icon="INFO")
+                wrapped_label(
+                    box,
+                    context,
+                    f"{status.num_floppy} floppy modes: parts joined at a vertex",
+                    icon="INFO",
+                )
             reason = stale_reason(obj)
             if reason:
                 row = box.row()
                 row.alert = True
                 wrapped_label(row, context, f"Stale ({reason}): re-bake", icon="ERROR")
         row = layout.row(align=True)
-        row.operator("modal_deform.bake", text="Re-bake" if settings.basis else "Bake", icon="RENDER_STILL")
+        row.operator(
+            "modal_deform.bake", text="Re-bake" if settings.basis else "Bake", icon="RENDER_STILL"
+        )
         row.operator("modal_deform.clear_basis", text="", icon="X")
 
 
@@ -138,7 +157,9 @@ class VIEW3D_PT_modal_deform_handles(_Panel, bpy.types.Panel):
         settings = obj.modal_deform
         layout = self.layout
         # The list spans the sidebar (its buttons below it) so that a row has room for both names.
-        layout.template_list("MODAL_DEFORM_UL_handles", "", settings, "handles", settings, "active_handle", rows=3)
+        layout.template_list(
+            "MODAL_DEFORM_UL_handles", "", settings, "handles", settings, "active_handle", rows=3
+        )
         row = layout.row(align=True)
         row.operator("modal_deform.add_handle", icon="ADD")
         row.operator("modal_deform.remove_handle", text="", icon="REMOVE")
@@ -173,7 +194,9 @@ class VIEW3D_PT_modal_deform_pose(_Panel, bpy.types.Panel):
         layout.operator("modal_deform.reset", icon="LOOP_BACK")
         column = layout.column(align=True)
         column.operator("modal_deform.bake_animation", icon="RENDER_ANIMATION")
-        column.operator("modal_deform.bake_animation", text="Bake Refined Animation", icon="SHADERFX").refine = True
+        column.operator(
+            "modal_deform.bake_animation", text="Bake Refined Animation", icon="SHADERFX"
+        ).refine = True
 
 
 class VIEW3D_PT_modal_deform_preview(_Panel, bpy.types.Panel):
@@ -193,10 +216,18 @@ class VIEW3D_PT_modal_deform_preview(_Panel, bpy.types.Panel):
         status = settings.status
         if settings.basis is not None:
             index = min(settings.preview_vector, status.dimension - 1)
-            wrapped_label(layout, context, f"Vector {index} of {status.dimension}: {ops_preview.describe(status, index)}")
+            wrapped_label(
+                layout,
+                context,
+                f"Vector {index} of {status.dimension}: {ops_preview.describe(status, index)}",
+            )
         showing = ops_preview.showing(obj)
-        layout.operator("modal_deform.preview_mode", text="Hide Preview" if showing else "Show Preview",
-                        icon="HIDE_OFF" if showing else "HIDE_ON", depress=showing)
+        layout.operator(
+            "modal_deform.preview_mode",
+            text="Hide Preview" if showing else "Show Preview",
+            icon="HIDE_OFF" if showing else "HIDE_ON",
+            depress=showing,
+        )
 
 
 # Dynamics and the per-frame cache.
@@ -240,13 +271,21 @@ class VIEW3D_PT_modal_deform_dynamics(_Panel, bpy.types.Panel):
         row.operator("modal_deform.bake_animation", text="Bake", icon="RENDER_ANIMATION")
         row.operator("modal_deform.free_cache", text="Free", icon="TRASH")
         column = layout.column(align=True)
-        column.operator("modal_deform.export_shape_keys", text="Export Shape Keys", icon="SHAPEKEY_DATA")
+        column.operator(
+            "modal_deform.export_shape_keys", text="Export Shape Keys", icon="SHAPEKEY_DATA"
+        )
         column.operator("modal_deform.export_mesh_cache", text="Export Mesh Cache", icon="EXPORT")
 
 
-CLASSES = (MODAL_DEFORM_UL_handles, VIEW3D_PT_modal_deform, VIEW3D_PT_modal_deform_bake,
-           VIEW3D_PT_modal_deform_handles, VIEW3D_PT_modal_deform_pose, VIEW3D_PT_modal_deform_dynamics,
-           VIEW3D_PT_modal_deform_preview)
+CLASSES = (
+    MODAL_DEFORM_UL_handles,
+    VIEW3D_PT_modal_deform,
+    VIEW3D_PT_modal_deform_bake,
+    VIEW3D_PT_modal_deform_handles,
+    VIEW3D_PT_modal_deform_pose,
+    VIEW3D_PT_modal_deform_dynamics,
+    VIEW3D_PT_modal_deform_preview,
+)
 
 
 register, unregister = bpy.utils.register_classes_factory(CLASSES)

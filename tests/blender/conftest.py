@@ -16,13 +16,13 @@ the Blender app on PATH (Debian's 3.4.1; `make test-blender`).
 A script fails by raising (exit code 1) and passes by running to its end: the tests read its output
 only for what it reports.
 """
+
 import os
 import pathlib
 import subprocess
 
-import pytest
-
 import package
+import pytest
 import support
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -36,14 +36,20 @@ def built(pattern):
     """The one file in dist/ matching `pattern` (made by `make addon`)."""
     found = sorted(DIST.glob(pattern))
     if len(found) != 1:
-        pytest.fail(f"{DIST}: expected one {pattern}, found {[p.name for p in found]}: run `make addon`")
+        pytest.fail(
+            f"{DIST}: expected one {pattern}, found {[p.name for p in found]}: run `make addon`"
+        )
     return found[0]
 
 
 def blender_python_version():
-    """"3.13": the Python of the bpy venv (BLENDER_PYTHON), which is the one its Blender embeds."""
-    return subprocess.run([BLENDER_PYTHON, "-c", "import sys; print('%d.%d' % sys.version_info[:2])"],
-                          capture_output=True, text=True, check=True).stdout.strip()
+    """ "3.13": the Python of the bpy venv (BLENDER_PYTHON), which is the one its Blender embeds."""
+    return subprocess.run(
+        [BLENDER_PYTHON, "-c", "import sys; print('%d.%d' % sys.version_info[:2])"],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout.strip()
 
 
 def blender_platform():
@@ -67,7 +73,9 @@ def extension_zip():
     python = blender_python_version()
     extension = next((e for e in package.EXTENSIONS if e.python == python), None)
     if extension is None:
-        pytest.fail(f"{BLENDER_PYTHON} runs Python {python}: no extension zip is made for it (package.EXTENSIONS)")
+        pytest.fail(
+            f"{BLENDER_PYTHON} runs Python {python}: no extension zip is made for it (package.EXTENSIONS)"
+        )
     return built(package.extension_zip_name(extension, blender_platform()))
 
 
@@ -90,12 +98,23 @@ def run_blender(tmp_path, extension_zip):
             base.update(LD_LIBRARY_PATH="", BLENDER_USER_RESOURCES=str(tmp_path / "blender_user"))
         else:
             command = ["blender", "-b"] + ([str(blend)] if blend is not None else [])
-            command += ["--factory-startup", "--python-exit-code", "1", *support.in_blender(script), "--", *map(str, args)]
+            command += [
+                "--factory-startup",
+                "--python-exit-code",
+                "1",
+                *support.in_blender(script),
+                "--",
+                *map(str, args),
+            ]
             base = dict(os.environ)
         environment = dict(base, TEST_TMP=str(tmp_path), **(env or {}))
-        result = subprocess.run(command, capture_output=True, text=True, timeout=timeout, env=environment, cwd=tmp_path)
+        result = subprocess.run(
+            command, capture_output=True, text=True, timeout=timeout, env=environment, cwd=tmp_path
+        )
         if check:
-            assert result.returncode == 0, f"{script.name} failed:\n{result.stdout[-4000:]}\n{result.stderr[-4000:]}"
+            assert result.returncode == 0, (
+                f"{script.name} failed:\n{result.stdout[-4000:]}\n{result.stderr[-4000:]}"
+            )
         return result
 
     return run

@@ -1,9 +1,9 @@
 """The add-on in headless Blender: bake, store, reload, solve, stale data, cancel (the animation cache:
 test_dynamics.py)."""
+
 import pathlib
 
 import pytest
-
 from support import SHARED_MESHES
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -60,11 +60,29 @@ def test_basis_follows_append_and_link(run_blender):
 
 def test_headless_bake_and_pose_scripts(run_blender, tmp_path):
     run_blender("bake_and_save.py", "suzanne")
-    baked = run_blender(BLENDER_SCRIPTS / "bake.py", "--object", "Suzanne", "--modes", "12", "--derivatives", "10",
-                        "--ghost", "300", "--output", tmp_path / "rebaked.blend", blend=tmp_path / "baked.blend")
+    baked = run_blender(
+        BLENDER_SCRIPTS / "bake.py",
+        "--object",
+        "Suzanne",
+        "--modes",
+        "12",
+        "--derivatives",
+        "10",
+        "--ghost",
+        "300",
+        "--output",
+        tmp_path / "rebaked.blend",
+        blend=tmp_path / "baked.blend",
+    )
     assert "baked Suzanne: 22 dimensions, ghost 300 vertices" in baked.stdout, baked.stdout[-2000:]
-    run_blender(BLENDER_SCRIPTS / "pose.py", "--object", "Suzanne", "--output", tmp_path / "posed.blend",
-                blend=tmp_path / "rebaked.blend")
+    run_blender(
+        BLENDER_SCRIPTS / "pose.py",
+        "--object",
+        "Suzanne",
+        "--output",
+        tmp_path / "posed.blend",
+        blend=tmp_path / "rebaked.blend",
+    )
     run_blender("check_headless_pose.py", 22, blend=tmp_path / "posed.blend")
 
 
@@ -82,4 +100,6 @@ def test_a_stalled_solve_is_shown_to_the_artist(run_blender):
     out = run_blender("stalled_pose.py").stdout
     before, after = out.split("SOLVE_WITH_STALL")
     assert "Stalled after" not in before, before[-2000:]
-    assert "Warning: Stalled after" in after and "the solver cannot follow this pose" in after, after[-2000:]
+    assert "Warning: Stalled after" in after and "the solver cannot follow this pose" in after, (
+        after[-2000:]
+    )

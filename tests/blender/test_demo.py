@@ -1,21 +1,34 @@
 """`make demo`'s script (blender_scripts/demo.py), small: it runs to its end in the Blender app that
 `make demo` runs, writes its .blend and pictures, and Suzanne's ears overshoot and settle."""
+
 import re
 
 import pytest
-
 from conftest import BLENDER_PYTHON, ROOT
 
 
 @pytest.mark.skipif(BLENDER_PYTHON is not None, reason="make demo runs the Blender app")
 def test_demo_runs_and_the_ears_overshoot_and_settle(run_blender, tmp_path):
     output = tmp_path / "out"
-    result = run_blender(ROOT / "blender_scripts" / "demo.py", "--output", output, "--subdivisions", 1,
-                         "--samples", 1, "--width", 120, "--dynamics-subdivisions", 1)
+    result = run_blender(
+        ROOT / "blender_scripts" / "demo.py",
+        "--output",
+        output,
+        "--subdivisions",
+        1,
+        "--samples",
+        1,
+        "--width",
+        120,
+        "--dynamics-subdivisions",
+        1,
+    )
     for name in ("demo.blend", "demo.png", "demo_dynamics.png"):
         assert (output / name).stat().st_size > 0, name
-    found = re.search(r"the ears' way from rest \(0\) to where they settle \(1\), frames 1 to \d+: ([\d. ]+)",
-                      result.stdout)
+    found = re.search(
+        r"the ears' way from rest \(0\) to where they settle \(1\), frames 1 to \d+: ([\d. ]+)",
+        result.stdout,
+    )
     assert found, result.stdout[-2000:]
     way = [float(value) for value in found.group(1).split()]
     assert max(way) > 1.03, f"the ears do not overshoot: {way}"

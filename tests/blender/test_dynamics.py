@@ -1,5 +1,6 @@
 """The per-frame cache and secondary motion in headless Blender: play, scrub, keyframe changes,
 bake, free, save and reload (issue 40)."""
+
 import pytest
 
 
@@ -13,7 +14,9 @@ def test_dynamics_play_scrub_bake_free_and_invalidate(run_blender):
     run_blender("dynamics_play.py")
 
 
-def test_static_cache_plays_the_per_frame_solve_and_exports_to_mesh_cache_and_shape_keys(run_blender, tmp_path):
+def test_static_cache_plays_the_per_frame_solve_and_exports_to_mesh_cache_and_shape_keys(
+    run_blender, tmp_path
+):
     run_blender("animation_bake.py")
     run_blender("animation_playback.py", blend=tmp_path / "animated.blend", addon=False)
 
@@ -22,7 +25,9 @@ def test_playback_shows_frames_through_its_modifier_and_takes_it_away(run_blende
     run_blender("playback_display.py")
 
 
-def test_playing_timeline_shows_frames_through_a_stand_in_that_never_reaches_the_artist(run_blender):
+def test_playing_timeline_shows_frames_through_a_stand_in_that_never_reaches_the_artist(
+    run_blender,
+):
     out = run_blender("playback_stand_in.py").stdout
     if "STAND_IN_UNSUPPORTED" in out:
         pytest.skip("Blender 3.4 has no playback handlers: the attribute shows every frame")

@@ -2,24 +2,40 @@
 the shared objects inside them (nothing of the build machine), Blender's own validation, and
 installing each in a fresh Blender (the extension for its Python under bpy 4.2+, the legacy zip
 in the 3.4 app): enable, disable, enable; the other Python's extension is refused."""
+
 import ast
 import glob
 import io
 import os
 import re
 import subprocess
-import tomllib
 import zipfile
 
-import pytest
-from conftest import BLENDER_PYTHON, WINDOWS_PYTHON, blender_platform, blender_python_version, bpy_site_packages, built
-
 import package
+import pytest
+import tomllib
+from conftest import (
+    BLENDER_PYTHON,
+    WINDOWS_PYTHON,
+    blender_platform,
+    blender_python_version,
+    bpy_site_packages,
+    built,
+)
 
 # What a manylinux wheel may need from the system: the libraries of the manylinux policy (glibc's,
 # the C++ and GCC runtimes, zlib) that the core uses; everything else must be bundled in the zip.
-MANYLINUX = {"libc.so.6", "libm.so.6", "libstdc++.so.6", "libgcc_s.so.1", "libpthread.so.0", "libdl.so.2",
-             "librt.so.1", "ld-linux-x86-64.so.2", "libz.so.1"}
+MANYLINUX = {
+    "libc.so.6",
+    "libm.so.6",
+    "libstdc++.so.6",
+    "libgcc_s.so.1",
+    "libpthread.so.0",
+    "libdl.so.2",
+    "librt.so.1",
+    "ld-linux-x86-64.so.2",
+    "libz.so.1",
+}
 
 
 EXTENSIONS = {extension.blenders: extension for extension in package.EXTENSIONS}
@@ -55,10 +71,13 @@ def zip_manifest(extension):
 def test_the_extensions_serve_every_blender_from_4_2_once():
     """Sorted, the extensions' ranges of Blender versions start at 4.2.0 and each starts where the
     last one ended, the newest open: no Blender is left without a zip or offered two."""
+
     def parse(version):
         return tuple(map(int, version.split(".")))
 
-    ranges = sorted((parse(e.blender_min), e.blender_max and parse(e.blender_max)) for e in package.EXTENSIONS)
+    ranges = sorted(
+        (parse(e.blender_min), e.blender_max and parse(e.blender_max)) for e in package.EXTENSIONS
+    )
     assert ranges[0][0] == (4, 2, 0)
     for (low, high), (next_low, _) in zip(ranges, ranges[1:]):
         assert high is not None and low < high == next_low, ranges
@@ -76,10 +95,15 @@ def test_extension_zip_is_laid_out_as_blenders_extension_build(blenders):
     names = set(archive.namelist())
     wheels = [name for name in names if name.startswith("wheels/")]
     tag = python_tag(extension.python)
-    assert len(wheels) == 1 and re.fullmatch(rf"wheels/modal_deform_native-[\d.]+-{tag}-{tag}-manylinux_2_\d+_x86_64"
-                                             r"(\.manylinux_2_\d+_x86_64)*\.whl", wheels[0]), wheels
+    assert len(wheels) == 1 and re.fullmatch(
+        rf"wheels/modal_deform_native-[\d.]+-{tag}-{tag}-manylinux_2_\d+_x86_64"
+        r"(\.manylinux_2_\d+_x86_64)*\.whl",
+        wheels[0],
+    ), wheels
     assert archive.getinfo(wheels[0]).compress_type == zipfile.ZIP_STORED
-    assert names == sources() | {package.MANIFEST, wheels[0]}, "the package's files at the top, nothing else"
+    assert names == sources() | {package.MANIFEST, wheels[0]}, (
+        "the package's files at the top, nothing else"
+    )
     manifest = zip_manifest(path)
     assert manifest["wheels"] == [f"./{wheels[0]}"]
     assert manifest["blender_version_min"] == extension.blender_min
@@ -89,8 +113,10 @@ def test_extension_zip_is_laid_out_as_blenders_extension_build(blenders):
 def test_legacy_zip_holds_the_add_on_folder_with_a_core_per_python(legacy):
     assert legacy.name == f"modal_deform-{package.version()}-legacy-linux_x64.zip"
     names = set(zipfile.ZipFile(legacy).namelist())
-    native = {f"modal_deform/_native.cpython-{python_tag(python)[2:]}-x86_64-linux-gnu.so"
-              for python in package.LEGACY_PYTHONS}
+    native = {
+        f"modal_deform/_native.cpython-{python_tag(python)[2:]}-x86_64-linux-gnu.so"
+        for python in package.LEGACY_PYTHONS
+    }
     libraries = {name for name in names if name.startswith("modal_deform/_native.libs/")}
     assert native <= names and any("cholmod" in name for name in libraries), sorted(names)
     assert names == {f"modal_deform/{name}" for name in sources()} | native | libraries
@@ -100,8 +126,10 @@ def test_legacy_zip_holds_the_add_on_folder_with_a_core_per_python(legacy):
 def test_legacy_zip_carries_a_core_for_every_python_from_3_10_to_3_13(legacy):
     """Blenders of Linux distributions embed the distribution's Python (Debian 13's 4.3.2: 3.13,
     Ubuntu 24.04's 4.0: 3.12) and install the legacy zip: it has a core for each of them."""
-    cores = [re.fullmatch(r"modal_deform/_native\.cpython-3(\d+)-x86_64-linux-gnu\.so", name)
-             for name in zipfile.ZipFile(legacy).namelist()]
+    cores = [
+        re.fullmatch(r"modal_deform/_native\.cpython-3(\d+)-x86_64-linux-gnu\.so", name)
+        for name in zipfile.ZipFile(legacy).namelist()
+    ]
     assert sorted(f"3.{core[1]}" for core in cores if core) == ["3.10", "3.11", "3.12", "3.13"]
 
 
@@ -120,17 +148,34 @@ def test_manifest_fields_and_version_match_bl_info(blenders):
     assert manifest["platforms"] == ["linux-x64"]
     # Files only, for Export Mesh Cache: no network, clipboard, camera or microphone.
     assert manifest["permissions"] == {"files": "Export the cached animation to a PC2 or MDD file"}
-    assert set(manifest) <= {"schema_version", "id", "version", "name", "tagline", "maintainer", "type", "tags",
-                             "blender_version_min", "blender_version_max", "license", "platforms", "permissions",
-                             "website", "copyright", "wheels"}
+    assert set(manifest) <= {
+        "schema_version",
+        "id",
+        "version",
+        "name",
+        "tagline",
+        "maintainer",
+        "type",
+        "tags",
+        "blender_version_min",
+        "blender_version_max",
+        "license",
+        "platforms",
+        "permissions",
+        "website",
+        "copyright",
+        "wheels",
+    }
 
 
 def shared_objects(archive):
     """(name, bytes) of every shared object in a zip, including those inside the wheels it holds."""
     for name in archive.namelist():
         if name.endswith(".whl"):
-            yield from ((f"{name}!{inner}", data) for inner, data in shared_objects(zipfile.ZipFile(
-                io.BytesIO(archive.read(name)))))
+            yield from (
+                (f"{name}!{inner}", data)
+                for inner, data in shared_objects(zipfile.ZipFile(io.BytesIO(archive.read(name))))
+            )
         elif re.search(r"\.so(\.[\d.]+)?$", name):
             yield name, archive.read(name)
 
@@ -138,8 +183,9 @@ def shared_objects(archive):
 def readelf(data, tmp_path, *options):
     path = tmp_path / "object.so"
     path.write_bytes(data)
-    return subprocess.run(["readelf", "--wide", *options, str(path)], capture_output=True, text=True,
-                          check=True).stdout
+    return subprocess.run(
+        ["readelf", "--wide", *options, str(path)], capture_output=True, text=True, check=True
+    ).stdout
 
 
 @pytest.mark.parametrize("which", [*EXTENSIONS, "legacy"])
@@ -152,28 +198,50 @@ def test_shared_objects_need_only_manylinux_libraries_and_what_is_bundled(which,
     bundled = {os.path.basename(name) for name in objects}
     # OpenBLAS's threaded build (libopenblasp: pthreads) and OpenMP, renamed: a reference BLAS or a
     # lost OpenMP would cost the bake twice the time.
-    assert any(re.fullmatch(r"libopenblasp-r[\d.]+-[0-9a-f]{8}\.[\d.]+so", name) for name in bundled), bundled
+    assert any(
+        re.fullmatch(r"libopenblasp-r[\d.]+-[0-9a-f]{8}\.[\d.]+so", name) for name in bundled
+    ), bundled
     assert any(re.fullmatch(r"libgomp-[0-9a-f]{8}\.so[.\d]*", name) for name in bundled), bundled
     for name, data in objects.items():
         dynamic = readelf(data, tmp_path, "-d")
         needed = set(re.findall(r"\(NEEDED\)\s+Shared library: \[(.+?)\]", dynamic))
         assert needed <= MANYLINUX | bundled, f"{name} needs {sorted(needed - MANYLINUX - bundled)}"
-        for path in re.findall(r"\((?:RPATH|RUNPATH)\)\s+Library (?:rpath|runpath): \[(.+?)\]", dynamic):
-            assert all(entry.startswith("$ORIGIN") for entry in path.split(":")), f"{name}: run path {path}"
+        for path in re.findall(
+            r"\((?:RPATH|RUNPATH)\)\s+Library (?:rpath|runpath): \[(.+?)\]", dynamic
+        ):
+            assert all(entry.startswith("$ORIGIN") for entry in path.split(":")), (
+                f"{name}: run path {path}"
+            )
         if os.path.basename(name).startswith("_native"):
-            exported = re.findall(r"^\s*\d+:\s+\w+\s+\d+\s+\w+\s+GLOBAL\s+DEFAULT\s+\d+\s+(\S+)$",
-                                  readelf(data, tmp_path, "--dyn-syms"), re.MULTILINE)
+            exported = re.findall(
+                r"^\s*\d+:\s+\w+\s+\d+\s+\w+\s+GLOBAL\s+DEFAULT\s+\d+\s+(\S+)$",
+                readelf(data, tmp_path, "--dyn-syms"),
+                re.MULTILINE,
+            )
             assert exported == ["PyInit__native"], f"{name} exports {exported[:20]}"
 
 
 @pytest.mark.skipif(not BLENDER_PYTHON, reason="Blender's extension validator ships with bpy 4.2+")
 @pytest.mark.parametrize("blenders", EXTENSIONS)
 def test_blenders_validator_accepts_the_extension(blenders):
-    validator = glob.glob(str(bpy_site_packages() / "bpy" / "*" / "scripts" / "addons_core" / "bl_pkg" / "cli"
-                              / "blender_ext.py"))
+    validator = glob.glob(
+        str(
+            bpy_site_packages()
+            / "bpy"
+            / "*"
+            / "scripts"
+            / "addons_core"
+            / "bl_pkg"
+            / "cli"
+            / "blender_ext.py"
+        )
+    )
     assert len(validator) == 1, validator
-    result = subprocess.run([BLENDER_PYTHON, validator[0], "validate", str(zip_for(blenders, blender_platform()))],
-                            capture_output=True, text=True)
+    result = subprocess.run(
+        [BLENDER_PYTHON, validator[0], "validate", str(zip_for(blenders, blender_platform()))],
+        capture_output=True,
+        text=True,
+    )
     assert result.returncode == 0, result.stdout + result.stderr
     assert "Success parsing TOML" in result.stdout, result.stdout
 
@@ -199,9 +267,16 @@ def test_the_other_pythons_and_the_other_platforms_extensions_are_refused(run_bl
     unexplained = []
     for blenders in others:
         result = run_blender("install_refused.py", zip_for(blenders, platform), addon=False)
-        bounds = "|".join(re.escape(v) for v in (EXTENSIONS[blenders].blender_min, EXTENSIONS[blenders].blender_max) if v)
-        if not re.search(r"This Blender version \([\d.]+\) (doesn't meet the minimum supported version|must be "
-                         rf"less than the maximum version) \(({bounds})\)", result.stdout):
+        bounds = "|".join(
+            re.escape(v)
+            for v in (EXTENSIONS[blenders].blender_min, EXTENSIONS[blenders].blender_max)
+            if v
+        )
+        if not re.search(
+            r"This Blender version \([\d.]+\) (doesn't meet the minimum supported version|must be "
+            rf"less than the maximum version) \(({bounds})\)",
+            result.stdout,
+        ):
             unexplained.append(result.stdout)
     (own,) = [blenders for blenders, extension in EXTENSIONS.items() if extension.python == python]
     (other_platform,) = set(package.PLATFORMS) - {platform}
@@ -209,7 +284,9 @@ def test_the_other_pythons_and_the_other_platforms_extensions_are_refused(run_bl
     if package.PLATFORMS[other_platform].manifest not in result.stdout:
         unexplained.append(result.stdout)
     if unexplained and WINDOWS_PYTHON:
-        pytest.skip("Wine: the zips were refused and nothing was installed, but Blender 4.2's and 4.5's installer "
-                    "did not say why: its reader stops when the installer's child process ends and, under Wine's "
-                    "pipes, misses the child's last message. On Windows the reasons are checked as on Linux.")
+        pytest.skip(
+            "Wine: the zips were refused and nothing was installed, but Blender 4.2's and 4.5's installer "
+            "did not say why: its reader stops when the installer's child process ends and, under Wine's "
+            "pipes, misses the child's last message. On Windows the reasons are checked as on Linux."
+        )
     assert not unexplained, unexplained

@@ -22,7 +22,8 @@ namespace modal_deform::testing {
 inline SparseMatrix spring_network_hessian(const VerticesRef& V, const FacesRef& F) {
   const MeshTopology topology = build_topology(V, F);
   std::vector<std::array<int, 2>> springs = topology.edges;
-  for (const Hinge& hinge : topology.hinges) springs.push_back({hinge.vertices[2], hinge.vertices[3]});
+  for (const Hinge& hinge : topology.hinges)
+    springs.push_back({hinge.vertices[2], hinge.vertices[3]});
   std::vector<Eigen::Triplet<double>> triplets;
   for (const auto& [a, b] : springs) {
     const Eigen::Vector3d e = (V.row(a) - V.row(b)).transpose();

@@ -12,11 +12,11 @@
 #include <vector>
 
 #include "energy/arap.h"
+#include "finite_differences.h"
 #include "mesh/cotangent_weights.h"
 #include "mesh/mesh_topology.h"
 #include "mesh/normalization.h"
 #include "mesh/primitives.h"
-#include "finite_differences.h"
 #include "test_support.h"
 #include "util/errors.h"
 #include "util/math_constants.h"
@@ -46,26 +46,34 @@ std::vector<std::pair<std::string, Eigen::VectorXd>> large_deformations(const Ro
   const Eigen::Vector3d lo = V.colwise().minCoeff(), hi = V.colwise().maxCoeff();
   const Eigen::Vector3d centre = (lo + hi) / 2;
   const double length = hi.z() - lo.z();
-  const Eigen::Matrix3d turn = Eigen::AngleAxisd(kPi / 2, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix();
+  const Eigen::Matrix3d turn =
+      Eigen::AngleAxisd(kPi / 2, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix();
   return {
-      {"upper half turned",
-       deformed(V, [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
-         return p.y() > centre.y() ? Eigen::Vector3d(centre + turn * (p - centre)) : p;
-       })},
-      {"stretched 30%", deformed(V, [](const Eigen::Vector3d& p) { return Eigen::Vector3d(1.3 * p.x(), p.y(), p.z()); })},
+      {"upper half turned", deformed(V,
+                                     [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+                                       return p.y() > centre.y()
+                                                  ? Eigen::Vector3d(centre + turn * (p - centre))
+                                                  : p;
+                                     })},
+      {"stretched 30%",
+       deformed(
+           V, [](const Eigen::Vector3d& p) { return Eigen::Vector3d(1.3 * p.x(), p.y(), p.z()); })},
       {"bent 90 degrees",
        deformed(V,
                 [&](const Eigen::Vector3d& p) {
                   const double radius = length / (kPi / 2), angle = (p.z() - lo.z()) / radius;
                   const double r = radius - (p.x() - centre.x());
-                  return Eigen::Vector3d(centre.x() + radius - r * std::cos(angle), p.y(), lo.z() + r * std::sin(angle));
+                  return Eigen::Vector3d(centre.x() + radius - r * std::cos(angle), p.y(),
+                                         lo.z() + r * std::sin(angle));
                 })},
-      {"mirrored", deformed(V, [](const Eigen::Vector3d& p) { return Eigen::Vector3d(-p.x(), p.y(), p.z()); })},
+      {"mirrored",
+       deformed(V, [](const Eigen::Vector3d& p) { return Eigen::Vector3d(-p.x(), p.y(), p.z()); })},
   };
 }
 
 std::vector<std::pair<std::string, TriangleMesh>> test_shapes() {
-  return {{"bunny", normalized(shared_mesh("bunny.obj.gz"))}, {"cylinder", normalized(cylinder(16, 12, 1.0, 4.0))}};
+  return {{"bunny", normalized(shared_mesh("bunny.obj.gz"))},
+          {"cylinder", normalized(cylinder(16, 12, 1.0, 4.0))}};
 }
 
 TEST(CotangentWeights, RightTrianglesOfAGrid) {
@@ -74,7 +82,8 @@ TEST(CotangentWeights, RightTrianglesOfAGrid) {
   const MeshTopology topology = build_topology(mesh.V, mesh.F);
   const Eigen::VectorXd weights = cotangent_weights(mesh.V, mesh.F, topology);
   for (size_t e = 0; e < topology.edges.size(); ++e) {
-    const Eigen::RowVector3d edge = mesh.V.row(topology.edges[e][1]) - mesh.V.row(topology.edges[e][0]);
+    const Eigen::RowVector3d edge =
+        mesh.V.row(topology.edges[e][1]) - mesh.V.row(topology.edges[e][0]);
     const bool diagonal = std::abs(edge.x()) > 0.5 && std::abs(edge.y()) > 0.5;
     const bool boundary = topology.num_edge_faces(static_cast<int>(e)) == 1;
     EXPECT_NEAR(weights[e], diagonal ? 0.0 : boundary ? 0.5 : 1.0, 1e-14) << "edge " << e;
@@ -111,9 +120,11 @@ TEST(Arap, ZeroAtRestAndAfterRigidMotions) {
   for (const auto& [name, mesh] : test_shapes()) {
     SCOPED_TRACE(name);
     const Arap energy(mesh.V, mesh.F);
-    const Eigen::Matrix3d rotation = Eigen::AngleAxisd(2.0, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
-    const Eigen::VectorXd moved =
-        deformed(mesh.V, [&](const Eigen::Vector3d& p) { return Eigen::Vector3d(rotation * p + Eigen::Vector3d(3, -1, 7)); });
+    const Eigen::Matrix3d rotation =
+        Eigen::AngleAxisd(2.0, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
+    const Eigen::VectorXd moved = deformed(mesh.V, [&](const Eigen::Vector3d& p) {
+      return Eigen::Vector3d(rotation * p + Eigen::Vector3d(3, -1, 7));
+    });
     for (const Eigen::VectorXd& x : {energy.rest(), moved}) {
       EXPECT_LT(std::abs(energy.value(x)), 1e-20);
       Eigen::VectorXd gradient(x.size());
@@ -142,7 +153,8 @@ TEST(Arap, MirrorImageCostsMoreThanAStretch) {
     SCOPED_TRACE(name);
     const Arap energy(mesh.V, mesh.F);
     const auto deformations = large_deformations(mesh.V);
-    const double stretched = energy.value(deformations[1].second), mirrored = energy.value(deformations[3].second);
+    const double stretched = energy.value(deformations[1].second),
+                 mirrored = energy.value(deformations[3].second);
     EXPECT_GT(stretched, 1.0);
     EXPECT_GT(mirrored, stretched);
   }
@@ -166,7 +178,8 @@ TEST(Arap, HessianMatchesFiniteDifferencesOfTheGradient) {
     const Arap energy(mesh.V, mesh.F);
     const Eigen::VectorXd d = random_vector(energy.rest().size(), 11);
     expect_hessian_matches(energy, energy.rest(), d, name + " at rest");
-    for (const auto& [deformation, x] : large_deformations(mesh.V)) expect_hessian_matches(energy, x, d, name + " " + deformation);
+    for (const auto& [deformation, x] : large_deformations(mesh.V))
+      expect_hessian_matches(energy, x, d, name + " " + deformation);
   }
 }
 
@@ -195,13 +208,17 @@ TEST(Arap, RestHessianIsPsdWithSixZeroModesPerComponent) {
   // then costs nothing, a seventh zero mode of the cotangent energy itself.)
   TriangleMesh jittered = grid(5, 5, 1.0, 1.0);
   const Eigen::VectorXd jitter = random_vector(2 * jittered.V.rows(), 3);
-  for (Eigen::Index v = 0; v < jittered.V.rows(); ++v) jittered.V.row(v).head<2>() += 0.05 * jitter.segment<2>(2 * v);
+  for (Eigen::Index v = 0; v < jittered.V.rows(); ++v)
+    jittered.V.row(v).head<2>() += 0.05 * jitter.segment<2>(2 * v);
   const std::vector<std::tuple<std::string, TriangleMesh, int>> cases{
       {"cylinder", cylinder(8, 3, 1.0, 3.0), 1},
       {"bar", bar(2, 2, 3, 1.0, 1.0, 3.0), 1},
       {"bumpy plane", bumpy_plane(6, 10.0, 3, 2.0), 1},
       {"jittered grid", jittered, 1},
-      {"cylinder and bar", side_by_side(cylinder(8, 3, 1.0, 3.0), bar(2, 2, 3, 1.0, 1.0, 3.0), Eigen::RowVector3d(20, 0, 0)), 2},
+      {"cylinder and bar",
+       side_by_side(cylinder(8, 3, 1.0, 3.0), bar(2, 2, 3, 1.0, 1.0, 3.0),
+                    Eigen::RowVector3d(20, 0, 0)),
+       2},
   };
   for (const auto& [name, mesh, components] : cases) {
     SCOPED_TRACE(name);
@@ -223,9 +240,10 @@ TEST(Arap, ObtuseTrianglesKeepTheRestStateTheMinimum) {
   F << 0, 1, 2;
   const Arap triangle(V, F);
   EXPECT_LT(std::abs(triangle.value(triangle.rest())), 1e-20);
-  const Eigen::VectorXd eigenvalues = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(
-                                          Eigen::MatrixXd(triangle.hessian(triangle.rest())), Eigen::EigenvaluesOnly)
-                                          .eigenvalues();
+  const Eigen::VectorXd eigenvalues =
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(
+          Eigen::MatrixXd(triangle.hessian(triangle.rest())), Eigen::EigenvaluesOnly)
+          .eigenvalues();
   EXPECT_GT(eigenvalues.minCoeff(), -1e-12 * eigenvalues.maxCoeff());
   EXPECT_EQ((eigenvalues.array().abs() < 1e-9 * eigenvalues.maxCoeff()).count(), 6);
 
@@ -241,7 +259,8 @@ TEST(Arap, DegenerateTrianglesAndLooseVerticesStayFinite) {
   // A fan around vertex 0, plus a collinear face, a repeated index, a 1e-9 sliver, a face with
   // two vertices in one place (8 on 1) and an unreferenced vertex (7).
   RowMatrixX3d V(9, 3);
-  V << 0, 0, 0, 1, 0, 0, 0.3, 1, 0.2, -1, 0.2, 0, 0.5, -1, 0.1, 2, 0, 0, 0.5, 1e-9, 0, 5, 5, 5, 1, 0, 0;
+  V << 0, 0, 0, 1, 0, 0, 0.3, 1, 0.2, -1, 0.2, 0, 0.5, -1, 0.1, 2, 0, 0, 0.5, 1e-9, 0, 5, 5, 5, 1,
+      0, 0;
   RowMatrixX3i F(8, 3);
   F << 0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1, 0, 1, 5, 2, 2, 3, 0, 6, 1, 1, 8, 2;
   const Arap energy(V, F);
@@ -259,7 +278,8 @@ TEST(Arap, DegenerateTrianglesAndLooseVerticesStayFinite) {
 }
 
 TEST(Arap, SharedDragonsGiveFiniteValues) {
-  for (const char* file : {"dragon_vrip_res4.ply.gz", "dragon_vrip_res3.ply.gz", "dragon_vrip_res2.ply.gz"}) {
+  for (const char* file :
+       {"dragon_vrip_res4.ply.gz", "dragon_vrip_res3.ply.gz", "dragon_vrip_res2.ply.gz"}) {
     SCOPED_TRACE(file);
     const TriangleMesh mesh = normalized(shared_mesh(file));
     const Arap energy(mesh.V, mesh.F);
@@ -294,7 +314,8 @@ TEST(Arap, BadPositionsAreNamed) {
   x[3 * 5 + 1] = std::numeric_limits<double>::infinity();
   Eigen::VectorXd gradient(x.size());
   for (const auto& call : std::vector<std::function<void()>>{
-           [&] { energy.value(x); }, [&] { energy.value_and_gradient(x, gradient); }, [&] { energy.hessian(x); }}) {
+           [&] { energy.value(x); }, [&] { energy.value_and_gradient(x, gradient); },
+           [&] { energy.hessian(x); }}) {
     try {
       call();
       FAIL() << "a non-finite position was accepted";

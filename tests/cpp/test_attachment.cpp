@@ -14,7 +14,8 @@ using testing::head_with_eyes;
 using testing::side_by_side;
 
 // The displacements x ↦ A x + t (3n, interleaved) of the rows of V.
-Eigen::VectorXd affine_motion(const RowMatrixX3d& V, const Eigen::Matrix3d& A, const Eigen::Vector3d& t) {
+Eigen::VectorXd affine_motion(const RowMatrixX3d& V, const Eigen::Matrix3d& A,
+                              const Eigen::Vector3d& t) {
   Eigen::VectorXd u(3 * V.rows());
   for (Eigen::Index i = 0; i < V.rows(); ++i) u.segment<3>(3 * i) = A * V.row(i).transpose() + t;
   return u;
@@ -27,19 +28,22 @@ Eigen::Matrix3d skew(const Eigen::Vector3d& w) {
 }
 
 // Extends the motion of the simulated vertices and compares with the motion of all vertices.
-double extension_error(const Attachment& attachment, const RowMatrixX3d& V, const Eigen::Matrix3d& A,
-                       const Eigen::Vector3d& t) {
+double extension_error(const Attachment& attachment, const RowMatrixX3d& V,
+                       const Eigen::Matrix3d& A, const Eigen::Vector3d& t) {
   const Eigen::VectorXd all = affine_motion(V, A, t);
   Eigen::VectorXd simulated(3 * attachment.simulated.size());
   for (size_t s = 0; s < attachment.simulated.size(); ++s)
-    simulated.segment<3>(3 * static_cast<Eigen::Index>(s)) = all.segment<3>(3 * attachment.simulated[s]);
-  return (extend_to_attached(attachment, simulated) - all).cwiseAbs().maxCoeff() / all.cwiseAbs().maxCoeff();
+    simulated.segment<3>(3 * static_cast<Eigen::Index>(s)) =
+        all.segment<3>(3 * attachment.simulated[s]);
+  return (extend_to_attached(attachment, simulated) - all).cwiseAbs().maxCoeff() /
+         all.cwiseAbs().maxCoeff();
 }
 
 TEST(Attachment, SmallComponentsFollowTheMeshAffinely) {
   const TriangleMesh mesh = head_with_eyes();
   const Attachment attachment = attach(mesh.V, mesh.F);
-  const int head = 6 * 7 * 7 - 12 * 5 - 8 * 2;  // bar(6, 6, 6): 6 faces of 7 x 7 vertices, shared edges once
+  const int head =
+      6 * 7 * 7 - 12 * 5 - 8 * 2;  // bar(6, 6, 6): 6 faces of 7 x 7 vertices, shared edges once
   ASSERT_EQ(static_cast<int>(attachment.simulated.size()), head);
   EXPECT_EQ(attachment.num_components, 1);
   EXPECT_EQ(attachment.num_attached_components, 2);
@@ -53,9 +57,12 @@ TEST(Attachment, SmallComponentsFollowTheMeshAffinely) {
     EXPECT_EQ(follower.normal, Eigen::Vector3d::Zero());
     EXPECT_GE(follower.anchors.size(), 16u);
   }
-  const Eigen::Matrix3d A = (Eigen::Matrix3d() << 0.3, -0.2, 0.1, 0.05, -0.4, 0.2, 0.7, 0.1, 0.0).finished();
+  const Eigen::Matrix3d A =
+      (Eigen::Matrix3d() << 0.3, -0.2, 0.1, 0.05, -0.4, 0.2, 0.7, 0.1, 0.0).finished();
   EXPECT_LT(extension_error(attachment, mesh.V, A, Eigen::Vector3d(1, -2, 0.5)), 1e-12);
-  EXPECT_LT(extension_error(attachment, mesh.V, skew(Eigen::Vector3d(0.2, -1, 0.4)), Eigen::Vector3d(0, 0, 1)), 1e-12);
+  EXPECT_LT(extension_error(attachment, mesh.V, skew(Eigen::Vector3d(0.2, -1, 0.4)),
+                            Eigen::Vector3d(0, 0, 1)),
+            1e-12);
 }
 
 TEST(Attachment, DebrisOverAFlatSheetTurnsWithIt) {
@@ -69,9 +76,11 @@ TEST(Attachment, DebrisOverAFlatSheetTurnsWithIt) {
   ASSERT_EQ(attachment.followers.size(), 1u);
   EXPECT_EQ(attachment.followers[0].vertices.size(), 4u);
   EXPECT_NEAR(std::abs(attachment.followers[0].normal.z()), 1.0, 1e-12);
-  EXPECT_LT(extension_error(attachment, mesh.V, skew(Eigen::Vector3d(0.5, 0.3, -0.2)), Eigen::Vector3d(1, 2, 3)),
+  EXPECT_LT(extension_error(attachment, mesh.V, skew(Eigen::Vector3d(0.5, 0.3, -0.2)),
+                            Eigen::Vector3d(1, 2, 3)),
             1e-12);
-  const Eigen::Matrix3d in_plane = (Eigen::Matrix3d() << 0.3, -0.2, 0, 0.5, 0.1, 0, 0, 0, 0).finished();
+  const Eigen::Matrix3d in_plane =
+      (Eigen::Matrix3d() << 0.3, -0.2, 0, 0.5, 0.1, 0, 0, 0, 0).finished();
   EXPECT_LT(extension_error(attachment, mesh.V, in_plane, Eigen::Vector3d(1, 0, 0)), 1e-12);
 }
 
@@ -91,7 +100,9 @@ TEST(Attachment, UnreferencedAndMasslessVerticesAreAttached) {
   EXPECT_EQ(attachment.followers[1].vertices, std::vector<int>{n + 1});
   EXPECT_EQ(attachment.submesh_index[n], -1);
   EXPECT_EQ(attachment.faces.rows(), mesh.F.rows() - 1);  // the degenerate face is not simulated
-  EXPECT_LT(extension_error(attachment, mesh.V, skew(Eigen::Vector3d(1, 2, 3)), Eigen::Vector3d(-1, 0, 1)), 1e-12);
+  EXPECT_LT(extension_error(attachment, mesh.V, skew(Eigen::Vector3d(1, 2, 3)),
+                            Eigen::Vector3d(-1, 0, 1)),
+            1e-12);
 }
 
 TEST(Attachment, DoubledTrianglesCountOnceAndABlobHangingByAVertexIsAttached) {
@@ -112,9 +123,9 @@ TEST(Attachment, DoubledTrianglesCountOnceAndABlobHangingByAVertexIsAttached) {
   mesh.V.row(n + 4) = mesh.V.row(root) + Eigen::RowVector3d(0.2, 0.1, 0.0);
   mesh.V.row(n + 5) = mesh.V.row(root) + Eigen::RowVector3d(0.1, 0.2, 0.1);
   mesh.F.conservativeResize(box_faces + 8, 3);
-  mesh.F.bottomRows(8) << a, b, n, b, a, n,  // the fin
+  mesh.F.bottomRows(8) << a, b, n, b, a, n,                                          // the fin
       pin, n + 1, n + 2, pin, n + 2, n + 3, pin, n + 3, n + 1, n + 1, n + 3, n + 2,  // the blob
-      root, n + 4, n + 5, n + 5, n + 4, root;  // the pair
+      root, n + 4, n + 5, n + 5, n + 4, root;                                        // the pair
   const Attachment attachment = attach(mesh.V, mesh.F);
   EXPECT_EQ(static_cast<int>(attachment.simulated.size()), n + 1);
   EXPECT_GE(attachment.submesh_index[n], 0);
@@ -124,7 +135,9 @@ TEST(Attachment, DoubledTrianglesCountOnceAndABlobHangingByAVertexIsAttached) {
   EXPECT_EQ(attachment.followers[0].vertices, (std::vector<int>{n + 1, n + 2, n + 3}));
   EXPECT_EQ(attachment.followers[1].vertices, (std::vector<int>{n + 4, n + 5}));
   EXPECT_EQ(attachment.faces.rows(), box_faces + 1);
-  EXPECT_LT(extension_error(attachment, mesh.V, skew(Eigen::Vector3d(1, -2, 0.5)), Eigen::Vector3d(0, 1, 2)), 1e-12);
+  EXPECT_LT(extension_error(attachment, mesh.V, skew(Eigen::Vector3d(1, -2, 0.5)),
+                            Eigen::Vector3d(0, 1, 2)),
+            1e-12);
 }
 
 TEST(Attachment, LargePiecesJoinedAtAVertexAreOneComponent) {
@@ -144,7 +157,8 @@ TEST(Attachment, LargePiecesJoinedAtAVertexAreOneComponent) {
     for (int k = 0; k < 3; ++k)
       if (mesh.F(f, k) == n + other) mesh.F(f, k) = static_cast<int>(corner);
   const Attachment attachment = attach(mesh.V, mesh.F);
-  EXPECT_EQ(static_cast<int>(attachment.simulated.size()), 2 * n - 1);  // the second corner unreferenced
+  EXPECT_EQ(static_cast<int>(attachment.simulated.size()),
+            2 * n - 1);  // the second corner unreferenced
   EXPECT_EQ(attachment.num_components, 1);
   EXPECT_EQ(attachment.faces.rows(), mesh.F.rows());
   ASSERT_EQ(attachment.followers.size(), 1u);

@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "bake/bake.h"
 #include "energy/discrete_shells.h"
 #include "mesh/mass.h"
 #include "mesh/normalization.h"
@@ -15,7 +16,6 @@
 #include "modes/shifted_pencil.h"
 #include "modes/stiffness_and_mass.h"
 #include "modes/vibration_modes.h"
-#include "bake/bake.h"
 #include "reduction/attachment.h"
 #include "reduction/ghost.h"
 #include "test_bake_meshes.h"
@@ -75,16 +75,18 @@ TEST(Bake, TwoTubesHaveTwelveRigidMotionsFirstAndAnOrthonormalBasis) {
   for (int j = 0; j < 12; ++j) {
     const Eigen::VectorXd u = basis.vectors.col(j).cast<double>();
     const Eigen::Index moving = j < 6 ? 0 : half, resting = j < 6 ? half : 0;
-    EXPECT_LT(rigid_misfit(mesh.V.middleRows(moving, half), u.segment(3 * moving, 3 * half)), 1e-5) << j;
+    EXPECT_LT(rigid_misfit(mesh.V.middleRows(moving, half), u.segment(3 * moving, 3 * half)), 1e-5)
+        << j;
     EXPECT_EQ(u.segment(3 * resting, 3 * half).cwiseAbs().maxCoeff(), 0.0) << j;
   }
-  for (const char* stage : {"attachment", "hessian", "factorisation", "modes", "third derivatives", "derivative solves",
-                            "orthonormalisation", "assembly", "ghost"})
+  for (const char* stage : {"attachment", "hessian", "factorisation", "modes", "third derivatives",
+                            "derivative solves", "orthonormalisation", "assembly", "ghost"})
     EXPECT_GE(basis.timings.at(stage), 0.0) << stage;
 }
 
 TEST(Bake, ModesAreTheEigenpairsOfTheNormalisedShellsHessian) {
-  const TriangleMesh mesh = bar(4, 3, 5, 0.02, 0.015, 0.03);  // mesh units far from the normalised frame
+  const TriangleMesh mesh =
+      bar(4, 3, 5, 0.02, 0.015, 0.03);  // mesh units far from the normalised frame
   const Basis basis = bake_with(mesh, 16, 10);
   const double s = basis.scale;
   EXPECT_NEAR(s, normalizing_scale(mesh.V), 0);
@@ -127,8 +129,9 @@ TEST(Bake, BasisSpansTheModalDerivativesOfEquation13) {
   // The paper's pairs: the three rotations first (λ = 0), then the six flexible modes.
   Eigen::MatrixXd phi(K.rows(), 9);
   phi << Z.rightCols(3), modes.modes;
-  const std::vector<std::array<int, 2>> pairs =
-      derivative_pairs(components_moved(phi, Eigen::VectorXi::Zero(X.rows())), 12),
+  const std::vector<std::array<int, 2>> pairs = derivative_pairs(
+                                            components_moved(phi, Eigen::VectorXi::Zero(X.rows())),
+                                            12),
                                         swapped = [&] {
                                           std::vector<std::array<int, 2>> p;
                                           for (const auto& [i, j] : pairs) p.push_back({j, i});
@@ -138,7 +141,8 @@ TEST(Bake, BasisSpansTheModalDerivativesOfEquation13) {
   const Eigen::MatrixXd B = shells.third_batch(shells.rest(), phi, pairs);
   const Eigen::MatrixXd Psi = solve_in_range(K, mass, Z, B);
   // The pairs swapped: ∇³E(x̄)(φᵢ, φⱼ) is symmetric, so are the derivatives.
-  const Eigen::MatrixXd Psi_swapped = solve_in_range(K, mass, Z, shells.third_batch(shells.rest(), phi, swapped));
+  const Eigen::MatrixXd Psi_swapped =
+      solve_in_range(K, mass, Z, shells.third_batch(shells.rest(), phi, swapped));
   EXPECT_LT((Psi - Psi_swapped).norm(), 1e-8 * Psi.norm());
   const Eigen::MatrixXd PB = B - Z * (Z.transpose() * Z).ldlt().solve(Z.transpose() * B);
   for (Eigen::Index c = 0; c < Psi.cols(); ++c)
@@ -147,8 +151,8 @@ TEST(Bake, BasisSpansTheModalDerivativesOfEquation13) {
   // within 1e-3 on the others, so within 1e-3 in all. With σ near 0 they are hardly off; with σ
   // at a third of the lowest eigenvalue, uncorrected steps would leave 2% of that component.
   const Eigen::VectorXd m = dof_masses(mass);
-  for (const auto& [sigma, tolerance] :
-       {std::pair{-1e-9 * K.diagonal().sum() / m.sum(), 1e-7}, std::pair{-0.3 * modes.eigenvalues[0], 1e-3}}) {
+  for (const auto& [sigma, tolerance] : {std::pair{-1e-9 * K.diagonal().sum() / m.sum(), 1e-7},
+                                         std::pair{-0.3 * modes.eigenvalues[0], 1e-3}}) {
     ShiftedPencil pencil(K, mass, Z, sigma);
     pencil.lowest_modes(6);
     EXPECT_EQ(pencil.shift(), sigma);
@@ -160,14 +164,15 @@ TEST(Bake, BasisSpansTheModalDerivativesOfEquation13) {
   for (Eigen::Index c = 0; c < Psi.cols(); ++c) {
     const Eigen::VectorXd psi = Psi.col(c);
     const Eigen::VectorXd outside = psi - U * (U.transpose() * m.cwiseProduct(psi));
-    EXPECT_LT(std::sqrt(outside.dot(m.cwiseProduct(outside)) / psi.dot(m.cwiseProduct(psi))), 1e-4) << "pair " << c;
+    EXPECT_LT(std::sqrt(outside.dot(m.cwiseProduct(outside)) / psi.dot(m.cwiseProduct(psi))), 1e-4)
+        << "pair " << c;
   }
 }
 
 // Why the rotations pair (paper §4): E is invariant under rotations R, so ∇²E(R x̄) = R ∇²E(x̄) Rᵀ;
-// differentiated along a linearised rotation r = W x̄ (W: ω × per vertex), ∇³E(x̄)(r, u) = (W K − K W) u.
-// Hence the right-hand side of a rotation with a mode φ is λ W M φ − K W φ (its derivative is φ
-// rotated, −W φ, up to a part ∝ λ), and with another rotation −K W_a W_b x̄.
+// differentiated along a linearised rotation r = W x̄ (W: ω × per vertex), ∇³E(x̄)(r, u) = (W K − K
+// W) u. Hence the right-hand side of a rotation with a mode φ is λ W M φ − K W φ (its derivative is
+// φ rotated, −W φ, up to a part ∝ λ), and with another rotation −K W_a W_b x̄.
 TEST(Bake, RotationsDerivativesAreTheModesRotated) {
   const TriangleMesh mesh = bumpy_plane(8, 1.0, 3, 0.2);
   const auto& [X, shells, K, mass, Z] = ShellsAtRest(mesh);
@@ -178,11 +183,13 @@ TEST(Bake, RotationsDerivativesAreTheModesRotated) {
   const auto turn = [&](int c, const Eigen::VectorXd& u) {
     Eigen::MatrixXd cross(3 * P.rows(), 3);
     for (Eigen::Index v = 0; v < P.rows(); ++v)
-      cross.middleRows<3>(3 * v) << 0, P(v, 2), -P(v, 1), -P(v, 2), 0, P(v, 0), P(v, 1), -P(v, 0), 0;
+      cross.middleRows<3>(3 * v) << 0, P(v, 2), -P(v, 1), -P(v, 2), 0, P(v, 0), P(v, 1), -P(v, 0),
+          0;
     const Eigen::Vector3d omega = cross.colPivHouseholderQr().solve(Z.col(c));
     EXPECT_LT((cross * omega - Z.col(c)).norm(), 1e-10 * Z.col(c).norm());
     Eigen::VectorXd out(u.size());
-    for (Eigen::Index v = 0; v < P.rows(); ++v) out.segment<3>(3 * v) = omega.cross(u.segment<3>(3 * v));
+    for (Eigen::Index v = 0; v < P.rows(); ++v)
+      out.segment<3>(3 * v) = omega.cross(u.segment<3>(3 * v));
     return out;
   };
   const Eigen::VectorXd p = Eigen::Map<const Eigen::VectorXd>(RowMatrixX3d(P).data(), P.size());
@@ -190,13 +197,17 @@ TEST(Bake, RotationsDerivativesAreTheModesRotated) {
   for (int a = 3; a < 6; ++a) {
     for (int b = 3; b < 6; ++b) {
       const Eigen::VectorXd expected = -(K * turn(a, turn(b, p)));
-      EXPECT_LT((shells.third(shells.rest(), Z.col(a), Z.col(b)) - expected).norm(), 1e-8 * K.norm()) << a << b;
+      EXPECT_LT((shells.third(shells.rest(), Z.col(a), Z.col(b)) - expected).norm(),
+                1e-8 * K.norm())
+          << a << b;
     }
     for (int i = 0; i < 2; ++i) {
       const Eigen::VectorXd phi = modes.modes.col(i);
       const Eigen::VectorXd expected =
           modes.eigenvalues[i] * turn(a, m.cwiseProduct(phi)) - K * turn(a, phi);
-      EXPECT_LT((shells.third(shells.rest(), Z.col(a), phi) - expected).norm(), 1e-8 * expected.norm()) << a << i;
+      EXPECT_LT((shells.third(shells.rest(), Z.col(a), phi) - expected).norm(),
+                1e-8 * expected.norm())
+          << a << i;
     }
   }
 }
@@ -232,8 +243,10 @@ TEST(Bake, EyesDoNotEatTheModeBudgetAndFollowTheHead) {
   std::fill(simulated.begin(), simulated.begin() + head, true);
   EXPECT_LT(identity_error(normalised_gram(basis, simulated)), 1e-5);
   for (int j = 0; j < 6; ++j)  // the whole mesh, eyes included, moves rigidly
-    EXPECT_LT(rigid_misfit(mesh.V, basis.vectors.col(j).cast<double>()), 1e-5) << "rigid motion " << j;
-  for (int j = 6; j < basis.dimension(); ++j)  // eyes move, as one piece each with the head beside them
+    EXPECT_LT(rigid_misfit(mesh.V, basis.vectors.col(j).cast<double>()), 1e-5)
+        << "rigid motion " << j;
+  for (int j = 6; j < basis.dimension();
+       ++j)  // eyes move, as one piece each with the head beside them
     EXPECT_GT(basis.vectors.col(j).tail(3 * (mesh.V.rows() - head)).cwiseAbs().maxCoeff(), 0.0f);
 }
 
@@ -248,15 +261,18 @@ TEST(Bake, GhostMapsEveryVertexAndKeepsRigidMotionsRigid) {
   EXPECT_EQ(basis.ghost_vectors.rows(), 3 * g);
   EXPECT_EQ(basis.ghost_vectors.cols(), basis.dimension());
   for (int j = 0; j < basis.num_rigid; ++j)
-    EXPECT_LT(rigid_misfit(basis.ghost_vertices, basis.ghost_vectors.col(j)), 1e-12) << "rigid motion " << j;
+    EXPECT_LT(rigid_misfit(basis.ghost_vertices, basis.ghost_vectors.col(j)), 1e-12)
+        << "rigid motion " << j;
   // The restriction of the float32 vectors agrees with the ghost vectors to float precision.
-  const Eigen::MatrixXd restricted =
-      restrict_to_ghost(basis.ghost_map, static_cast<int>(g), basis.mass, basis.vectors.cast<double>());
-  EXPECT_LT((restricted - basis.ghost_vectors).cwiseAbs().maxCoeff(), 1e-6 * basis.ghost_vectors.cwiseAbs().maxCoeff());
+  const Eigen::MatrixXd restricted = restrict_to_ghost(basis.ghost_map, static_cast<int>(g),
+                                                       basis.mass, basis.vectors.cast<double>());
+  EXPECT_LT((restricted - basis.ghost_vectors).cwiseAbs().maxCoeff(),
+            1e-6 * basis.ghost_vectors.cwiseAbs().maxCoeff());
   // A ghost at least as large as the mesh is the mesh.
   const Basis whole = bake_with(mesh, 12, 0, 100000);
   EXPECT_EQ(whole.ghost_vertices, mesh.V);
-  EXPECT_EQ(whole.ghost_map, Eigen::VectorXi::LinSpaced(mesh.V.rows(), 0, static_cast<int>(mesh.V.rows()) - 1));
+  EXPECT_EQ(whole.ghost_map,
+            Eigen::VectorXi::LinSpaced(mesh.V.rows(), 0, static_cast<int>(mesh.V.rows()) - 1));
 }
 
 TEST(Bake, ArapWithoutDerivatives) {
@@ -267,7 +283,8 @@ TEST(Bake, ArapWithoutDerivatives) {
 }
 
 // Expects the bake of `mesh` with `options` to throw InputError naming `needle`.
-void expect_refused(const TriangleMesh& mesh, const BakeOptions& options, const std::string& needle) {
+void expect_refused(const TriangleMesh& mesh, const BakeOptions& options,
+                    const std::string& needle) {
   expect_input_error(
       [&] {
         Progress progress;
@@ -305,10 +322,11 @@ TEST(Bake, RefusesBadOptionsNamingThem) {
 
 TEST(Bake, CancelsAtTheNextReportAndLeavesNothing) {
   const TriangleMesh mesh = bumpy_plane(30, 2.0, 5, 0.3);
-  for (const std::string stop_at :
-       {"hessian", "modes", "third derivatives", "derivative solves", "orthonormalisation", "ghost"}) {
+  for (const std::string stop_at : {"hessian", "modes", "third derivatives", "derivative solves",
+                                    "orthonormalisation", "ghost"}) {
     bool stopped = false;
-    Progress progress([&](const std::string& stage, double) { return !(stopped = stopped || stage == stop_at); });
+    Progress progress(
+        [&](const std::string& stage, double) { return !(stopped = stopped || stage == stop_at); });
     BakeOptions options;
     options.ghost = 200;
     EXPECT_THROW(bake(mesh.V, mesh.F, options, progress), Cancelled) << stop_at;
@@ -347,7 +365,8 @@ TEST(Bake, DragonScanHasNoZeroModesItsDebrisFollows) {
   EXPECT_LT(identity_error(normalised_gram(basis, simulated)), 1e-4);
   for (Eigen::Index j = 20; j < basis.dimension(); ++j) {
     Eigen::VectorXd size(basis.num_vertices());
-    for (Eigen::Index v = 0; v < size.size(); ++v) size[v] = basis.vectors.col(j).segment<3>(3 * v).cast<double>().norm();
+    for (Eigen::Index v = 0; v < size.size(); ++v)
+      size[v] = basis.vectors.col(j).segment<3>(3 * v).cast<double>().norm();
     std::vector<double> sorted(size.data(), size.data() + size.size());
     std::nth_element(sorted.begin(), sorted.begin() + size.size() / 2, sorted.end());
     EXPECT_LT(size.maxCoeff(), 20 * sorted[sorted.size() / 2]) << "derivative column " << j;
@@ -373,7 +392,8 @@ TEST(Bake, FloppyPlateDeflatesZeroModesThatKeepTheOthersFromConverging) {
     const int corner = n + 2 * static_cast<int>(k);
     plate.V.row(corner) = plate.V.row(hinges[k]) + Eigen::RowVector3d(0.8, 0.0, 1.0);
     plate.V.row(corner + 1) = plate.V.row(hinges[k]) + Eigen::RowVector3d(-0.8, 0.3, 1.0);
-    plate.F.row(plate.F.rows() - static_cast<Eigen::Index>(hinges.size() - k)) << hinges[k], corner, corner + 1;
+    plate.F.row(plate.F.rows() - static_cast<Eigen::Index>(hinges.size() - k)) << hinges[k], corner,
+        corner + 1;
   }
   const Basis basis = bake_with(plate, 20, 0);
   EXPECT_EQ(basis.num_floppy, 9);

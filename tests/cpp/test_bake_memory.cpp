@@ -2,8 +2,8 @@
 
 #include <string>
 
-#include "linalg/cholmod_llt.h"
 #include "bake/bake_memory.h"
+#include "linalg/cholmod_llt.h"
 #include "stand_in_stiffness.h"
 #include "test_support.h"
 #include "util/errors.h"
@@ -22,7 +22,8 @@ TEST(BakeMemory, TheFactorSizeIsKnownFromTheAnalysisAlone) {
   EXPECT_EQ(llt.factor_bytes(), 0.0);
   llt.analyze(K);
   const double analysed = llt.factor_bytes();
-  EXPECT_GE(analysed, 8 * static_cast<double>(K.nonZeros()) / 2);  // at least the lower triangle's values
+  EXPECT_GE(analysed,
+            8 * static_cast<double>(K.nonZeros()) / 2);  // at least the lower triangle's values
   llt.factorize(K);
   EXPECT_EQ(llt.factor_bytes(), analysed);
   EXPECT_GE(analysed, 8 * llt.factor_nonzeros());
@@ -35,7 +36,8 @@ TEST(BakeMemory, TheEstimateGrowsWithWhatIsAskedFor) {
   EXPECT_EQ(small.factor, 5.6e8);
   EXPECT_GT(wider.vectors, small.vectors);
   EXPECT_GT(finer.total(), 3 * small.total());
-  // dragon_vrip_res2 at 20 + 47 peaked at 2.07 GB resident, 0.1 GB of it the process before the bake.
+  // dragon_vrip_res2 at 20 + 47 peaked at 2.07 GB resident, 0.1 GB of it the process before the
+  // bake.
   EXPECT_GT(small.total(), 1.5e9);
   EXPECT_LT(small.total(), 2.5e9);
 }
@@ -48,7 +50,8 @@ TEST(BakeMemory, MoreThanIsAvailableIsRefusedWithTheFigures) {
     ADD_FAILURE() << "no exception";
   } catch (const OutOfMemory& e) {
     const std::string text = e.what();
-    EXPECT_NE(text.find("bake: not enough memory: the bake needs about"), std::string::npos) << text;
+    EXPECT_NE(text.find("bake: not enough memory: the bake needs about"), std::string::npos)
+        << text;
     EXPECT_NE(text.find("factor of K 0.56 GB from CHOLMOD's analysis"), std::string::npos) << text;
     EXPECT_NE(text.find("only 0.50 GB is available"), std::string::npos) << text;
   }

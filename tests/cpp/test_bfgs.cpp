@@ -47,8 +47,8 @@ struct Quadratic {
 };
 
 void expect_strong_wolfe(const Objective& f, const Eigen::VectorXd& x, const Eigen::VectorXd& p,
-                         const LineSearchResult& result, double value_new, const Eigen::VectorXd& x_new,
-                         const Eigen::VectorXd& gradient_new) {
+                         const LineSearchResult& result, double value_new,
+                         const Eigen::VectorXd& x_new, const Eigen::VectorXd& gradient_new) {
   Eigen::VectorXd g(x.size());
   const double value = f(x, g);
   const WolfeConditions c;
@@ -129,8 +129,10 @@ TEST(BacktrackingLineSearch, HalvesUntilSufficientDecreaseSkippingWhatCannotBeEv
   const Eigen::VectorXd newton = -quadratic.A.llt().solve(g);
   double value_new;
   // The Newton step passes at once; 8 times too long, after three halvings (α = 1/8).
-  EXPECT_EQ(backtracking_line_search(quadratic, x, value, g, newton, x_new, value_new, g_new).step, 1.0);
-  BacktrackingResult result = backtracking_line_search(quadratic, x, value, g, 8 * newton, x_new, value_new, g_new);
+  EXPECT_EQ(backtracking_line_search(quadratic, x, value, g, newton, x_new, value_new, g_new).step,
+            1.0);
+  BacktrackingResult result =
+      backtracking_line_search(quadratic, x, value, g, 8 * newton, x_new, value_new, g_new);
   EXPECT_EQ(result.step, 0.125);
   EXPECT_EQ(result.evaluations, 4);
   EXPECT_EQ(result.insufficient, 3);
@@ -142,7 +144,8 @@ TEST(BacktrackingLineSearch, HalvesUntilSufficientDecreaseSkippingWhatCannotBeEv
   };
   result = backtracking_line_search(bounded, x, value, g, newton, x_new, value_new, g_new);
   EXPECT_EQ(result.step, 0.25);
-  EXPECT_EQ(result.undefined, 2);  // why the step was cut: the domain, not the decrease (full_solver)
+  EXPECT_EQ(result.undefined,
+            2);  // why the step was cut: the domain, not the decrease (full_solver)
   EXPECT_EQ(result.insufficient, 0);
   Eigen::VectorXd check(6);
   EXPECT_EQ(quadratic(x_new, check), value_new);
@@ -291,13 +294,16 @@ TEST(Bfgs, APredictedFinishSavesTheConfirmingEvaluation) {
     Bfgs predicted, evaluated;
     predicted.start(rosenbrock_start(6), Eigen::MatrixXd::Identity(6, 6));
     evaluated.start(rosenbrock_start(6), Eigen::MatrixXd::Identity(6, 6));
-    const BfgsResult a = predicted.minimize(rosenbrock, 500, tolerance, std::numeric_limits<double>::infinity(),
-                                            Finish::kPredicted);
+    const BfgsResult a = predicted.minimize(
+        rosenbrock, 500, tolerance, std::numeric_limits<double>::infinity(), Finish::kPredicted);
     const BfgsResult b = evaluated.minimize(rosenbrock, 500, tolerance);
     ASSERT_TRUE(a.converged && b.converged) << tolerance;
     EXPECT_LT(a.evaluations, b.evaluations) << tolerance;
-    EXPECT_LE((predicted.x() - Eigen::VectorXd::Ones(6)).norm(), 10 * std::sqrt(tolerance)) << tolerance;
-    EXPECT_LE((predicted.x() - evaluated.x()).norm(), std::sqrt(tolerance) * (1 + evaluated.x().norm())) << tolerance;
+    EXPECT_LE((predicted.x() - Eigen::VectorXd::Ones(6)).norm(), 10 * std::sqrt(tolerance))
+        << tolerance;
+    EXPECT_LE((predicted.x() - evaluated.x()).norm(),
+              std::sqrt(tolerance) * (1 + evaluated.x().norm()))
+        << tolerance;
     // Converged: f and ∇f at the point taken are evaluated by the next call, which returns at once.
     const BfgsResult again = predicted.minimize(rosenbrock, 10, tolerance);
     EXPECT_TRUE(again.converged);

@@ -23,9 +23,11 @@ TEST(BlockSparsity, PatternHasEveryPairBothWaysAndTheDiagonal) {
   for (auto [a, b] : {std::pair{0, 0}, {0, 1}, {1, 0}, {1, 1}, {1, 2}, {2, 1}, {2, 2}, {3, 3}})
     for (int j = 0; j < 3; ++j)
       for (int i = 0; i < 3; ++i)
-        matrix.valuePtr()[pattern.offset(a, b) + j * pattern.column_stride(b) + i] = 100 * (3 * a + i) + 3 * b + j;
+        matrix.valuePtr()[pattern.offset(a, b) + j * pattern.column_stride(b) + i] =
+            100 * (3 * a + i) + 3 * b + j;
   for (int k = 0; k < matrix.outerSize(); ++k)
-    for (SparseMatrix::InnerIterator it(matrix, k); it; ++it) EXPECT_EQ(it.value(), 100 * it.row() + it.col());
+    for (SparseMatrix::InnerIterator it(matrix, k); it; ++it)
+      EXPECT_EQ(it.value(), 100 * it.row() + it.col());
   EXPECT_THROW(pattern.offset(0, 2), std::logic_error);
   EXPECT_THROW(pattern.offset(3, 0), std::logic_error);
 }
@@ -38,10 +40,11 @@ TEST(BlockSparsity, ColumnsFilledInPiecesEqualTheWholeMatrix) {
   pattern.zero_columns(pieces, 0, 3);
   const SparseMatrix whole = pattern.zero_matrix();
   ASSERT_EQ(pieces.nonZeros(), whole.nonZeros());
-  for (int k = 0; k <= pieces.outerSize(); ++k) EXPECT_EQ(pieces.outerIndexPtr()[k], whole.outerIndexPtr()[k]);
-  for (int k = 0; k < pieces.nonZeros(); ++k) EXPECT_EQ(pieces.innerIndexPtr()[k], whole.innerIndexPtr()[k]);
+  for (int k = 0; k <= pieces.outerSize(); ++k)
+    EXPECT_EQ(pieces.outerIndexPtr()[k], whole.outerIndexPtr()[k]);
+  for (int k = 0; k < pieces.nonZeros(); ++k)
+    EXPECT_EQ(pieces.innerIndexPtr()[k], whole.innerIndexPtr()[k]);
 }
-
 
 // Enough vertices that the columns are sorted in parallel: each column holds its distinct rows in
 // order, the diagonal included, as a set of the pairs says.
@@ -65,7 +68,8 @@ TEST(BlockSparsity, LargePatternMatchesASetOfItsPairs) {
   for (int b = 0; b < n; ++b)
     for (SparseMatrix::InnerIterator it(zero, 3 * b); it; ++it)
       if (it.row() % 3 == 0) {
-        ASSERT_EQ(*block, (std::pair<int, int>{b, static_cast<int>(it.row() / 3)})) << "column " << b;
+        ASSERT_EQ(*block, (std::pair<int, int>{b, static_cast<int>(it.row() / 3)}))
+            << "column " << b;
         EXPECT_EQ(pattern.offset(block->second, b), &it.valueRef() - zero.valuePtr());
         ++block;
       }

@@ -6,8 +6,8 @@
 #include <random>
 
 #include "linalg/cholmod_llt.h"
-#include "mesh/mass.h"
 #include "linalg/sparse_operations.h"
+#include "mesh/mass.h"
 #include "modes/stiffness_and_mass.h"
 #include "stand_in_stiffness.h"
 #include "test_support.h"
@@ -64,7 +64,8 @@ double relative_error(const Eigen::MatrixXd& x, const Eigen::MatrixXd& reference
 
 TEST(CholmodLLT, SolvesLikeSimplicialLDLT) {
   // 3 DOFs per node orders the node graph; 2000 rows is not a multiple of 3 and falls back to 1.
-  for (const SparseMatrix& A : {random_spd(400, 6, 1), random_spd(2000, 3, 2), bunny_stiffness_plus_mass()})
+  for (const SparseMatrix& A :
+       {random_spd(400, 6, 1), random_spd(2000, 3, 2), bunny_stiffness_plus_mass()})
     for (int dofs_per_node : {1, 3}) {
       const Eigen::MatrixXd B = random_block(A.rows(), 3, 3);
       CholmodLLT llt(dofs_per_node);
@@ -98,7 +99,8 @@ TEST(CholmodLLT, BlockSolveEqualsColumnSolves) {
   const Eigen::MatrixXd tall = random_block(2 * A.rows(), 5, 5);
   const Eigen::MatrixXd top = tall.topRows(A.rows());
   EXPECT_LT(relative_error(llt.solve(tall.topRows(A.rows())), llt.solve(top)), 1e-15);
-  // Into a caller's buffer, a view included: the same solution; a buffer of another size is refused.
+  // Into a caller's buffer, a view included: the same solution; a buffer of another size is
+  // refused.
   Eigen::MatrixXd into = Eigen::MatrixXd::Zero(A.rows(), 70);
   llt.solve(B, into.middleCols(3, 64));
   EXPECT_EQ(into.middleCols(3, 64), X);
@@ -178,7 +180,8 @@ TEST(CholmodLLT, FactorizationLeavesTheCallersOpenMPAsItWas) {
 TEST(CholmodLLT, SingularMatricesThrow) {
   const TriangleMesh& bunny = shared_mesh("bunny.obj.gz");
   // Positive semidefinite with 3 and 6 zero eigenvalues: the last pivots are rounding noise.
-  for (const SparseMatrix& K : {laplacian_stiffness(bunny.V, bunny.F), spring_network_hessian(bunny.V, bunny.F)}) {
+  for (const SparseMatrix& K :
+       {laplacian_stiffness(bunny.V, bunny.F), spring_network_hessian(bunny.V, bunny.F)}) {
     CholmodLLT llt;
     EXPECT_THROW(llt.factorize(K), NumericalError);
   }

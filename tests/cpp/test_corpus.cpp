@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "bake/bake.h"
 #include "energy/arap.h"
 #include "energy/discrete_shells.h"
 #include "mesh/mass.h"
@@ -18,14 +19,13 @@
 #include "mesh/normalization.h"
 #include "mesh/primitives.h"
 #include "reduction/attachment.h"
-#include "bake/bake.h"
 #include "reduction/ghost.h"
 #include "solve/full_solver.h"
 #include "solve/reduced_solver.h"
 #include "test_support.h"
 #include "util/errors.h"
-#include "util/require_weight.h"
 #include "util/math_constants.h"
+#include "util/require_weight.h"
 
 namespace modal_deform {
 namespace {
@@ -52,7 +52,8 @@ TriangleMesh with_face(TriangleMesh mesh, const Eigen::RowVector3i& face) {
 // alone carries a vertex.
 TriangleMesh sliver_flap(double height) {
   TriangleMesh mesh = unit_grid();
-  const Eigen::RowVector3d apex = 0.5 * (mesh.V.row(0) + mesh.V.row(1)) + Eigen::RowVector3d(0, -height, 0);
+  const Eigen::RowVector3d apex =
+      0.5 * (mesh.V.row(0) + mesh.V.row(1)) + Eigen::RowVector3d(0, -height, 0);
   const int n = static_cast<int>(mesh.V.rows());
   return with_face(with_vertices(mesh, apex), {1, 0, n});
 }
@@ -88,7 +89,8 @@ TriangleMesh two_fans() {
 TriangleMesh fin() {
   const TriangleMesh mesh = unit_grid();
   const int a = mesh.F(4, 0), b = mesh.F(4, 1), n = static_cast<int>(mesh.V.rows());
-  const Eigen::RowVector3d top = 0.5 * (mesh.V.row(a) + mesh.V.row(b)) + Eigen::RowVector3d(0, 0, 0.3);
+  const Eigen::RowVector3d top =
+      0.5 * (mesh.V.row(a) + mesh.V.row(b)) + Eigen::RowVector3d(0, 0, 0.3);
   return with_face(with_vertices(mesh, top), {a, b, n});
 }
 
@@ -131,21 +133,29 @@ constexpr const char* kNothingToSimulate = "F: every face is degenerate or a sli
 
 std::vector<MeshCase> corpus() {
   const TriangleMesh g = unit_grid();
-  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN(),
+               inf = std::numeric_limits<double>::infinity();
   return {
       {"empty mesh", {RowMatrixX3d(0, 3), RowMatrixX3i(0, 3)}, "V: the mesh has no vertices", {}},
       {"vertices, no faces", {g.V, RowMatrixX3i(0, 3)}, "F: the mesh has no faces", {}},
-      {"lone vertex in a face", {RowMatrixX3d::Zero(1, 3), RowMatrixX3i::Zero(1, 3)}, "V: the mesh's extent", {}},
+      {"lone vertex in a face",
+       {RowMatrixX3d::Zero(1, 3), RowMatrixX3i::Zero(1, 3)},
+       "V: the mesh's extent",
+       {}},
       {"one triangle", mesh_from_buffers({0, 0, 0, 1, 0, 0, 0, 1, 0}, {0, 1, 2}), kWorks, {}},
       {"collinear faces",
        mesh_from_buffers({0, 0, 0, 1, 0, 0, 2, 0, 0, 3, 0, 0}, {0, 1, 2, 1, 2, 3}),
        kWorks,
        {{"bake", kNothingToSimulate}, {"pose", kNothingToSimulate}}},
       {"unreferenced vertices", with_vertices(g, RowMatrixX3d::Constant(2, 3, 5.0)), kWorks, {}},
-      {"duplicate vertices", changed(with_vertices(g, g.V.row(5)), [](TriangleMesh& m) {
-         for (Eigen::Index f = 0; f < m.F.rows(); ++f)
-           if (m.F(f, 0) == 5) m.F(f, 0) = static_cast<int>(m.V.rows()) - 1;
-       }), kWorks, {}},
+      {"duplicate vertices",
+       changed(with_vertices(g, g.V.row(5)),
+               [](TriangleMesh& m) {
+                 for (Eigen::Index f = 0; f < m.F.rows(); ++f)
+                   if (m.F(f, 0) == 5) m.F(f, 0) = static_cast<int>(m.V.rows()) - 1;
+               }),
+       kWorks,
+       {}},
       {"zero-area face", with_face(g, {0, 1, 2}), kWorks, {}},
       {"face with a repeated index", with_face(g, {0, 5, 5}), kWorks, {}},
       {"sliver flap (ratio 6e-9)", sliver_flap(1e-9), kWorks, {}},
@@ -153,24 +163,42 @@ std::vector<MeshCase> corpus() {
       {"duplicate face", with_face(g, g.F.row(3)), kWorks, {}},
       {"double sheet", with_face(g, {g.F(3, 0), g.F(3, 2), g.F(3, 1)}), kWorks, {}},
       {"non-manifold edge", fin(), kWorks, {}},
-      // Three zero modes from the cones' relative rotation: the bake deflates them and solves again.
+      // Three zero modes from the cones' relative rotation: the bake deflates them and solves
+      // again.
       {"non-manifold vertex", two_fans(), kWorks, {}},
       {"closed surface", bar(1, 1, 2, 1, 1, 4), kWorks, {}},
       {"many components (debris)", debris(), kWorks, {}},
-      {"inverted faces", changed(g, [](TriangleMesh& m) { m.F.col(1).swap(m.F.col(2)); }), kWorks, {}},
-      {"NaN coordinate", changed(g, [nan](TriangleMesh& m) { m.V(7, 1) = nan; }), "V[7]: vertex 7 has a non-finite", {}},
-      {"infinite coordinate", changed(g, [inf](TriangleMesh& m) { m.V(3, 2) = -inf; }), "V[3]: vertex 3 has a non-finite",
+      {"inverted faces",
+       changed(g, [](TriangleMesh& m) { m.F.col(1).swap(m.F.col(2)); }),
+       kWorks,
+       {}},
+      {"NaN coordinate",
+       changed(g, [nan](TriangleMesh& m) { m.V(7, 1) = nan; }),
+       "V[7]: vertex 7 has a non-finite",
+       {}},
+      {"infinite coordinate",
+       changed(g, [inf](TriangleMesh& m) { m.V(3, 2) = -inf; }),
+       "V[3]: vertex 3 has a non-finite",
        {}},
       {"tiny scale (1e-6)", changed(g, [](TriangleMesh& m) { m.V *= 1e-6; }), kWorks, {}},
       {"huge scale (1e6)", changed(g, [](TriangleMesh& m) { m.V *= 1e6; }), kWorks, {}},
-      {"coordinate too large (1e200)", changed(g, [](TriangleMesh& m) { m.V(2, 0) = 1e200; }),
-       "V[2]: vertex 2 has a coordinate too large", {}},
-      {"extent too small (1e-200)", changed(g, [](TriangleMesh& m) { m.V *= 1e-200; }), "V: the mesh's extent", {}},
+      {"coordinate too large (1e200)",
+       changed(g, [](TriangleMesh& m) { m.V(2, 0) = 1e200; }),
+       "V[2]: vertex 2 has a coordinate too large",
+       {}},
+      {"extent too small (1e-200)",
+       changed(g, [](TriangleMesh& m) { m.V *= 1e-200; }),
+       "V: the mesh's extent",
+       {}},
       {"a component 1e-20 the size of the mesh", tiny_component(1e-20), kWorks, {}},
-      {"index out of range", changed(g, [](TriangleMesh& m) { m.F(4, 2) = 16; }),
-       "F[4]: face 4 refers to vertex 16, outside [0, 16)", {}},
-      {"negative index", changed(g, [](TriangleMesh& m) { m.F(2, 0) = std::numeric_limits<int>::min(); }),
-       "F[2]: face 2 refers to vertex -2147483648", {}},
+      {"index out of range",
+       changed(g, [](TriangleMesh& m) { m.F(4, 2) = 16; }),
+       "F[4]: face 4 refers to vertex 16, outside [0, 16)",
+       {}},
+      {"negative index",
+       changed(g, [](TriangleMesh& m) { m.F(2, 0) = std::numeric_limits<int>::min(); }),
+       "F[2]: face 2 refers to vertex -2147483648",
+       {}},
   };
 }
 
@@ -205,13 +233,16 @@ void run(const std::string& entry, const TriangleMesh& mesh) {
       energy = std::make_unique<Arap>(mesh.V, mesh.F);
     const Eigen::VectorXd rest = energy->rest();
     const double extent = bounding_box_extent(mesh.V);
-    for (const Eigen::VectorXd& x : {rest, Eigen::VectorXd(rest + 0.05 * extent * testing::random_vector(3 * n, 1))}) {
+    for (const Eigen::VectorXd& x :
+         {rest, Eigen::VectorXd(rest + 0.05 * extent * testing::random_vector(3 * n, 1))}) {
       Eigen::VectorXd gradient(3 * n);
       EXPECT_TRUE(std::isfinite(energy->value_and_gradient(x, gradient))) << entry;
       expect_finite(gradient, entry + " gradient");
       expect_finite(Eigen::MatrixXd(energy->hessian(x)), entry + " Hessian");
       if (entry == "shells")
-        expect_finite(energy->third(x, testing::random_vector(3 * n, 2), testing::random_vector(3 * n, 3)), "third");
+        expect_finite(
+            energy->third(x, testing::random_vector(3 * n, 2), testing::random_vector(3 * n, 3)),
+            "third");
     }
   } else if (entry == "ghost") {
     validate_mesh(mesh.V, mesh.F);
@@ -238,7 +269,7 @@ void run(const std::string& entry, const TriangleMesh& mesh) {
     } else {
       const FullSolveResult result =
           solve_full(mesh.V, mesh.F, {{0}}, Eigen::VectorXd(), {T}, 1e3,
-              FullSolveOptions{EnergyKind::kShells, {1, 1}, 1e-6, 10});
+                     FullSolveOptions{EnergyKind::kShells, {1, 1}, 1e-6, 10});
       expect_finite(result.positions, "solve_full");
     }
   }
@@ -287,11 +318,14 @@ TEST(Corpus, WeightsBeyondTheLimitAreRefused) {
   EXPECT_TRUE(gradient.allFinite());
   const Eigen::Matrix4d I = Eigen::Matrix4d::Identity();
   expect_input_error(
-      [&] { solve_full(mesh.V, mesh.F, {{0}}, Eigen::VectorXd(), {I}, 1e300,
-          FullSolveOptions{EnergyKind::kShells, {1, 1}, 1e-6, 3}); },
+      [&] {
+        solve_full(mesh.V, mesh.F, {{0}}, Eigen::VectorXd(), {I}, 1e300,
+                   FullSolveOptions{EnergyKind::kShells, {1, 1}, 1e-6, 3});
+      },
       "pull: expected a value in (0, 1e+12], got 1e+300");
-  expect_input_error([&] { checked_handle_weights({{0}}, Eigen::VectorXd::Constant(1, 1e300), 16); },
-                     "weights[0] = 1e+300 is not a finite number in [0, 1e+12]");
+  expect_input_error(
+      [&] { checked_handle_weights({{0}}, Eigen::VectorXd::Constant(1, 1e300), 16); },
+      "weights[0] = 1e+300 is not a finite number in [0, 1e+12]");
 }
 
 }  // namespace

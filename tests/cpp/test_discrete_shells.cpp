@@ -12,11 +12,11 @@
 #include <string>
 
 #include "energy/discrete_shells.h"
+#include "finite_differences.h"
 #include "mesh/mesh_check.h"
 #include "mesh/mesh_topology.h"
 #include "mesh/normalization.h"
 #include "mesh/primitives.h"
-#include "finite_differences.h"
 #include "test_support.h"
 #include "util/errors.h"
 #include "util/math_constants.h"
@@ -33,7 +33,9 @@ using testing::random_vector;
 using testing::shared_mesh;
 using testing::side_by_side;
 
-Eigen::VectorXd flat(const RowMatrixX3d& X) { return Eigen::Map<const Eigen::VectorXd>(X.data(), X.size()); }
+Eigen::VectorXd flat(const RowMatrixX3d& X) {
+  return Eigen::Map<const Eigen::VectorXd>(X.data(), X.size());
+}
 
 Eigen::Matrix3d rotation(double angle, const Eigen::Vector3d& axis) {
   return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
@@ -95,7 +97,8 @@ std::vector<State> states(const RowMatrixX3d& V) {
 void check_derivatives(const TriangleMesh& mesh, const std::string& mesh_name) {
   const DiscreteShells energy(mesh.V, mesh.F);
   const Eigen::Index size = mesh.V.size();
-  const Eigen::VectorXd d = random_vector(size, 11), u = random_vector(size, 12), w = random_vector(size, 13);
+  const Eigen::VectorXd d = random_vector(size, 11), u = random_vector(size, 12),
+                        w = random_vector(size, 13);
   for (const State& state : states(mesh.V)) {
     const Eigen::VectorXd& x = state.x;
     const std::string where = mesh_name + ", " + state.name;
@@ -195,7 +198,8 @@ TEST(DiscreteShells, BendingTermIsThePapersFormula) {
   for (double phi : {0.1, 1.0, 2.5, kPi, 3.5, -2.0}) {
     RowMatrixX3d X = V;
     X.row(3) << 1.5, -0.7 * std::cos(phi), -0.7 * std::sin(phi);
-    const double expected = bending * 0.5 * 3 * edge_squared / area * std::pow(2 * std::sin(phi / 2), 2);
+    const double expected =
+        bending * 0.5 * 3 * edge_squared / area * std::pow(2 * std::sin(phi / 2), 2);
     EXPECT_NEAR(energy.value(flat(X)), expected, 1e-12 * expected) << "phi = " << phi;
   }
 }
@@ -209,7 +213,8 @@ TEST(DiscreteShells, MembraneTermsAreThePapersFormula) {
   const double membrane = 0.6, s = 1.3;
   const DiscreteShells energy(V, F, 1.0, membrane);
   const double perimeter = 3 + std::sqrt(8.0) + std::sqrt(5.0), area = 3;
-  const double expected = membrane * (0.5 * std::pow(s - 1, 2) * perimeter + 0.5 * std::pow(s * s - 1, 2) * area);
+  const double expected =
+      membrane * (0.5 * std::pow(s - 1, 2) * perimeter + 0.5 * std::pow(s * s - 1, 2) * area);
   EXPECT_NEAR(energy.value(flat(s * V)), expected, 1e-13 * expected);
   EXPECT_EQ(energy.term_counts().hinges, 0);
 }
@@ -237,7 +242,8 @@ TEST(DiscreteShells, DerivativesRotateWithTheMesh) {
   const Eigen::Matrix3d R = rotation(2.0, Eigen::Vector3d(-1, 0.5, 2));
   const Eigen::RowVector3d t(1, 7, -3);
   auto rotate = [&R](const Eigen::VectorXd& v) {
-    const RowMatrixX3d rows = Eigen::Map<const RowMatrixX3d>(v.data(), v.size() / 3, 3) * R.transpose();
+    const RowMatrixX3d rows =
+        Eigen::Map<const RowMatrixX3d>(v.data(), v.size() / 3, 3) * R.transpose();
     return flat(rows);
   };
   const RowMatrixX3d X = part_rotated(bunny.V);
@@ -291,7 +297,9 @@ TEST(DiscreteShells, RestHessianKernelIsSixRigidMotionsPerComponent) {
   expect_rigid_kernel(bar(1, 1, 3, 1.0, 1.0, 3.0), 1, "closed bar");
   expect_rigid_kernel(grid(4, 3, 2.0, 1.5), 1, "flat grid");
   expect_rigid_kernel(blob(), 1, "closed blob");
-  expect_rigid_kernel(side_by_side(cylinder(8, 3, 1.0, 3.0), cylinder(8, 3, 1.0, 3.0), Eigen::RowVector3d(5, 0, 0)), 2, "two disjoint cylinders");
+  expect_rigid_kernel(
+      side_by_side(cylinder(8, 3, 1.0, 3.0), cylinder(8, 3, 1.0, 3.0), Eigen::RowVector3d(5, 0, 0)),
+      2, "two disjoint cylinders");
 }
 
 // The projected Hessian: the exact one at rest (every term's Hessian is semidefinite there), and
@@ -309,30 +317,40 @@ TEST(DiscreteShells, ProjectedHessianIsSemidefiniteAndExactWhereTermsAre) {
   const Eigen::MatrixXd exact(energy.hessian(x)), projected(energy.projected_hessian(x));
   const double scale = exact.cwiseAbs().maxCoeff();
   EXPECT_EQ(projected, projected.transpose());
-  const Eigen::VectorXd exact_eigenvalues = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(exact).eigenvalues();
+  const Eigen::VectorXd exact_eigenvalues =
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(exact).eigenvalues();
   ASSERT_LT(exact_eigenvalues(0), -1e-3 * scale) << "the test needs an indefinite exact Hessian";
-  EXPECT_GE(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(projected).eigenvalues()(0), -1e-12 * scale);
+  EXPECT_GE(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(projected).eigenvalues()(0),
+            -1e-12 * scale);
 
   const DiscreteShells membrane(mesh.V, mesh.F, 0.0, 1.0);
-  const Eigen::MatrixXd membrane_exact(membrane.hessian(x)), membrane_projected(membrane.projected_hessian(x));
-  EXPECT_GE(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(membrane_projected - membrane_exact).eigenvalues()(0),
+  const Eigen::MatrixXd membrane_exact(membrane.hessian(x)),
+      membrane_projected(membrane.projected_hessian(x));
+  EXPECT_GE(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(membrane_projected - membrane_exact)
+                .eigenvalues()(0),
             -1e-12 * scale);
 
   const DiscreteShells bending(mesh.V, mesh.F, 1.0, 0.0);
-  const Eigen::VectorXd bent = rest + 0.03 * random_vector(rest.size(), 8);  // hinges bent well below 90°
-  const Eigen::MatrixXd bending_exact(bending.hessian(bent)), bending_projected(bending.projected_hessian(bent));
+  const Eigen::VectorXd bent =
+      rest + 0.03 * random_vector(rest.size(), 8);  // hinges bent well below 90°
+  const Eigen::MatrixXd bending_exact(bending.hessian(bent)),
+      bending_projected(bending.projected_hessian(bent));
   const double bending_scale = bending_exact.cwiseAbs().maxCoeff();
   for (int axis = 0; axis < 3; ++axis) {
     Eigen::VectorXd rotation(bent.size());  // ω × x for ω the axis
     for (Eigen::Index v = 0; v < bent.size() / 3; ++v)
-      rotation.segment<3>(3 * v) = Eigen::Vector3d::Unit(axis).cross(Eigen::Vector3d(bent.segment<3>(3 * v)));
-    EXPECT_LE((bending_projected * rotation).norm(), 1e-10 * bending_scale * rotation.norm()) << "axis " << axis;
-    EXPECT_GE((bending_exact * rotation).norm(), 1e-4 * bending_scale * rotation.norm()) << "axis " << axis;
+      rotation.segment<3>(3 * v) =
+          Eigen::Vector3d::Unit(axis).cross(Eigen::Vector3d(bent.segment<3>(3 * v)));
+    EXPECT_LE((bending_projected * rotation).norm(), 1e-10 * bending_scale * rotation.norm())
+        << "axis " << axis;
+    EXPECT_GE((bending_exact * rotation).norm(), 1e-4 * bending_scale * rotation.norm())
+        << "axis " << axis;
   }
 }
 
 // What `energy` returns at x is finite everywhere.
-void expect_finite_everywhere(const DiscreteShells& energy, const Eigen::VectorXd& x, const std::string& where) {
+void expect_finite_everywhere(const DiscreteShells& energy, const Eigen::VectorXd& x,
+                              const std::string& where) {
   const Eigen::Index size = x.size();
   Eigen::VectorXd gradient(size);
   EXPECT_TRUE(std::isfinite(energy.value(x))) << where;
@@ -348,12 +366,14 @@ void expect_finite_everywhere(const DiscreteShells& energy, const Eigen::VectorX
 }
 
 // The term counts the rules in discrete_shells.h give, from the topology.
-void expect_terms_per_rules(const TriangleMesh& mesh, const DiscreteShells& energy, const std::string& name) {
+void expect_terms_per_rules(const TriangleMesh& mesh, const DiscreteShells& energy,
+                            const std::string& name) {
   const MeshTopology topology = build_topology(mesh.V, mesh.F);
   int triangles = 0, hinges = 0;
   for (int f = 0; f < mesh.F.rows(); ++f) triangles += !is_degenerate_face(mesh.V, mesh.F, f);
   for (const Hinge& hinge : topology.hinges)
-    hinges += !is_degenerate_face(mesh.V, mesh.F, hinge.faces[0]) && !is_degenerate_face(mesh.V, mesh.F, hinge.faces[1]);
+    hinges += !is_degenerate_face(mesh.V, mesh.F, hinge.faces[0]) &&
+              !is_degenerate_face(mesh.V, mesh.F, hinge.faces[1]);
   EXPECT_EQ(energy.term_counts().triangles, triangles) << name;
   EXPECT_EQ(energy.term_counts().hinges, hinges) << name;
 }
@@ -390,7 +410,8 @@ TEST(DiscreteShells, SharedDragonsGiveFiniteResults) {
 TriangleMesh awkward_mesh() {
   TriangleMesh mesh;
   mesh.V.resize(8, 3);
-  mesh.V << 0, 0, 0, 1, 0, 0, 0.5, 1, 0, 0.5, -1, 0, 0.5, 0, 1, 0.5, 0.7, 0.7, 0.75, 0.5, 0, 0.5, 0.7, 0.7;
+  mesh.V << 0, 0, 0, 1, 0, 0, 0.5, 1, 0, 0.5, -1, 0, 0.5, 0, 1, 0.5, 0.7, 0.7, 0.75, 0.5, 0, 0.5,
+      0.7, 0.7;
   mesh.F.resize(7, 3);
   mesh.F << 0, 1, 2, 1, 0, 3, 0, 1, 4, 0, 1, 5, 1, 2, 6, 2, 2, 3, 5, 7, 0;
   return mesh;
@@ -433,11 +454,13 @@ TEST(DiscreteShells, CollapsedElementsKeepEverythingFinite) {
   // Only the membrane terms remain (every hinge has collapsed); their values are the exact ones.
   double membrane = 0;
   for (int f = 0; f < tube.F.rows(); ++f) {
-    const Eigen::Vector3d a = tube.V.row(tube.F(f, 0)), b = tube.V.row(tube.F(f, 1)), c = tube.V.row(tube.F(f, 2));
+    const Eigen::Vector3d a = tube.V.row(tube.F(f, 0)), b = tube.V.row(tube.F(f, 1)),
+                          c = tube.V.row(tube.F(f, 2));
     const double area = 0.5 * (b - a).cross(c - a).norm();
     membrane += 0.5 * area;  // ½ (0 − Ā)² / Ā
   }
-  for (const auto& [a, b] : build_topology(tube.V, tube.F).edges) membrane += 0.5 * (tube.V.row(a) - tube.V.row(b)).norm();
+  for (const auto& [a, b] : build_topology(tube.V, tube.F).edges)
+    membrane += 0.5 * (tube.V.row(a) - tube.V.row(b)).norm();
   EXPECT_NEAR(energy.value(point), membrane, 1e-12 * membrane);
 }
 
@@ -455,9 +478,11 @@ TEST(DiscreteShells, WeightsScaleTheirTermsLinearly) {
   EXPECT_GT(em, 0);
   EXPECT_NEAR(e, 2.5 * eb + 0.3 * em, 1e-13 * e);
   EXPECT_LT((g - (2.5 * gb + 0.3 * gm)).norm(), 1e-13 * g.norm());
-  const Eigen::VectorXd h = both.hessian(x) * u, hb = bending.hessian(x) * u, hm = membrane.hessian(x) * u;
+  const Eigen::VectorXd h = both.hessian(x) * u, hb = bending.hessian(x) * u,
+                        hm = membrane.hessian(x) * u;
   EXPECT_LT((h - (2.5 * hb + 0.3 * hm)).norm(), 1e-13 * h.norm());
-  const Eigen::VectorXd t = both.third(x, u, w), tb = bending.third(x, u, w), tm = membrane.third(x, u, w);
+  const Eigen::VectorXd t = both.third(x, u, w), tb = bending.third(x, u, w),
+                        tm = membrane.third(x, u, w);
   EXPECT_LT((t - (2.5 * tb + 0.3 * tm)).norm(), 1e-13 * t.norm());
 }
 
@@ -482,11 +507,14 @@ TEST(DiscreteShells, PaintedStiffnessScalesEachElementByItsVerticesMeanWeight) {
   EXPECT_EQ(one.value(far), plain.value(far));
   EXPECT_GT(one.value(near), 5.0 * plain.value(near));
   EXPECT_LT(one.value(near), 40.0 * plain.value(near));
-  expect_input_error([&] { DiscreteShells(tube.V, tube.F, 1, 1, {Eigen::VectorXd::Zero(n - 1), 2.0}); },
-                     "stiffness_weights: expected one weight per vertex");
+  expect_input_error(
+      [&] { DiscreteShells(tube.V, tube.F, 1, 1, {Eigen::VectorXd::Zero(n - 1), 2.0}); },
+      "stiffness_weights: expected one weight per vertex");
   weights[4] = -1e-3;
-  expect_input_error([&] { DiscreteShells(tube.V, tube.F, 1, 1, {weights, 2.0}); }, "stiffness_weights[4]");
-  expect_input_error([&] { DiscreteShells(tube.V, tube.F, 1, 1, {Eigen::VectorXd(), 0.9}); }, "max_stiffness");
+  expect_input_error([&] { DiscreteShells(tube.V, tube.F, 1, 1, {weights, 2.0}); },
+                     "stiffness_weights[4]");
+  expect_input_error([&] { DiscreteShells(tube.V, tube.F, 1, 1, {Eigen::VectorXd(), 0.9}); },
+                     "max_stiffness");
 }
 
 // Each vertex sums its contributions in element order however many threads share the work.
@@ -505,7 +533,8 @@ TEST(DiscreteShells, ResultsDoNotDependOnTheNumberOfThreads) {
   RowMatrixX3d crushed = part_rotated(dragon.V);
   for (int f = 0; f < dragon.F.rows(); f += 50) {
     const Eigen::RowVector3d a = crushed.row(dragon.F(f, 0)), b = crushed.row(dragon.F(f, 1));
-    crushed.row(dragon.F(f, 2)) = f % 100 ? a : 0.95 * (0.5 * (a + b)) + 0.05 * crushed.row(dragon.F(f, 2));
+    crushed.row(dragon.F(f, 2)) =
+        f % 100 ? a : 0.95 * (0.5 * (a + b)) + 0.05 * crushed.row(dragon.F(f, 2));
   }
   for (const Eigen::VectorXd& at : {x, flat(crushed)}) {
     Eigen::VectorXd gs(size), gp(size);
@@ -544,7 +573,8 @@ TEST(DiscreteShells, BadInputIsRefusedWithItsName) {
   expect_input_error([&] { energy.value_and_gradient(energy.rest(), short_gradient); }, "gradient");
   Eigen::MatrixXd Phi = Eigen::MatrixXd::Ones(size, 3);
   expect_input_error([&] { energy.third_batch(energy.rest(), Phi, {{0, 1}, {2, 3}}); }, "pairs[1]");
-  expect_input_error([&] { energy.third_batch(energy.rest(), Phi.topRows(size - 1), {{0, 1}}); }, "Phi");
+  expect_input_error([&] { energy.third_batch(energy.rest(), Phi.topRows(size - 1), {{0, 1}}); },
+                     "Phi");
   Phi(4, 2) = INFINITY;
   expect_input_error([&] { energy.third_batch(energy.rest(), Phi, {{0, 1}}); }, "Phi[4, 2]");
 }

@@ -9,12 +9,12 @@
 #include <string>
 #include <vector>
 
+#include "mesh/edge_collapse.h"
 #include "mesh/mass.h"
 #include "mesh/mesh_check.h"
 #include "mesh/mesh_topology.h"
 #include "mesh/primitives.h"
 #include "mesh/union_find.h"
-#include "mesh/edge_collapse.h"
 #include "reduction/ghost.h"
 #include "test_support.h"
 #include "util/errors.h"
@@ -57,11 +57,13 @@ void expect_valid_ghost(const TriangleMesh& fine, const Eigen::VectorXd& mass, c
   std::vector<int> size(g, 0);
   std::vector<double> cluster_mass(g, 0.0);
   for (int i = 0; i < n; ++i) {
-    ASSERT_TRUE(ghost.map[i] >= 0 && ghost.map[i] < g) << "fine vertex " << i << " maps to " << ghost.map[i];
+    ASSERT_TRUE(ghost.map[i] >= 0 && ghost.map[i] < g)
+        << "fine vertex " << i << " maps to " << ghost.map[i];
     ++size[ghost.map[i]];
     cluster_mass[ghost.map[i]] += mass[i];
   }
-  for (int s = 0; s < g; ++s) ASSERT_GT(size[s], 0) << "ghost vertex " << s << " has no fine vertex";
+  for (int s = 0; s < g; ++s)
+    ASSERT_GT(size[s], 0) << "ghost vertex " << s << " has no fine vertex";
 
   RowMatrixX3d centroid = RowMatrixX3d::Zero(g, 3);
   for (int i = 0; i < n; ++i) {
@@ -78,7 +80,8 @@ void expect_valid_ghost(const TriangleMesh& fine, const Eigen::VectorXd& mass, c
   std::map<std::array<int, 3>, int> face_of;
   for (int f = 0; f < ghost.F.rows(); ++f) {
     EXPECT_FALSE(is_degenerate_face(ghost.V, ghost.F, f)) << "ghost face " << f;
-    EXPECT_TRUE(face_of.emplace(sorted_triple(ghost.F(f, 0), ghost.F(f, 1), ghost.F(f, 2)), f).second)
+    EXPECT_TRUE(
+        face_of.emplace(sorted_triple(ghost.F(f, 0), ghost.F(f, 1), ghost.F(f, 2)), f).second)
         << "duplicate ghost face " << f;
   }
   std::vector<Eigen::Vector3d> ancestors(ghost.F.rows(), Eigen::Vector3d::Zero());
@@ -88,12 +91,14 @@ void expect_valid_ghost(const TriangleMesh& fine, const Eigen::VectorXd& mass, c
         sorted_triple(ghost.map[fine.F(f, 0)], ghost.map[fine.F(f, 1)], ghost.map[fine.F(f, 2)]));
     if (it == face_of.end()) continue;
     ancestors[it->second] += face_normal(fine.V, fine.F, f);
-    worst_ancestor[it->second] = std::min(worst_ancestor[it->second], face_quality(fine.V, fine.F, f));
+    worst_ancestor[it->second] =
+        std::min(worst_ancestor[it->second], face_quality(fine.V, fine.F, f));
   }
   int flipped = 0, needles = 0;
   for (int f = 0; f < ghost.F.rows(); ++f) {
     flipped += !(face_normal(ghost.V, ghost.F, f).dot(ancestors[f]) > 0);
-    needles += face_quality(ghost.V, ghost.F, f) < std::min(kMinFaceQuality, worst_ancestor[f]) - 1e-6;
+    needles +=
+        face_quality(ghost.V, ghost.F, f) < std::min(kMinFaceQuality, worst_ancestor[f]) - 1e-6;
   }
   EXPECT_EQ(flipped, 0) << "of " << ghost.F.rows() << " ghost faces";
   EXPECT_EQ(needles, 0) << "of " << ghost.F.rows() << " ghost faces";
@@ -109,10 +114,12 @@ void expect_agrees_with_region_normals(const TriangleMesh& fine, const Ghost& gh
     for (int k = 0; k < 3; ++k) faces_around[ghost.F(f, k)].push_back(f);
   std::vector<Eigen::Vector3d> region(ghost.F.rows(), Eigen::Vector3d::Zero());
   for (int f = 0; f < fine.F.rows(); ++f) {
-    const std::set<int> clusters{ghost.map[fine.F(f, 0)], ghost.map[fine.F(f, 1)], ghost.map[fine.F(f, 2)]};
+    const std::set<int> clusters{ghost.map[fine.F(f, 0)], ghost.map[fine.F(f, 1)],
+                                 ghost.map[fine.F(f, 2)]};
     for (int h : faces_around[*clusters.begin()]) {
       bool inside = true;
-      for (int s : clusters) inside &= ghost.F(h, 0) == s || ghost.F(h, 1) == s || ghost.F(h, 2) == s;
+      for (int s : clusters)
+        inside &= ghost.F(h, 0) == s || ghost.F(h, 1) == s || ghost.F(h, 2) == s;
       if (inside) region[h] += face_normal(fine.V, fine.F, f);
     }
   }
@@ -142,7 +149,8 @@ int count_boundary_loops(const TriangleMesh& mesh) {
 std::vector<char> boundary_vertices(const TriangleMesh& mesh) {
   const MeshTopology topology = build_topology(mesh.V, mesh.F);
   std::vector<char> on_boundary(mesh.V.rows(), 0);
-  for (int e : topology.boundary_edges) on_boundary[topology.edges[e][0]] = on_boundary[topology.edges[e][1]] = 1;
+  for (int e : topology.boundary_edges)
+    on_boundary[topology.edges[e][0]] = on_boundary[topology.edges[e][1]] = 1;
   return on_boundary;
 }
 
@@ -157,16 +165,19 @@ void expect_topology_kept(const TriangleMesh& fine, int target) {
   EXPECT_EQ(ghost.V.rows(), target);
   const TriangleMesh coarse{ghost.V, ghost.F};
   EXPECT_EQ(euler_characteristic(coarse), euler_characteristic(fine));
-  EXPECT_EQ(build_topology(coarse.V, coarse.F).num_components, build_topology(fine.V, fine.F).num_components);
+  EXPECT_EQ(build_topology(coarse.V, coarse.F).num_components,
+            build_topology(fine.V, fine.F).num_components);
   EXPECT_EQ(build_topology(coarse.V, coarse.F).nonmanifold_edges.size(), 0u);
   EXPECT_EQ(count_boundary_loops(coarse), count_boundary_loops(fine));
-  const std::vector<char> fine_boundary = boundary_vertices(fine), coarse_boundary = boundary_vertices(coarse);
+  const std::vector<char> fine_boundary = boundary_vertices(fine),
+                          coarse_boundary = boundary_vertices(coarse);
   for (int i = 0; i < fine.V.rows(); ++i)
     ASSERT_EQ(fine_boundary[i], coarse_boundary[ghost.map[i]]) << "fine vertex " << i;
 }
 
 TriangleMesh two_cylinders() {
-  return testing::side_by_side(cylinder(24, 20, 1.0, 4.0), cylinder(16, 30, 0.5, 6.0), Eigen::RowVector3d(3, 0, 0));
+  return testing::side_by_side(cylinder(24, 20, 1.0, 4.0), cylinder(16, 30, 0.5, 6.0),
+                               Eigen::RowVector3d(3, 0, 0));
 }
 
 // A bumpy plane with what scans contain: coincident vertices (zero-area faces), a face with a
@@ -216,7 +227,8 @@ TEST(Ghost, FacesAgreeWithTheNormalsOfTheRegionTheyCover) {
                                                         {cylinder(32, 30, 1.0, 6.0), 200},
                                                         {bumpy_plane(40, 10.0, 12, 1.0), 300}};
   for (const auto& [mesh, target] : cases)
-    expect_agrees_with_region_normals(mesh, ghost_mesh(mesh.V, mesh.F, lumped_mass(mesh.V, mesh.F), target));
+    expect_agrees_with_region_normals(
+        mesh, ghost_mesh(mesh.V, mesh.F, lumped_mass(mesh.V, mesh.F), target));
 }
 
 // A region bake's proxy: a bumpy plane split by the line x = 0 into sides that never merge, and
@@ -228,7 +240,8 @@ TEST(Ghost, SidesStayApartAndTheLineBetweenThemStays) {
   const Eigen::VectorXd mass = lumped_mass(plane.V, plane.F);
   const double column = 10.0 / 40;
   std::vector<char> sides(static_cast<size_t>(plane.V.rows()));
-  for (Eigen::Index i = 0; i < plane.V.rows(); ++i) sides[static_cast<size_t>(i)] = plane.V(i, 0) > 1e-9;
+  for (Eigen::Index i = 0; i < plane.V.rows(); ++i)
+    sides[static_cast<size_t>(i)] = plane.V(i, 0) > 1e-9;
   const Ghost ghost = ghost_mesh(plane.V, plane.F, mass, 150, nullptr, sides);
   expect_valid_ghost(plane, mass, ghost);
   EXPECT_LE(ghost.V.rows(), 160);
@@ -246,10 +259,12 @@ TEST(Ghost, SidesStayApartAndTheLineBetweenThemStays) {
     if (!on_line[c]) continue;
     ++line_clusters;
     const double x = ghost.V(static_cast<Eigen::Index>(c), 0);
-    EXPECT_TRUE(std::abs(x) < 1e-9 || std::abs(x - column) < 1e-9) << "ghost vertex " << c << " at x " << x;
+    EXPECT_TRUE(std::abs(x) < 1e-9 || std::abs(x - column) < 1e-9)
+        << "ghost vertex " << c << " at x " << x;
   }
   EXPECT_GT(line_clusters, 4);
-  EXPECT_THROW(ghost_mesh(plane.V, plane.F, mass, 150, nullptr, std::vector<char>(3, 0)), InputError);
+  EXPECT_THROW(ghost_mesh(plane.V, plane.F, mass, 150, nullptr, std::vector<char>(3, 0)),
+               InputError);
 }
 
 class GhostOfDragon : public ::testing::TestWithParam<std::pair<std::string, int>> {};
@@ -288,9 +303,10 @@ TEST(Ghost, MessyInputGivesACleanGhost) {
 
 // A 30 by 30 grid of side 1 with a fin of no thickness standing on its middle row: 3 rows of
 // quads, 0.003 high each (a tenth of the grid's spacing), on the same vertices on both sides, cut
-// along one diagonal on the front and the other on the back. So tests/support/subdivision.split_edges cuts
-// the two copies of a scan's double-sheet face, and so the dragon refined to 3.2M vertices is full
-// of them. (#V = 961 grid vertices, then the fin's, row after row.)
+// along one diagonal on the front and the other on the back. So
+// tests/support/subdivision.split_edges cuts the two copies of a scan's double-sheet face, and so
+// the dragon refined to 3.2M vertices is full of them. (#V = 961 grid vertices, then the fin's, row
+// after row.)
 TriangleMesh grid_with_a_fin(int* first_fin_vertex) {
   const TriangleMesh plane = grid(30, 30, 1.0, 1.0);
   constexpr int kColumns = 31, kRows = 3;
@@ -302,7 +318,8 @@ TriangleMesh grid_with_a_fin(int* first_fin_vertex) {
   mesh.V.resize(n + kRows * kColumns, 3);
   mesh.V.topRows(n) = plane.V;
   for (int r = 1; r <= kRows; ++r)
-    for (int i = 0; i < kColumns; ++i) mesh.V.row(fin(i, r)) = plane.V.row(base(i)) + Eigen::RowVector3d(0, 0, r * kHeight);
+    for (int i = 0; i < kColumns; ++i)
+      mesh.V.row(fin(i, r)) = plane.V.row(base(i)) + Eigen::RowVector3d(0, 0, r * kHeight);
   std::vector<int> faces(plane.F.data(), plane.F.data() + plane.F.size());
   for (int r = 0; r < kRows; ++r)
     for (int i = 0; i + 1 < kColumns; ++i) {
@@ -310,7 +327,8 @@ TriangleMesh grid_with_a_fin(int* first_fin_vertex) {
       faces.insert(faces.end(), {a, b, c, a, c, d});  // the front, cut along ac
       faces.insert(faces.end(), {a, d, b, b, d, c});  // the back, reversed, cut along bd
     }
-  mesh.F = Eigen::Map<const RowMatrixX3i>(faces.data(), static_cast<Eigen::Index>(faces.size() / 3), 3);
+  mesh.F =
+      Eigen::Map<const RowMatrixX3i>(faces.data(), static_cast<Eigen::Index>(faces.size() / 3), 3);
   *first_fin_vertex = n;
   return mesh;
 }
@@ -331,7 +349,8 @@ TEST(Ghost, ASheetOfNoThicknessCutTwoWaysCollapsesAndCancels) {
   for (Eigen::Index i = 0; i < ghost.map.size(); ++i) ++size[ghost.map[i]];
   int alone = 0;
   for (Eigen::Index i = first_fin_vertex; i < mesh.V.rows(); ++i) alone += size[ghost.map[i]] == 1;
-  EXPECT_EQ(alone, 0) << "of " << mesh.V.rows() - first_fin_vertex << " fin vertices are clusters of their own";
+  EXPECT_EQ(alone, 0) << "of " << mesh.V.rows() - first_fin_vertex
+                      << " fin vertices are clusters of their own";
 }
 
 TEST(Ghost, UnreferencedVerticesJoinTheNearestGhostVertex) {
@@ -359,7 +378,8 @@ TEST(Ghost, NearestFineVertexIsTheClosestOfThoseCollapsedOntoIt) {
         ASSERT_LE(distance, (plane.V.row(i) - ghost.V.row(g)).norm()) << "ghost vertex " << g;
       }
   }
-  expect_input_error([&] { nearest_fine_vertex(ghost, plane.V, static_cast<int>(ghost.V.rows())); }, "g");
+  expect_input_error([&] { nearest_fine_vertex(ghost, plane.V, static_cast<int>(ghost.V.rows())); },
+                     "g");
   expect_input_error([&] { nearest_fine_vertex(ghost, plane.V.topRows(10), 0); }, "fine_V");
 }
 
@@ -378,7 +398,8 @@ TEST(Ghost, TargetOfAtLeastTheVertexCountGivesTheMeshItself) {
   const Ghost ghost = ghost_mesh(dragon.V, dragon.F, mass, static_cast<int>(dragon.V.rows()));
   EXPECT_EQ(ghost.V, dragon.V);
   EXPECT_EQ(ghost.F, dragon.F);
-  EXPECT_EQ(ghost.map, Eigen::VectorXi::LinSpaced(dragon.V.rows(), 0, static_cast<int>(dragon.V.rows()) - 1));
+  EXPECT_EQ(ghost.map,
+            Eigen::VectorXi::LinSpaced(dragon.V.rows(), 0, static_cast<int>(dragon.V.rows()) - 1));
 }
 
 // The 6 rigid motions of the fine mesh as columns: translations along x, y, z and linearised
@@ -445,11 +466,13 @@ TEST(Ghost, ProgressIsReportedOftenAndCancelStopsIt) {
   const TriangleMesh& dragon = shared_mesh("dragon_vrip_res3.ply.gz");
   const Eigen::VectorXd mass = lumped_mass(dragon.V, dragon.F);
   std::vector<double> fractions;
-  Progress every_report([&](const std::string& stage, double fraction) {
-    EXPECT_EQ(stage, "ghost");
-    fractions.push_back(fraction);
-    return true;
-  }, 0.0);
+  Progress every_report(
+      [&](const std::string& stage, double fraction) {
+        EXPECT_EQ(stage, "ghost");
+        fractions.push_back(fraction);
+        return true;
+      },
+      0.0);
   ghost_mesh(dragon.V, dragon.F, mass, 1000, &every_report);
   ASSERT_GE(fractions.size(), 50u);  // at most kReportInterval heap pops apart
   EXPECT_TRUE(std::is_sorted(fractions.begin(), fractions.end()));
@@ -474,11 +497,14 @@ TEST(Ghost, BadInputIsRefusedNamingIt) {
   expect_input_error([&] { ghost_mesh(mesh.V, folded, mass, 10); }, "F: no triangle");
 
   Eigen::VectorXi map = Eigen::VectorXi::Zero(25);
-  expect_input_error([&] { restrict_to_ghost(map, 1, mass, Eigen::MatrixXd::Zero(74, 2)); }, "U: expected 75");
+  expect_input_error([&] { restrict_to_ghost(map, 1, mass, Eigen::MatrixXd::Zero(74, 2)); },
+                     "U: expected 75");
   map[4] = 2;
-  expect_input_error([&] { restrict_to_ghost(map, 2, mass, Eigen::MatrixXd::Zero(75, 2)); }, "map[4]");
+  expect_input_error([&] { restrict_to_ghost(map, 2, mass, Eigen::MatrixXd::Zero(75, 2)); },
+                     "map[4]");
   map[4] = 0;
-  expect_input_error([&] { restrict_to_ghost(map, 2, mass, Eigen::MatrixXd::Zero(75, 2)); }, "ghost vertex 1");
+  expect_input_error([&] { restrict_to_ghost(map, 2, mass, Eigen::MatrixXd::Zero(75, 2)); },
+                     "ghost vertex 1");
   Eigen::MatrixXd U = Eigen::MatrixXd::Zero(75, 2);
   U(9, 1) = std::numeric_limits<double>::infinity();
   expect_input_error([&] { restrict_to_ghost(map, 1, mass, U); }, "U[9, 1]");

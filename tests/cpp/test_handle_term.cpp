@@ -3,8 +3,8 @@
 #include <cmath>
 #include <string>
 
-#include "solve/handle_term.h"
 #include "finite_differences.h"
+#include "solve/handle_term.h"
 #include "test_posing.h"
 #include "test_support.h"
 #include "util/errors.h"
@@ -17,15 +17,17 @@ using testing::expect_slope_matches;
 using testing::rigid_transform;
 
 // μs⁴ Σ_h w_h Σ_{i∈h} m_i ‖x̄_i + U_i q − R_h x̄_i − t_h‖², summed over the handle vertices.
-double direct_handle_term(const RowMatrixX3d& rest, const Eigen::VectorXd& mass, const RowMatrixXf& U,
-                          const Handles& handles, const Eigen::VectorXd& weights, const Transforms& T,
-                          double coefficient, const Eigen::VectorXd& q) {
+double direct_handle_term(const RowMatrixX3d& rest, const Eigen::VectorXd& mass,
+                          const RowMatrixXf& U, const Handles& handles,
+                          const Eigen::VectorXd& weights, const Transforms& T, double coefficient,
+                          const Eigen::VectorXd& q) {
   const Eigen::VectorXd displacement = U.cast<double>() * q;
   double sum = 0;
   for (size_t h = 0; h < handles.size(); ++h)
     for (int v : handles[h]) {
       const Eigen::Vector3d x = rest.row(v).transpose() + displacement.segment<3>(3 * v);
-      const Eigen::Vector3d target = T[h].topLeftCorner<3, 3>() * rest.row(v).transpose() + T[h].topRightCorner<3, 1>();
+      const Eigen::Vector3d target =
+          T[h].topLeftCorner<3, 3>() * rest.row(v).transpose() + T[h].topRightCorner<3, 1>();
       sum += coefficient * weights[h] * mass[v] * (x - target).squaredNorm();
     }
   return sum;
@@ -37,9 +39,11 @@ VertexRows rows_of(const RowMatrixXf& U) {
 }
 
 // The reduced term of `setup`-like arguments: the fine term restricted to x̄ + U q.
-ReducedHandleTerm reduced(const RowMatrixX3d& rest, const Eigen::VectorXd& mass, const RowMatrixXf& U,
-                          const Handles& handles, const Eigen::VectorXd& weights, double coefficient) {
-  return ReducedHandleTerm(HandleTerm(rest, mass, handles, weights, coefficient), rows_of(U), U.cols());
+ReducedHandleTerm reduced(const RowMatrixX3d& rest, const Eigen::VectorXd& mass,
+                          const RowMatrixXf& U, const Handles& handles,
+                          const Eigen::VectorXd& weights, double coefficient) {
+  return ReducedHandleTerm(HandleTerm(rest, mass, handles, weights, coefficient), rows_of(U),
+                           U.cols());
 }
 
 struct Handled {
@@ -58,25 +62,28 @@ struct Handled {
     mass = Eigen::VectorXd::Random(12).cwiseAbs();
     U = RowMatrixXf::Random(36, 5);
     transforms = {rigid_transform({1, 2, 3}, 0.7, {1000, 0, 0}, {3, -2, 1}),
-                  rigid_transform({0, 0, 1}, -2.9, {1010, 5, 0}, {0, 0, 0}), Eigen::Matrix4d::Identity()};
+                  rigid_transform({0, 0, 1}, -2.9, {1010, 5, 0}, {0, 0, 0}),
+                  Eigen::Matrix4d::Identity()};
   }
 };
 
 TEST(ReducedHandleTerm, EqualsTheSumOverHandleVertices) {
   const Handled setup;
-  ReducedHandleTerm term = reduced(setup.rest, setup.mass, setup.U, setup.handles, setup.weights, setup.coefficient);
+  ReducedHandleTerm term =
+      reduced(setup.rest, setup.mass, setup.U, setup.handles, setup.weights, setup.coefficient);
   term.set_transforms(setup.transforms);
   for (int trial = 0; trial < 3; ++trial) {
     const Eigen::VectorXd q = 10 * Eigen::VectorXd::Random(5);
-    const double expected = direct_handle_term(setup.rest, setup.mass, setup.U, setup.handles, setup.weights,
-                                               setup.transforms, setup.coefficient, q);
+    const double expected =
+        direct_handle_term(setup.rest, setup.mass, setup.U, setup.handles, setup.weights,
+                           setup.transforms, setup.coefficient, q);
     Eigen::VectorXd gradient(5);
     EXPECT_NEAR(term.value_and_gradient(q, gradient), expected, 1e-10 * expected);
     const Eigen::VectorXd d = Eigen::VectorXd::Random(5);
     expect_slope_matches(
         [&](const Eigen::VectorXd& p) {
-          return direct_handle_term(setup.rest, setup.mass, setup.U, setup.handles, setup.weights, setup.transforms,
-                                    setup.coefficient, p);
+          return direct_handle_term(setup.rest, setup.mass, setup.U, setup.handles, setup.weights,
+                                    setup.transforms, setup.coefficient, p);
         },
         q, d, gradient.dot(d), "reduced handle term");
     // ∇E_C(q) − ∇E_C(0) = 2A q.
@@ -94,8 +101,8 @@ TEST(HandleTerm, OnTheFineMeshEqualsTheSumAndItsDerivatives) {
   term.set_transforms(setup.transforms);
   const Eigen::VectorXd q = 10 * Eigen::VectorXd::Random(5);
   const Eigen::VectorXd x = flatten(setup.rest) + setup.U.cast<double>() * q;
-  const double expected = direct_handle_term(setup.rest, setup.mass, setup.U, setup.handles, setup.weights,
-                                             setup.transforms, setup.coefficient, q);
+  const double expected = direct_handle_term(setup.rest, setup.mass, setup.U, setup.handles,
+                                             setup.weights, setup.transforms, setup.coefficient, q);
   const Eigen::VectorXd offset = Eigen::VectorXd::Random(36);
   Eigen::VectorXd gradient = offset;
   EXPECT_NEAR(term.add_value_and_gradient(x, gradient), expected, 1e-10 * expected);
@@ -116,7 +123,8 @@ TEST(HandleTerm, OnTheFineMeshEqualsTheSumAndItsDerivatives) {
   restricted.set_transforms(setup.transforms);
   Eigen::VectorXd reduced_gradient(5);
   EXPECT_NEAR(restricted.value_and_gradient(q, reduced_gradient), expected, 1e-10 * expected);
-  EXPECT_LE((reduced_gradient - setup.U.cast<double>().transpose() * gradient).norm(), 1e-8 * gradient.norm());
+  EXPECT_LE((reduced_gradient - setup.U.cast<double>().transpose() * gradient).norm(),
+            1e-8 * gradient.norm());
 }
 
 TEST(ReducedHandleTerm, LargeHandlesAreSummedInBlocks) {
@@ -139,7 +147,8 @@ TEST(ReducedHandleTerm, LargeHandlesAreSummedInBlocks) {
 
 TEST(ReducedHandleTerm, ZeroAtRestWithIdentityTransformsAndPositiveAfterAMove) {
   const Handled setup;
-  ReducedHandleTerm term = reduced(setup.rest, setup.mass, setup.U, setup.handles, setup.weights, setup.coefficient);
+  ReducedHandleTerm term =
+      reduced(setup.rest, setup.mass, setup.U, setup.handles, setup.weights, setup.coefficient);
   Eigen::VectorXd gradient(5);
   EXPECT_EQ(term.value_and_gradient(Eigen::VectorXd::Zero(5), gradient), 0.0);
   EXPECT_EQ(gradient.norm(), 0.0);
@@ -163,10 +172,14 @@ TEST(HandleTerm, HandlesAreValidated) {
   expect_input_error([&] { checked_handle_weights({{1}, {}}, none, 10); }, "handles[1] is empty");
   expect_input_error([&] { checked_handle_weights({{1, 10}}, none, 10); }, "handles[0][1] = 10");
   expect_input_error([&] { checked_handle_weights({{1, -1}}, none, 10); }, "handles[0][1] = -1");
-  expect_input_error([&] { checked_handle_weights({{2}, {1, 4, 1}}, none, 10); }, "handles[1] lists vertex 1 twice");
-  expect_input_error([&] { checked_handle_weights({{1}, {2}}, Eigen::VectorXd::Ones(3), 10); }, "weights");
-  expect_input_error([&] { checked_handle_weights({{1}, {2}}, Eigen::Vector2d(1, -1), 10); }, "weights[1]");
-  EXPECT_EQ(checked_handle_weights({{1}, {1, 2}}, none, 10), Eigen::Vector2d(1, 1));  // overlap is fine
+  expect_input_error([&] { checked_handle_weights({{2}, {1, 4, 1}}, none, 10); },
+                     "handles[1] lists vertex 1 twice");
+  expect_input_error([&] { checked_handle_weights({{1}, {2}}, Eigen::VectorXd::Ones(3), 10); },
+                     "weights");
+  expect_input_error([&] { checked_handle_weights({{1}, {2}}, Eigen::Vector2d(1, -1), 10); },
+                     "weights[1]");
+  EXPECT_EQ(checked_handle_weights({{1}, {1, 2}}, none, 10),
+            Eigen::Vector2d(1, 1));  // overlap is fine
   EXPECT_EQ(checked_handle_weights({{1}, {2}}, Eigen::Vector2d(0, 3), 10), Eigen::Vector2d(0, 3));
 }
 

@@ -25,7 +25,8 @@ TEST(LoadSchedule, IncrementsFollowHowHardTheLastStepWas) {
   schedule.advance(schedule.next(false), 1, false);
   EXPECT_DOUBLE_EQ(schedule.next(false) - schedule.load(), 0.25 / 12);  // tolerance missed: halved
   EXPECT_EQ(schedule.next(true), 1.0);  // no iterations left: the full load
-  for (int step = 0; step < 200 && !schedule.done(); ++step) schedule.advance(schedule.next(false), 1, true);
+  for (int step = 0; step < 200 && !schedule.done(); ++step)
+    schedule.advance(schedule.next(false), 1, true);
   EXPECT_TRUE(schedule.done());
   EXPECT_EQ(schedule.load(), 1.0);
 
@@ -43,16 +44,19 @@ TEST(LoadPath, TurnsAboutTheHandleCentreByTheFraction) {
   V << 0, 0, 0, 2, 0, 0, 0, 2, 0, 2, 2, 10;
   const Handles handles = {{0, 1, 2}};  // centre (2/3, 2/3, 0)
   const double pi = kPi;
-  const Eigen::Matrix4d T = rigid_transform({0, 0, 1}, 2 * pi / 3, {2.0 / 3, 2.0 / 3, 0}, {0, 0, 0.1});
+  const Eigen::Matrix4d T =
+      rigid_transform({0, 0, 1}, 2 * pi / 3, {2.0 / 3, 2.0 / 3, 0}, {0, 0, 0.1});
   const LoadPath path(V, handles, {T});
   EXPECT_EQ(path.suggested_steps(), 4);
   EXPECT_EQ(path.at(1.0)[0], T);
   const Eigen::Matrix4d half = path.at(0.5)[0];
   const Eigen::Vector3d centre(2.0 / 3, 2.0 / 3, 0);
-  EXPECT_LE((half.topLeftCorner<3, 3>() * centre + half.topRightCorner<3, 1>() - (centre + Eigen::Vector3d(0, 0, 0.05)))
+  EXPECT_LE((half.topLeftCorner<3, 3>() * centre + half.topRightCorner<3, 1>() -
+             (centre + Eigen::Vector3d(0, 0, 0.05)))
                 .norm(),
             1e-12);
-  EXPECT_NEAR(Eigen::AngleAxisd(Eigen::Matrix3d(half.topLeftCorner<3, 3>())).angle(), pi / 3, 1e-12);
+  EXPECT_NEAR(Eigen::AngleAxisd(Eigen::Matrix3d(half.topLeftCorner<3, 3>())).angle(), pi / 3,
+              1e-12);
 }
 
 }  // namespace

@@ -120,7 +120,8 @@ TEST(Mesh, BarFacesPointOutwards) {
   // Divergence theorem: the signed volume equals the box volume only if every face points out.
   double volume = 0;
   for (int f = 0; f < mesh.F.rows(); ++f) {
-    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)),
+                          c = mesh.V.row(mesh.F(f, 2));
     volume += a.dot(b.cross(c)) / 6.0;
   }
   EXPECT_NEAR(volume, 6.0, 1e-12);
@@ -167,12 +168,15 @@ namespace {
 // Inside, beyond an edge, beyond a corner, and on triangles that are a segment or a point.
 TEST(ClosestPoint, InsideOnEdgesAtCornersAndOnDegenerateTriangles) {
   const Eigen::Vector3d a(0, 0, 0), b(2, 0, 0), c(0, 2, 0);
-  EXPECT_TRUE(closest_point_barycentric({0.5, 0.5, 3}, a, b, c).isApprox(Eigen::Vector3d(0.5, 0.25, 0.25)));
-  EXPECT_TRUE(closest_point_barycentric({1, -1, 0}, a, b, c).isApprox(Eigen::Vector3d(0.5, 0.5, 0)));
+  EXPECT_TRUE(
+      closest_point_barycentric({0.5, 0.5, 3}, a, b, c).isApprox(Eigen::Vector3d(0.5, 0.25, 0.25)));
+  EXPECT_TRUE(
+      closest_point_barycentric({1, -1, 0}, a, b, c).isApprox(Eigen::Vector3d(0.5, 0.5, 0)));
   EXPECT_TRUE(closest_point_barycentric({2, 2, 1}, a, b, c).isApprox(Eigen::Vector3d(0, 0.5, 0.5)));
   EXPECT_TRUE(closest_point_barycentric({3, -1, 0}, a, b, c).isApprox(Eigen::Vector3d(0, 1, 0)));
   EXPECT_TRUE(closest_point_barycentric({-1, -1, -1}, a, b, c).isApprox(Eigen::Vector3d(1, 0, 0)));
-  const Eigen::Vector3d on_segment = closest_point_barycentric({1, 1, 0}, a, b, Eigen::Vector3d(1, 0, 0));
+  const Eigen::Vector3d on_segment =
+      closest_point_barycentric({1, 1, 0}, a, b, Eigen::Vector3d(1, 0, 0));
   EXPECT_TRUE((on_segment[0] * a + on_segment[1] * b + on_segment[2] * Eigen::Vector3d(1, 0, 0))
                   .isApprox(Eigen::Vector3d(1, 0, 0)));
   EXPECT_NEAR(on_segment.sum(), 1, 1e-15);

@@ -29,13 +29,15 @@ struct Problem {
 
 Problem two_boxes() {
   Problem p;
-  p.mesh = side_by_side(jittered_bar(2, 2, 3, 0.05, 1), jittered_bar(1, 2, 2, 0.05, 2), Eigen::RowVector3d(3, 0, 0));
+  p.mesh = side_by_side(jittered_bar(2, 2, 3, 0.05, 1), jittered_bar(1, 2, 2, 0.05, 2),
+                        Eigen::RowVector3d(3, 0, 0));
   p.mesh.V.conservativeResize(p.mesh.V.rows() + 1, 3);
   p.mesh.V.bottomRows(1) << 9, 9, 9;
   p.K = spring_network_hessian(p.mesh.V, p.mesh.F);
   p.mass = lumped_mass(p.mesh.V, p.mesh.F);
   const std::vector<int> component = build_topology(p.mesh.V, p.mesh.F).vertex_component;
-  p.labels = Eigen::Map<const Eigen::VectorXi>(component.data(), static_cast<Eigen::Index>(component.size()));
+  p.labels = Eigen::Map<const Eigen::VectorXi>(component.data(),
+                                               static_cast<Eigen::Index>(component.size()));
   p.Z = rigid_motions(p.mesh.V, p.labels, p.mass);
   return p;
 }
@@ -51,7 +53,9 @@ Eigen::MatrixXd project_to_range(const Eigen::MatrixXd& Z, const Eigen::MatrixXd
 }
 
 TEST(DerivativePairs, FollowThePapersOrder) {
-  const auto one_component = [](int k) { return std::vector<std::vector<int>>(static_cast<size_t>(k), {0}); };
+  const auto one_component = [](int k) {
+    return std::vector<std::vector<int>>(static_cast<size_t>(k), {0});
+  };
   const std::vector<std::array<int, 2>> expected{{0, 0}, {0, 1}, {1, 1}, {0, 2}, {1, 2}, {2, 2}};
   EXPECT_EQ(derivative_pairs(one_component(3), 6), expected);
   EXPECT_EQ(derivative_pairs(one_component(5), 4),
@@ -65,20 +69,24 @@ TEST(DerivativePairs, FollowThePapersOrder) {
 TEST(DerivativePairs, LeaveOutModesOfDifferentComponents) {
   // A rotation of component 0, one of component 1, a mode moving both, a mode of component 1.
   const std::vector<std::vector<int>> components{{0}, {1}, {0, 1}, {1}};
-  const std::vector<std::array<int, 2>> expected{{0, 0}, {1, 1}, {0, 2}, {1, 2}, {2, 2}, {1, 3}, {2, 3}, {3, 3}};
+  const std::vector<std::array<int, 2>> expected{{0, 0}, {1, 1}, {0, 2}, {1, 2},
+                                                 {2, 2}, {1, 3}, {2, 3}, {3, 3}};
   EXPECT_EQ(derivative_pairs(components, 8), expected);
   try {
     derivative_pairs(components, 9);
     ADD_FAILURE() << "9 pairs accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("derivatives: 9 asked for, but the 4 modes"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("derivatives: 9 asked for, but the 4 modes"),
+              std::string::npos)
+        << e.what();
     EXPECT_NE(std::string(e.what()).find("only 8 pairs"), std::string::npos) << e.what();
   }
 }
 
 TEST(DerivativePairs, ComponentsMovedAreThoseCarryingTheMode) {
   const Problem p = two_boxes();
-  const Eigen::VectorXi labels = p.labels.head(p.labels.size() - 1);  // without the unreferenced vertex
+  const Eigen::VectorXi labels =
+      p.labels.head(p.labels.size() - 1);  // without the unreferenced vertex
   const Eigen::MatrixXd Z = p.Z.topRows(3 * labels.size());
   Eigen::MatrixXd Phi(Z.rows(), 3);
   Phi << Z.col(3), Z.col(9), Z.col(4) + Z.col(10);
@@ -117,7 +125,8 @@ TEST(SolveInRange, ReportsProgressPerBlock) {
   // Three blocks of equal width (at most 64): 44 + 44 + 42.
   EXPECT_EQ(fractions, (std::vector<double>{0.0, 44.0 / 130, 88.0 / 130, 1.0}));
   Progress cancel([](const std::string&, double) { return false; }, 0.0);
-  EXPECT_THROW(solve_in_range(p.K, p.mass, p.Z, random_block(p.K.rows(), 3, 6), &cancel), Cancelled);
+  EXPECT_THROW(solve_in_range(p.K, p.mass, p.Z, random_block(p.K.rows(), 3, 6), &cancel),
+               Cancelled);
 }
 
 TEST(SolveInRange, RejectsAKernelBasisThatIsWrong) {
@@ -129,8 +138,10 @@ TEST(SolveInRange, RejectsAKernelBasisThatIsWrong) {
   const Eigen::MatrixXd sheared = p.Z + 0.01 * random_block(p.Z.rows(), p.Z.cols(), 8);
   const Eigen::MatrixXd m = dof_masses(p.mass).asDiagonal();
   const Eigen::MatrixXd orthonormal =
-      sheared *
-      (sheared.transpose() * m * sheared).llt().matrixU().solve(Eigen::MatrixXd::Identity(p.Z.cols(), p.Z.cols()));
+      sheared * (sheared.transpose() * m * sheared)
+                    .llt()
+                    .matrixU()
+                    .solve(Eigen::MatrixXd::Identity(p.Z.cols(), p.Z.cols()));
   try {
     solve_in_range(p.K, p.mass, orthonormal, B);
     ADD_FAILURE() << "no exception";

@@ -22,7 +22,9 @@ Eigen::VectorXd random_masses(Eigen::Index n, unsigned seed) {
 }
 
 double orthonormality_error(const Eigen::MatrixXd& Q, const Eigen::VectorXd& m) {
-  return (Q.transpose() * m.asDiagonal() * Q - Eigen::MatrixXd::Identity(Q.cols(), Q.cols())).cwiseAbs().maxCoeff();
+  return (Q.transpose() * m.asDiagonal() * Q - Eigen::MatrixXd::Identity(Q.cols(), Q.cols()))
+      .cwiseAbs()
+      .maxCoeff();
 }
 
 // The relative M-norm of what is left of u after M-projection onto the columns of Q.
@@ -54,7 +56,8 @@ TEST(Orthonormalize, DropsDependentColumnsAcrossBlocksAndKeepsTheSpan) {
   }
   // Triangular: the first k columns of Q span the first k kept columns.
   for (int k = 1; k < 10; ++k)
-    EXPECT_LT(outside_span(U.leftCols(k), m, original.col(kept[static_cast<size_t>(k - 1)])), 1e-10);
+    EXPECT_LT(outside_span(U.leftCols(k), m, original.col(kept[static_cast<size_t>(k - 1)])),
+              1e-10);
 }
 
 TEST(Orthonormalize, LeavesAnOrthonormalLeadingBlockAsItIs) {

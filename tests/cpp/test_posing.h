@@ -7,19 +7,19 @@
 #include <functional>
 #include <vector>
 
+#include "basis/basis.h"
 #include "energy/discrete_shells.h"
 #include "mesh/mass.h"
 #include "mesh/normalization.h"
 #include "mesh/primitives.h"
 #include "mesh/triangle_mesh.h"
-#include "basis/basis.h"
 #include "solve/handle_term.h"
 
 namespace modal_deform::testing {
 
 // The 4 by 4 transform x ↦ R (x − centre) + centre + t, R a rotation by `angle` about `axis`.
-inline Eigen::Matrix4d rigid_transform(const Eigen::Vector3d& axis, double angle, const Eigen::Vector3d& centre,
-                                       const Eigen::Vector3d& t) {
+inline Eigen::Matrix4d rigid_transform(const Eigen::Vector3d& axis, double angle,
+                                       const Eigen::Vector3d& centre, const Eigen::Vector3d& t) {
   const Eigen::Matrix3d R = Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
   Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
   T.topLeftCorner<3, 3>() = R;
@@ -44,7 +44,8 @@ struct SmallTube {
   explicit SmallTube(int around = 6, int along = 5) : mesh(cylinder(around, along, 1.0, 3.0)) {
     handles = {vertices_where(mesh.V, [](const Eigen::Vector3d& x) { return x.z() < 1e-9; }),
                vertices_where(mesh.V, [](const Eigen::Vector3d& x) { return x.z() > 3 - 1e-9; })};
-    transforms = {Eigen::Matrix4d::Identity(), rigid_transform({1, 1, 1}, 1.0, {0, 0, 3}, {0.8, 0.2, -0.5})};
+    transforms = {Eigen::Matrix4d::Identity(),
+                  rigid_transform({1, 1, 1}, 1.0, {0, 0, 3}, {0.8, 0.2, -0.5})};
   }
 };
 
@@ -60,7 +61,8 @@ inline Basis dense_modal_basis(const TriangleMesh& mesh, int r) {
   const Eigen::VectorXd mass = lumped_mass(mesh.V, mesh.F);
   Eigen::VectorXd dof_mass(3 * n);
   for (int v = 0; v < n; ++v) dof_mass.segment<3>(3 * v).setConstant(s * s * mass[v]);
-  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eigen(K, Eigen::MatrixXd(dof_mass.asDiagonal()));
+  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eigen(
+      K, Eigen::MatrixXd(dof_mass.asDiagonal()));
   Basis basis;
   basis.rest = mesh.V;
   basis.mass = mass;

@@ -48,7 +48,8 @@ TEST(Prolongation, PositionsAreRestPlusTheInterpolatedDisplacement) {
   const Prolongation P = prolongation_to_proxy(g.fine.V, g.proxy.V, g.proxy.F, g.cluster);
   // A displacement linear in the rest position reaches the fine vertices exactly (they lie on
   // the proxy), up to float rounding.
-  const Eigen::Matrix3d A = (Eigen::Matrix3d() << 0.1, -0.2, 0.0, 0.3, 0.05, 0.0, -0.4, 0.2, 0.0).finished();
+  const Eigen::Matrix3d A =
+      (Eigen::Matrix3d() << 0.1, -0.2, 0.0, 0.3, 0.05, 0.0, -0.4, 0.2, 0.0).finished();
   const Eigen::VectorXf d = flatten(RowMatrixX3d(g.proxy.V * A.transpose())).cast<float>();
   Eigen::VectorXf out(3 * g.fine.V.rows());
   prolongate_positions(P, flatten(g.fine.V).cast<float>().eval().data(), d.data(), out.data());
@@ -58,19 +59,25 @@ TEST(Prolongation, PositionsAreRestPlusTheInterpolatedDisplacement) {
 
 TEST(Prolongation, DetailOffTheProxyStaysInTheRestFrame) {
   Grids g;
-  g.fine.V.col(2) = 0.01 * (7.0 * g.fine.V.col(0)).array().sin().matrix();  // detail the proxy lacks
+  g.fine.V.col(2) =
+      0.01 * (7.0 * g.fine.V.col(0)).array().sin().matrix();  // detail the proxy lacks
   const Prolongation P = prolongation_to_proxy(g.fine.V, g.proxy.V, g.proxy.F, g.cluster);
-  const Eigen::VectorXf d = Eigen::VectorXf::Constant(3 * g.proxy.V.rows(), 0.25f);  // a translation
+  const Eigen::VectorXf d =
+      Eigen::VectorXf::Constant(3 * g.proxy.V.rows(), 0.25f);  // a translation
   Eigen::VectorXf out(3 * g.fine.V.rows());
   prolongate_positions(P, flatten(g.fine.V).cast<float>().eval().data(), d.data(), out.data());
-  EXPECT_LT((out.cast<double>() - (flatten(g.fine.V).array() + 0.25).matrix()).cwiseAbs().maxCoeff(), 1e-6);
+  EXPECT_LT(
+      (out.cast<double>() - (flatten(g.fine.V).array() + 0.25).matrix()).cwiseAbs().maxCoeff(),
+      1e-6);
 }
 
 TEST(Prolongation, BadClusterIsRefused) {
   Grids g;
   g.cluster[5] = static_cast<int>(g.proxy.V.rows());
-  expect_input_error([&] { prolongation_to_proxy(g.fine.V, g.proxy.V, g.proxy.F, g.cluster); }, "cluster[5]");
-  expect_input_error([&] { prolongation_to_proxy(g.fine.V, g.proxy.V, g.proxy.F, g.cluster.head(3)); }, "cluster");
+  expect_input_error([&] { prolongation_to_proxy(g.fine.V, g.proxy.V, g.proxy.F, g.cluster); },
+                     "cluster[5]");
+  expect_input_error(
+      [&] { prolongation_to_proxy(g.fine.V, g.proxy.V, g.proxy.F, g.cluster.head(3)); }, "cluster");
 }
 
 // A bumpy plane of about 6,400 vertices baked on a proxy of 800, and the same bake without one.
@@ -130,7 +137,8 @@ TEST(BakeOnProxy, SmallerMeshesAreBakedAsTheyAre) {
   EXPECT_EQ(basis.vectors.rows(), 3 * mesh.V.rows());
   options.proxy_above = 300;
   options.proxy = 3;  // fewer than a mesh needs
-  expect_input_error([&] { bake(mesh.V, mesh.F, options, progress); }, "proxy: expected at least 4, got 3");
+  expect_input_error([&] { bake(mesh.V, mesh.F, options, progress); },
+                     "proxy: expected at least 4, got 3");
   options.proxy = 400;  // more than proxy_above
   expect_input_error([&] { bake(mesh.V, mesh.F, options, progress); }, "proxy: expected between");
   options.proxy_above = -1;
@@ -146,10 +154,12 @@ TEST(BakeOnProxy, ReportsTheProxyAndProlongationStages) {
   options.proxy_above = 400;
   options.proxy = 400;
   std::vector<std::string> stages;
-  Progress progress([&stages](const std::string& stage, double) {
-    if (stages.empty() || stages.back() != stage) stages.push_back(stage);
-    return true;
-  }, 0.0);
+  Progress progress(
+      [&stages](const std::string& stage, double) {
+        if (stages.empty() || stages.back() != stage) stages.push_back(stage);
+        return true;
+      },
+      0.0);
   bake(mesh.V, mesh.F, options, progress);
   ASSERT_FALSE(stages.empty());
   EXPECT_EQ(stages.front(), "proxy");
@@ -163,12 +173,15 @@ TEST(BakeOnProxy, SolverAgreesWithTheDenseProlongatedBasis) {
   Basis dense = b.basis;
   dense.prolongation = Prolongation{};
   dense.vectors.resize(3 * dense.num_vertices(), dense.dimension());
-  for (int v = 0; v < dense.num_vertices(); ++v) dense.vectors.middleRows<3>(3 * v) = b.basis.vertex_rows(v).cast<float>();
+  for (int v = 0; v < dense.num_vertices(); ++v)
+    dense.vectors.middleRows<3>(3 * v) = b.basis.vertex_rows(v).cast<float>();
   validate_basis(dense);
 
-  const Handles handles{vertices_where(b.mesh.V, [](const Eigen::Vector3d& x) { return x.x() < -4.0; }),
-                        vertices_where(b.mesh.V, [](const Eigen::Vector3d& x) { return x.x() > 4.0; })};
-  const Transforms transforms{Eigen::Matrix4d::Identity(), rigid_transform({0, 1, 0}, 0.5, {4.5, 0, 0}, {0, 0, 1})};
+  const Handles handles{
+      vertices_where(b.mesh.V, [](const Eigen::Vector3d& x) { return x.x() < -4.0; }),
+      vertices_where(b.mesh.V, [](const Eigen::Vector3d& x) { return x.x() > 4.0; })};
+  const Transforms transforms{Eigen::Matrix4d::Identity(),
+                              rigid_transform({0, 1, 0}, 0.5, {4.5, 0, 0}, {0, 0, 1})};
   ReducedSolver on_proxy(b.basis, handles, Eigen::VectorXd(), 1000.0);
   ReducedSolver made_dense(dense, handles, Eigen::VectorXd(), 1000.0);
   on_proxy.set_transforms(transforms);

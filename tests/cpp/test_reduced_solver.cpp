@@ -4,11 +4,11 @@
 #include <limits>
 #include <map>
 
+#include "finite_differences.h"
 #include "mesh/normalization.h"
 #include "mesh/primitives.h"
 #include "solve/line_search.h"
 #include "solve/reduced_solver.h"
-#include "finite_differences.h"
 #include "test_posing.h"
 #include "util/errors.h"
 #include "util/math_constants.h"
@@ -21,7 +21,6 @@ using testing::expect_slope_matches;
 using testing::rigid_transform;
 using testing::vertices_where;
 
-
 // A tube along z, 4 long, held at its bottom ring; the top ring is turned and pushed sideways.
 struct Tube {
   TriangleMesh mesh = cylinder(8, 8, 1.0, 4.0);
@@ -30,7 +29,8 @@ struct Tube {
   Tube() {
     handles = {vertices_where(mesh.V, [](const Eigen::Vector3d& x) { return x.z() < 1e-9; }),
                vertices_where(mesh.V, [](const Eigen::Vector3d& x) { return x.z() > 4 - 1e-9; })};
-    transforms = {Eigen::Matrix4d::Identity(), rigid_transform({1, 0, 1}, 0.8, {0, 0, 4}, {1.0, 0, -0.3})};
+    transforms = {Eigen::Matrix4d::Identity(),
+                  rigid_transform({1, 0, 1}, 0.8, {0, 0, 4}, {1.0, 0, -0.3})};
   }
 };
 
@@ -54,8 +54,8 @@ TEST(ReducedSolver, ObjectiveGradientMatchesFiniteDifferences) {
     Eigen::VectorXd gradient(30), ignored(30);
     solver.objective(q, gradient);
     const Eigen::VectorXd d = Eigen::VectorXd::Random(30);
-    expect_slope_matches([&](const Eigen::VectorXd& p) { return solver.objective(p, ignored); }, q, d,
-                         gradient.dot(d), "reduced objective");
+    expect_slope_matches([&](const Eigen::VectorXd& p) { return solver.objective(p, ignored); }, q,
+                         d, gradient.dot(d), "reduced objective");
   }
 }
 
@@ -81,7 +81,8 @@ TEST(ReducedSolver, DecreasesMonotonicallyToASmallGradient) {
 
 int iterations_to_converge(ReducedSolver& solver, double tolerance, int cap) {
   int iterations = 0;
-  for (ReducedSolveStats stats; !stats.converged && iterations < cap; iterations += stats.iterations)
+  for (ReducedSolveStats stats; !stats.converged && iterations < cap;
+       iterations += stats.iterations)
     stats = solver.solve(cap - iterations, tolerance);
   return iterations;
 }
@@ -90,13 +91,16 @@ TEST(ReducedSolver, WarmStartBeatsColdStartAndSteepestDescent) {
   const Tube tube;
   const Basis& basis = tube_basis(40);
   ReducedSolver warm(basis, tube.handles, Eigen::VectorXd(), kStiffness, EnergyKind::kShells, true);
-  ReducedSolver cold(basis, tube.handles, Eigen::VectorXd(), kStiffness, EnergyKind::kShells, false);
+  ReducedSolver cold(basis, tube.handles, Eigen::VectorXd(), kStiffness, EnergyKind::kShells,
+                     false);
   warm.set_transforms(tube.transforms);
   cold.set_transforms(tube.transforms);
   const int warm_iterations = iterations_to_converge(warm, 1e-8, 1000);
   const int cold_iterations = iterations_to_converge(cold, 1e-8, 1000);
   // Steepest descent: the same line search along −∇f.
-  const Objective f = [&cold](const Eigen::VectorXd& q, Eigen::VectorXd& g) { return cold.objective(q, g); };
+  const Objective f = [&cold](const Eigen::VectorXd& q, Eigen::VectorXd& g) {
+    return cold.objective(q, g);
+  };
   Eigen::VectorXd q = Eigen::VectorXd::Zero(40), g(40), q_new(40), g_new(40);
   double value = f(q, g), value_new;
   const double target = warm.solve(0, 1e-8).energy;
@@ -109,8 +113,10 @@ TEST(ReducedSolver, WarmStartBeatsColdStartAndSteepestDescent) {
     value = value_new;
     ++descent_iterations;
   }
-  std::printf("iterations to converge (tolerance 1e-8): warm %d, cold %d; steepest descent to the same energy %d\n",
-              warm_iterations, cold_iterations, descent_iterations);
+  std::printf(
+      "iterations to converge (tolerance 1e-8): warm %d, cold %d; steepest descent to the same "
+      "energy %d\n",
+      warm_iterations, cold_iterations, descent_iterations);
   EXPECT_LE(warm_iterations, cold_iterations);
   EXPECT_GT(descent_iterations, 5 * warm_iterations);
 }
@@ -119,8 +125,10 @@ TEST(ReducedSolver, StatePersistsAcrossSolves) {
   const Tube tube;
   const Basis& basis = tube_basis(30);
   // Cold starts, which take more than 10 iterations here.
-  ReducedSolver once(basis, tube.handles, Eigen::VectorXd(), kStiffness, EnergyKind::kShells, false);
-  ReducedSolver twice(basis, tube.handles, Eigen::VectorXd(), kStiffness, EnergyKind::kShells, false);
+  ReducedSolver once(basis, tube.handles, Eigen::VectorXd(), kStiffness, EnergyKind::kShells,
+                     false);
+  ReducedSolver twice(basis, tube.handles, Eigen::VectorXd(), kStiffness, EnergyKind::kShells,
+                      false);
   once.set_transforms(tube.transforms);
   twice.set_transforms(tube.transforms);
   const ReducedSolveStats ten = once.solve(10, 1e-14);
@@ -139,9 +147,11 @@ TEST(ReducedSolver, MovingHandlesUpdatesTheObjectiveInPlace) {
   // Frames of an animation: after each move, BFGS's f(q) is the new objective at the old q.
   for (int frame = 1; frame <= 4; ++frame) {
     solver.set_transforms(
-        {Eigen::Matrix4d::Identity(), rigid_transform({1, 0, 1}, 0.2 * frame, {0, 0, 4}, {0.25 * frame, 0, 0})});
+        {Eigen::Matrix4d::Identity(),
+         rigid_transform({1, 0, 1}, 0.2 * frame, {0, 0, 4}, {0.25 * frame, 0, 0})});
     const double updated = solver.solve(0, 1e-8).energy;
-    EXPECT_NEAR(updated, solver.objective(solver.q(), gradient), 1e-12 * std::abs(updated)) << "frame " << frame;
+    EXPECT_NEAR(updated, solver.objective(solver.q(), gradient), 1e-12 * std::abs(updated))
+        << "frame " << frame;
     const ReducedSolveStats stats = solver.solve(10, 1e-8);
     EXPECT_LE(stats.energy, updated);
   }
@@ -171,15 +181,17 @@ TEST(ReducedSolver, PositionsAreRestPlusUqInTheCallersBuffer) {
   Eigen::VectorXf out = Eigen::VectorXf::Constant(3 * basis.num_vertices(), std::nanf(""));
   const float* buffer = out.data();
   solver.positions(out);
-  EXPECT_EQ(out.cast<double>(), flatten(basis.rest).cast<float>().cast<double>());  // q = 0: the rest shape
+  EXPECT_EQ(out.cast<double>(),
+            flatten(basis.rest).cast<float>().cast<double>());  // q = 0: the rest shape
   solver.set_transforms(tube.transforms);
   solver.solve(20, 1e-8);
   solver.positions(out);
   EXPECT_EQ(out.data(), buffer);
   const Eigen::VectorXd expected = flatten(basis.rest) + basis.vectors.cast<double>() * solver.q();
-  const double magnitude =
-      flatten(basis.rest).cwiseAbs().maxCoeff() + (expected - flatten(basis.rest)).cwiseAbs().maxCoeff();
-  // Read from 16 bits (QuantizedVectors): within the map's tolerance, beside float32's own rounding.
+  const double magnitude = flatten(basis.rest).cwiseAbs().maxCoeff() +
+                           (expected - flatten(basis.rest)).cwiseAbs().maxCoeff();
+  // Read from 16 bits (QuantizedVectors): within the map's tolerance, beside float32's own
+  // rounding.
   const double diagonal = bounding_box_diagonal(basis.rest);
   EXPECT_LE((out.cast<double>() - expected).cwiseAbs().maxCoeff(),
             FinePositions::kTolerance * diagonal + 1e-6 * magnitude);
@@ -216,7 +228,9 @@ TEST(ReducedSolver, BadInputIsRefused) {
   EXPECT_THROW(ReducedSolver(broken, tube.handles, none, 1.0), InputError);
   ReducedSolver solver(basis, tube.handles, none, 1.0);
   EXPECT_THROW(solver.set_transforms({Eigen::Matrix4d::Identity()}), InputError);
-  EXPECT_THROW(solver.set_transforms({Eigen::Matrix4d::Identity(), 2 * Eigen::Matrix4d::Identity()}), InputError);
+  EXPECT_THROW(
+      solver.set_transforms({Eigen::Matrix4d::Identity(), 2 * Eigen::Matrix4d::Identity()}),
+      InputError);
   EXPECT_THROW(solver.solve(-1, 1e-6), InputError);
   EXPECT_THROW(solver.solve(5, 0.0), InputError);
 }

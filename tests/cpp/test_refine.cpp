@@ -21,17 +21,17 @@ struct RefineCase {
   FullSolveOptions options{EnergyKind::kShells, {1.0, 1.0}, 1e-8, 100};
 
   FullSolveResult from(const RowMatrixX3d* initial) const {
-    return solve_full(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd(), tube.transforms, 1e3, options,
-                      initial);
+    return solve_full(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd(), tube.transforms,
+                      1e3, options, initial);
   }
   RefineResult refine(const RowMatrixX3d& initial, ProgressCallback progress = nullptr) const {
     FullSolveOptions reporting = options;
     reporting.progress = std::move(progress);
-    return modal_deform::refine(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd(), tube.transforms, 1e3,
-                                reporting, initial);
+    return modal_deform::refine(tube.mesh.V, tube.mesh.F, tube.handles, Eigen::VectorXd(),
+                                tube.transforms, 1e3, reporting, initial);
   }
-  // The tube turned inside out through the origin: a start from which Newton needs several times the
-  // iterations of the solve from rest (and finds a higher minimum).
+  // The tube turned inside out through the origin: a start from which Newton needs several times
+  // the iterations of the solve from rest (and finds a higher minimum).
   RowMatrixX3d inside_out() const { return -tube.mesh.V; }
 };
 
@@ -48,7 +48,8 @@ struct Reports {
     ASSERT_GE(seen.size(), 2u);
     EXPECT_EQ(seen.front(), std::make_pair(std::string("solve"), 0.0));
     EXPECT_EQ(seen.back(), std::make_pair(std::string("solve"), 1.0));
-    for (size_t i = 1; i < seen.size(); ++i) EXPECT_LE(seen[i - 1].second, seen[i].second) << "report " << i;
+    for (size_t i = 1; i < seen.size(); ++i)
+      EXPECT_LE(seen[i - 1].second, seen[i].second) << "report " << i;
   }
 };
 
@@ -67,7 +68,8 @@ TEST(Refine, AConvergedStartIsTheAnswerWithoutTheSolveFromRest) {
   EXPECT_EQ(refined.history.size(), alone.history.size());
   reports.expect_one_bar();
   // The solve from the start reports over the first share of the bar; the last report fills it.
-  for (size_t i = 0; i + 1 < reports.seen.size(); ++i) EXPECT_LE(reports.seen[i].second, kFromStartShare);
+  for (size_t i = 0; i + 1 < reports.seen.size(); ++i)
+    EXPECT_LE(reports.seen[i].second, kFromStartShare);
 }
 
 TEST(Refine, AStartThatDoesNotConvergeFallsBackToTheSolveFromRest) {
@@ -101,7 +103,8 @@ TEST(Refine, KeepsTheStartsAnswerWhenTheSolveFromRestIsWorse) {
   RefineCase c;
   const RowMatrixX3d minimum = c.from(nullptr).positions;
   const RowMatrixX3d nudged = minimum + 1e-3 * RowMatrixX3d::Random(minimum.rows(), 3);
-  c.options.max_iterations = 0;  // neither solve converges; the start is near the minimum, rest is not
+  c.options.max_iterations =
+      0;  // neither solve converges; the start is near the minimum, rest is not
   const FullSolveResult first = c.from(&nudged);
   const FullSolveResult rest = c.from(nullptr);
   ASSERT_FALSE(first.converged);

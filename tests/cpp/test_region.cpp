@@ -34,9 +34,11 @@ TEST(Region, OneVertexHoldsEveryTermThatMovesIt) {
   x.segment<3>(3 * middle) += Eigen::Vector3d(0.02, -0.01, 0.05);
   y.head<3>() += Eigen::Vector3d(0.02, -0.01, 0.05);
   EXPECT_NEAR(sub.value(y), whole.value(x), 1e-12 * whole.value(x));
-  const auto all = Eigen::VectorXi::LinSpaced(static_cast<int>(mass.size()), 0, static_cast<int>(mass.size()) - 1);
+  const auto all = Eigen::VectorXi::LinSpaced(static_cast<int>(mass.size()), 0,
+                                              static_cast<int>(mass.size()) - 1);
   expect_input_error([&] { region_mesh(grid_mesh.F, mass, all); }, "region: it holds every vertex");
-  expect_input_error([&] { region_mesh(grid_mesh.F, mass, Eigen::Vector2i(3, 3)); }, "region[1] = 3 is there twice");
+  expect_input_error([&] { region_mesh(grid_mesh.F, mass, Eigen::Vector2i(3, 3)); },
+                     "region[1] = 3 is there twice");
 }
 
 }  // namespace

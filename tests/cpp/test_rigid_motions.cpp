@@ -18,12 +18,13 @@ using testing::spring_network_hessian;
 
 Eigen::VectorXi labels_of(const TriangleMesh& mesh) {
   const std::vector<int> component = build_topology(mesh.V, mesh.F).vertex_component;
-  return Eigen::Map<const Eigen::VectorXi>(component.data(), static_cast<Eigen::Index>(component.size()));
+  return Eigen::Map<const Eigen::VectorXi>(component.data(),
+                                           static_cast<Eigen::Index>(component.size()));
 }
 
 TEST(RigidMotions, SpanTheKernelOfEachComponentMOrthonormally) {
-  const TriangleMesh mesh =
-      side_by_side(shared_mesh("bunny.obj.gz"), jittered_bar(2, 2, 3, 0.05), Eigen::RowVector3d(1, 0, 0));
+  const TriangleMesh mesh = side_by_side(shared_mesh("bunny.obj.gz"), jittered_bar(2, 2, 3, 0.05),
+                                         Eigen::RowVector3d(1, 0, 0));
   const Eigen::VectorXi labels = labels_of(mesh);
   ASSERT_EQ(labels.maxCoeff(), 1);
   const Eigen::VectorXd mass = lumped_mass(mesh.V, mesh.F);
@@ -34,7 +35,8 @@ TEST(RigidMotions, SpanTheKernelOfEachComponentMOrthonormally) {
   EXPECT_LT((gram - Eigen::MatrixXd::Identity(12, 12)).cwiseAbs().maxCoeff(), 1e-12);
   const SparseMatrix K = spring_network_hessian(mesh.V, mesh.F);
   for (Eigen::Index k = 0; k < Z.cols(); ++k) {
-    EXPECT_LT((K * Z.col(k)).norm(), 1e-12 * K.cwiseAbs().sum() / K.rows() * Z.col(k).norm()) << "column " << k;
+    EXPECT_LT((K * Z.col(k)).norm(), 1e-12 * K.cwiseAbs().sum() / K.rows() * Z.col(k).norm())
+        << "column " << k;
     // Each column moves one component only.
     for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) {
       if (labels[i] != k / 6) {
@@ -52,16 +54,20 @@ TEST(RigidMotions, AreTranslationsAndRotationsAboutTheCentroid) {
   // Translations: the same displacement at every vertex, along x, y and z.
   for (int a = 0; a < 3; ++a)
     for (Eigen::Index i = 0; i < mesh.V.rows(); ++i)
-      EXPECT_NEAR((Z.block(3 * i, a, 3, 1) - Eigen::Vector3d::Unit(a) / std::sqrt(mass.sum())).norm(), 0.0, 1e-14);
+      EXPECT_NEAR(
+          (Z.block(3 * i, a, 3, 1) - Eigen::Vector3d::Unit(a) / std::sqrt(mass.sum())).norm(), 0.0,
+          1e-14);
   // The rotation about each coordinate axis through the centroid lies in the span of the last
   // three columns.
   const Eigen::MatrixXd rotations = Z.rightCols(3);
   for (int a = 0; a < 3; ++a) {
     Eigen::VectorXd rotation(Z.rows());
     for (Eigen::Index i = 0; i < mesh.V.rows(); ++i)
-      rotation.segment<3>(3 * i) = Eigen::Vector3d::Unit(a).cross((mesh.V.row(i) - centroid).transpose());
+      rotation.segment<3>(3 * i) =
+          Eigen::Vector3d::Unit(a).cross((mesh.V.row(i) - centroid).transpose());
     const Eigen::VectorXd coefficients = rotations.colPivHouseholderQr().solve(rotation);
-    EXPECT_LT((rotations * coefficients - rotation).norm(), 1e-12 * rotation.norm()) << "axis " << a;
+    EXPECT_LT((rotations * coefficients - rotation).norm(), 1e-12 * rotation.norm())
+        << "axis " << a;
   }
 }
 
@@ -84,7 +90,8 @@ TEST(RigidMotions, RejectsBadLabelsAndDegenerateComponents) {
   labels[2] = 2;  // component 1 has no vertices
   EXPECT_THROW(rigid_motions(mesh.V, labels, mass), InputError);
   EXPECT_THROW(rigid_motions(mesh.V, Eigen::VectorXi::Zero(n - 1), mass), InputError);
-  EXPECT_THROW(rigid_motions(mesh.V, Eigen::VectorXi::Zero(n), Eigen::VectorXd::Zero(n)), InputError);
+  EXPECT_THROW(rigid_motions(mesh.V, Eigen::VectorXi::Zero(n), Eigen::VectorXd::Zero(n)),
+               InputError);
   // Only two vertices with mass: no rotation about the line through them.
   Eigen::VectorXd two = Eigen::VectorXd::Zero(n);
   two[0] = two[5] = 1;

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "linalg/row_blocks.h"
-#include "util/parallel_for.h"
 #include "test_support.h"
+#include "util/parallel_for.h"
 
 namespace modal_deform {
 namespace {
@@ -17,13 +17,16 @@ Eigen::MatrixXd random_matrix(Eigen::Index rows, Eigen::Index cols, unsigned see
   return testing::random_vector(rows * cols, seed).reshaped(rows, cols);
 }
 
-// The sum over blocks, written out serially in block order: the parallel one must give the same bits.
-Eigen::MatrixXd inner_in_block_order(const Eigen::MatrixXd& A, const Eigen::VectorXd& d, const Eigen::MatrixXd& B) {
+// The sum over blocks, written out serially in block order: the parallel one must give the same
+// bits.
+Eigen::MatrixXd inner_in_block_order(const Eigen::MatrixXd& A, const Eigen::VectorXd& d,
+                                     const Eigen::MatrixXd& B) {
   Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(A.cols(), B.cols());
   for (Eigen::Index first = 0; first < A.rows(); first += kRowBlock) {
     const Eigen::Index count = std::min(kRowBlock, A.rows() - first);
     const Eigen::MatrixXd part =
-        A.middleRows(first, count).transpose() * (d.segment(first, count).asDiagonal() * B.middleRows(first, count));
+        A.middleRows(first, count).transpose() *
+        (d.segment(first, count).asDiagonal() * B.middleRows(first, count));
     sum += part;
   }
   return sum;
@@ -31,14 +34,16 @@ Eigen::MatrixXd inner_in_block_order(const Eigen::MatrixXd& A, const Eigen::Vect
 
 TEST(RowBlocks, ProductsMatchTheirDefinitionForAnyNumberOfThreads) {
   const Eigen::Index n = 5 * kRowBlock + 123;  // a short last block
-  const Eigen::MatrixXd A = random_matrix(n, 7, 1), B = random_matrix(n, 5, 2), C = random_matrix(7, 5, 3);
+  const Eigen::MatrixXd A = random_matrix(n, 7, 1), B = random_matrix(n, 5, 2),
+                        C = random_matrix(7, 5, 3);
   const Eigen::VectorXd d = testing::random_vector(n, 4).cwiseAbs();
   const Eigen::MatrixXd expected = inner_in_block_order(A, d, B);
   const int threads = omp_get_max_threads();
   for (int t : {1, 2, 3}) {
     omp_set_num_threads(t);
     EXPECT_EQ(inner_product(A, d, B), expected) << t << " threads";
-    EXPECT_EQ(inner_product(A, B), inner_in_block_order(A, Eigen::VectorXd::Ones(n), B)) << t << " threads";
+    EXPECT_EQ(inner_product(A, B), inner_in_block_order(A, Eigen::VectorXd::Ones(n), B))
+        << t << " threads";
     Eigen::MatrixXd X = B;
     add_dense_product(X, A, C);
     EXPECT_LT((X - (B + A * C)).cwiseAbs().maxCoeff(), 1e-12) << t << " threads";
@@ -48,7 +53,8 @@ TEST(RowBlocks, ProductsMatchTheirDefinitionForAnyNumberOfThreads) {
     EXPECT_LT((AC - A * C).cwiseAbs().maxCoeff(), 1e-12) << t << " threads";
   }
   omp_set_num_threads(threads);
-  EXPECT_LT((inner_product(A, d, B) - A.transpose() * d.asDiagonal() * B).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT((inner_product(A, d, B) - A.transpose() * d.asDiagonal() * B).cwiseAbs().maxCoeff(),
+            1e-9);
 }
 
 TEST(RowBlocks, VisitsEachRowOnceAndHandlesFewOrNoRows) {
@@ -69,7 +75,8 @@ TEST(ParallelFor, RunsEveryIndexOnceAndRethrowsTheFirstFailure) {
   for (const auto& count : runs) EXPECT_EQ(count.load(), 1);
   EXPECT_THROW(parallel_for(1000,
                             [](int i) {
-                              if (i % 100 == 7) throw std::runtime_error("index " + std::to_string(i));
+                              if (i % 100 == 7)
+                                throw std::runtime_error("index " + std::to_string(i));
                             }),
                std::runtime_error);
 }

@@ -17,7 +17,8 @@ namespace modal_deform::testing {
 inline const TriangleMesh& shared_mesh(const std::string& file) {
   static std::map<std::string, TriangleMesh> cache;
   auto it = cache.find(file);
-  if (it == cache.end()) it = cache.emplace(file, read_mesh(std::string(MODAL_DEFORM_SHARED_MESHES) + "/" + file)).first;
+  if (it == cache.end())
+    it = cache.emplace(file, read_mesh(std::string(MODAL_DEFORM_SHARED_MESHES) + "/" + file)).first;
   return it->second;
 }
 
@@ -28,7 +29,8 @@ inline TriangleMesh normalized(TriangleMesh mesh) {
 }
 
 // Meshes a and b as one mesh of two components, b shifted by `offset`.
-inline TriangleMesh side_by_side(const TriangleMesh& a, const TriangleMesh& b, const Eigen::RowVector3d& offset) {
+inline TriangleMesh side_by_side(const TriangleMesh& a, const TriangleMesh& b,
+                                 const Eigen::RowVector3d& offset) {
   TriangleMesh both;
   both.V.resize(a.V.rows() + b.V.rows(), 3);
   both.V << a.V, b.V.rowwise() + offset;

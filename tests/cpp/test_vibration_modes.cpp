@@ -26,7 +26,8 @@ using testing::spring_network_hessian;
 
 // Two rigid spring networks side by side: two components.
 TriangleMesh two_boxes() {
-  return side_by_side(jittered_bar(2, 2, 3, 0.05, 1), jittered_bar(1, 2, 2, 0.05, 2), Eigen::RowVector3d(3, 0, 0));
+  return side_by_side(jittered_bar(2, 2, 3, 0.05, 1), jittered_bar(1, 2, 2, 0.05, 2),
+                      Eigen::RowVector3d(3, 0, 0));
 }
 
 // Eigenvalues below this fraction of the first nonzero one count as zero.
@@ -36,16 +37,18 @@ int count_zero(const Eigen::VectorXd& eigenvalues, double first_nonzero) {
 
 void expect_m_orthonormal(const Eigen::MatrixXd& Phi, const Eigen::VectorXd& m) {
   const Eigen::MatrixXd gram = Phi.transpose() * m.asDiagonal() * Phi;
-  EXPECT_LT((gram - Eigen::MatrixXd::Identity(Phi.cols(), Phi.cols())).cwiseAbs().maxCoeff(), 1e-10);
+  EXPECT_LT((gram - Eigen::MatrixXd::Identity(Phi.cols(), Phi.cols())).cwiseAbs().maxCoeff(),
+            1e-10);
 }
 
 TEST(VibrationModes, MatchDenseGeneralizedEigensolver) {
   const TriangleMesh mesh = two_boxes();
   const Eigen::VectorXd mass = lumped_mass(mesh.V, mesh.F);
   const Eigen::VectorXd m = dof_masses(mass);
-  for (const SparseMatrix& K : {spring_network_hessian(mesh.V, mesh.F), laplacian_stiffness(mesh.V, mesh.F)}) {
-    const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> dense(Eigen::MatrixXd(K),
-                                                                          Eigen::MatrixXd(m.asDiagonal()));
+  for (const SparseMatrix& K :
+       {spring_network_hessian(mesh.V, mesh.F), laplacian_stiffness(mesh.V, mesh.F)}) {
+    const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> dense(
+        Eigen::MatrixXd(K), Eigen::MatrixXd(m.asDiagonal()));
     const int count = 20;
     const VibrationModes modes = vibration_modes(K, mass, count);
     ASSERT_EQ(modes.eigenvalues.size(), count);
@@ -54,7 +57,8 @@ TEST(VibrationModes, MatchDenseGeneralizedEigensolver) {
     const double top = dense.eigenvalues()[count - 1];
     for (int i = 0; i < count; ++i) {
       EXPECT_NEAR(modes.eigenvalues[i], dense.eigenvalues()[i], 1e-9 * top) << "eigenvalue " << i;
-      const Eigen::VectorXd r = K * modes.modes.col(i) - modes.eigenvalues[i] * m.cwiseProduct(modes.modes.col(i));
+      const Eigen::VectorXd r =
+          K * modes.modes.col(i) - modes.eigenvalues[i] * m.cwiseProduct(modes.modes.col(i));
       EXPECT_NEAR(modes.residuals[i], std::sqrt(r.cwiseAbs2().cwiseQuotient(m).sum()), 1e-14 * top);
       EXPECT_LT(modes.residuals[i], 1e-8 * top) << "mode " << i;
     }
@@ -90,14 +94,18 @@ TEST(VibrationModes, DeflatingTheRigidMotionsLeavesTheFlexibleModes) {
   const SparseMatrix K = spring_network_hessian(mesh.V, mesh.F);
   const std::vector<int> labels = build_topology(mesh.V, mesh.F).vertex_component;
   const Eigen::MatrixXd Z = rigid_motions(
-      mesh.V, Eigen::Map<const Eigen::VectorXi>(labels.data(), static_cast<Eigen::Index>(labels.size())), mass);
+      mesh.V,
+      Eigen::Map<const Eigen::VectorXi>(labels.data(), static_cast<Eigen::Index>(labels.size())),
+      mass);
   const VibrationModes all = vibration_modes(K, mass, 20);
   const VibrationModes flexible = vibration_modes(K, mass, 8, Z);
   const double top = all.eigenvalues[19];
-  for (int i = 0; i < 8; ++i) EXPECT_NEAR(flexible.eigenvalues[i], all.eigenvalues[12 + i], 1e-9 * top) << "mode " << i;
+  for (int i = 0; i < 8; ++i)
+    EXPECT_NEAR(flexible.eigenvalues[i], all.eigenvalues[12 + i], 1e-9 * top) << "mode " << i;
   EXPECT_LT((Z.transpose() * m.asDiagonal() * flexible.modes).cwiseAbs().maxCoeff(), 1e-10);
   // The same modes up to sign (the eigenvalues are distinct).
-  const Eigen::MatrixXd overlap = all.modes.middleCols(12, 8).transpose() * m.asDiagonal() * flexible.modes;
+  const Eigen::MatrixXd overlap =
+      all.modes.middleCols(12, 8).transpose() * m.asDiagonal() * flexible.modes;
   EXPECT_LT((overlap.cwiseAbs() - Eigen::MatrixXd::Identity(8, 8)).cwiseAbs().maxCoeff(), 1e-6);
   expect_m_orthonormal(flexible.modes, m);
   EXPECT_LT(flexible.solves, all.solves);
@@ -112,7 +120,9 @@ TEST(VibrationModes, ReportedResidualsAreCheckedOnRequest) {
   const SparseMatrix K = spring_network_hessian(mesh.V, mesh.F);
   const std::vector<int> labels = build_topology(mesh.V, mesh.F).vertex_component;
   const Eigen::MatrixXd Z = rigid_motions(
-      mesh.V, Eigen::Map<const Eigen::VectorXi>(labels.data(), static_cast<Eigen::Index>(labels.size())), mass);
+      mesh.V,
+      Eigen::Map<const Eigen::VectorXi>(labels.data(), static_cast<Eigen::Index>(labels.size())),
+      mass);
   ShiftedPencil pencil(K, mass, Z);
   VibrationModes modes = pencil.lowest_modes(8);
   ASSERT_EQ(modes.tolerances.size(), 8);
@@ -143,8 +153,10 @@ TEST(VibrationModes, DeflatedZeroModesLeaveTheFlexibleModes) {
   const VibrationModes flexible = pencil.lowest_modes(8);
   EXPECT_GT(pencil.shift(), undeflated_shift);  // closer to 0 with the kernel deflated
   const double top = all.eigenvalues[19];
-  for (int i = 0; i < 8; ++i) EXPECT_NEAR(flexible.eigenvalues[i], all.eigenvalues[12 + i], 1e-9 * top) << "mode " << i;
-  EXPECT_LT((pencil.kernel().transpose() * m.asDiagonal() * flexible.modes).cwiseAbs().maxCoeff(), 1e-10);
+  for (int i = 0; i < 8; ++i)
+    EXPECT_NEAR(flexible.eigenvalues[i], all.eigenvalues[12 + i], 1e-9 * top) << "mode " << i;
+  EXPECT_LT((pencil.kernel().transpose() * m.asDiagonal() * flexible.modes).cwiseAbs().maxCoeff(),
+            1e-10);
   expect_m_orthonormal(flexible.modes, m);
   expect_input_error([&] { pencil.deflate(9); }, "deflate:");
 }
@@ -217,12 +229,14 @@ TEST(VibrationModes, SymmetryCheckPairsEveryEntry) {
   const int last = static_cast<int>(K.rows()) - 1;
   ASSERT_EQ(K.coeff(0, last), 0.0);  // the bar's two ends are not coupled
   validate_stiffness_and_mass(K, mass);
-  for (const auto& [i, j] : std::vector<std::pair<int, int>>{{0, last}, {last, 0}, {4, 2}, {2, 4}, {last, last - 1}}) {
+  for (const auto& [i, j] :
+       std::vector<std::pair<int, int>>{{0, last}, {last, 0}, {4, 2}, {2, 4}, {last, last - 1}}) {
     SparseMatrix changed = K;
     changed.coeffRef(i, j) += 1.0;
     for (SparseMatrix matrix : {changed, SparseMatrix(changed.transpose())}) {
       matrix.makeCompressed();
-      testing::expect_input_error([&] { validate_stiffness_and_mass(matrix, mass); }, "not symmetric");
+      testing::expect_input_error([&] { validate_stiffness_and_mass(matrix, mass); },
+                                  "not symmetric");
     }
     changed.coeffRef(j, i) += 1.0;  // symmetric again
     validate_stiffness_and_mass(changed, mass);
@@ -233,8 +247,8 @@ TEST(VibrationModes, SymmetryCheckPairsEveryEntry) {
   validate_stiffness_and_mass(zeros, mass);
   zeros.coeffRef(last - 2, 1) = 1e-3;
   testing::expect_input_error([&] { validate_stiffness_and_mass(zeros, mass); },
-                              "K(" + std::to_string(last - 2) + ", 1) = 0.001 but K(1, " + std::to_string(last - 2) +
-                                  ") = 0");
+                              "K(" + std::to_string(last - 2) + ", 1) = 0.001 but K(1, " +
+                                  std::to_string(last - 2) + ") = 0");
 }
 
 }  // namespace

@@ -27,10 +27,26 @@ namespace modal_deform::fuzz {
 // Numbers that break naive geometry code.
 inline double awkward_number(std::uint8_t choice) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  const double numbers[] = {0.0,    -0.0,   1.0,     -1.0,    0.5,     1e-6,     1e6,
-                            1e-30,  1e30,   1e-300,  1e300,   5e-324,  1.7e308,  -1.7e308,
-                            kInf,   -kInf,  std::numeric_limits<double>::quiet_NaN(),
-                            1 + 1e-15, 3.0, 1e15};
+  const double numbers[] = {0.0,
+                            -0.0,
+                            1.0,
+                            -1.0,
+                            0.5,
+                            1e-6,
+                            1e6,
+                            1e-30,
+                            1e30,
+                            1e-300,
+                            1e300,
+                            5e-324,
+                            1.7e308,
+                            -1.7e308,
+                            kInf,
+                            -kInf,
+                            std::numeric_limits<double>::quiet_NaN(),
+                            1 + 1e-15,
+                            3.0,
+                            1e15};
   return numbers[choice % (sizeof numbers / sizeof numbers[0])];
 }
 
@@ -101,26 +117,33 @@ inline TriangleMesh fuzz_mesh(FuzzInput& in, int max_vertices, int max_faces) {
         mesh = cylinder(around, along, 0.5, 2.0);
         break;
       }
-      case 2: mesh = bar(1, 1, in.integer(1, 2), 1.0, 1.0, 2.0); break;
+      case 2:
+        mesh = bar(1, 1, in.integer(1, 2), 1.0, 1.0, 2.0);
+        break;
       case 3: {
         const int cells = in.integer(1, 3), bumps = in.integer(0, 2);
         const double height = in.number();
         mesh = bumpy_plane(cells, 2.0, bumps, height, in.byte());
         break;
       }
-      default: mesh = mesh_from_buffers({0, 0, 0, 1, 0, 0, 0, 1, 0}, {0, 1, 2}); break;
+      default:
+        mesh = mesh_from_buffers({0, 0, 0, 1, 0, 0, 0, 1, 0}, {0, 1, 2});
+        break;
     }
   } else {
     const int n = in.integer(0, max_vertices), m = in.integer(0, max_faces);
     std::vector<double> positions;
     for (int v = 0; v < n; ++v) {
       const std::uint8_t how = in.byte() % 8;
-      if (how < 5 || v == 0) {  // on a small lattice: collinear, coplanar and coincident points abound
+      if (how < 5 ||
+          v == 0) {  // on a small lattice: collinear, coplanar and coincident points abound
         for (int c = 0; c < 3; ++c) positions.push_back(in.integer(-2, 2) * 0.5);
-      } else if (how == 5) {  // a copy of an earlier vertex, maybe nudged: zero-area and needle faces
+      } else if (how ==
+                 5) {  // a copy of an earlier vertex, maybe nudged: zero-area and needle faces
         const int of = in.integer(0, v - 1);
         const double nudge = in.flag() ? 1e-9 : 0.0;
-        for (int c = 0; c < 3; ++c) positions.push_back(positions[3 * of + c] + (c == 0 ? nudge : 0.0));
+        for (int c = 0; c < 3; ++c)
+          positions.push_back(positions[3 * of + c] + (c == 0 ? nudge : 0.0));
       } else {
         for (int c = 0; c < 3; ++c) positions.push_back(in.number());
       }
@@ -228,7 +251,8 @@ inline Transforms fuzz_transforms(FuzzInput& in, int count) {
     for (int c = 0; c < 3; ++c) axis[c] = in.number();
     axis[2] += 0.01;
     if (!(axis.norm() > 0) || !axis.allFinite()) axis = Eigen::Vector3d::UnitZ();
-    T.topLeftCorner<3, 3>() = Eigen::AngleAxisd(in.integer(-12, 12) * 0.5, axis.normalized()).toRotationMatrix();
+    T.topLeftCorner<3, 3>() =
+        Eigen::AngleAxisd(in.integer(-12, 12) * 0.5, axis.normalized()).toRotationMatrix();
     for (int c = 0; c < 3; ++c) T(c, 3) = in.number();
     if (in.byte() > 240) {
       const double value = in.number();

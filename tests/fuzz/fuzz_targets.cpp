@@ -4,13 +4,13 @@
 #include <string>
 #include <vector>
 
+#include "bake/bake.h"
 #include "energy/arap.h"
 #include "energy/discrete_shells.h"
 #include "fuzz_input.h"
 #include "mesh/mass.h"
 #include "mesh/mesh_check.h"
 #include "mesh/normalization.h"
-#include "bake/bake.h"
 #include "reduction/ghost.h"
 #include "solve/full_solver.h"
 #include "solve/reduced_solver.h"
@@ -34,7 +34,8 @@ bool runs(const char* what, Call&& call) {
   } catch (const InputError& error) {
     if (std::string(error.what()).empty()) fail(message(what, ": InputError without a message"));
   } catch (const NumericalError& error) {
-    if (std::string(error.what()).empty()) fail(message(what, ": NumericalError without a message"));
+    if (std::string(error.what()).empty())
+      fail(message(what, ": NumericalError without a message"));
   } catch (const OutOfMemory& error) {
     if (std::string(error.what()).empty()) fail(message(what, ": OutOfMemory without a message"));
   }
@@ -101,7 +102,8 @@ void energy_at(const Energy& energy, const Eigen::VectorXd& x, FuzzInput& in, bo
   // The energies take finite coordinates up to kMaxCoordinate in magnitude, and refuse the rest.
   const bool in_range = positions_in_range(x);
   const bool accepted = runs("Energy::value", [&] { require_finite(energy.value(x), "E(x)"); });
-  if (accepted != in_range) fail(message("Energy::value accepted = ", accepted, " for in range = ", in_range));
+  if (accepted != in_range)
+    fail(message("Energy::value accepted = ", accepted, " for in range = ", in_range));
   if (!in_range) return;
   Eigen::VectorXd gradient(x.size());
   must_run("Energy::value_and_gradient", [&] {
@@ -116,10 +118,12 @@ void energy_at(const Energy& energy, const Eigen::VectorXd& x, FuzzInput& in, bo
   Eigen::VectorXd u(x.size()), w(x.size());
   for (Eigen::Index i = 0; i < x.size(); ++i) u[i] = in.number(), w[i] = in.number();
   if (!has_third) {
-    if (runs("Energy::third", [&] { energy.third(x, u, w); })) fail("ARAP computed a third derivative");
+    if (runs("Energy::third", [&] { energy.third(x, u, w); }))
+      fail("ARAP computed a third derivative");
     return;
   }
-  const bool third_accepted = runs("Energy::third", [&] { require_finite(energy.third(x, u, w), "third"); });
+  const bool third_accepted =
+      runs("Energy::third", [&] { require_finite(energy.third(x, u, w), "third"); });
   if (third_accepted != (positions_in_range(u) && positions_in_range(w)))
     fail("third: accepted a direction out of range or refused one in range");
 }
@@ -132,9 +136,11 @@ void mesh_entry_points(const std::uint8_t* data, std::size_t size) {
   const bool valid = valid_mesh(mesh);
   const bool checked = runs("check_mesh", [&] {
     const MeshReport report = check_mesh(mesh.V, mesh.F);
-    if (report.num_vertices != mesh.V.rows() || report.num_faces != mesh.F.rows()) fail("check_mesh: wrong counts");
+    if (report.num_vertices != mesh.V.rows() || report.num_faces != mesh.F.rows())
+      fail("check_mesh: wrong counts");
   });
-  if (checked != valid) fail(message("check_mesh accepted = ", checked, " but validate_mesh accepted = ", valid));
+  if (checked != valid)
+    fail(message("check_mesh accepted = ", checked, " but validate_mesh accepted = ", valid));
   if (!valid) return;
 
   const Eigen::VectorXd mass = lumped_mass(mesh.V, mesh.F);
@@ -142,19 +148,22 @@ void mesh_entry_points(const std::uint8_t* data, std::size_t size) {
   if ((mass.array() < 0).any()) fail("lumped_mass: a negative mass");
 
   const double bending = in.positive(), membrane = in.positive();
-  const bool weights_valid = bending >= 0 && bending <= kMaxWeight && membrane >= 0 && membrane <= kMaxWeight;
+  const bool weights_valid =
+      bending >= 0 && bending <= kMaxWeight && membrane >= 0 && membrane <= kMaxWeight;
   std::unique_ptr<DiscreteShells> shells;
   const bool built = runs("DiscreteShells", [&] {
     shells = std::make_unique<DiscreteShells>(mesh.V, mesh.F, bending, membrane);
   });
-  if (built != weights_valid) fail(message("DiscreteShells built = ", built, " for weights ", bending, ", ", membrane));
+  if (built != weights_valid)
+    fail(message("DiscreteShells built = ", built, " for weights ", bending, ", ", membrane));
   std::unique_ptr<Arap> arap;
   must_run("Arap", [&] { arap = std::make_unique<Arap>(mesh.V, mesh.F); });
 
   if (shells) {
     Eigen::VectorXd gradient(shells->rest().size());
     const double at_rest = shells->value_and_gradient(shells->rest(), gradient);
-    if (at_rest != 0 || !gradient.isZero(0)) fail(message("shells: E(rest) = ", at_rest, ", |gradient| = ", gradient.norm()));
+    if (at_rest != 0 || !gradient.isZero(0))
+      fail(message("shells: E(rest) = ", at_rest, ", |gradient| = ", gradient.norm()));
     energy_at(*shells, shells->rest(), in, true);
     energy_at(*shells, fuzz_positions(in, shells->rest()), in, true);
   }
@@ -177,11 +186,13 @@ void mesh_entry_points(const std::uint8_t* data, std::size_t size) {
   if (ghost.map.size() != mesh.V.rows()) fail("ghost map of the wrong size");
   std::vector<int> preimage(g, 0);
   for (Eigen::Index v = 0; v < ghost.map.size(); ++v) {
-    if (ghost.map[v] < 0 || ghost.map[v] >= g) fail(message("ghost map[", v, "] = ", ghost.map[v], " out of range"));
+    if (ghost.map[v] < 0 || ghost.map[v] >= g)
+      fail(message("ghost map[", v, "] = ", ghost.map[v], " out of range"));
     ++preimage[ghost.map[v]];
   }
   if (std::count(preimage.begin(), preimage.end(), 0)) fail("a ghost vertex without fine vertices");
-  if (ghost.F.size() && (ghost.F.minCoeff() < 0 || ghost.F.maxCoeff() >= g)) fail("ghost face index out of range");
+  if (ghost.F.size() && (ghost.F.minCoeff() < 0 || ghost.F.maxCoeff() >= g))
+    fail("ghost face index out of range");
 }
 
 void bake_and_pose(const std::uint8_t* data, std::size_t size) {
@@ -214,7 +225,9 @@ void bake_and_pose(const std::uint8_t* data, std::size_t size) {
   const double tolerance = in.byte() < 200 ? 1e-6 : in.number();
 
   std::unique_ptr<ReducedSolver> solver;
-  if (runs("ReducedSolver", [&] { solver = std::make_unique<ReducedSolver>(basis, handles, weights, stiffness, kind); })) {
+  if (runs("ReducedSolver", [&] {
+        solver = std::make_unique<ReducedSolver>(basis, handles, weights, stiffness, kind);
+      })) {
     if (runs("set_transforms", [&] { solver->set_transforms(transforms); })) {
       runs("solve", [&] {
         const ReducedSolveStats stats = solver->solve(iterations, tolerance);
@@ -229,9 +242,10 @@ void bake_and_pose(const std::uint8_t* data, std::size_t size) {
     });
   }
   runs("solve_full", [&] {
-    const FullSolveResult result =
-        solve_full(mesh.V, mesh.F, handles, weights, transforms, stiffness,
-                   FullSolveOptions{kind, {options.material.bending, options.material.membrane}, tolerance, iterations});
+    const FullSolveResult result = solve_full(
+        mesh.V, mesh.F, handles, weights, transforms, stiffness,
+        FullSolveOptions{
+            kind, {options.material.bending, options.material.membrane}, tolerance, iterations});
     require_finite(result.positions, "solve_full: positions");
     require_finite(result.energy, "solve_full: energy");
   });
@@ -252,14 +266,16 @@ void stored_basis(const std::uint8_t* data, std::size_t size) {
   b.mass.resize(std::max(0, n + off()));
   for (Eigen::Index i = 0; i < b.mass.size(); ++i) b.mass[i] = in.positive();
   b.vectors.resize(std::max(0, 3 * p + off()), std::max(0, r + off()));
-  for (Eigen::Index i = 0; i < b.vectors.size(); ++i) b.vectors.data()[i] = static_cast<float>(in.number());
+  for (Eigen::Index i = 0; i < b.vectors.size(); ++i)
+    b.vectors.data()[i] = static_cast<float>(in.number());
   if (proxy) {
     Prolongation& P = b.prolongation;
     P.vertices.resize(std::max(0, n + off()), 3);
     P.weights.resize(std::max(0, static_cast<int>(P.vertices.rows()) + off()), 3);
     for (Eigen::Index i = 0; i < P.vertices.size(); ++i) P.vertices.data()[i] = vertex_index(in, p);
     for (Eigen::Index i = 0; i < P.weights.rows(); ++i) {
-      for (int k = 0; k < 3; ++k) P.weights(i, k) = static_cast<float>(in.byte() > 250 ? in.number() : in.positive());
+      for (int k = 0; k < 3; ++k)
+        P.weights(i, k) = static_cast<float>(in.byte() > 250 ? in.number() : in.positive());
       if (in.byte() < 240) P.weights.row(i) /= P.weights.row(i).sum();
     }
   }
@@ -296,9 +312,11 @@ void stored_basis(const std::uint8_t* data, std::size_t size) {
         b.ghost_vectors(k, j) = rows(k - 3 * i, j);
   }
   if (!baked)
-    for (Eigen::Index i = 0; i < b.ghost_vectors.size(); ++i) b.ghost_vectors.data()[i] = in.number();
+    for (Eigen::Index i = 0; i < b.ghost_vectors.size(); ++i)
+      b.ghost_vectors.data()[i] = in.number();
   b.ghost_faces.resize(std::max(0, h + off()), 3);
-  for (Eigen::Index i = 0; i < b.ghost_faces.size(); ++i) b.ghost_faces.data()[i] = vertex_index(in, g);
+  for (Eigen::Index i = 0; i < b.ghost_faces.size(); ++i)
+    b.ghost_faces.data()[i] = vertex_index(in, g);
   b.ghost_map.resize(std::max(0, n + off()));
   for (Eigen::Index i = 0; i < b.ghost_map.size(); ++i) b.ghost_map[i] = vertex_index(in, g);
   const double extent = bounding_box_extent(b.rest);
@@ -311,16 +329,19 @@ void stored_basis(const std::uint8_t* data, std::size_t size) {
   const auto weight = [&in] { return in.byte() > 250 ? in.number() : in.byte() / 255.0; };
   if (in.byte() > 220) {
     b.material.paint.weights.resize(std::max(0, n + off()));
-    for (Eigen::Index i = 0; i < b.material.paint.weights.size(); ++i) b.material.paint.weights[i] = weight();
+    for (Eigen::Index i = 0; i < b.material.paint.weights.size(); ++i)
+      b.material.paint.weights[i] = weight();
     b.ghost_stiffness_weights.resize(std::max(0, g + off()));
-    for (Eigen::Index i = 0; i < b.ghost_stiffness_weights.size(); ++i) b.ghost_stiffness_weights[i] = weight();
+    for (Eigen::Index i = 0; i < b.ghost_stiffness_weights.size(); ++i)
+      b.ghost_stiffness_weights[i] = weight();
     b.material.paint.max_stiffness = in.byte() > 250 ? in.number() : 1.0 + in.byte();
   }
   if (in.byte() > 220 && n > 0) {
     std::vector<int> region;
     for (int v = 0; v < n; ++v)
       if (in.flag()) region.push_back(in.byte() > 250 ? in.integer(-1, n) : v);
-    b.region = Eigen::Map<const Eigen::VectorXi>(region.data(), static_cast<Eigen::Index>(region.size()));
+    b.region =
+        Eigen::Map<const Eigen::VectorXi>(region.data(), static_cast<Eigen::Index>(region.size()));
     for (int v = 0; v < n && b.vectors.rows() == 3 * n; ++v)
       if (!std::binary_search(region.begin(), region.end(), v) && in.byte() < 250)
         b.vectors.middleRows(3 * v, 3).setZero();
@@ -332,7 +353,9 @@ void stored_basis(const std::uint8_t* data, std::size_t size) {
   const EnergyKind kind = in.flag() ? EnergyKind::kArap : EnergyKind::kShells;
   const Transforms transforms = fuzz_transforms(in, static_cast<int>(handles.size()));
   std::unique_ptr<ReducedSolver> solver;
-  if (!runs("ReducedSolver", [&] { solver = std::make_unique<ReducedSolver>(b, handles, Eigen::VectorXd(), stiffness, kind); }))
+  if (!runs("ReducedSolver", [&] {
+        solver = std::make_unique<ReducedSolver>(b, handles, Eigen::VectorXd(), stiffness, kind);
+      }))
     return;
   if (runs("set_transforms", [&] { solver->set_transforms(transforms); })) {
     runs("solve", [&] {

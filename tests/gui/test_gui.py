@@ -2,6 +2,7 @@
 every panel drawn and screenshotted (scripts/draw_panels.py), and the viewport's frame time while
 posing (bench/viewport_frames.py). Each runs in every window (the `window` fixture); its screenshots
 and figures stay in build/test-artefacts/gui-<Blender X.Y>/ (build/ is the build's own, ignored by git)."""
+
 import json
 import os
 import pathlib
@@ -10,7 +11,6 @@ import shutil
 import subprocess
 
 import pytest
-
 import support
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -39,10 +39,26 @@ def debian13():
     home.mkdir(parents=True)
     env = dict(os.environ, HOME=str(home))
     install = f"import bpy; bpy.ops.preferences.addon_install(filepath={str(zips[0])!r})"
-    subprocess.run(IN_DEBIAN13 + ["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python-expr",
-                                  install], capture_output=True, env=env, check=True, timeout=300)
+    subprocess.run(
+        IN_DEBIAN13
+        + [
+            "blender",
+            "-b",
+            "--factory-startup",
+            "--python-exit-code",
+            "1",
+            "--python-expr",
+            install,
+        ],
+        capture_output=True,
+        env=env,
+        check=True,
+        timeout=300,
+    )
     [addons] = home.glob(".config/blender/*/scripts/addons")
-    assert list((addons / "modal_deform").glob("_native.cpython-313-*.so")), "the legacy zip has no core for 3.13"
+    assert list((addons / "modal_deform").glob("_native.cpython-313-*.so")), (
+        "the legacy zip has no core for 3.13"
+    )
     return IN_DEBIAN13, dict(HOME=str(home), MODAL_DEFORM_GRAB="x11")
 
 
@@ -52,7 +68,9 @@ def window(request):
     that a result left by an earlier run cannot pass this one."""
     prefix, env = request.param()
     env = dict(os.environ, **env)
-    version = subprocess.run(prefix + ["blender", "--version"], capture_output=True, text=True, env=env, check=True)
+    version = subprocess.run(
+        prefix + ["blender", "--version"], capture_output=True, text=True, env=env, check=True
+    )
     major_minor = re.search(r"Blender (\d+\.\d+)", version.stdout)[1]
     artefacts = ROOT / "build" / "test-artefacts" / f"gui-{major_minor}"
     artefacts.mkdir(parents=True, exist_ok=True)
@@ -67,9 +85,21 @@ def run_script(window, script):
     wrote none, failed a step or printed a Python traceback (a panel's draw() that raises only prints)."""
     prefix, env, artefacts = window
     (artefacts / "result.json").unlink(missing_ok=True)
-    command = prefix + XVFB + ["blender", "--factory-startup", "--enable-event-simulate", *support.in_blender(script),
-                               "--", str(artefacts)]
-    run = subprocess.run(command, capture_output=True, text=True, timeout=900, env=env, cwd=artefacts)
+    command = (
+        prefix
+        + XVFB
+        + [
+            "blender",
+            "--factory-startup",
+            "--enable-event-simulate",
+            *support.in_blender(script),
+            "--",
+            str(artefacts),
+        ]
+    )
+    run = subprocess.run(
+        command, capture_output=True, text=True, timeout=900, env=env, cwd=artefacts
+    )
     output = f"{run.stdout[-4000:]}\n{run.stderr[-4000:]}"
     assert (artefacts / "result.json").exists(), f"Blender ended without a result:\n{output}"
     result = json.loads((artefacts / "result.json").read_text())
@@ -102,15 +132,42 @@ def test_viewport_frame_time_while_posing_100k(window):
     prefix, env, artefacts = window
     output = artefacts / "viewport_frames_100k.json"
     output.unlink(missing_ok=True)
-    command = prefix + XVFB + ["blender", "--factory-startup", "--python", str(ROOT / "bench" / "viewport_frames.py"),
-                               "--", str(output), "--updates", "2", "--modes", "8", "--derivatives", "8",
-                               "--proxy-above", "50000", "--proxy", "10000"]
-    run = subprocess.run(command, capture_output=True, text=True, timeout=900, env=env, cwd=artefacts)
-    assert output.exists(), f"Blender ended without a result:\n{run.stdout[-4000:]}\n{run.stderr[-4000:]}"
+    command = (
+        prefix
+        + XVFB
+        + [
+            "blender",
+            "--factory-startup",
+            "--python",
+            str(ROOT / "bench" / "viewport_frames.py"),
+            "--",
+            str(output),
+            "--updates",
+            "2",
+            "--modes",
+            "8",
+            "--derivatives",
+            "8",
+            "--proxy-above",
+            "50000",
+            "--proxy",
+            "10000",
+        ]
+    )
+    run = subprocess.run(
+        command, capture_output=True, text=True, timeout=900, env=env, cwd=artefacts
+    )
+    assert output.exists(), (
+        f"Blender ended without a result:\n{run.stdout[-4000:]}\n{run.stderr[-4000:]}"
+    )
     result = json.loads(output.read_text())
     assert result["ok"], "\n".join(result["log"])
     print("\n".join(result["log"]))
-    assert result["vertices"] == 100250 and set(result["displays"]) == {"positions", "stand_in", "shape_key"}
+    assert result["vertices"] == 100250 and set(result["displays"]) == {
+        "positions",
+        "stand_in",
+        "shape_key",
+    }
 
 
 # Installs a zip as an extension with Blender's own installer and prints what is enabled after.
@@ -134,10 +191,28 @@ def test_debian13_blender_enables_no_extension_zip(blenders, tmp_path):
     (3.13) isn't compatible with (3.11)"): such a Blender takes the legacy zip (the windows above)."""
     assert DEBIAN13_ROOT.is_dir(), f"{DEBIAN13_ROOT}: no Debian 13 root (make debian13-root)"
     [extension] = (ROOT / "dist").glob(f"modal_deform-*-{blenders}-linux_x64.zip")
-    run = subprocess.run(IN_DEBIAN13 + ["blender", "-b", "--factory-startup", "--python-exit-code", "1",
-                                        "--python-expr", INSTALL_EXTENSION, "--", str(extension)],
-                         capture_output=True, text=True, timeout=300, env=dict(os.environ, HOME=str(tmp_path)))
+    run = subprocess.run(
+        IN_DEBIAN13
+        + [
+            "blender",
+            "-b",
+            "--factory-startup",
+            "--python-exit-code",
+            "1",
+            "--python-expr",
+            INSTALL_EXTENSION,
+            "--",
+            str(extension),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=dict(os.environ, HOME=str(tmp_path)),
+    )
     output = run.stdout + run.stderr
     assert run.returncode == 0 and "ENABLED [] False" in output, output[-4000:]
-    assert ("isn't compatible with (3.11)" if blenders == "blender_4.2_to_5.0" else
-            "doesn't meet the minimum supported version (5.1.0)") in output, output[-4000:]
+    assert (
+        "isn't compatible with (3.11)"
+        if blenders == "blender_4.2_to_5.0"
+        else "doesn't meet the minimum supported version (5.1.0)"
+    ) in output, output[-4000:]

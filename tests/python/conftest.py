@@ -1,6 +1,6 @@
 """Shared fixtures: the scanned meshes from ../shared/meshes, read once a session."""
-import pytest
 
+import pytest
 from support.meshes import read_shared
 
 

@@ -46,7 +46,7 @@ def test_eigenvalues_and_residuals_match_scipy_eigh(two_tubes, tubes_basis):
     phi = s * basis.modes[:, 12:].astype(np.float64)
     residual = K @ phi - m[:, None] * phi * basis.eigenvalues[12:]
     # Single-precision vectors: the residual scales with float32 rounding times the spectrum's top.
-    assert np.sqrt((residual ** 2 / m[:, None]).sum(axis=0)).max() < 1e-6 * reference[-1]
+    assert np.sqrt((residual**2 / m[:, None]).sum(axis=0)).max() < 1e-6 * reference[-1]
 
 
 def test_zero_modes_beside_the_flexible_ones_are_deflated_and_solved_again():
@@ -71,36 +71,61 @@ def test_basis_is_m_orthonormal_with_the_rigid_motions_first(two_tubes, tubes_ba
     V, F = two_tubes
     basis = tubes_basis
     U = basis.scale * basis.vectors.astype(np.float64)
-    m = np.repeat(basis.scale ** 2 * basis.mass, 3)
+    m = np.repeat(basis.scale**2 * basis.mass, 3)
     np.testing.assert_allclose(U.T @ (m[:, None] * U), np.eye(basis.dimension), atol=1e-5)
     half = len(V) // 2
     for j in range(12):
         u = basis.vectors[:, j].astype(np.float64).reshape(-1, 3)
-        moving, resting = (slice(0, half), slice(half, None)) if j < 6 else (slice(half, None), slice(0, half))
+        moving, resting = (
+            (slice(0, half), slice(half, None)) if j < 6 else (slice(half, None), slice(0, half))
+        )
         assert np.all(u[resting] == 0)
         # u = ω × x + t on the moving tube: its displacement gradient is skew.
         X = np.c_[V[moving], np.ones(half)]
         gradient = np.linalg.lstsq(X, u[moving], rcond=None)[0][:3].T
-        assert np.abs(X @ np.linalg.lstsq(X, u[moving], rcond=None)[0] - u[moving]).max() < 1e-5 * np.abs(u).max()
+        assert (
+            np.abs(X @ np.linalg.lstsq(X, u[moving], rcond=None)[0] - u[moving]).max()
+            < 1e-5 * np.abs(u).max()
+        )
         assert np.abs(gradient + gradient.T).max() < 1e-5 * np.abs(gradient).max() + 1e-7
 
 
 def test_arrays_are_read_only_views(tubes_basis):
     basis = tubes_basis
-    assert basis.vectors.dtype == np.float32 and basis.vectors.shape == (3 * basis.num_vertices, basis.dimension)
+    assert basis.vectors.dtype == np.float32 and basis.vectors.shape == (
+        3 * basis.num_vertices,
+        basis.dimension,
+    )
     assert basis.modes.shape == (3 * basis.num_vertices, basis.num_modes)
     assert np.shares_memory(basis.modes, basis.vectors)
-    for name in ("rest", "mass", "vectors", "eigenvalues", "ghost_vertices", "ghost_faces", "ghost_map",
-                 "ghost_vectors"):
+    for name in (
+        "rest",
+        "mass",
+        "vectors",
+        "eigenvalues",
+        "ghost_vertices",
+        "ghost_faces",
+        "ghost_map",
+        "ghost_vectors",
+    ):
         array = getattr(basis, name)
         assert not array.flags.writeable, name
         with pytest.raises(ValueError):
             array[...] = 0
     assert basis.ghost_faces.dtype == np.int32 and basis.ghost_map.dtype == np.int32
-    assert basis.ghost_map.shape == (basis.num_vertices,) and basis.ghost_map.max() < len(basis.ghost_vertices)
+    assert basis.ghost_map.shape == (basis.num_vertices,) and basis.ghost_map.max() < len(
+        basis.ghost_vertices
+    )
     assert basis.ghost_vectors.shape == (3 * len(basis.ghost_vertices), basis.dimension)
-    assert set(basis.timings) >= {"hessian", "factorisation", "modes", "third derivatives", "derivative solves",
-                                  "orthonormalisation", "ghost"}
+    assert set(basis.timings) >= {
+        "hessian",
+        "factorisation",
+        "modes",
+        "third derivatives",
+        "derivative solves",
+        "orthonormalisation",
+        "ghost",
+    }
     assert "rigid" in repr(basis)
 
 
@@ -159,7 +184,7 @@ def corruptions(arrays):
     yield "bending", changed(bending=np.array(-1.0))
     yield "membrane", changed(membrane=np.array(np.inf))
     yield "rest", changed(rest=arrays["rest"] * 1e-200)
-    for bad in (-1, g, 2 ** 31 - 1):
+    for bad in (-1, g, 2**31 - 1):
         ghost_map = arrays["ghost_map"].copy()
         ghost_map[n // 2] = bad
         yield "ghost_map", changed(ghost_map=ghost_map)
@@ -191,7 +216,9 @@ def test_the_papers_pairs_give_its_67_dimensions(two_tubes):
     tube = mdc.testing.cylinder(14, 6, 0.5, 2.0)
     basis = mdc.bake(*tube, modes=15, derivatives=52, ghost=60)
     assert (basis.dimension, basis.num_dropped) == (67, 0)
-    with pytest.raises(ValueError, match="derivatives: 52 asked for, but the 9 modes .* only 45 pairs"):
+    with pytest.raises(
+        ValueError, match="derivatives: 52 asked for, but the 9 modes .* only 45 pairs"
+    ):
         mdc.bake(*tube, modes=15, derivatives=52, ghost=60, rotation_pairs=False)
     assert mdc.bake(*tube, modes=21, derivatives=52, ghost=60, rotation_pairs=False).dimension == 73
     with pytest.raises(ValueError, match="rotation_pairs: expected True or False"):
@@ -201,10 +228,16 @@ def test_the_papers_pairs_give_its_67_dimensions(two_tubes):
 
 def test_bad_options_raise_value_error_naming_them(two_tubes):
     V, F = two_tubes
-    for kwargs, name in [({"modes": 12}, "modes"), ({"derivatives": 500}, "derivatives"),
-                         ({"energy": "arap"}, "derivatives"), ({"energy": "springs"}, "energy"),
-                         ({"ghost": 3}, "ghost"), ({"modes": 2.5}, "modes"), ({"membrane": -1.0}, "membrane"),
-                         ({"progress": 3}, "progress")]:
+    for kwargs, name in [
+        ({"modes": 12}, "modes"),
+        ({"derivatives": 500}, "derivatives"),
+        ({"energy": "arap"}, "derivatives"),
+        ({"energy": "springs"}, "energy"),
+        ({"ghost": 3}, "ghost"),
+        ({"modes": 2.5}, "modes"),
+        ({"membrane": -1.0}, "membrane"),
+        ({"progress": 3}, "progress"),
+    ]:
         with pytest.raises(ValueError, match=name):
             mdc.bake(V, F, **kwargs)
     with pytest.raises(ValueError, match="F"):
@@ -224,13 +257,28 @@ def test_progress_is_frequent_and_a_scans_debris_makes_no_zero_modes(scan_dragon
     calls = []
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        basis = mdc.bake(*scan_dragon, modes=20, derivatives=15,
-                         progress=lambda stage, fraction: calls.append((stage, fraction)))
-    assert basis.num_floppy == 0 and basis.num_modes == 20 and basis.dimension + basis.num_dropped == 35
+        basis = mdc.bake(
+            *scan_dragon,
+            modes=20,
+            derivatives=15,
+            progress=lambda stage, fraction: calls.append((stage, fraction)),
+        )
+    assert (
+        basis.num_floppy == 0
+        and basis.num_modes == 20
+        and basis.dimension + basis.num_dropped == 35
+    )
     # (That the eigensolve reports between its ends is tested natively, with no minimum interval
     # between reports: here reports are at most every 0.1 s, so their count depends on the machine.)
     stages = [stage for stage, _ in calls]
-    for stage in ("hessian", "modes", "third derivatives", "derivative solves", "orthonormalisation", "ghost"):
+    for stage in (
+        "hessian",
+        "modes",
+        "third derivatives",
+        "derivative solves",
+        "orthonormalisation",
+        "ghost",
+    ):
         assert stage in stages
     assert all(0.0 <= fraction <= 1.0 for _, fraction in calls)
 
@@ -242,13 +290,25 @@ def test_one_bar_runs_forward_through_the_stages(on_proxy):
     and jumped to the ghost and back while the ordering waited for it."""
     V, F = mdc.testing.bumpy_plane(40)
     calls = []
-    basis = mdc.bake(V, F, modes=10, derivatives=4, ghost=100, proxy=400 if on_proxy else None, proxy_above=1000,
-                     progress=lambda stage, fraction: calls.append((stage, fraction)))
+    basis = mdc.bake(
+        V,
+        F,
+        modes=10,
+        derivatives=4,
+        ghost=100,
+        proxy=400 if on_proxy else None,
+        proxy_above=1000,
+        progress=lambda stage, fraction: calls.append((stage, fraction)),
+    )
     assert basis.on_proxy == on_proxy
     order = [stage for i, (stage, _) in enumerate(calls) if i == 0 or calls[i - 1][0] != stage]
     expected = mdc.BAKE_STAGES if on_proxy else mdc.BAKE_STAGES[1:-1]
     assert order == [stage for stage in expected if stage in order], order
-    assert {"proxy", "prolongation"} <= set(order) if on_proxy else not {"proxy", "prolongation"} & set(order)
+    assert (
+        {"proxy", "prolongation"} <= set(order)
+        if on_proxy
+        else not {"proxy", "prolongation"} & set(order)
+    )
     bar = [mdc.bake_fraction(stage, fraction, on_proxy) for stage, fraction in calls]
     assert all(a <= b for a, b in zip(bar, bar[1:])), bar
     assert bar[-1] == 1.0

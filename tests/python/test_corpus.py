@@ -5,6 +5,7 @@ error whose message names the problem and where (the argument, and the first off
 face or handle). docs/robustness.md lists the cases; tests/cpp/test_corpus.cpp runs the same
 meshes through the native entry points without the Python layer's checks.
 """
+
 import warnings
 
 import numpy as np
@@ -33,6 +34,7 @@ def finite(*arrays):
 
 
 # --- Meshes ------------------------------------------------------------------------------------
+
 
 def grid():
     return mdc.testing.grid(3, 3)
@@ -125,10 +127,12 @@ def scaled(factor):
 
 def with_entry(array, row, column, value):
     """The grid with one entry of V (array 0) or F (array 1) replaced."""
+
     def make():
         arrays = [a.copy() for a in grid()]
         arrays[array][row, column] = value
         return tuple(arrays)
+
     return make
 
 
@@ -146,6 +150,7 @@ def flipped(every):
         F = F.copy()
         F[::every] = F[::every, ::-1]
         return V, F
+
     return make
 
 
@@ -156,13 +161,33 @@ NO_EXTENT = Refused(r"V: the mesh's extent")
 
 # name: (make (V, F), default outcome, {entry point: outcome} where it differs)
 MESHES = {
-    "empty mesh": (lambda: (np.zeros((0, 3)), np.zeros((0, 3), np.int32)), Refused(r"V: the mesh has no vertices"), {}),
-    "vertices, no faces": (lambda: (grid()[0], np.zeros((0, 3), np.int32)), Refused(r"F: the mesh has no faces"), {}),
-    "lone vertex": (lambda: (np.zeros((1, 3)), np.zeros((0, 3), np.int32)), Refused(r"F: the mesh has no faces"), {}),
-    "lone vertex in a face": (lambda: (np.zeros((1, 3)), np.zeros((1, 3), np.int32)), NO_EXTENT, {}),
+    "empty mesh": (
+        lambda: (np.zeros((0, 3)), np.zeros((0, 3), np.int32)),
+        Refused(r"V: the mesh has no vertices"),
+        {},
+    ),
+    "vertices, no faces": (
+        lambda: (grid()[0], np.zeros((0, 3), np.int32)),
+        Refused(r"F: the mesh has no faces"),
+        {},
+    ),
+    "lone vertex": (
+        lambda: (np.zeros((1, 3)), np.zeros((0, 3), np.int32)),
+        Refused(r"F: the mesh has no faces"),
+        {},
+    ),
+    "lone vertex in a face": (
+        lambda: (np.zeros((1, 3)), np.zeros((1, 3), np.int32)),
+        NO_EXTENT,
+        {},
+    ),
     "one triangle": (lambda: ONE_TRIANGLE, WORKS, {}),
     "collinear faces": (lambda: COLLINEAR, WORKS, {"bake": NO_AREA, "pose": NO_AREA}),
-    "unreferenced vertices": (lambda: with_vertices(*grid(), [[5.0, 5.0, 5.0], [0.1, 0.1, 0.0]]), WORKS, {}),
+    "unreferenced vertices": (
+        lambda: with_vertices(*grid(), [[5.0, 5.0, 5.0], [0.1, 0.1, 0.0]]),
+        WORKS,
+        {},
+    ),
     "duplicate vertices": (duplicate_vertex, WORKS, {}),
     "zero-area face": (lambda: with_faces(*grid(), [[0, 1, 2]]), WORKS, {}),
     "face with a repeated index": (lambda: with_faces(*grid(), [[0, 5, 5]]), WORKS, {}),
@@ -171,7 +196,11 @@ MESHES = {
     "inner sliver (ratio 6e-6)": (lambda: inner_sliver(1e-6), WORKS, {}),
     "a component 1e-20 the size of the mesh": (lambda: tiny_component(1e-20), WORKS, {}),
     "duplicate face": (lambda: with_faces(*grid(), [grid()[1][3]]), WORKS, {}),
-    "double sheet (a face and its flip)": (lambda: with_faces(*grid(), [grid()[1][3][::-1]]), WORKS, {}),
+    "double sheet (a face and its flip)": (
+        lambda: with_faces(*grid(), [grid()[1][3][::-1]]),
+        WORKS,
+        {},
+    ),
     "non-manifold edge": (fin, WORKS, {}),
     # Three zero modes from the cones' relative rotation: the bake deflates them and solves again.
     "non-manifold vertex": (two_fans_at_a_vertex, WORKS, {}),
@@ -180,14 +209,29 @@ MESHES = {
     "many components (debris)": (debris, WORKS, {}),
     "inverted faces": (flipped(1), WORKS, {}),
     "inconsistently oriented faces": (flipped(2), WORKS, {}),
-    "NaN coordinate": (with_value(7, 1, np.nan), Refused(r"V\[7\]: vertex 7 has a non-finite coordinate"), {}),
-    "infinite coordinate": (with_value(3, 2, -np.inf), Refused(r"V\[3\]: vertex 3 has a non-finite coordinate"), {}),
+    "NaN coordinate": (
+        with_value(7, 1, np.nan),
+        Refused(r"V\[7\]: vertex 7 has a non-finite coordinate"),
+        {},
+    ),
+    "infinite coordinate": (
+        with_value(3, 2, -np.inf),
+        Refused(r"V\[3\]: vertex 3 has a non-finite coordinate"),
+        {},
+    ),
     "tiny scale (1e-6)": (scaled(1e-6), WORKS, {}),
     "huge scale (1e6)": (scaled(1e6), WORKS, {}),
-    "coordinate too large (1e200)": (with_value(2, 0, 1e200), Refused(r"V\[2\]: vertex 2 has a coordinate too large"),
-                                     {}),
+    "coordinate too large (1e200)": (
+        with_value(2, 0, 1e200),
+        Refused(r"V\[2\]: vertex 2 has a coordinate too large"),
+        {},
+    ),
     "extent too small (1e-200)": (scaled(1e-200), NO_EXTENT, {}),
-    "index out of range": (with_index(4, 2, 16), Refused(r"F\[4\]: face 4 refers to vertex 16, outside \[0, 16\)"), {}),
+    "index out of range": (
+        with_index(4, 2, 16),
+        Refused(r"F\[4\]: face 4 refers to vertex 16, outside \[0, 16\)"),
+        {},
+    ),
     "negative index": (with_index(2, 0, -1), Refused(r"F\[2\]: face 2 refers to vertex -1"), {}),
 }
 
@@ -272,12 +316,18 @@ def test_mesh_case(case, entry):
 ARRAYS = {
     "V of shape (n, 2)": (lambda V, F: (V[:, :2], F), r"V: expected an \(n, 3\) array"),
     "V flat": (lambda V, F: (V.reshape(-1), F), r"V: expected an \(n, 3\) array"),
-    "V of strings": (lambda V, F: (V.astype(str).astype(object) + "x", F), r"V: expected real numbers"),
+    "V of strings": (
+        lambda V, F: (V.astype(str).astype(object) + "x", F),
+        r"V: expected real numbers",
+    ),
     "V complex": (lambda V, F: (V + 1j, F), r"V: expected real numbers"),
     "V as None": (lambda V, F: (None, F), r"V: expected"),
     "F of shape (m, 4)": (lambda V, F: (V, np.c_[F, F[:, :1]]), r"F: expected an \(m, 3\) array"),
     "F of floats": (lambda V, F: (V, F.astype(float)), r"F: expected integer indices"),
-    "F beyond int32": (lambda V, F: (V, F.astype(np.int64) + 2**40), r"F: an index does not fit in 32 bits"),
+    "F beyond int32": (
+        lambda V, F: (V, F.astype(np.int64) + 2**40),
+        r"F: an index does not fit in 32 bits",
+    ),
 }
 
 
@@ -287,9 +337,12 @@ def test_wrong_arrays_name_the_argument(case, entry):
     change, pattern = ARRAYS[case]
     V, F = change(*grid())
     calls = {
-        "check": lambda: mdc.check(V, F), "mass": lambda: mdc.mass(V, F),
-        "shells": lambda: mdc.DiscreteShells(V, F), "arap": lambda: mdc.Arap(V, F),
-        "ghost": lambda: mdc.ghost_mesh(V, F, 4), "bake": lambda: mdc.bake(V, F, modes=8, derivatives=0),
+        "check": lambda: mdc.check(V, F),
+        "mass": lambda: mdc.mass(V, F),
+        "shells": lambda: mdc.DiscreteShells(V, F),
+        "arap": lambda: mdc.Arap(V, F),
+        "ghost": lambda: mdc.ghost_mesh(V, F, 4),
+        "bake": lambda: mdc.bake(V, F, modes=8, derivatives=0),
         "full": lambda: mdc.solve_full(V, F, [[0]], [np.eye(4)]),
     }
     with pytest.raises(ValueError, match=pattern):
@@ -305,11 +358,17 @@ def test_non_contiguous_and_read_only_arrays_work():
     np.testing.assert_array_equal(mdc.mass(V2, F2), mdc.mass(V, F))
 
 
-@pytest.mark.parametrize("X, pattern", [
-    (lambda V: np.where(np.arange(V.size).reshape(V.shape) == 13, np.nan, V), r"X\[4\]: vertex 4 has a non-finite"),
-    (lambda V: V[:-1], r"X: expected shape"),
-    (lambda V: V * 1e200, r"X\[\d+\]: .*too large"),
-])
+@pytest.mark.parametrize(
+    "X, pattern",
+    [
+        (
+            lambda V: np.where(np.arange(V.size).reshape(V.shape) == 13, np.nan, V),
+            r"X\[4\]: vertex 4 has a non-finite",
+        ),
+        (lambda V: V[:-1], r"X: expected shape"),
+        (lambda V: V * 1e200, r"X\[\d+\]: .*too large"),
+    ],
+)
 @pytest.mark.parametrize("energy", [mdc.DiscreteShells, mdc.Arap])
 def test_energies_refuse_bad_positions(energy, X, pattern):
     V, F = grid()
@@ -334,19 +393,55 @@ def test_third_derivative_refuses_bad_directions():
 # --- Bake options --------------------------------------------------------------------------------
 
 OPTIONS = {
-    "more modes than degrees of freedom": (ONE_TRIANGLE, {"modes": 9}, Refused(r"modes: .*ask for fewer than 9")),
-    "modes not above the rigid motions": ((grid()), {"modes": 6}, Refused(r"modes: 6 modes are not more than the 6")),
-    "derivatives beyond the pairs": (grid(), {"modes": 8, "derivatives": 16}, Refused(r"derivatives: 16 asked for")),
+    "more modes than degrees of freedom": (
+        ONE_TRIANGLE,
+        {"modes": 9},
+        Refused(r"modes: .*ask for fewer than 9"),
+    ),
+    "modes not above the rigid motions": (
+        (grid()),
+        {"modes": 6},
+        Refused(r"modes: 6 modes are not more than the 6"),
+    ),
+    "derivatives beyond the pairs": (
+        grid(),
+        {"modes": 8, "derivatives": 16},
+        Refused(r"derivatives: 16 asked for"),
+    ),
     "ghost larger than the mesh": (grid(), {"modes": 8, "ghost": 10**6}, WORKS),
     "ghost below 4": (grid(), {"ghost": 3}, Refused(r"ghost: expected at least 4")),
-    "NaN bending": (grid(), {"bending": np.nan}, Refused(r"bending: expected a value in \[0, 1e\+12\], got nan")),
-    "negative membrane": (grid(), {"membrane": -1.0}, Refused(r"membrane: expected a value in \[0, 1e\+12\], got -1")),
-    "bending above 1e12": (grid(), {"bending": 1e300}, Refused(r"bending: expected a value in \[0, 1e\+12\], got 1e\+300")),
+    "NaN bending": (
+        grid(),
+        {"bending": np.nan},
+        Refused(r"bending: expected a value in \[0, 1e\+12\], got nan"),
+    ),
+    "negative membrane": (
+        grid(),
+        {"membrane": -1.0},
+        Refused(r"membrane: expected a value in \[0, 1e\+12\], got -1"),
+    ),
+    "bending above 1e12": (
+        grid(),
+        {"bending": 1e300},
+        Refused(r"bending: expected a value in \[0, 1e\+12\], got 1e\+300"),
+    ),
     "bending not a number": (grid(), {"bending": "stiff"}, Refused(r"bending: expected a number")),
-    "unknown energy": (grid(), {"energy": "springs"}, Refused(r"energy: expected \"shells\" or \"arap\"")),
-    "ARAP with derivatives": (grid(), {"energy": "arap"}, Refused(r"derivatives: the ARAP energy has no third")),
+    "unknown energy": (
+        grid(),
+        {"energy": "springs"},
+        Refused(r"energy: expected \"shells\" or \"arap\""),
+    ),
+    "ARAP with derivatives": (
+        grid(),
+        {"energy": "arap"},
+        Refused(r"derivatives: the ARAP energy has no third"),
+    ),
     "modes not an integer": (grid(), {"modes": 8.5}, Refused(r"modes: expected an integer")),
-    "progress not callable": (grid(), {"progress": "yes"}, Refused(r"progress: expected a callable")),
+    "progress not callable": (
+        grid(),
+        {"progress": "yes"},
+        Refused(r"progress: expected a callable"),
+    ),
 }
 
 
@@ -358,6 +453,7 @@ def test_bake_option_case(case):
 
 
 # --- Handles and transforms ----------------------------------------------------------------------
+
 
 @pytest.fixture(scope="module")
 def tube():
@@ -390,28 +486,129 @@ def nan_transform():
 # name: (handles (n) -> list, transforms, weights, stiffness, outcome)
 HANDLES = {
     "no handles": (lambda n: [], [], None, 100.0, Refused(r"handles: no handle given")),
-    "an empty handle": (lambda n: [[0, 1], []], [turn(), turn()], None, 100.0, Refused(r"handles\[1\]")),
+    "an empty handle": (
+        lambda n: [[0, 1], []],
+        [turn(), turn()],
+        None,
+        100.0,
+        Refused(r"handles\[1\]"),
+    ),
     "a handle covering every vertex": (lambda n: [np.arange(n)], [turn()], None, 100.0, WORKS),
     "overlapping handles": (lambda n: [[0, 1, 2], [2, 3]], [turn(), np.eye(4)], None, 100.0, WORKS),
-    "index out of range": (lambda n: [[0, n]], [turn()], None, 100.0, Refused(r"handles\[0\]\[1\] = \d+ is outside")),
-    "negative index": (lambda n: [[-1]], [turn()], None, 100.0, Refused(r"handles\[0\]\[0\] = -1 is outside")),
-    "vertex listed twice": (lambda n: [[3, 3]], [turn()], None, 100.0, Refused(r"handles\[0\] lists vertex 3 twice")),
-    "a single index array": (lambda n: np.arange(3), [turn()], None, 100.0, Refused(r"handles: .*single index array")),
-    "float indices": (lambda n: [[0.0, 1.0]], [turn()], None, 100.0, Refused(r"handles\[0\]: expected integer")),
-    "too few transforms": (lambda n: [[0], [1]], [turn()], None, 100.0, Refused(r"transforms: expected 2")),
-    "scaled transform": (lambda n: [[0]], [scaled_transform()], None, 100.0, Refused(r"transforms\[0\]: .*not a rotation")),
-    "mirroring transform": (lambda n: [[0]], [mirror()], None, 100.0, Refused(r"transforms\[0\]: .*reflection")),
-    "NaN in a transform": (lambda n: [[0]], [nan_transform()], None, 100.0, Refused(r"transforms\[0\] has non-finite")),
-    "3x3 transform": (lambda n: [[0]], [np.eye(3)], None, 100.0, Refused(r"transforms\[0\]: expected a 4x4")),
+    "index out of range": (
+        lambda n: [[0, n]],
+        [turn()],
+        None,
+        100.0,
+        Refused(r"handles\[0\]\[1\] = \d+ is outside"),
+    ),
+    "negative index": (
+        lambda n: [[-1]],
+        [turn()],
+        None,
+        100.0,
+        Refused(r"handles\[0\]\[0\] = -1 is outside"),
+    ),
+    "vertex listed twice": (
+        lambda n: [[3, 3]],
+        [turn()],
+        None,
+        100.0,
+        Refused(r"handles\[0\] lists vertex 3 twice"),
+    ),
+    "a single index array": (
+        lambda n: np.arange(3),
+        [turn()],
+        None,
+        100.0,
+        Refused(r"handles: .*single index array"),
+    ),
+    "float indices": (
+        lambda n: [[0.0, 1.0]],
+        [turn()],
+        None,
+        100.0,
+        Refused(r"handles\[0\]: expected integer"),
+    ),
+    "too few transforms": (
+        lambda n: [[0], [1]],
+        [turn()],
+        None,
+        100.0,
+        Refused(r"transforms: expected 2"),
+    ),
+    "scaled transform": (
+        lambda n: [[0]],
+        [scaled_transform()],
+        None,
+        100.0,
+        Refused(r"transforms\[0\]: .*not a rotation"),
+    ),
+    "mirroring transform": (
+        lambda n: [[0]],
+        [mirror()],
+        None,
+        100.0,
+        Refused(r"transforms\[0\]: .*reflection"),
+    ),
+    "NaN in a transform": (
+        lambda n: [[0]],
+        [nan_transform()],
+        None,
+        100.0,
+        Refused(r"transforms\[0\] has non-finite"),
+    ),
+    "3x3 transform": (
+        lambda n: [[0]],
+        [np.eye(3)],
+        None,
+        100.0,
+        Refused(r"transforms\[0\]: expected a 4x4"),
+    ),
     "negative weight": (lambda n: [[0]], [turn()], [-1.0], 100.0, Refused(r"weights\[0\] = -1")),
-    "weights of the wrong length": (lambda n: [[0]], [turn()], [1.0, 2.0], 100.0, Refused(r"weights: expected \(1,\)")),
-    "zero stiffness": (lambda n: [[0]], [turn()], None, 0.0, Refused(r"pull: expected a value in \(0, 1e\+12\], got 0")),
-    "NaN stiffness": (lambda n: [[0]], [turn()], None, np.nan, Refused(r"pull: expected a value in \(0, 1e\+12\], got nan")),
-    "stiffness above 1e12": (lambda n: [[0]], [turn()], None, 1e300, Refused(r"pull: expected a value in \(0, 1e\+12\], got 1e\+300")),
-    "weight above 1e12": (lambda n: [[0]], [turn()], [1e300], 100.0, Refused(r"weights\[0\] = 1e\+300 is not")),
+    "weights of the wrong length": (
+        lambda n: [[0]],
+        [turn()],
+        [1.0, 2.0],
+        100.0,
+        Refused(r"weights: expected \(1,\)"),
+    ),
+    "zero stiffness": (
+        lambda n: [[0]],
+        [turn()],
+        None,
+        0.0,
+        Refused(r"pull: expected a value in \(0, 1e\+12\], got 0"),
+    ),
+    "NaN stiffness": (
+        lambda n: [[0]],
+        [turn()],
+        None,
+        np.nan,
+        Refused(r"pull: expected a value in \(0, 1e\+12\], got nan"),
+    ),
+    "stiffness above 1e12": (
+        lambda n: [[0]],
+        [turn()],
+        None,
+        1e300,
+        Refused(r"pull: expected a value in \(0, 1e\+12\], got 1e\+300"),
+    ),
+    "weight above 1e12": (
+        lambda n: [[0]],
+        [turn()],
+        [1e300],
+        100.0,
+        Refused(r"weights\[0\] = 1e\+300 is not"),
+    ),
     "a far translation (1e6 extents)": (lambda n: [[0]], [turn(0.0, 2e6)], None, 100.0, WORKS),
-    "a translation beyond 1e15": (lambda n: [[0]], [turn(0.0, -1.7e308)], None, 100.0,
-                                  Refused(r"transforms\[0\]: the translation .* is beyond 1e\+15")),
+    "a translation beyond 1e15": (
+        lambda n: [[0]],
+        [turn(0.0, -1.7e308)],
+        None,
+        100.0,
+        Refused(r"transforms\[0\]: the translation .* is beyond 1e\+15"),
+    ),
 }
 
 
@@ -428,7 +625,11 @@ def test_handle_case(tube, case, entry):
         finite(solver.solve(max_iterations=20)["energy"], solver.positions())
 
     def full():
-        finite(mdc.solve_full(V, F, handles, transforms, pull=stiffness, weights=weights, max_iterations=20)[0])
+        finite(
+            mdc.solve_full(
+                V, F, handles, transforms, pull=stiffness, weights=weights, max_iterations=20
+            )[0]
+        )
 
     expect(outcome, reduced if entry == "reduced" else full)
 
@@ -441,15 +642,21 @@ def test_solver_refuses_what_is_not_a_basis(tube):
 def test_positions_refuse_a_wrong_buffer(tube):
     V, F, basis = tube
     solver = mdc.ReducedSolver(basis, [[0]])
-    for out in (np.empty((len(V), 3)), np.empty((len(V) - 1, 3), np.float32), np.empty((3, len(V)), np.float32).T):
+    for out in (
+        np.empty((len(V), 3)),
+        np.empty((len(V) - 1, 3), np.float32),
+        np.empty((3, len(V)), np.float32).T,
+    ):
         with pytest.raises(ValueError, match=r"out: expected a writeable C-contiguous float32"):
             solver.positions(out)
 
 
 # --- Stored bases ----------------------------------------------------------------------------------
 
+
 def stored_corruptions(arrays):
     """(pattern the error must match, corrupted copy) beyond test_bake's list."""
+
     def changed(**replacements):
         return {**arrays, **replacements}
 

@@ -2,11 +2,10 @@
 
 import numpy as np
 import pytest
-
-import modal_deform.core as mdc
-
 from support.dynamics import damped_oscillation, released  # the benchmark's free-body measurement
 from support.poses import rigid_transform as rigid
+
+import modal_deform.core as mdc
 
 
 @pytest.fixture(scope="module")
@@ -24,7 +23,9 @@ def tube():
     return V, F, handles, mdc.bake(V, F, modes=16, derivatives=30, ghost=400)
 
 
-@pytest.mark.parametrize("period, fps, substeps", [(12.0, 24.0, 2), (12.0, 24.0, 1), (6.0, 60.0, 3)])
+@pytest.mark.parametrize(
+    "period, fps, substeps", [(12.0, 24.0, 2), (12.0, 24.0, 1), (6.0, 60.0, 3)]
+)
 def test_undamped_free_body_keeps_its_period_and_amplitude(bar, period, fps, substeps):
     *_, basis = bar
     frames = int(10 * period) + 1
@@ -32,7 +33,7 @@ def test_undamped_free_body_keeps_its_period_and_amplitude(bar, period, fps, sub
     measured, decrement = damped_oscillation(trace)
     assert abs(measured - period) <= 0.02 * period
     # After 10 periods: at least 90% of the amplitude (the largest value over the last period).
-    last_period = np.abs(trace[-int(np.ceil(period)):]).max()
+    last_period = np.abs(trace[-int(np.ceil(period)) :]).max()
     assert last_period >= 0.9 * 0.01
     assert last_period <= 1.0001 * 0.01
 
@@ -54,10 +55,14 @@ def tube_bases():
     V, F = mdc.testing.cylinder(25, 40, radius=1.0, length=4.0)
     sizes = dict(modes=16, derivatives=30, ghost=400)
     upper = np.flatnonzero(V[:, 2] > 2.0)
-    bases = {"whole": mdc.bake(V, F, **sizes),
-             "painted": mdc.bake(V, F, **sizes, stiffness_weights=np.clip(V[:, 2] / 4, 0, 1), max_stiffness=20.0),
-             "proxy": mdc.bake(V, F, **sizes, proxy=400, proxy_above=500),
-             "region": mdc.bake(V, F, **sizes, region=upper)}
+    bases = {
+        "whole": mdc.bake(V, F, **sizes),
+        "painted": mdc.bake(
+            V, F, **sizes, stiffness_weights=np.clip(V[:, 2] / 4, 0, 1), max_stiffness=20.0
+        ),
+        "proxy": mdc.bake(V, F, **sizes, proxy=400, proxy_above=500),
+        "region": mdc.bake(V, F, **sizes, region=upper),
+    }
     return V, F, upper, bases
 
 
@@ -82,7 +87,9 @@ def test_every_kind_of_basis_keeps_the_period_and_follows_a_controller(tube_base
 def random_controller(rng, centre):
     """A random rigid move of the controller: turns up to 150° about a random axis, jumps up to about
     a bar's length."""
-    return rigid(rng.normal(size=3), rng.uniform(0, np.radians(150)), centre, rng.normal(scale=1.5, size=3))
+    return rigid(
+        rng.normal(size=3), rng.uniform(0, np.radians(150)), centre, rng.normal(scale=1.5, size=3)
+    )
 
 
 def test_fast_random_controllers_then_settling_to_the_pose(tube):
@@ -125,7 +132,10 @@ def test_a_run_is_deterministic_and_its_state_reloads_bit_identical(tube):
     def run(sim, transforms):
         return [sim.step(T).copy() for T in transforms]
 
-    first, second = mdc.Simulation(basis, handles, pull=100.0), mdc.Simulation(basis, handles, pull=100.0)
+    first, second = (
+        mdc.Simulation(basis, handles, pull=100.0),
+        mdc.Simulation(basis, handles, pull=100.0),
+    )
     a, b = run(first, moves), run(second, moves)
     assert all(np.array_equal(x, y) for x, y in zip(a, b))
     assert all(np.array_equal(x, y) for x, y in zip(first.state, second.state))
@@ -144,7 +154,10 @@ def test_a_run_is_deterministic_and_its_state_reloads_bit_identical(tube):
     # A cached frame shown by positions_of: the positions set_state would map, the state untouched.
     state, energy = reloaded.state, reloaded.energy()
     assert np.array_equal(reloaded.positions_of(q), cached.positions())
-    assert all(np.array_equal(x, y) for x, y in zip(reloaded.state, state)) and reloaded.energy() == energy
+    assert (
+        all(np.array_equal(x, y) for x, y in zip(reloaded.state, state))
+        and reloaded.energy() == energy
+    )
     with pytest.raises(ValueError, match="q"):
         reloaded.positions_of(q[:-1])
     # Its own state set again, as playback does before each step, continues the same.
@@ -205,14 +218,23 @@ def test_bfgs_memory_spans_blocks_of_frames_and_a_frame_inside_one_is_reached_ag
 
 def test_parameters_are_defined_once_and_checked(bar):
     V, F, basis = bar
-    assert mdc.SIMULATION_OPTIONS["period"].default == 12.0 and mdc.SIMULATION_OPTIONS["substeps"].default == 2
+    assert (
+        mdc.SIMULATION_OPTIONS["period"].default == 12.0
+        and mdc.SIMULATION_OPTIONS["substeps"].default == 2
+    )
     sim = mdc.Simulation(basis, [])
     assert sim.dimension == basis.vectors.shape[1] and sim.num_handles == 0
     X = sim.step([])
     assert X.shape == V.shape and X.dtype == np.float32
     assert np.array_equal(X, sim.positions())
-    for name, value in [("period", 2.0), ("damping", -0.1), ("damping", 1.5), ("fps", 0.0), ("pull", -1.0),
-                        ("period", float("nan"))]:
+    for name, value in [
+        ("period", 2.0),
+        ("damping", -0.1),
+        ("damping", 1.5),
+        ("fps", 0.0),
+        ("pull", -1.0),
+        ("period", float("nan")),
+    ]:
         with pytest.raises(ValueError, match=name):
             mdc.Simulation(basis, [], **{name: value})
     with pytest.raises(ValueError, match="substeps"):
@@ -248,7 +270,9 @@ def test_an_unconverged_step_says_so_and_stays_finite(tube):
         assert np.isfinite(X).all() and np.isfinite(sim.energy())
         stats.append(sim.stats)
     assert not all(s["converged"] for s in stats)
-    assert all(s["substeps"] == 2 and s["iterations"] <= 2 * (1 + s["implicit_euler"]) for s in stats)
+    assert all(
+        s["substeps"] == 2 and s["iterations"] <= 2 * (1 + s["implicit_euler"]) for s in stats
+    )
     # Unconverged steps cannot create energy either: with the controllers still it never grows.
     still = [np.eye(4), random_controller(rng, centre)]
     sim.step(still)

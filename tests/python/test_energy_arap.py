@@ -1,4 +1,5 @@
 """mdc.Arap through the Python API: shapes, derivatives, rigid invariance, errors."""
+
 import numpy as np
 import pytest
 import scipy.sparse

@@ -2,6 +2,7 @@
 
 The derivatives are checked in depth by tests/cpp/test_discrete_shells.cpp.
 """
+
 import numpy as np
 import pytest
 import scipy.sparse
@@ -37,14 +38,18 @@ def paper_energy(V, F, X, bending, membrane):
     first, second = order[0::2], order[1::2]
     v0, v1 = ends[first, 0], ends[first, 1]
     v2, v3 = opposite[first], opposite[second]
-    face_area = lambda P: 0.5 * np.linalg.norm(np.cross(P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]]), axis=1)
+    face_area = lambda P: (
+        0.5 * np.linalg.norm(np.cross(P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]]), axis=1)
+    )
 
     def theta(P):
         e = P[v1] - P[v0]
         n1 = np.cross(e, P[v2] - P[v0])
         n2 = np.cross(P[v3] - P[v0], e)
         unit = e / np.linalg.norm(e, axis=1)[:, None]
-        return np.arctan2(np.einsum("ij,ij->i", np.cross(n1, n2), unit), np.einsum("ij,ij->i", n1, n2))
+        return np.arctan2(
+            np.einsum("ij,ij->i", np.cross(n1, n2), unit), np.einsum("ij,ij->i", n1, n2)
+        )
 
     rest_area = face_area(V)
     combined = rest_area[first // 3] + rest_area[second // 3]
@@ -92,8 +97,13 @@ def test_shapes_types_and_layouts(bunny):
     B = E.third_batch(X, np.stack([U, W], axis=1), [(0, 1), (1, 1)])
     assert B.shape == (3 * n, 2)
     np.testing.assert_allclose(B[:, 0], t, rtol=0, atol=1e-12 * np.abs(t).max())
-    np.testing.assert_allclose(B[:, 1], E.third(X, W, W), rtol=0, atol=1e-12 * np.abs(B[:, 1]).max())
-    assert E.third_batch(X, np.stack([U, W], axis=1), np.zeros((0, 2), dtype=int)).shape == (3 * n, 0)
+    np.testing.assert_allclose(
+        B[:, 1], E.third(X, W, W), rtol=0, atol=1e-12 * np.abs(B[:, 1]).max()
+    )
+    assert E.third_batch(X, np.stack([U, W], axis=1), np.zeros((0, 2), dtype=int)).shape == (
+        3 * n,
+        0,
+    )
 
 
 def test_hessian_is_the_derivative_of_the_gradient(bunny):
@@ -114,11 +124,20 @@ def test_hessian_is_the_derivative_of_the_gradient(bunny):
         (lambda V, F, E: mdc.DiscreteShells(V, F, membrane=np.inf), "membrane"),
         (lambda V, F, E: mdc.DiscreteShells(V[:, :2], F), "V: expected an (n, 3)"),
         (lambda V, F, E: E.value(V[:-1]), "X: expected shape"),
-        (lambda V, F, E: E.value(np.where(np.arange(V.size).reshape(V.shape) == 7, np.nan, V)), "X[2]: vertex 2"),
+        (
+            lambda V, F, E: E.value(np.where(np.arange(V.size).reshape(V.shape) == 7, np.nan, V)),
+            "X[2]: vertex 2",
+        ),
         (lambda V, F, E: E.third(V, V, np.full(V.shape, np.inf)), "W[0]"),
         (lambda V, F, E: E.third_batch(V, np.ones((V.size, 2)), [(0, 2)]), "pairs[0]"),
-        (lambda V, F, E: E.third_batch(V, np.ones((V.size, 2)), [0, 1]), "pairs: expected a (p, 2)"),
-        (lambda V, F, E: E.third_batch(V, np.ones((V.size - 1, 2)), [(0, 1)]), "Phi: expected shape"),
+        (
+            lambda V, F, E: E.third_batch(V, np.ones((V.size, 2)), [0, 1]),
+            "pairs: expected a (p, 2)",
+        ),
+        (
+            lambda V, F, E: E.third_batch(V, np.ones((V.size - 1, 2)), [(0, 1)]),
+            "Phi: expected shape",
+        ),
     ],
 )
 def test_bad_input_raises_value_error_naming_it(call, needle):

@@ -4,11 +4,10 @@ import numpy as np
 import pytest
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
-
-import modal_deform.core as mdc
-
 from support.meshes import read_shared
 from support.subdivision import midpoint_subdivide
+
+import modal_deform.core as mdc
 
 
 def normals(V, F):
@@ -33,7 +32,12 @@ def boundary_loops(V, F):
 
 def euler_characteristic(V, F):
     report = mdc.check(V, F)
-    return report["vertices"] - report["unreferenced_vertices"]["count"] - report["edges"] + report["faces"]
+    return (
+        report["vertices"]
+        - report["unreferenced_vertices"]["count"]
+        - report["edges"]
+        + report["faces"]
+    )
 
 
 def two_cylinders():
@@ -51,8 +55,12 @@ def assert_valid_ghost(V, F, M, Vg, Fg, ghost_map):
     assert ghost_map.min() >= 0 and ghost_map.max() < g
     assert np.all(np.bincount(ghost_map, minlength=g) > 0), "a ghost vertex without fine vertices"
     cluster_mass = np.bincount(ghost_map, weights=M, minlength=g)
-    centroids = np.stack([np.bincount(ghost_map, weights=M * V[:, c], minlength=g) for c in range(3)], axis=1)
-    np.testing.assert_allclose(centroids / cluster_mass[:, None], Vg, rtol=0, atol=1e-12 * np.ptp(V, axis=0).max())
+    centroids = np.stack(
+        [np.bincount(ghost_map, weights=M * V[:, c], minlength=g) for c in range(3)], axis=1
+    )
+    np.testing.assert_allclose(
+        centroids / cluster_mass[:, None], Vg, rtol=0, atol=1e-12 * np.ptp(V, axis=0).max()
+    )
 
     report = mdc.check(Vg, Fg)
     assert report["degenerate_faces"]["count"] == 0
@@ -73,8 +81,14 @@ def assert_valid_ghost(V, F, M, Vg, Fg, ghost_map):
 
 @pytest.mark.parametrize(
     "name, target",
-    [("bunny", 300), ("grid", 150), ("cylinder", 200), ("two cylinders", 250),
-     ("dragon_vrip_res4.ply.gz", 1000), ("dragon_vrip_res3.ply.gz", 1000)],
+    [
+        ("bunny", 300),
+        ("grid", 150),
+        ("cylinder", 200),
+        ("two cylinders", 250),
+        ("dragon_vrip_res4.ply.gz", 1000),
+        ("dragon_vrip_res3.ply.gz", 1000),
+    ],
 )
 def test_ghost_is_valid_and_reaches_the_target(shared_mesh, name, target):
     V, F = {
@@ -91,8 +105,12 @@ def test_ghost_is_valid_and_reaches_the_target(shared_mesh, name, target):
 
 @pytest.mark.parametrize(
     "make, target",
-    [(lambda V, F: (V, F), 20), (lambda V, F: mdc.testing.grid(30, 30, 10.0, 10.0), 12),
-     (lambda V, F: mdc.testing.cylinder(32, 30, 1.0, 6.0), 12), (lambda V, F: two_cylinders(), 24)],
+    [
+        (lambda V, F: (V, F), 20),
+        (lambda V, F: mdc.testing.grid(30, 30, 10.0, 10.0), 12),
+        (lambda V, F: mdc.testing.cylinder(32, 30, 1.0, 6.0), 12),
+        (lambda V, F: two_cylinders(), 24),
+    ],
     ids=["bunny", "grid", "cylinder", "two cylinders"],
 )
 def test_topology_and_boundary_are_kept(shared_mesh, make, target):
@@ -123,7 +141,9 @@ def test_restriction_of_a_rigid_motion_is_that_rigid_motion(shared_mesh, name):
     Vg, Fg, ghost_map = mdc.ghost_mesh(V, F, vertices=500)
     restricted = mdc.restrict_to_ghost(ghost_map, mdc.mass(V, F), rigid_motions(V))
     assert restricted.shape == (3 * len(Vg), 6)
-    np.testing.assert_allclose(restricted, rigid_motions(Vg), rtol=0, atol=1e-13 * max(1.0, np.ptp(V)))
+    np.testing.assert_allclose(
+        restricted, rigid_motions(Vg), rtol=0, atol=1e-13 * max(1.0, np.ptp(V))
+    )
 
 
 def test_restriction_takes_single_vectors_and_any_layout(shared_mesh):
@@ -147,7 +167,9 @@ def test_a_target_of_at_least_the_vertex_count_gives_the_mesh_itself(shared_mesh
 def test_progress_reports_the_ghost_stage_and_false_cancels(shared_mesh):
     V, F = shared_mesh("dragon_vrip_res4.ply.gz")
     seen = []
-    mdc.ghost_mesh(V, F, vertices=1000, progress=lambda stage, fraction: seen.append((stage, fraction)))
+    mdc.ghost_mesh(
+        V, F, vertices=1000, progress=lambda stage, fraction: seen.append((stage, fraction))
+    )
     assert {stage for stage, _ in seen} == {"ghost"} and seen[-1][1] == 1.0
     with pytest.raises(mdc.Cancelled):
         mdc.ghost_mesh(V, F, vertices=1000, progress=lambda stage, fraction: False)
@@ -169,16 +191,34 @@ V_GRID, F_GRID = mdc.testing.grid(4, 4)
 @pytest.mark.parametrize(
     "call, needle",
     [
-        (lambda: mdc.ghost_mesh(V_GRID, F_GRID, vertices=3), "vertices: a ghost needs at least 4 vertices"),
-        (lambda: mdc.ghost_mesh(V_GRID, F_GRID, vertices=-10**12), "vertices: a ghost needs at least 4"),
+        (
+            lambda: mdc.ghost_mesh(V_GRID, F_GRID, vertices=3),
+            "vertices: a ghost needs at least 4 vertices",
+        ),
+        (
+            lambda: mdc.ghost_mesh(V_GRID, F_GRID, vertices=-(10**12)),
+            "vertices: a ghost needs at least 4",
+        ),
         (lambda: mdc.ghost_mesh(V_GRID, F_GRID, vertices=10.5), "vertices: expected an integer"),
         (lambda: mdc.ghost_mesh(V_GRID, F_GRID, progress="yes"), "progress: expected a callable"),
         (lambda: mdc.ghost_mesh(V_GRID, [[0, 1, 99]]), "F[0]"),
         (lambda: mdc.ghost_mesh(V_GRID, [[0, 1, 2], [0, 2, 1]], vertices=4), "F: no triangle"),
-        (lambda: mdc.restrict_to_ghost(np.zeros(25, int), np.ones(24), np.zeros(75)), "mass: expected shape (25,)"),
-        (lambda: mdc.restrict_to_ghost(np.zeros(25, int), np.ones(25), np.zeros(74)), "U: expected shape (75,)"),
-        (lambda: mdc.restrict_to_ghost(np.full(25, -1), np.ones(25), np.zeros(75)), "ghost_map: expected indices"),
-        (lambda: mdc.restrict_to_ghost(np.arange(25) % 3 * 2, np.ones(25), np.zeros(75)), "ghost vertex 1"),
+        (
+            lambda: mdc.restrict_to_ghost(np.zeros(25, int), np.ones(24), np.zeros(75)),
+            "mass: expected shape (25,)",
+        ),
+        (
+            lambda: mdc.restrict_to_ghost(np.zeros(25, int), np.ones(25), np.zeros(74)),
+            "U: expected shape (75,)",
+        ),
+        (
+            lambda: mdc.restrict_to_ghost(np.full(25, -1), np.ones(25), np.zeros(75)),
+            "ghost_map: expected indices",
+        ),
+        (
+            lambda: mdc.restrict_to_ghost(np.arange(25) % 3 * 2, np.ones(25), np.zeros(75)),
+            "ghost vertex 1",
+        ),
         (lambda: mdc.restrict_to_ghost(np.zeros(25, int), -np.ones(25), np.zeros(75)), "mass[0]"),
     ],
 )
@@ -200,7 +240,8 @@ def test_a_subdivided_scan_leaves_no_island_of_fine_triangles(target):
     G, GF, ghost_map = mdc.ghost_mesh(V, F, target)
     assert len(G) <= target
     sizes = np.bincount(ghost_map[ghost_map >= 0])
-    assert (sizes == 1).sum() <= 1, f"{(sizes == 1).sum()} ghost vertices stand for a single fine vertex"
+    assert (sizes == 1).sum() <= 1, (
+        f"{(sizes == 1).sum()} ghost vertices stand for a single fine vertex"
+    )
     area = np.linalg.norm(normals(G, GF), axis=1)
     assert (area < np.median(area) / 100).sum() <= 0.002 * len(GF)
-

@@ -1,6 +1,7 @@
 """Vibration modes, rigid motions and the modal-derivative solves against dense scipy references,
 with a spring network (edges and hinges: the shells pattern, rigid motions in its kernel) and a
 graph Laplacian as stand-in stiffness matrices."""
+
 import re
 
 import numpy as np
@@ -36,7 +37,9 @@ def spring_stiffness(V, F):
         cols.append((3 * q[:, None, None] + c).ravel())
         vals.append(sign * block.ravel())
     n = 3 * len(V)
-    return scipy.sparse.csc_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), (n, n))
+    return scipy.sparse.csc_matrix(
+        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), (n, n)
+    )
 
 
 def laplacian_stiffness(V, F):
@@ -67,7 +70,9 @@ def test_modes_match_scipy_eigh(two_boxes):
     V, F, K, mass, _ = two_boxes
     m = np.repeat(mass, 3)
     for stiffness in (K, laplacian_stiffness(V, F)):
-        reference = scipy.linalg.eigh(stiffness.toarray(), np.diag(m), eigvals_only=True, subset_by_index=[0, 19])
+        reference = scipy.linalg.eigh(
+            stiffness.toarray(), np.diag(m), eigvals_only=True, subset_by_index=[0, 19]
+        )
         eigenvalues, modes = mdc.vibration_modes(stiffness, mass, 20)
         top = reference[-1]
         np.testing.assert_allclose(eigenvalues, reference, rtol=0, atol=1e-9 * top)
@@ -124,7 +129,9 @@ def test_solve_in_range_is_the_limit_of_k_plus_eps_m(two_boxes):
         shifted = scipy.sparse.linalg.spsolve((K + eps * scipy.sparse.diags(m)).tocsc(), PB)
         assert np.abs(shifted - Psi).max() < 10 * eps / lam[flexible][0] * np.abs(Psi).max()
     # One vector works too, and K does not need to be csc.
-    np.testing.assert_allclose(mdc.solve_in_range(K.tocoo(), mass, Z, B[:, 0])[:, 0], Psi[:, 0], atol=1e-12)
+    np.testing.assert_allclose(
+        mdc.solve_in_range(K.tocoo(), mass, Z, B[:, 0])[:, 0], Psi[:, 0], atol=1e-12
+    )
 
 
 def test_unsorted_duplicate_entries_are_summed(two_boxes):
@@ -132,14 +139,23 @@ def test_unsorted_duplicate_entries_are_summed(two_boxes):
     # Each column twice, the second copy reversed, each copy with half the values.
     indices, data = [], []
     for j in range(K.shape[1]):
-        rows, values = K.indices[K.indptr[j]:K.indptr[j + 1]], K.data[K.indptr[j]:K.indptr[j + 1]]
+        rows, values = (
+            K.indices[K.indptr[j] : K.indptr[j + 1]],
+            K.data[K.indptr[j] : K.indptr[j + 1]],
+        )
         indices += [rows, rows[::-1]]
         data += [values / 2, values[::-1] / 2]
-    doubled = scipy.sparse.csc_matrix((np.concatenate(data), np.concatenate(indices), 2 * K.indptr), K.shape)
+    doubled = scipy.sparse.csc_matrix(
+        (np.concatenate(data), np.concatenate(indices), 2 * K.indptr), K.shape
+    )
     assert not doubled.has_canonical_format
     before = doubled.indices.copy(), doubled.data.copy()
-    np.testing.assert_allclose(mdc.vibration_modes(doubled, mass, 14)[0], mdc.vibration_modes(K, mass, 14)[0],
-                               rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(
+        mdc.vibration_modes(doubled, mass, 14)[0],
+        mdc.vibration_modes(K, mass, 14)[0],
+        rtol=1e-10,
+        atol=1e-12,
+    )
     # The caller's matrix is left as it was.
     np.testing.assert_array_equal(doubled.indices, before[0])
     np.testing.assert_array_equal(doubled.data, before[1])
@@ -148,19 +164,51 @@ def test_unsorted_duplicate_entries_are_summed(two_boxes):
 @pytest.mark.parametrize(
     "call, error, needle",
     [
-        (lambda K, m, Z: mdc.vibration_modes(K.toarray(), m, 4), ValueError, "K: expected a scipy.sparse matrix"),
+        (
+            lambda K, m, Z: mdc.vibration_modes(K.toarray(), m, 4),
+            ValueError,
+            "K: expected a scipy.sparse matrix",
+        ),
         (lambda K, m, Z: mdc.vibration_modes(K, m[:-1], 4), ValueError, "K: expected"),
         (lambda K, m, Z: mdc.vibration_modes(K, m, 0), ValueError, "count: expected 1 to"),
         (lambda K, m, Z: mdc.vibration_modes(K, -m, 4), ValueError, "mass[0]"),
-        (lambda K, m, Z: mdc.vibration_modes(K - 0.01 * scipy.sparse.diags(np.repeat(m, 3)), m, 4),
-         RuntimeError, "not positive definite"),
-        (lambda K, m, Z: mdc.vibration_modes(K, m, 4, kernel=Z[:, :5] + 1), ValueError, "M-orthonormal"),
-        (lambda K, m, Z: mdc.solve_in_range(K, m, Z[:-3], np.ones(K.shape[0])), ValueError, "Z: expected shape"),
-        (lambda K, m, Z: mdc.solve_in_range(K, m, 2 * Z, np.ones(K.shape[0])), ValueError, "M-orthonormal"),
-        (lambda K, m, Z: mdc.solve_in_range(K, m, Z[:, :3], np.ones(K.shape[0])), RuntimeError, "whole kernel"),
-        (lambda K, m, Z: mdc.rigid_motions(np.zeros((len(m), 3)), np.zeros(len(m), int), m), ValueError, "line"),
-        (lambda K, m, Z: mdc.rigid_motions(np.zeros((len(m), 3)), np.zeros(len(m)), m), ValueError,
-         "labels: expected integers"),
+        (
+            lambda K, m, Z: mdc.vibration_modes(
+                K - 0.01 * scipy.sparse.diags(np.repeat(m, 3)), m, 4
+            ),
+            RuntimeError,
+            "not positive definite",
+        ),
+        (
+            lambda K, m, Z: mdc.vibration_modes(K, m, 4, kernel=Z[:, :5] + 1),
+            ValueError,
+            "M-orthonormal",
+        ),
+        (
+            lambda K, m, Z: mdc.solve_in_range(K, m, Z[:-3], np.ones(K.shape[0])),
+            ValueError,
+            "Z: expected shape",
+        ),
+        (
+            lambda K, m, Z: mdc.solve_in_range(K, m, 2 * Z, np.ones(K.shape[0])),
+            ValueError,
+            "M-orthonormal",
+        ),
+        (
+            lambda K, m, Z: mdc.solve_in_range(K, m, Z[:, :3], np.ones(K.shape[0])),
+            RuntimeError,
+            "whole kernel",
+        ),
+        (
+            lambda K, m, Z: mdc.rigid_motions(np.zeros((len(m), 3)), np.zeros(len(m), int), m),
+            ValueError,
+            "line",
+        ),
+        (
+            lambda K, m, Z: mdc.rigid_motions(np.zeros((len(m), 3)), np.zeros(len(m)), m),
+            ValueError,
+            "labels: expected integers",
+        ),
     ],
 )
 def test_bad_input_raises_naming_it(two_boxes, call, error, needle):

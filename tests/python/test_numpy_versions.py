@@ -6,6 +6,7 @@ handles, q, an initial pose). The copy goes through NumPy's C API table, whose l
 changed: a core built with pybind11 older than 2.12 called an empty slot there and the process (an
 artist's Blender) died at the first Solve. Each path runs in a child process, so a crash fails the
 test with its signal instead of ending the test run."""
+
 import signal
 import subprocess
 import sys
@@ -13,8 +14,6 @@ import textwrap
 
 import numpy as np
 import pytest
-
-import modal_deform.core as mdc
 
 COPIED_INTO_THE_CORE = {
     "handles and q": """
@@ -34,7 +33,8 @@ COPIED_INTO_THE_CORE = {
 
 @pytest.mark.parametrize("path", COPIED_INTO_THE_CORE)
 def test_arrays_copied_into_the_core(path):
-    script = textwrap.dedent("""
+    script = (
+        textwrap.dedent("""
         import numpy as np
         import modal_deform.core as mdc
         V, F = mdc.testing.cylinder(8, 6, radius=1.0, length=3.0)
@@ -42,10 +42,19 @@ def test_arrays_copied_into_the_core(path):
         turn = np.eye(4)
         turn[:3, :3] = [[0, -1, 0], [1, 0, 0], [0, 0, 1]]
         transforms = [np.eye(4), turn]
-    """) + textwrap.dedent(COPIED_INTO_THE_CORE[path]) + "print('OK')\n"
-    result = subprocess.run([sys.executable, "-X", "faulthandler", "-c", script], capture_output=True, text=True,
-                            timeout=300)
+    """)
+        + textwrap.dedent(COPIED_INTO_THE_CORE[path])
+        + "print('OK')\n"
+    )
+    result = subprocess.run(
+        [sys.executable, "-X", "faulthandler", "-c", script],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     if result.returncode < 0:
-        pytest.fail(f"NumPy {np.__version__}: the core crashed with {signal.Signals(-result.returncode).name} "
-                    f"({path}):\n{result.stderr[-3000:]}")
+        pytest.fail(
+            f"NumPy {np.__version__}: the core crashed with {signal.Signals(-result.returncode).name} "
+            f"({path}):\n{result.stderr[-3000:]}"
+        )
     assert result.returncode == 0 and "OK" in result.stdout, result.stderr[-3000:]

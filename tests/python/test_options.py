@@ -1,5 +1,6 @@
 """The options the native core declares once (cpp/util/option.h tables) reach the Python API as
 explicit keyword-only parameters with the core's defaults, and the core checks their values."""
+
 import inspect
 import warnings
 
@@ -16,10 +17,17 @@ def tube():
     return V, F, handles, mdc.bake(V, F, modes=10, derivatives=5, ghost=50)
 
 
-@pytest.mark.parametrize("function, table", [
-    (mdc.bake, mdc.BAKE_OPTIONS), (mdc.solve_full, mdc.FULL_SOLVE_OPTIONS), (mdc.ReducedSolver, mdc.SOLVER_OPTIONS),
-    (mdc.ReducedSolver.solve, mdc.SOLVE_OPTIONS), (mdc.Simulation, mdc.SIMULATION_OPTIONS),
-    (mdc.DiscreteShells, mdc.MATERIAL_OPTIONS)])
+@pytest.mark.parametrize(
+    "function, table",
+    [
+        (mdc.bake, mdc.BAKE_OPTIONS),
+        (mdc.solve_full, mdc.FULL_SOLVE_OPTIONS),
+        (mdc.ReducedSolver, mdc.SOLVER_OPTIONS),
+        (mdc.ReducedSolver.solve, mdc.SOLVE_OPTIONS),
+        (mdc.Simulation, mdc.SIMULATION_OPTIONS),
+        (mdc.DiscreteShells, mdc.MATERIAL_OPTIONS),
+    ],
+)
 def test_signatures_show_every_option_with_the_core_default(function, table):
     parameters = inspect.signature(function).parameters
     doc = (function.__init__ if inspect.isclass(function) else function).__doc__
@@ -31,10 +39,16 @@ def test_signatures_show_every_option_with_the_core_default(function, table):
 
 
 def test_one_pull_and_one_max_stiffness():
-    pulls = {t["pull"].default for t in (mdc.SOLVER_OPTIONS, mdc.SIMULATION_OPTIONS, mdc.FULL_SOLVE_OPTIONS)}
+    pulls = {
+        t["pull"].default
+        for t in (mdc.SOLVER_OPTIONS, mdc.SIMULATION_OPTIONS, mdc.FULL_SOLVE_OPTIONS)
+    }
     assert pulls == {1000.0}
-    assert mdc.BAKE_OPTIONS["max_stiffness"] == mdc.FULL_SOLVE_OPTIONS["max_stiffness"] \
+    assert (
+        mdc.BAKE_OPTIONS["max_stiffness"]
+        == mdc.FULL_SOLVE_OPTIONS["max_stiffness"]
         == mdc.MATERIAL_OPTIONS["max_stiffness"]
+    )
     assert mdc.BAKE_OPTIONS["max_stiffness"].range_text() == "in [1, 10000]"
 
 

@@ -2,6 +2,7 @@
 dragons) bake and pose; near-degenerate elements have bounded stiffness; a bake that cannot fit
 in memory is refused up front with the sizes, and a lack of memory is never reported as a matrix
 that is not positive definite. The 400k-vertex raw scan is in make bench (bench/raw_scan.py)."""
+
 import os
 import pathlib
 import subprocess
@@ -11,10 +12,9 @@ import warnings
 
 import numpy as np
 import pytest
+from support import SHARED_MESHES, raw_scans
 
 import modal_deform.core as mdc
-
-from support import SHARED_MESHES, raw_scans
 
 
 @pytest.mark.parametrize("seed", [0, 1])
@@ -53,7 +53,9 @@ def test_pairs_of_slivers_bake(seed):
     V, F = mdc.testing.grid(25, 25, 10.0, 10.0)
     V = V.copy()
     V[:, 2] = 0.3 * np.sin(0.7 * V[:, 0]) * np.cos(0.5 * V[:, 1])
-    V, F = raw_scans.damaged(V, F, seed=seed, rates={kind: 0 for kind in raw_scans.RATES} | {"sliver_pairs": 1000})
+    V, F = raw_scans.damaged(
+        V, F, seed=seed, rates={kind: 0 for kind in raw_scans.RATES} | {"sliver_pairs": 1000}
+    )
     basis = mdc.bake(V, F, modes=20, derivatives=10, ghost=200)
     assert basis.num_floppy == 0 and np.isfinite(basis.vectors).all()
     assert 0 < basis.eigenvalues[6] <= basis.eigenvalues[-1] < 10
@@ -93,41 +95,56 @@ def test_sliver_stiffness_is_bounded_and_sound_elements_keep_theirs():
 #: AddressSanitizer reserves terabytes of address space for its shadow memory: under `make sanitize`
 #: (libasan preloaded) any limit on the address space leaves it none, and it aborts.
 def limits_address_space(test):
-    test = pytest.mark.skipif("libasan" in os.environ.get("LD_PRELOAD", ""),
-                              reason="AddressSanitizer cannot run under an address-space limit")(test)
-    return pytest.mark.skipif(sys.platform == "win32", reason="Windows has no RLIMIT_AS: the memory check "
-                              "reads GlobalMemoryStatusEx there, and this test would need a job object's "
-                              "memory limit, on Windows as under Wine")(test)
+    test = pytest.mark.skipif(
+        "libasan" in os.environ.get("LD_PRELOAD", ""),
+        reason="AddressSanitizer cannot run under an address-space limit",
+    )(test)
+    return pytest.mark.skipif(
+        sys.platform == "win32",
+        reason="Windows has no RLIMIT_AS: the memory check "
+        "reads GlobalMemoryStatusEx there, and this test would need a job object's "
+        "memory limit, on Windows as under Wine",
+    )(test)
 
 
 def run_limited(code, address_space, setup=""):
     """Runs `code` in a fresh Python that has read dragon_vrip_res3 into V, F and run `setup`, with
     its address space limited to `address_space` bytes more than it has mapped then; returns
     (exit code, output). The Python imports the modal_deform under test."""
-    script = textwrap.dedent(f"""
+    script = (
+        textwrap.dedent(f"""
         import resource, sys
         sys.path.insert(0, {str(pathlib.Path(mdc.__file__).parents[2])!r})
         import numpy as np
         import modal_deform.core as mdc
         V, F = mdc.read_mesh({str(SHARED_MESHES / "dragon_vrip_res3.ply.gz")!r})
-    """) + textwrap.dedent(setup) + textwrap.dedent(f"""
+    """)
+        + textwrap.dedent(setup)
+        + textwrap.dedent(f"""
         pages = int(open("/proc/self/statm").read().split()[0])
         limit = pages * resource.getpagesize() + {address_space}
         resource.setrlimit(resource.RLIMIT_AS, (limit, resource.RLIM_INFINITY))
-    """) + textwrap.dedent(code)
-    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=600)
+    """)
+        + textwrap.dedent(code)
+    )
+    result = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=600
+    )
     return result.returncode, result.stdout + result.stderr
 
 
 @limits_address_space
 def test_a_bake_that_cannot_fit_is_refused_before_the_factorisation():
-    code, output = run_limited("""
+    code, output = run_limited(
+        """
         try:
             mdc.bake(V, F, modes=20, derivatives=47, ghost=500)
         except mdc.OutOfMemoryError as error:
             assert isinstance(error, MemoryError)
             print("refused:", error)
-    """, 300_000_000)
+    """,
+        300_000_000,
+    )
     assert code == 0, output
     assert "refused: bake: not enough memory: the bake needs about" in output, output
     assert "factor of K" in output and "from CHOLMOD's analysis" in output, output
@@ -139,7 +156,8 @@ def test_a_factorisation_out_of_memory_is_not_called_indefinite():
     for anything to too small for the factor only: every failure is a MemoryError, those in CHOLMOD
     say so (its status), none says the matrix is not positive definite. (Beyond, a limit that
     leaves no room for a thread's stack makes libgomp abort the process: nothing to catch.)"""
-    code, output = run_limited("""
+    code, output = run_limited(
+        """
         for extra in range(0, 400_000_000, 10_000_000):
             resource.setrlimit(resource.RLIMIT_AS, (limit + extra, resource.RLIM_INFINITY))
             try:
@@ -150,12 +168,18 @@ def test_a_factorisation_out_of_memory_is_not_called_indefinite():
                 print("memory:", error)
                 if "factorize: out of memory" in str(error):
                     break
-    """, 0, setup="""
+    """,
+        0,
+        setup="""
         K, m = mdc.DiscreteShells(V, F).hessian(V), mdc.mass(V, F)
-    """)
+    """,
+    )
     assert code == 0, output
     assert "CHOLMOD factorize: out of memory" in output.splitlines()[-1], output
-    assert "memory: vibration modes: not enough memory to factor K - sigma M (68994 rows, a factor of 0.1" in output, output
+    assert (
+        "memory: vibration modes: not enough memory to factor K - sigma M (68994 rows, a factor of 0.1"
+        in output
+    ), output
     assert "positive definite" not in output, output
 
 
@@ -170,4 +194,7 @@ def test_raw_scan_bakes_on_its_proxy_without_zero_modes():
         warnings.simplefilter("error")
         basis = mdc.bake(V, F, modes=20, derivatives=10, ghost=300)
     assert basis.on_proxy and basis.num_floppy == 0
-    assert np.isfinite(basis.vectors).all() and basis.eigenvalues[basis.num_rigid + basis.num_floppy] > 0
+    assert (
+        np.isfinite(basis.vectors).all()
+        and basis.eigenvalues[basis.num_rigid + basis.num_floppy] > 0
+    )

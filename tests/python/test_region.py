@@ -1,4 +1,5 @@
 """Region bakes (issue 24): only the region moves, every other vertex stays exactly at rest."""
+
 import numpy as np
 import pytest
 
@@ -19,7 +20,9 @@ def test_outside_the_region_nothing_moves_and_the_inside_follows_its_handle(tube
     outside = np.setdiff1d(np.arange(len(V)), region)
     assert not basis.vectors.reshape(len(V), 3, -1)[outside].any()
     # The ghost is spent where the mesh moves: the region and the two rings of faces around it.
-    assert len(basis.ghost_vertices) <= 100 and basis.ghost_vertices[:, 2].min() > 3.0 - 3 * 6.0 / 30
+    assert (
+        len(basis.ghost_vertices) <= 100 and basis.ghost_vertices[:, 2].min() > 3.0 - 3 * 6.0 / 30
+    )
     top = np.flatnonzero(V[:, 2] > 6 - 1e-9)
     T = np.eye(4)
     T[:3, 3] = [0.6, 0.0, -0.3]
@@ -82,7 +85,9 @@ def test_a_dense_region_is_baked_on_a_proxy_of_its_own_faces():
     arrays = basis.to_arrays()
     weights = arrays["prolongation_weights"].copy()
     weights[outside[0]] = [1.0, 0.0, 0.0]
-    with pytest.raises(ValueError, match=rf"prolongation weights\[{outside[0]}\]: vertex {outside[0]} lies outside"):
+    with pytest.raises(
+        ValueError, match=rf"prolongation weights\[{outside[0]}\]: vertex {outside[0]} lies outside"
+    ):
         mdc.Basis.from_arrays({**arrays, "prolongation_weights": weights})
 
 
@@ -120,20 +125,24 @@ def test_a_free_part_of_the_region_keeps_its_rigid_motions_as_zero_modes(tube):
     V, F, _ = tube
     W = V + [3.0, 0.0, 0.0]
     V2, F2 = np.vstack([V, W]), np.vstack([F, F + len(V)])
-    basis = mdc.bake(V2, F2, modes=12, derivatives=10, ghost=200, region=np.arange(len(V), 2 * len(V)))
+    basis = mdc.bake(
+        V2, F2, modes=12, derivatives=10, ghost=200, region=np.arange(len(V), 2 * len(V))
+    )
     assert basis.num_rigid == 0 and basis.num_floppy == 6
-    assert not basis.vectors[:3 * len(V)].any()
+    assert not basis.vectors[: 3 * len(V)].any()
 
 
 def test_bad_regions_are_refused_naming_them(tube):
     V, F, region = tube
     n = len(V)
-    for bad, message in [([], "region: it has no vertices"),
-                         ([0, n], rf"region\[1\] = {n} is not a vertex"),
-                         ([3, 4, 3], r"region\[2\] = 3 is there twice"),
-                         (np.arange(n), "region: it holds every vertex"),
-                         ([[1, 2]], "region: expected a 1-d array"),
-                         ([0.5], "region: expected a 1-d array of vertex indices")]:
+    for bad, message in [
+        ([], "region: it has no vertices"),
+        ([0, n], rf"region\[1\] = {n} is not a vertex"),
+        ([3, 4, 3], r"region\[2\] = 3 is there twice"),
+        (np.arange(n), "region: it holds every vertex"),
+        ([[1, 2]], "region: expected a 1-d array"),
+        ([0.5], "region: expected a 1-d array of vertex indices"),
+    ]:
         with pytest.raises(ValueError, match=message):
             mdc.bake(V, F, modes=8, derivatives=0, ghost=100, region=bad)
     # A region vertex without a face has no mass: nothing is left free.
@@ -141,8 +150,10 @@ def test_bad_regions_are_refused_naming_them(tube):
     with pytest.raises(ValueError, match="region: no vertex of it is left free"):
         mdc.bake(V2, F, modes=8, derivatives=0, ghost=100, region=[n])
     arrays = mdc.bake(V, F, modes=8, derivatives=0, ghost=100, region=region).to_arrays()
-    for value, message in [(arrays["region"][::-1].copy(), r"region\[1\]"),
-                           (arrays["region"][1:], "vectors: vertex %d lies outside the region" % region[0])]:
+    for value, message in [
+        (arrays["region"][::-1].copy(), r"region\[1\]"),
+        (arrays["region"][1:], "vectors: vertex %d lies outside the region" % region[0]),
+    ]:
         with pytest.raises(ValueError, match=message):
             mdc.Basis.from_arrays({**arrays, "region": value})
 
@@ -153,7 +164,9 @@ def test_the_solver_minimises_the_whole_mesh_energy_with_the_outside_held(tube):
     V, F, region = tube
     basis = mdc.bake(V, F, modes=12, derivatives=20, ghost=1000, region=region)
     q = np.random.default_rng(2).normal(scale=0.02, size=basis.dimension)
-    f1, f2 = (mdc.ReducedSolver(basis, [region[-10:]], pull=mu).objective(q)[0] for mu in (1.0, 2.0))
+    f1, f2 = (
+        mdc.ReducedSolver(basis, [region[-10:]], pull=mu).objective(q)[0] for mu in (1.0, 2.0)
+    )
     s = basis.scale
     X = s * (V.reshape(-1) + basis.vectors.astype(np.float64) @ q)
     assert 2 * f1 - f2 == pytest.approx(mdc.DiscreteShells(s * V, F).value(X), rel=1e-6)

@@ -2,10 +2,9 @@
 
 import numpy as np
 import pytest
+from support.poses import rigid_transform as rigid
 
 import modal_deform.core as mdc
-
-from support.poses import rigid_transform as rigid
 
 
 @pytest.fixture(scope="module")
@@ -40,7 +39,9 @@ def test_solve_full_finds_a_stationary_point(tube, energy):
     g0 = objective_gradient(V, F, handles, transforms, V, 100.0, energy)
     assert np.linalg.norm(g) <= 1e-8 * np.linalg.norm(g0)
     # The same solve again: the same positions to the bit.
-    assert np.array_equal(mdc.solve_full(V, F, handles, transforms, pull=100.0, energy=energy, tolerance=1e-10)[0], X)
+    assert np.array_equal(
+        mdc.solve_full(V, F, handles, transforms, pull=100.0, energy=energy, tolerance=1e-10)[0], X
+    )
 
 
 def test_solve_full_refuses_bad_input(tube):
@@ -97,7 +98,14 @@ def test_reduced_solver_poses_close_to_the_full_solve(tube, tube_basis):
     energies = []
     for _ in range(30):
         stats = solver.solve(max_iterations=1)
-        assert set(stats) >= {"iterations", "energy", "converged", "ms", "evaluations", "gradient_norm"}
+        assert set(stats) >= {
+            "iterations",
+            "energy",
+            "converged",
+            "ms",
+            "evaluations",
+            "gradient_norm",
+        }
         energies.append(stats["energy"])
     assert all(b <= a for a, b in zip(energies, energies[1:]))
     assert converge(solver)["converged"]
@@ -133,9 +141,15 @@ def test_positions_fill_the_callers_buffer(tube, tube_basis):
         out = np.full(shape, np.nan, dtype=np.float32)
         assert solver.positions(out) is out
         expected = tube_basis.rest.reshape(-1) + tube_basis.vectors.astype(np.float64) @ solver.q
-        assert np.allclose(out.reshape(-1), expected, rtol=0, atol=1e-4 * np.linalg.norm(np.ptp(rest, axis=0)))
-    for bad in [np.zeros(rest.shape, np.float64), np.zeros((rest.shape[0], 4), np.float32),
-                np.zeros(rest.shape, np.float32, order="F"), [[0.0] * 3] * len(rest)]:
+        assert np.allclose(
+            out.reshape(-1), expected, rtol=0, atol=1e-4 * np.linalg.norm(np.ptp(rest, axis=0))
+        )
+    for bad in [
+        np.zeros(rest.shape, np.float64),
+        np.zeros((rest.shape[0], 4), np.float32),
+        np.zeros(rest.shape, np.float32, order="F"),
+        [[0.0] * 3] * len(rest),
+    ]:
         with pytest.raises(ValueError, match="out"):
             solver.positions(bad)
     read_only = np.zeros(rest.shape, np.float32)
@@ -152,7 +166,10 @@ def test_state_persists_across_solves(tube, tube_basis):
     for solver in (once, twice):
         solver.set_transforms(transforms)
     ten = once.solve(max_iterations=10, tolerance=1e-14)
-    first, second = twice.solve(max_iterations=5, tolerance=1e-14), twice.solve(max_iterations=5, tolerance=1e-14)
+    first, second = (
+        twice.solve(max_iterations=5, tolerance=1e-14),
+        twice.solve(max_iterations=5, tolerance=1e-14),
+    )
     assert first["iterations"] + second["iterations"] == ten["iterations"]
     assert np.array_equal(once.q, twice.q)
 
@@ -181,7 +198,9 @@ def test_warm_start_saves_iterations(tube, tube_basis):
     for warm in (True, False):
         solver = mdc.ReducedSolver(tube_basis, handles, pull=100.0, warm_start=warm)
         solver.set_transforms(transforms)
-        counts[warm] = sum(solver.solve(max_iterations=20, tolerance=1e-10)["iterations"] for _ in range(50))
+        counts[warm] = sum(
+            solver.solve(max_iterations=20, tolerance=1e-10)["iterations"] for _ in range(50)
+        )
         assert solver.solve(max_iterations=20, tolerance=1e-10)["converged"]
     assert counts[True] < counts[False]
 
@@ -226,8 +245,14 @@ def _rotation(axis, angle):
     return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
 
 
-@pytest.mark.parametrize("distortion", [np.diag([2.0, 0.5, 1.5]), np.diag([-1.0, 1.0, 1.0]),
-                                        np.array([[1.0, 0.3, 0.0], [0.0, 1.0, 0.0], [0.0, 0.2, 1.0]])])
+@pytest.mark.parametrize(
+    "distortion",
+    [
+        np.diag([2.0, 0.5, 1.5]),
+        np.diag([-1.0, 1.0, 1.0]),
+        np.array([[1.0, 0.3, 0.0], [0.0, 1.0, 0.0], [0.0, 0.2, 1.0]]),
+    ],
+)
 def test_nearest_rigid_keeps_the_rotation_and_the_centre(distortion):
     # Controllers may be scaled, sheared or mirrored: the handle gets the nearest rotation, and
     # its centre goes where the controller's full matrix takes it.
@@ -242,7 +267,9 @@ def test_nearest_rigid_keeps_the_rotation_and_the_centre(distortion):
     assert np.allclose(R @ centre + T[:3, 3], M[:3, :3] @ centre + M[:3, 3], atol=1e-12)
     assert np.array_equal(T[3], [0, 0, 0, 1])
     if np.allclose(distortion, np.diag(np.diag(distortion))) and (np.diag(distortion) > 0).all():
-        assert np.allclose(R, rotation, atol=1e-12)  # a scale along the axes: the controller's own rotation
+        assert np.allclose(
+            R, rotation, atol=1e-12
+        )  # a scale along the axes: the controller's own rotation
 
 
 def test_nearest_rigid_names_a_bad_argument():
@@ -260,7 +287,10 @@ def dragon_turn(V, degrees):
     lo, hi = V.min(axis=0), V.max(axis=0)
     a = int(np.argmax(hi - lo))
     length = hi[a] - lo[a]
-    handles = [np.flatnonzero(V[:, a] < lo[a] + 0.15 * length), np.flatnonzero(V[:, a] > hi[a] - 0.15 * length)]
+    handles = [
+        np.flatnonzero(V[:, a] < lo[a] + 0.15 * length),
+        np.flatnonzero(V[:, a] > hi[a] - 0.15 * length),
+    ]
     axis, shift = np.zeros(3), np.zeros(3)
     axis[a], shift[(a + 1) % 3], shift[(a + 2) % 3] = 1.0, 0.09 * length, 0.045 * length
     return handles, [np.eye(4), rigid(axis, np.radians(degrees), V[handles[1]].mean(axis=0), shift)]
@@ -325,7 +355,9 @@ def test_refine_relaxes_a_vertex_its_start_pulled_off_before_newton(tube, tube_b
     assert stats["relaxed_vertices"] == 0
     pulled = start.copy()
     middle = int(np.argmin(np.abs(V[:, 2] - 1.5)))
-    pulled[middle] += 5.0 * V[middle] * [1, 1, 0]  # 5 radii outwards: its edges stretched 10 times and more
+    pulled[middle] += (
+        5.0 * V[middle] * [1, 1, 0]
+    )  # 5 radii outwards: its edges stretched 10 times and more
     Y, spiked = solver.refine(F, initial=pulled)
     assert spiked["converged"] and spiked["relaxed_vertices"] >= 7, spiked
     assert spiked["initial_energy"] > 10 * stats["initial_energy"]
@@ -383,10 +415,15 @@ def test_refine_of_a_strong_turn_is_not_held_back_by_crushed_triangles(shared_me
     guarded = [i for i, it in enumerate(history[:-1]) if it["guarded"]]
     assert guarded and all(0 < history[i]["step"] < 1 for i in guarded)
     # After a step taken, Nielsen's rule at most doubles τ; a cut to α would multiply it by 1/α.
-    assert all(history[i + 1]["shift"] <= 2 * history[i]["shift"] for i in guarded
-               if history[i + 1]["model"] == "projected")
+    assert all(
+        history[i + 1]["shift"] <= 2 * history[i]["shift"]
+        for i in guarded
+        if history[i + 1]["model"] == "projected"
+    )
     assert min(history[i]["step"] for i in guarded) < 0.5
-    assert any(not float(np.log2(history[i]["step"])).is_integer() for i in guarded)  # started short of a turn
+    assert any(
+        not float(np.log2(history[i]["step"])).is_integer() for i in guarded
+    )  # started short of a turn
     assert history[-1]["model"] == "exact"  # quadratic convergence at the end
 
 
@@ -431,8 +468,10 @@ def test_an_adapted_budget_reaches_the_same_pose_once_the_controller_stops(tube,
     operator's do. With the budget cut to one iteration per update while Blender is slow, the pose
     lags while the controller moves and ends within 1e-4 of the diagonal of the fixed budget's."""
     V, _, handles, transforms = tube
-    path = [[np.eye(4), rigid([1, 0, 1], 0.8 * t, [0, 0, 3], [0.8 * t, 0, -0.3 * t])]
-            for t in np.linspace(0, 1, 21)[1:]]
+    path = [
+        [np.eye(4), rigid([1, 0, 1], 0.8 * t, [0, 0, 3], [0.8 * t, 0, -0.3 * t])]
+        for t in np.linspace(0, 1, 21)[1:]
+    ]
 
     def pose(budget_ms, measure):
         solver = mdc.ReducedSolver(tube_basis, handles, pull=100.0)
@@ -443,7 +482,9 @@ def test_an_adapted_budget_reaches_the_same_pose_once_the_controller_stops(tube,
             measure(update)
             lag.append(stats["converged"])
         for _ in range(1000):
-            if solver.solve(max_iterations=1000, tolerance=1e-6, budget_ms=budget_ms())["converged"]:
+            if solver.solve(max_iterations=1000, tolerance=1e-6, budget_ms=budget_ms())[
+                "converged"
+            ]:
                 return solver.positions(), lag
         raise AssertionError("the pose did not converge once the controller stopped")
 
@@ -451,6 +492,8 @@ def test_an_adapted_budget_reaches_the_same_pose_once_the_controller_stops(tube,
     adapted = mdc.FrameBudget(most_ms=5.0, least_ms=1e-6)
     slow_blender = lambda update: adapted.measured(30.0 if update % 10 < 7 else 2.0)  # noqa: E731
     ours, ours_converged = pose(lambda: adapted.ms, slow_blender)
-    assert sum(ours_converged) < sum(fixed_converged), "the adapted budget never cut the solve short"
+    assert sum(ours_converged) < sum(fixed_converged), (
+        "the adapted budget never cut the solve short"
+    )
     diagonal = np.linalg.norm(np.ptp(V, axis=0))
     assert np.abs(ours - fixed).max() < 1e-4 * diagonal

@@ -3,14 +3,17 @@ degrees converge, never stall, on the bar, the 23k dragon, a proxy bake and a ra
 along every solve path the objective is continuous with the gradient the solver follows (centred
 differences along a random direction). The 100k and 1.6M dragons are in make bench
 (bench/strong_poses.py); Suzanne is in the Blender tests (scripts/strong_pose.py)."""
+
 import warnings
 
-import numpy as np
 import pytest
+from support import (  # the poses and the difference check, shared with make bench
+    raw_scans,
+    strong_poses,
+)
+from support.meshes import read_shared
 
 import modal_deform.core as mdc
-from support import raw_scans, strong_poses  # the poses and the difference check, shared with make bench
-from support.meshes import read_shared
 
 
 def _bake(V, F, **options):
@@ -47,4 +50,6 @@ def test_strong_pose_converges_with_a_continuous_objective(baked, pose):
     final = path[-1]
     assert final["converged"], f"{name}, {pose}: not converged: {final}"
     worst = max(step["difference_error"] for step in path)
-    assert worst < 1e-4, f"{name}, {pose}: the objective's centred differences disagree with its gradient by {worst}"
+    assert worst < 1e-4, (
+        f"{name}, {pose}: the objective's centred differences disagree with its gradient by {worst}"
+    )

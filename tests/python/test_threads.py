@@ -20,11 +20,19 @@ ADDON_FOLDER = pathlib.Path(mdc.__file__).resolve().parents[2]
 
 def import_in_fresh_python(**environment):
     """(what libgomp reports of its settings, OMP_WAIT_POLICY as Python sees it after the import)."""
-    env = {key: value for key, value in os.environ.items() if key not in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT")}
+    env = {
+        key: value
+        for key, value in os.environ.items()
+        if key not in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT")
+    }
     env.update(environment, OMP_DISPLAY_ENV="verbose")
-    script = f"import os, sys; sys.path.insert(0, {str(ADDON_FOLDER)!r}); import modal_deform.core; " \
-             "print(os.environ.get('OMP_WAIT_POLICY'))"
-    run = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True)
+    script = (
+        f"import os, sys; sys.path.insert(0, {str(ADDON_FOLDER)!r}); import modal_deform.core; "
+        "print(os.environ.get('OMP_WAIT_POLICY'))"
+    )
+    run = subprocess.run(
+        [sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True
+    )
     return run.stderr, run.stdout.strip()
 
 
@@ -52,7 +60,9 @@ def loaded_openblas():
         paths = {line.split()[-1] for line in maps if "openblas" in line.rsplit("/", 1)[-1]}
     for path in sorted(paths):
         library = ctypes.CDLL(path)
-        if hasattr(library, "openblas_get_num_threads") and hasattr(library, "openblas_set_num_threads"):
+        if hasattr(library, "openblas_get_num_threads") and hasattr(
+            library, "openblas_set_num_threads"
+        ):
             return library
     return None
 
@@ -61,7 +71,9 @@ def test_the_callers_openblas_threads_are_kept_during_and_after_the_bake():
     np.dot(np.ones((64, 64)), np.ones((64, 64)))  # NumPy's BLAS is loaded
     openblas = loaded_openblas()
     if openblas is None or (os.cpu_count() or 1) < 2:
-        pytest.skip("needs an OpenBLAS in this process and two cores, so that the bake would lower its threads")
+        pytest.skip(
+            "needs an OpenBLAS in this process and two cores, so that the bake would lower its threads"
+        )
     callers = openblas.openblas_get_num_threads()
     openblas.openblas_set_num_threads(os.cpu_count())
     try:
@@ -72,7 +84,13 @@ def test_the_callers_openblas_threads_are_kept_during_and_after_the_bake():
             seen.append(openblas.openblas_get_num_threads())
             return True
 
-        mdc.bake(*mdc.testing.cylinder(14, 6, 0.5, 2.0), modes=12, derivatives=6, ghost=40, progress=progress)
+        mdc.bake(
+            *mdc.testing.cylinder(14, 6, 0.5, 2.0),
+            modes=12,
+            derivatives=6,
+            ghost=40,
+            progress=progress,
+        )
         assert seen and set(seen) == {setting}
         assert openblas.openblas_get_num_threads() == setting
     finally:

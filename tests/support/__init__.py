@@ -11,6 +11,7 @@ bench/common.py put it on sys.path).
 
 Nothing here imports modal_deform at import time: inside Blender the add-on is the one enabled.
 """
+
 import pathlib
 
 TESTS = pathlib.Path(__file__).resolve().parents[1]
@@ -18,8 +19,12 @@ ROOT = TESTS.parent
 #: The scanned meshes, in the folder `shared` beside the repository.
 SHARED_MESHES = ROOT.parent / "shared" / "meshes"
 #: The shared scans by the names the benchmarks and tests give them.
-SCAN_FILES = {"bunny": "bunny.obj.gz", "dragon_res4": "dragon_vrip_res4.ply.gz",
-              "dragon_res3": "dragon_vrip_res3.ply.gz", "dragon_res2": "dragon_vrip_res2.ply.gz"}
+SCAN_FILES = {
+    "bunny": "bunny.obj.gz",
+    "dragon_res4": "dragon_vrip_res4.ply.gz",
+    "dragon_res3": "dragon_vrip_res3.ply.gz",
+    "dragon_res2": "dragon_vrip_res2.ply.gz",
+}
 
 
 def in_blender(script):

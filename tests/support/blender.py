@@ -3,6 +3,7 @@
 Enabling the add-on and making handles are blender_scripts/headless.py's, the user-facing helpers
 the demo and the benchmarks use too: this module puts that folder on sys.path and builds on them.
 """
+
 import importlib
 import os
 import pathlib
@@ -48,7 +49,11 @@ def suzanne(levels=1):
 def baked_suzanne(levels, modes, derivatives, ghost):
     """suzanne(levels) baked through the operator with these settings; (obj, rest positions)."""
     obj = suzanne(levels)
-    obj.modal_deform.modes, obj.modal_deform.derivatives, obj.modal_deform.ghost = modes, derivatives, ghost
+    obj.modal_deform.modes, obj.modal_deform.derivatives, obj.modal_deform.ghost = (
+        modes,
+        derivatives,
+        ghost,
+    )
     assert bpy.ops.modal_deform.bake() == {"FINISHED"}
     return obj, positions(obj)
 
@@ -95,17 +100,24 @@ def mesh_state(obj):
     mesh = obj.data
     return {
         "co": positions(obj).tobytes(),
-        "polygons": len(mesh.polygons), "loops": len(mesh.loops),
-        "shape_keys": None if mesh.shape_keys is None else [
-            (b.name, b.value, b.mute, key_positions(obj, b.name).tobytes()) for b in mesh.shape_keys.key_blocks],
-        "basis": obj.modal_deform.basis, "palettes": stored_bases(),
-        "status": obj.modal_deform.status.dimension, "vertex_groups": len(obj.vertex_groups),
+        "polygons": len(mesh.polygons),
+        "loops": len(mesh.loops),
+        "shape_keys": None
+        if mesh.shape_keys is None
+        else [
+            (b.name, b.value, b.mute, key_positions(obj, b.name).tobytes())
+            for b in mesh.shape_keys.key_blocks
+        ],
+        "basis": obj.modal_deform.basis,
+        "palettes": stored_bases(),
+        "status": obj.modal_deform.status.dimension,
+        "vertex_groups": len(obj.vertex_groups),
     }
 
 
 def arguments():
     """The script's arguments (after "--")."""
-    return sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    return sys.argv[sys.argv.index("--") + 1 :] if "--" in sys.argv else []
 
 
 def mesh_object(name, V, F):

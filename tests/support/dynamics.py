@@ -1,6 +1,7 @@
 """The free-body measurement of secondary motion, shared by tests/python/test_dynamics.py and
 bench/dynamics.py: a body released along its lowest flexible mode, and the period and decrement of
 the trace it leaves."""
+
 import numpy as np
 
 import modal_deform.core as mdc

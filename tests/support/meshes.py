@@ -1,6 +1,6 @@
 """Reading the shared meshes (support.SHARED_MESHES) with the core's reader."""
-import modal_deform.core as mdc
 
+import modal_deform.core as mdc
 from support import SCAN_FILES, SHARED_MESHES
 
 

@@ -1,9 +1,10 @@
 """Rigid transforms and poses of handles, as the benchmarks and tests move them (NumPy only).
 
-    handles, poses = poses.end_pull(V)
-    for frame in range(1, poses[0].frames + 1):
-        transforms = poses[0].at(frame / poses[0].frames)   # one 4x4 per handle
+handles, poses = poses.end_pull(V)
+for frame in range(1, poses[0].frames + 1):
+    transforms = poses[0].at(frame / poses[0].frames)   # one 4x4 per handle
 """
+
 import dataclasses
 from typing import Callable
 
@@ -14,6 +15,7 @@ import numpy as np
 class Pose:
     """A motion of the handles: ``at(t)`` the transforms (one 4x4 per handle, mesh units) a
     fraction t in [0, 1] of the way from rest; reached in ``frames`` steps, as an animation."""
+
     name: str
     description: str
     at: Callable[[float], list]
@@ -46,8 +48,10 @@ def end_handles(V, fraction):
     lo, hi = V.min(axis=0), V.max(axis=0)
     a = int(np.argmax(hi - lo))
     length = hi[a] - lo[a]
-    handles = [np.flatnonzero(V[:, a] < lo[a] + fraction * length),
-               np.flatnonzero(V[:, a] > hi[a] - fraction * length)]
+    handles = [
+        np.flatnonzero(V[:, a] < lo[a] + fraction * length),
+        np.flatnonzero(V[:, a] > hi[a] - fraction * length),
+    ]
     axes = np.eye(3)[[a, (a + 1) % 3, (a + 2) % 3]]
     return handles, axes, length, V[handles[1]].mean(axis=0)
 
@@ -61,4 +65,7 @@ def end_pull(V):
 
     def at(t):
         return [np.eye(4), rigid_transform(axis, 0.6 * t, centre, t * shift)]
-    return handles, (Pose("pull", "far 10% turned by 0.6 rad and moved by a quarter of the length", at, 6),)
+
+    return handles, (
+        Pose("pull", "far 10% turned by 0.6 rad and moved by a quarter of the length", at, 6),
+    )

@@ -26,14 +26,26 @@ damage a scan has, each placed at random (seeded) and in proportion to the mesh'
     V, F = raw_scans.damaged(*mdc.read_mesh(path), seed=1)
     V, F = raw_scans.raw_scan("dragon_res2")      # ~400k vertices, every kind of damage
 """
+
 import numpy as np
 
 from support.meshes import read_scan
 from support.subdivision import midpoint_subdivide
 
 #: What each kind of damage does to a mesh, per 10,000 faces of the input.
-RATES = {"slivers": 20, "sliver_pairs": 2, "needles": 10, "seams": 3, "duplicates": 4, "double_sheets": 2, "flips": 20,
-         "zero_area": 5, "holes": 0.3, "fins": 2, "debris": 3}
+RATES = {
+    "slivers": 20,
+    "sliver_pairs": 2,
+    "needles": 10,
+    "seams": 3,
+    "duplicates": 4,
+    "double_sheets": 2,
+    "flips": 20,
+    "zero_area": 5,
+    "holes": 0.3,
+    "fins": 2,
+    "debris": 3,
+}
 
 
 def _log_uniform(rng, low, high, size):
@@ -46,7 +58,9 @@ def _faces_on_both_sides(F, touched, k, rng):
     halfedges = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
     face = np.tile(np.arange(len(F)), 3)
     first = np.repeat([0, 1, 2], len(F))
-    _, inverse, counts = np.unique(np.sort(halfedges, axis=1), axis=0, return_inverse=True, return_counts=True)
+    _, inverse, counts = np.unique(
+        np.sort(halfedges, axis=1), axis=0, return_inverse=True, return_counts=True
+    )
     inverse = inverse.ravel()
     order = np.argsort(inverse, kind="stable")
     starts = np.flatnonzero(counts[inverse[order]] == 2)
@@ -148,7 +162,9 @@ def damaged(V, F, seed=0, rates=None):
     new_faces.append(F[rng.choice(len(F), count("double_sheets"), replace=False)][:, ::-1])
     chosen = F[rng.choice(len(F), count("zero_area"), replace=False)]
     half = len(chosen) // 2
-    new_faces.append(np.c_[chosen[:half, 0], chosen[:half, 1], chosen[:half, 1]])  # a repeated index
+    new_faces.append(
+        np.c_[chosen[:half, 0], chosen[:half, 1], chosen[:half, 1]]
+    )  # a repeated index
     ends = chosen[half:]
     middle = add_vertices(0.5 * (P[ends[:, 0]] + P[ends[:, 1]]))  # collinear with its edge
     new_faces.append(np.c_[ends[:, 0], ends[:, 1], middle])

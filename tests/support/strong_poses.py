@@ -6,6 +6,7 @@ arc (bench/shapes.rod_end's motion, for any axis). A pose is reached in steps of
 degrees, each solved to convergence as a script would (follow), with a centred-difference check
 of the objective at the end of each step. NumPy only: `follow` takes the modal_deform.core to use.
 """
+
 import numpy as np
 
 POSES = ("turn_90", "turn_170", "bend_90", "bend_180")
@@ -32,7 +33,10 @@ def ends(V, fraction=0.15):
     lo, hi = V.min(axis=0), V.max(axis=0)
     a = int(np.argmax(hi - lo))
     length = hi[a] - lo[a]
-    handles = [np.flatnonzero(V[:, a] < lo[a] + fraction * length), np.flatnonzero(V[:, a] > hi[a] - fraction * length)]
+    handles = [
+        np.flatnonzero(V[:, a] < lo[a] + fraction * length),
+        np.flatnonzero(V[:, a] > hi[a] - fraction * length),
+    ]
     return handles, a, V[handles[0]].mean(axis=0), V[handles[1]].mean(axis=0), length
 
 

@@ -1,6 +1,7 @@
 """Midpoint subdivision, the project's way of making dense meshes from the shared ones. NumPy
 only: benchmarks running inside Blender import it beside the installed extension, which must be
 the only modal_deform they load."""
+
 import numpy as np
 
 
@@ -49,14 +50,24 @@ def split_edges(V, F, count):
             F_turned, split_turned = corners.copy(), mids.copy()
             done = count_split != 1
             done &= count_split != 2
-        pick = ~done & (((count_split == 1) & (mids[:, 0] >= 0)) | ((count_split == 2) & (mids[:, 2] < 0)))
+        pick = ~done & (
+            ((count_split == 1) & (mids[:, 0] >= 0)) | ((count_split == 2) & (mids[:, 2] < 0))
+        )
         F_turned[pick], split_turned[pick] = corners[pick], mids[pick]
         done |= pick
     a, b, c = F_turned.T
     ab, bc, ca = split_turned.T
     one, two, three = count_split == 1, count_split == 2, count_split == 3
-    faces = [F[count_split == 0],
-             np.c_[a, ab, c][one], np.c_[ab, b, c][one],
-             np.c_[ab, b, bc][two], np.c_[a, ab, bc][two], np.c_[a, bc, c][two],
-             np.c_[a, ab, ca][three], np.c_[ab, b, bc][three], np.c_[ca, bc, c][three], np.c_[ab, bc, ca][three]]
+    faces = [
+        F[count_split == 0],
+        np.c_[a, ab, c][one],
+        np.c_[ab, b, c][one],
+        np.c_[ab, b, bc][two],
+        np.c_[a, ab, bc][two],
+        np.c_[a, bc, c][two],
+        np.c_[a, ab, ca][three],
+        np.c_[ab, b, bc][three],
+        np.c_[ca, bc, c][three],
+        np.c_[ab, bc, ca][three],
+    ]
     return V, np.concatenate(faces).astype(np.int32)

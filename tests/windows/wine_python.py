@@ -6,6 +6,7 @@ that name folders for the scripts and for Blender, are written as Windows progra
 them (drive Z: is /). Windows CPython needs its standard input and output to be pipes (it stops in
 init_sys_streams otherwise): its output is read here and passed on. The exit status is Python's;
 a crash is a non-zero status (the Wine prefix starts no debugger)."""
+
 import os
 import subprocess
 import sys

@@ -7,21 +7,51 @@ shells, ARAP), ``modes`` (vibration modes, rigid motions, modal-derivative solve
 (the ghost), ``bake`` (the whole preprocess, mesh to Basis), ``solve`` (posing), ``dynamics``
 (secondary motion); ``testing`` holds the generated test shapes.
 """
+
 from .._native import Cancelled, OutOfMemoryError
-from . import testing
-from .bake import BAKE_OPTIONS, BAKE_STAGES, Basis, bake, bake_fraction
+from . import testing as testing
+from .bake import BAKE_OPTIONS, BAKE_STAGES, Basis, bake
+from .bake import bake_fraction as bake_fraction
 from .dynamics import SIMULATION_OPTIONS, Simulation
 from .energy import MATERIAL_OPTIONS, Arap, DiscreteShells
-from .frame_budget import FrameBudget
+from .frame_budget import FrameBudget as FrameBudget
 from .mesh import check, mass, read_mesh
 from .modes import rigid_motions, solve_in_range, vibration_modes
 from .reduction import ghost_mesh, restrict_to_ghost
-from .solve import FULL_SOLVE_OPTIONS, SOLVE_OPTIONS, SOLVER_OPTIONS, ReducedSolver, nearest_rigid, solve_full
+from .solve import (
+    FULL_SOLVE_OPTIONS,
+    SOLVE_OPTIONS,
+    SOLVER_OPTIONS,
+    ReducedSolver,
+    solve_full,
+)
+from .solve import nearest_rigid as nearest_rigid
 
-# FrameBudget, bake_fraction and nearest_rigid serve the add-on: mdc.<name> works, __all__ leaves them out.
+# FrameBudget, bake_fraction and nearest_rigid serve the add-on, testing the tests: mdc.<name>
+# works (imported `as` themselves, re-exported), __all__ leaves them out.
 __all__ = [
-    "Arap", "BAKE_OPTIONS", "BAKE_STAGES", "Basis", "Cancelled", "DiscreteShells", "FULL_SOLVE_OPTIONS",
-    "MATERIAL_OPTIONS", "OutOfMemoryError", "ReducedSolver", "SIMULATION_OPTIONS", "SOLVER_OPTIONS", "SOLVE_OPTIONS",
-    "Simulation", "bake", "check", "ghost_mesh", "mass", "read_mesh", "restrict_to_ghost", "rigid_motions",
-    "solve_full", "solve_in_range", "vibration_modes",
+    "Arap",
+    "BAKE_OPTIONS",
+    "BAKE_STAGES",
+    "Basis",
+    "Cancelled",
+    "DiscreteShells",
+    "FULL_SOLVE_OPTIONS",
+    "MATERIAL_OPTIONS",
+    "OutOfMemoryError",
+    "ReducedSolver",
+    "SIMULATION_OPTIONS",
+    "SOLVER_OPTIONS",
+    "SOLVE_OPTIONS",
+    "Simulation",
+    "bake",
+    "check",
+    "ghost_mesh",
+    "mass",
+    "read_mesh",
+    "restrict_to_ghost",
+    "rigid_motions",
+    "solve_full",
+    "solve_in_range",
+    "vibration_modes",
 ]

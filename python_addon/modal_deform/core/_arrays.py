@@ -4,6 +4,7 @@ Each function returns an array the native core takes without a copy (C order, th
 and raises ValueError naming the argument when the input cannot be one. Contents (index ranges,
 finiteness) are checked by the native core, which must refuse bad data on its own anyway.
 """
+
 import operator
 
 import numpy as np
@@ -30,7 +31,9 @@ def faces(F, name="F"):
     """(m, 3) int32, C order; larger integer types are narrowed when their values fit."""
     F = np.asarray(F)
     if F.ndim != 2 or F.shape[1] != 3:
-        raise ValueError(f"{name}: expected an (m, 3) array of triangle indices, got shape {F.shape}")
+        raise ValueError(
+            f"{name}: expected an (m, 3) array of triangle indices, got shape {F.shape}"
+        )
     if F.dtype.kind not in "iu":
         raise ValueError(f"{name}: expected integer indices, got dtype {F.dtype}")
     if F.size and (F.max() > np.iinfo(np.int32).max or F.min() < np.iinfo(np.int32).min):
@@ -43,7 +46,8 @@ def positions(X, num_vertices, name="X"):
     X = reals(X, name)
     if X.shape not in ((num_vertices, 3), (3 * num_vertices,)):
         raise ValueError(
-            f"{name}: expected shape ({num_vertices}, 3) or ({3 * num_vertices},), got {X.shape}")
+            f"{name}: expected shape ({num_vertices}, 3) or ({3 * num_vertices},), got {X.shape}"
+        )
     return X.reshape(-1)
 
 
@@ -54,10 +58,17 @@ def positions_out(out, num_vertices):
     n = num_vertices
     if out is None:
         return np.empty((n, 3), dtype=np.float32)
-    if not (isinstance(out, np.ndarray) and out.dtype == np.float32 and out.flags.c_contiguous
-            and out.flags.writeable and out.shape in ((n, 3), (3 * n,))):
-        raise ValueError(f"out: expected a writeable C-contiguous float32 array of shape ({n}, 3) or ({3 * n},), "
-                         f"got {getattr(out, 'dtype', type(out).__name__)} {getattr(out, 'shape', '')}")
+    if not (
+        isinstance(out, np.ndarray)
+        and out.dtype == np.float32
+        and out.flags.c_contiguous
+        and out.flags.writeable
+        and out.shape in ((n, 3), (3 * n,))
+    ):
+        raise ValueError(
+            f"out: expected a writeable C-contiguous float32 array of shape ({n}, 3) or ({3 * n},), "
+            f"got {getattr(out, 'dtype', type(out).__name__)} {getattr(out, 'shape', '')}"
+        )
     return out
 
 
@@ -82,7 +93,9 @@ def indices(x, name):
     """(k,) int32 vertex indices from integer input (ranges and repeats are checked natively)."""
     x = np.asarray(x)
     if x.ndim != 1 or (x.size and x.dtype.kind not in "iu"):
-        raise ValueError(f"{name}: expected a 1-d array of vertex indices, got dtype {x.dtype} and shape {x.shape}")
+        raise ValueError(
+            f"{name}: expected a 1-d array of vertex indices, got dtype {x.dtype} and shape {x.shape}"
+        )
     if x.size and (x.max() > np.iinfo(np.int32).max or x.min() < np.iinfo(np.int32).min):
         raise ValueError(f"{name}: an index does not fit in 32 bits")
     return np.ascontiguousarray(x, dtype=np.int32)

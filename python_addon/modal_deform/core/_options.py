@@ -6,6 +6,7 @@ the signature ``inspect.signature`` and ``help`` show, and a docstring section),
 reads its properties' defaults, limits and tooltips from the same records. The core checks every
 value, so nothing here re-checks one.
 """
+
 import functools
 import inspect
 import math
@@ -29,8 +30,10 @@ class Option(NamedTuple):
         """The accepted values in words ("at least 1", "in (0, 1)"), or "" when any value is."""
         low, high = math.isfinite(self.min), math.isfinite(self.max)
         if low and high:
-            return (f"in {'(' if self.min_open else '['}{_number(self.min)}, {_number(self.max)}"
-                    f"{')' if self.max_open else ']'}")
+            return (
+                f"in {'(' if self.min_open else '['}{_number(self.min)}, {_number(self.max)}"
+                f"{')' if self.max_open else ']'}"
+            )
         if low:
             return f"{'more than' if self.min_open else 'at least'} {_number(self.min)}"
         if high:
@@ -66,9 +69,13 @@ def takes_options(*tables, exclude=()):
     options = {name: option for t in tables for name, option in t.items() if name not in exclude}
 
     def decorate(function):
-        own = [p for p in inspect.signature(function).parameters.values() if p.kind != p.VAR_KEYWORD]
-        parameters = own + [inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=option.default)
-                            for name, option in options.items()]
+        own = [
+            p for p in inspect.signature(function).parameters.values() if p.kind != p.VAR_KEYWORD
+        ]
+        parameters = own + [
+            inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=option.default)
+            for name, option in options.items()
+        ]
         signature = inspect.Signature(parameters)
 
         @functools.wraps(function)
@@ -76,18 +83,30 @@ def takes_options(*tables, exclude=()):
             for old, new in ALIASES.items():
                 if old in keywords and new in options:
                     if new in keywords:
-                        raise TypeError(f"{function.__name__}() got both {new!r} and its old name {old!r}")
-                    warnings.warn(f"{function.__name__}: {old!r} is now called {new!r}", DeprecationWarning,
-                                  stacklevel=2)
+                        raise TypeError(
+                            f"{function.__name__}() got both {new!r} and its old name {old!r}"
+                        )
+                    warnings.warn(
+                        f"{function.__name__}: {old!r} is now called {new!r}",
+                        DeprecationWarning,
+                        stacklevel=2,
+                    )
                     keywords[new] = keywords.pop(old)
             bound = signature.bind(*args, **keywords)
-            given = {name: value for name, value in bound.arguments.items()
-                     if name in options and not (value is None and options[name].default is None)}
-            own_arguments = {name: value for name, value in bound.arguments.items() if name not in options}
+            given = {
+                name: value
+                for name, value in bound.arguments.items()
+                if name in options and not (value is None and options[name].default is None)
+            }
+            own_arguments = {
+                name: value for name, value in bound.arguments.items() if name not in options
+            }
             return function(**own_arguments, **given)
 
         with_options.__signature__ = signature
-        with_options.__doc__ = (function.__doc__ or "").rstrip() + "\n\n" + _options_section(options)
+        with_options.__doc__ = (
+            (function.__doc__ or "").rstrip() + "\n\n" + _options_section(options)
+        )
         return with_options
 
     return decorate
@@ -97,5 +116,8 @@ def _options_section(options):
     lines = ["    Options (keyword-only; their defaults and ranges are the native core's):"]
     for option in options.values():
         accepted = option.range_text()
-        lines.append(f"        {option.name}={option.default!r}: {option.doc}" + (f" ({accepted})" if accepted else ""))
+        lines.append(
+            f"        {option.name}={option.default!r}: {option.doc}"
+            + (f" ({accepted})" if accepted else "")
+        )
     return "\n".join(lines) + "\n"

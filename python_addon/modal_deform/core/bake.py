@@ -10,6 +10,7 @@ Scan debris (components with less than 10% of the largest one's area), unreferen
 vertices without mass are not simulated: they follow the affine motion of nearby simulated
 vertices, so they move rigidly with the mesh.
 """
+
 import warnings
 
 import numpy as np
@@ -37,6 +38,7 @@ def bake_fraction(stage, fraction, on_proxy):
     if stage not in stages:
         return 0.0
     return (stages.index(stage) + fraction) / len(stages)
+
 
 # The stored fields, one table: the native core's (cpp/basis/basis.h, for_each_stored_field), each
 # with its name, the format version that introduced it, dtype, number of dimensions, fixed number of
@@ -78,8 +80,10 @@ class Basis:
     dimension = property(lambda self: self._native.dimension, doc="r, the number of basis vectors")
     num_vertices = property(lambda self: self._native.num_vertices)
     on_proxy = property(lambda self: self._native.on_proxy, doc="baked on a proxy of the mesh")
-    num_basis_vertices = property(lambda self: self._native.num_basis_vertices,
-                                  doc="vertices of vectors' rows: the proxy's, or n")
+    num_basis_vertices = property(
+        lambda self: self._native.num_basis_vertices,
+        doc="vertices of vectors' rows: the proxy's, or n",
+    )
 
     def fine_vectors(self, columns=slice(None)):
         """(3n, c) float32: the basis vectors ``columns`` (default all r) on the fine mesh: a view of
@@ -94,7 +98,7 @@ class Basis:
     @property
     def modes(self):
         """(3n, num_modes) float32: the first columns of ``vectors`` (a view)."""
-        return self.vectors[:, :self.num_modes]
+        return self.vectors[:, : self.num_modes]
 
     @property
     def timings(self):
@@ -102,10 +106,12 @@ class Basis:
         return dict(self._native.timings)
 
     def __repr__(self):
-        return (f"<Basis: {self.num_vertices} vertices, dimension {self.dimension} ({self.num_rigid} rigid, "
-                f"{self.num_modes} modes, {self.dimension - self.num_modes} derivatives), "
-                f"ghost {len(self.ghost_vertices)} vertices"
-                f"{f', proxy {self.num_basis_vertices} vertices' if self.on_proxy else ''}>")
+        return (
+            f"<Basis: {self.num_vertices} vertices, dimension {self.dimension} ({self.num_rigid} rigid, "
+            f"{self.num_modes} modes, {self.dimension - self.num_modes} derivatives), "
+            f"ghost {len(self.ghost_vertices)} vertices"
+            f"{f', proxy {self.num_basis_vertices} vertices' if self.on_proxy else ''}>"
+        )
 
     def to_arrays(self):
         """dict[str, np.ndarray] of copies, counts and scalars as 0-d arrays, with a format version:
@@ -127,16 +133,22 @@ class Basis:
         try:
             keys = set(arrays.keys())
         except AttributeError:
-            raise ValueError(f"arrays: expected a dict of numpy arrays, got {type(arrays).__name__}") from None
+            raise ValueError(
+                f"arrays: expected a dict of numpy arrays, got {type(arrays).__name__}"
+            ) from None
         if "format_version" not in keys:
             raise ValueError("format_version: missing from the stored basis")
         version = np.asarray(arrays["format_version"])
         if version.dtype != np.int32 or version.ndim != 0:
-            raise ValueError(f"format_version: expected a 0-d int32, got {version.dtype} of shape {version.shape}")
+            raise ValueError(
+                f"format_version: expected a 0-d int32, got {version.dtype} of shape {version.shape}"
+            )
         version = int(version)
         if not 1 <= version <= FORMAT_VERSION:
-            raise ValueError(f"format_version: this add-on reads versions 1 to {FORMAT_VERSION}, got {version}; "
-                             f"re-bake")
+            raise ValueError(
+                f"format_version: this add-on reads versions 1 to {FORMAT_VERSION}, got {version}; "
+                f"re-bake"
+            )
         fields = {}
         for field in _SCHEMA:
             name = field["name"]
@@ -148,9 +160,13 @@ class Basis:
             if a.dtype != field["dtype"]:
                 raise ValueError(f"{name}: expected dtype {field['dtype']}, got {a.dtype}")
             if a.ndim != field["ndim"]:
-                raise ValueError(f"{name}: expected {field['ndim']} dimensions, got shape {a.shape}")
+                raise ValueError(
+                    f"{name}: expected {field['ndim']} dimensions, got shape {a.shape}"
+                )
             if field["columns"] and a.shape[1] != field["columns"]:
-                raise ValueError(f"{name}: expected {field['columns']} columns, got shape {a.shape}")
+                raise ValueError(
+                    f"{name}: expected {field['columns']} columns, got shape {a.shape}"
+                )
             if a.ndim == 0:
                 fields[name] = a.item()
             else:
@@ -169,8 +185,10 @@ for _field in _SCHEMA:
 def _basis(basis):
     """``basis`` once checked to be a Basis: what the solvers and the simulation take."""
     if not isinstance(basis, Basis):
-        raise ValueError(f"basis: expected a modal_deform.core.Basis (from bake or Basis.from_arrays), "
-                         f"got {type(basis).__name__}")
+        raise ValueError(
+            f"basis: expected a modal_deform.core.Basis (from bake or Basis.from_arrays), "
+            f"got {type(basis).__name__}"
+        )
     return basis
 
 
@@ -201,18 +219,27 @@ def bake(V, F, progress=None, **options):
     if "region" in options:
         options["region"] = _arrays.indices(options["region"], "region")
         if not options["region"].size:
-            raise ValueError("region: it has no vertices; give the vertices that may move, or None for the whole mesh")
+            raise ValueError(
+                "region: it has no vertices; give the vertices that may move, or None for the whole mesh"
+            )
     if "stiffness_weights" in options:
-        options["stiffness_weights"] = _arrays.stiffness_weights(options["stiffness_weights"], len(V))
+        options["stiffness_weights"] = _arrays.stiffness_weights(
+            options["stiffness_weights"], len(V)
+        )
     if progress is not None and not callable(progress):
-        raise ValueError(f"progress: expected a callable progress(stage, fraction) or None, got {progress!r}")
+        raise ValueError(
+            f"progress: expected a callable progress(stage, fraction) or None, got {progress!r}"
+        )
     if "proxy" in options and options["proxy"] is None:
         del options["proxy"]
         options["proxy_above"] = 0
     basis = Basis(_native.bake(V, F, progress=progress, **options))
     if basis.num_floppy:
-        warnings.warn(f"the mesh is floppy: it has {basis.num_floppy} zero modes besides its rigid motions "
-                      f"(mechanisms, e.g. large parts of the mesh joined at a single vertex, or the rigid motions of a part of "
-                      f"the region that touches nothing outside it); they are in the basis on top of the "
-                      f"{options.get('modes', BAKE_OPTIONS['modes'].default)} modes asked for, without modal derivatives", stacklevel=2)
+        warnings.warn(
+            f"the mesh is floppy: it has {basis.num_floppy} zero modes besides its rigid motions "
+            f"(mechanisms, e.g. large parts of the mesh joined at a single vertex, or the rigid motions of a part of "
+            f"the region that touches nothing outside it); they are in the basis on top of the "
+            f"{options.get('modes', BAKE_OPTIONS['modes'].default)} modes asked for, without modal derivatives",
+            stacklevel=2,
+        )
     return basis

@@ -7,6 +7,7 @@ The artist's parameters are in frames: ``period``, the period of the lowest flex
 the mass), and ``damping``, that mode's damping ratio ζ (Rayleigh damping, stiffer modes damped
 more). Both hold exactly for the lowest mode of small motions, whatever ``fps`` and ``substeps``.
 """
+
 import numpy as np
 
 from .. import _native
@@ -29,12 +30,14 @@ class Simulation(_InBasis):
     """
 
     @_options.takes_options(SIMULATION_OPTIONS)
-    def __init__(self, basis, handles, weights=None, energy=SOLVER_OPTIONS["energy"].default, **options):
+    def __init__(
+        self, basis, handles, weights=None, energy=SOLVER_OPTIONS["energy"].default, **options
+    ):
         basis = _basis(basis)
         handles = [] if _is_empty(handles) else _handles(handles)
         weights = np.zeros(0) if not handles else _weights(weights, len(handles))
         if not isinstance(energy, str):
-            raise ValueError(f"energy: expected \"shells\" or \"arap\", got {energy!r}")
+            raise ValueError(f'energy: expected "shells" or "arap", got {energy!r}')
         self._native = _native.Simulation(basis._native, handles, weights, energy, **options)
         self._basis = basis
         self.stats = None  #: the last step's: see step()
@@ -106,7 +109,9 @@ class Simulation(_InBasis):
         r = self.dimension
         q = _arrays.values(q, "q", r)
         v = _arrays.values(v, "v", r)
-        self._native.set_state(q, v, [] if transforms is None else self._checked_transforms(transforms))
+        self._native.set_state(
+            q, v, [] if transforms is None else self._checked_transforms(transforms)
+        )
 
     def energy(self):
         """The total energy, kinetic plus potential (deformation energy plus handle term), in the

@@ -1,4 +1,5 @@
 """Deformation energies with their derivatives: value, gradient, Hessian, third derivative."""
+
 import numpy as np
 
 from .. import _native
@@ -85,6 +86,8 @@ class DiscreteShells(_Energy):
         if pairs.size == 0:
             pairs = pairs.reshape(0, 2)
         if pairs.ndim != 2 or pairs.shape[1] != 2 or pairs.dtype.kind not in "iu":
-            raise ValueError(f"pairs: expected a (p, 2) array of integer column indices, got shape "
-                             f"{pairs.shape} and dtype {pairs.dtype}")
+            raise ValueError(
+                f"pairs: expected a (p, 2) array of integer column indices, got shape "
+                f"{pairs.shape} and dtype {pairs.dtype}"
+            )
         return self._native.third_batch(self._flat(X, "X"), Phi, pairs.tolist())

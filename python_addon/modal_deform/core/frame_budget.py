@@ -7,6 +7,7 @@ the controllers stop, so fewer iterations per update delay the converged pose, n
 FrameBudget gives the solve what the rest of the recent updates left of the frame, between a
 floor (one iteration always runs) and the artist's Milliseconds per Update.
 """
+
 import numpy as np
 
 #: 60 frames a second.
@@ -24,8 +25,14 @@ class FrameBudget:
 
     def __init__(self, most_ms, least_ms=0.5, frame_ms=FRAME_MS):
         if not 0 < least_ms <= most_ms:
-            raise ValueError(f"least_ms and most_ms: expected 0 < least_ms <= most_ms, got {least_ms} and {most_ms}")
-        self.most_ms, self.least_ms, self.frame_ms = float(most_ms), float(least_ms), float(frame_ms)
+            raise ValueError(
+                f"least_ms and most_ms: expected 0 < least_ms <= most_ms, got {least_ms} and {most_ms}"
+            )
+        self.most_ms, self.least_ms, self.frame_ms = (
+            float(most_ms),
+            float(least_ms),
+            float(frame_ms),
+        )
         self._rest = []
 
     @property

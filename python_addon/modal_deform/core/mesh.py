@@ -1,4 +1,5 @@
 """Meshes: validation report, lumped mass and file reading (the test shapes are in ``testing``)."""
+
 from .. import _native
 from . import _arrays
 

@@ -5,6 +5,7 @@ K is a (3n, 3n) symmetric positive semidefinite scipy.sparse matrix (an energy's
 DOFs interleaved x0 y0 z0 x1 ...); mass holds the n vertex masses, M = diag(mass) ⊗ I₃. DOFs
 with neither mass nor stiffness (unreferenced vertices) stay zero in every result.
 """
+
 import numpy as np
 
 from .. import _native
@@ -14,6 +15,7 @@ from . import _arrays
 def _stiffness(K):
     """K as a float64 csc matrix with sorted, unique indices (what the native core reads)."""
     import scipy.sparse  # not at the top: Blender's own Python has NumPy but no SciPy
+
     if not scipy.sparse.issparse(K):
         raise ValueError(f"K: expected a scipy.sparse matrix, got {type(K).__name__}")
     K = scipy.sparse.csc_matrix(K, dtype=np.float64)
@@ -34,8 +36,9 @@ def vibration_modes(K, mass, count, kernel=None):
     """
     K = _stiffness(K)
     kernel = np.zeros((K.shape[0], 0)) if kernel is None else kernel
-    return _native.vibration_modes(K, _arrays.values(mass, "mass"), int(count),
-                                   _arrays.columns(kernel, K.shape[0], "kernel"))
+    return _native.vibration_modes(
+        K, _arrays.values(mass, "mass"), int(count), _arrays.columns(kernel, K.shape[0], "kernel")
+    )
 
 
 def rigid_motions(V, labels, mass):
@@ -46,7 +49,9 @@ def rigid_motions(V, labels, mass):
     translations along x, y, z, then rotations about its principal axes through its centroid.
     """
     V = _arrays.vertices(V)
-    return _native.rigid_motions(V, _arrays.labels(labels, len(V)), _arrays.values(mass, "mass", len(V)))
+    return _native.rigid_motions(
+        V, _arrays.labels(labels, len(V)), _arrays.values(mass, "mass", len(V))
+    )
 
 
 def solve_in_range(K, mass, Z, B):
@@ -56,5 +61,9 @@ def solve_in_range(K, mass, Z, B):
     M-orthonormal, spanning the kernel of K (e.g. rigid_motions); B: (3n, p) or (3n,).
     """
     K = _stiffness(K)
-    return _native.solve_in_range(K, _arrays.values(mass, "mass"), _arrays.columns(Z, K.shape[0], "Z"),
-                                  _arrays.columns(B, K.shape[0], "B"))
+    return _native.solve_in_range(
+        K,
+        _arrays.values(mass, "mass"),
+        _arrays.columns(Z, K.shape[0], "Z"),
+        _arrays.columns(B, K.shape[0], "B"),
+    )

@@ -27,7 +27,9 @@ def ghost_mesh(V, F, vertices=1000, progress=None):
     if vertices < 4:
         raise ValueError(f"vertices: a ghost needs at least 4 vertices, got {vertices}")
     if progress is not None and not callable(progress):
-        raise ValueError(f"progress: expected a callable progress(stage, fraction) or None, got {progress!r}")
+        raise ValueError(
+            f"progress: expected a callable progress(stage, fraction) or None, got {progress!r}"
+        )
     return _native.ghost_mesh(V, F, min(vertices, _INT32_MAX), progress)
 
 
@@ -42,16 +44,26 @@ def restrict_to_ghost(ghost_map, mass, U):
     if ghost_map.ndim != 1 or ghost_map.size == 0 or ghost_map.dtype.kind not in "iu":
         raise ValueError(
             f"ghost_map: expected a non-empty (n,) integer array, got shape {ghost_map.shape} "
-            f"dtype {ghost_map.dtype}")
+            f"dtype {ghost_map.dtype}"
+        )
     if ghost_map.min() < 0 or ghost_map.max() >= _INT32_MAX:
-        raise ValueError(f"ghost_map: expected indices in [0, {_INT32_MAX}), got [{ghost_map.min()}, {ghost_map.max()}]")
+        raise ValueError(
+            f"ghost_map: expected indices in [0, {_INT32_MAX}), got [{ghost_map.min()}, {ghost_map.max()}]"
+        )
     mass = np.ascontiguousarray(mass, dtype=np.float64)
     if mass.shape != ghost_map.shape:
-        raise ValueError(f"mass: expected shape {ghost_map.shape} (one per fine vertex), got {mass.shape}")
+        raise ValueError(
+            f"mass: expected shape {ghost_map.shape} (one per fine vertex), got {mass.shape}"
+        )
     U = np.asarray(U, dtype=np.float64)
     if U.ndim not in (1, 2) or U.shape[0] != 3 * ghost_map.size:
-        raise ValueError(f"U: expected shape ({3 * ghost_map.size},) or ({3 * ghost_map.size}, r), got {U.shape}")
+        raise ValueError(
+            f"U: expected shape ({3 * ghost_map.size},) or ({3 * ghost_map.size}, r), got {U.shape}"
+        )
     restricted = _native.restrict_to_ghost(
-        np.ascontiguousarray(ghost_map, dtype=np.int32), int(ghost_map.max()) + 1, mass,
-        np.asfortranarray(U.reshape(U.shape[0], -1)))
+        np.ascontiguousarray(ghost_map, dtype=np.int32),
+        int(ghost_map.max()) + 1,
+        mass,
+        np.asfortranarray(U.reshape(U.shape[0], -1)),
+    )
     return restricted.reshape(-1) if U.ndim == 1 else restricted

@@ -11,6 +11,7 @@ belong to several handles (its pulls add up, so it settles between their targets
 their weights), but not twice to one. Vertices without mass (in no triangle) pull with zero
 weight.
 """
+
 import numpy as np
 
 from .. import _native
@@ -29,21 +30,29 @@ FULL_SOLVE_OPTIONS = _options.table(_native.FULL_SOLVE_OPTIONS)
 def _handles(handles):
     """A non-empty list of non-empty 1-d int32 arrays (ranges and repeats are checked natively)."""
     if isinstance(handles, np.ndarray) and handles.ndim == 1 and handles.dtype.kind in "iu":
-        raise ValueError("handles: expected a list of index arrays, one per handle, got a single index array "
-                         "(wrap it in a list for one handle)")
+        raise ValueError(
+            "handles: expected a list of index arrays, one per handle, got a single index array "
+            "(wrap it in a list for one handle)"
+        )
     try:
         handles = list(handles)
     except TypeError:
-        raise ValueError(f"handles: expected a list of index arrays, got {type(handles).__name__}") from None
+        raise ValueError(
+            f"handles: expected a list of index arrays, got {type(handles).__name__}"
+        ) from None
     if not handles:
         raise ValueError("handles: no handle given; posing needs at least one")
     arrays = []
     for h, indices in enumerate(handles):
         indices = np.asarray(indices)
         if indices.ndim != 1 or indices.size == 0:
-            raise ValueError(f"handles[{h}]: expected a non-empty 1-d array of vertex indices, got shape {indices.shape}")
+            raise ValueError(
+                f"handles[{h}]: expected a non-empty 1-d array of vertex indices, got shape {indices.shape}"
+            )
         if indices.dtype.kind not in "iu":
-            raise ValueError(f"handles[{h}]: expected integer vertex indices, got dtype {indices.dtype}")
+            raise ValueError(
+                f"handles[{h}]: expected integer vertex indices, got dtype {indices.dtype}"
+            )
         if indices.max() > np.iinfo(np.int32).max or indices.min() < np.iinfo(np.int32).min:
             raise ValueError(f"handles[{h}]: an index does not fit in 32 bits")
         arrays.append(np.ascontiguousarray(indices, dtype=np.int32))
@@ -154,8 +163,18 @@ class ReducedSolver(_InBasis):
         """
         return self._native.solve(**options)
 
-    @_options.takes_options(FULL_SOLVE_OPTIONS, exclude=("pull", "energy", "bending", "membrane",
-                                                         "stiffness_weights", "max_stiffness", "held"))
+    @_options.takes_options(
+        FULL_SOLVE_OPTIONS,
+        exclude=(
+            "pull",
+            "energy",
+            "bending",
+            "membrane",
+            "stiffness_weights",
+            "max_stiffness",
+            "held",
+        ),
+    )
     def refine(self, F, initial=None, progress=None, **options):
         """Refine: the pose's exact minimum on the full mesh, by ``solve_full`` from a start.
 
@@ -181,19 +200,36 @@ class ReducedSolver(_InBasis):
         """
         n = self.num_vertices
         if n > REFINE_MAX_VERTICES:
-            raise ValueError(f"refine: the mesh has {n} vertices; refining works on meshes of up to "
-                             f"{REFINE_MAX_VERTICES} (a full Newton solve of a denser one needs more memory than "
-                             f"is safe here)")
-        start = self.positions().astype(np.float64) if initial is None else _arrays.vertices(initial, "initial")
+            raise ValueError(
+                f"refine: the mesh has {n} vertices; refining works on meshes of up to "
+                f"{REFINE_MAX_VERTICES} (a full Newton solve of a denser one needs more memory than "
+                f"is safe here)"
+            )
+        start = (
+            self.positions().astype(np.float64)
+            if initial is None
+            else _arrays.vertices(initial, "initial")
+        )
         if start.shape != (n, 3):
             raise ValueError(f"initial: expected shape ({n}, 3), got {start.shape}")
         basis, problem = self._basis, self._problem
         # A region bake's outside stays exactly at rest (where the reduced pose left it).
         held = np.setdiff1d(np.arange(n), basis.region) if len(basis.region) else None
-        return _on_full_mesh(_native.refine, basis.rest, F, self._transforms, initial=start, progress=progress,
-                             bending=basis.bending, membrane=basis.membrane,
-                             stiffness_weights=basis.stiffness_weights, max_stiffness=basis.max_stiffness,
-                             held=held, **problem, **options)
+        return _on_full_mesh(
+            _native.refine,
+            basis.rest,
+            F,
+            self._transforms,
+            initial=start,
+            progress=progress,
+            bending=basis.bending,
+            membrane=basis.membrane,
+            stiffness_weights=basis.stiffness_weights,
+            max_stiffness=basis.max_stiffness,
+            held=held,
+            **problem,
+            **options,
+        )
 
     def objective(self, q):
         """The objective f(q) (ghost energy plus handle term, normalised frame) and its gradient
@@ -233,8 +269,17 @@ def solve_full(V, F, handles, transforms, weights=None, initial=None, progress=N
     turned a triangle over), "ratio" (the decrease over the model's, at α ≤ 1), "cg_iterations" (conjugate gradient iterations of the step; 0: a new
     factorisation solved it), "progress", "energy" and "gradient_norm" after it.
     """
-    return _on_full_mesh(_native.solve_full, V, F, transforms, handles=handles, weights=weights, initial=initial,
-                         progress=progress, **options)
+    return _on_full_mesh(
+        _native.solve_full,
+        V,
+        F,
+        transforms,
+        handles=handles,
+        weights=weights,
+        initial=initial,
+        progress=progress,
+        **options,
+    )
 
 
 def _on_full_mesh(native, V, F, transforms, *, handles, weights, initial, progress, **options):
@@ -245,9 +290,18 @@ def _on_full_mesh(native, V, F, transforms, *, handles, weights, initial, progre
     if options.get("held") is not None:
         options["held"] = _arrays.indices(options["held"], "held")
     if options.get("stiffness_weights") is not None:
-        options["stiffness_weights"] = _arrays.stiffness_weights(options["stiffness_weights"], len(V))
+        options["stiffness_weights"] = _arrays.stiffness_weights(
+            options["stiffness_weights"], len(V)
+        )
     if progress is not None and not callable(progress):
         raise ValueError(f"progress: expected a callable or None, got {type(progress).__name__}")
-    return native(V, F, handles, _transforms(transforms, len(handles)), _weights(weights, len(handles)),
-                  initial=None if initial is None else _arrays.vertices(initial, "initial"), progress=progress,
-                  **options)
+    return native(
+        V,
+        F,
+        handles,
+        _transforms(transforms, len(handles)),
+        _weights(weights, len(handles)),
+        initial=None if initial is None else _arrays.vertices(initial, "initial"),
+        progress=progress,
+        **options,
+    )

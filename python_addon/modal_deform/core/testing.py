@@ -6,6 +6,7 @@
 They are the C++ core's own (cpp/mesh/primitives.h), which its tests use: one definition for C++,
 Python tests and the benchmarks. Quads are split into two triangles with alternating diagonals.
 """
+
 from .. import _native
 
 

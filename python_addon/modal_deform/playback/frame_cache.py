@@ -20,6 +20,7 @@ first frame whose curve values changed (``keyframes_changed``, when the keyframe
 checked at every frame shown); and a frame whose controllers stand elsewhere than when it was cached (a
 constraint, a driver, a moved parent) cuts the cache there when it is shown.
 """
+
 import hashlib
 import json
 
@@ -31,8 +32,11 @@ from .. import mesh_io, storage
 PREFIX = ".Modal Deform Cache "
 _ARRAYS = ("q", "v", "transforms", "curves")
 #: What a cache datablock holds (create() writes them all).
-_FIELDS = ("kind", "start", "signature", "basis_id", "curve_paths", "keys_digest", "frames") + _ARRAYS + tuple(
-    name + "_width" for name in _ARRAYS)
+_FIELDS = (
+    ("kind", "start", "signature", "basis_id", "curve_paths", "keys_digest", "frames")
+    + _ARRAYS
+    + tuple(name + "_width" for name in _ARRAYS)
+)
 
 
 def kind(obj):
@@ -43,9 +47,21 @@ def kind(obj):
 def _pose_fields(obj):
     """The settings the static pose depends on, (name, value) pairs: the stiffness and the handles."""
     settings = obj.modal_deform
-    return (("stiffness", settings.stiffness),
-            ("handles", tuple((h.vertex_group, h.weight, h.controller.name if h.controller else "",
-                               tuple(value for row in h.bind_matrix for value in row)) for h in settings.handles)))
+    return (
+        ("stiffness", settings.stiffness),
+        (
+            "handles",
+            tuple(
+                (
+                    h.vertex_group,
+                    h.weight,
+                    h.controller.name if h.controller else "",
+                    tuple(value for row in h.bind_matrix for value in row),
+                )
+                for h in settings.handles
+            ),
+        ),
+    )
 
 
 def pose_signature(obj):
@@ -61,8 +77,13 @@ def signature(obj, scene):
     dynamics = obj.modal_deform.dynamics
     fields = (("kind", kind(obj)),) + _pose_fields(obj)
     if dynamics.enabled:
-        fields += (("period", dynamics.period), ("damping", dynamics.damping), ("substeps", dynamics.substeps),
-                   ("start", dynamics.frame_start), ("fps", scene.render.fps / scene.render.fps_base))
+        fields += (
+            ("period", dynamics.period),
+            ("damping", dynamics.damping),
+            ("substeps", dynamics.substeps),
+            ("start", dynamics.frame_start),
+            ("fps", scene.render.fps / scene.render.fps_base),
+        )
     return repr(fields)
 
 
@@ -80,7 +101,9 @@ class Cache:
         """Raises ValueError when the datablock lacks what a cache holds (damaged, or not a cache)."""
         missing = [name for name in _FIELDS if name not in block]
         if missing:
-            raise ValueError(f"the cache '{block.name}' is damaged (no '{missing[0]}'): Free it and bake again")
+            raise ValueError(
+                f"the cache '{block.name}' is damaged (no '{missing[0]}'): Free it and bake again"
+            )
         self.block = block
 
     kind = property(lambda self: self.block["kind"])
@@ -94,7 +117,7 @@ class Cache:
         width = self.block[name + "_width"]
         if not width:
             return np.empty((len(self), 0))
-        return _values(self.block, name)[:len(self) * width].reshape(-1, width)
+        return _values(self.block, name)[: len(self) * width].reshape(-1, width)
 
     def __len__(self):
         """The number of frames cached, from start on."""
@@ -121,19 +144,26 @@ class Cache:
         keeps after the last frame, the array grown to twice the frames when full (so that caching a
         frame costs the same at any length of cache, where copying every array grew with it)."""
         frames = len(self)
-        rows = {"q": q, "v": np.empty(0) if v is None else v, "transforms": transforms, "curves": curves}
+        rows = {
+            "q": q,
+            "v": np.empty(0) if v is None else v,
+            "transforms": transforms,
+            "curves": curves,
+        }
         for name, row in rows.items():
             row = np.asarray(row, np.float64).ravel()
             width = self.block[name + "_width"]
             if frames and row.size != width:
-                raise ValueError(f"cache: frame {self.end + 1}'s {name} has {row.size} values, earlier frames "
-                                 f"{width}")
+                raise ValueError(
+                    f"cache: frame {self.end + 1}'s {name} has {row.size} values, earlier frames "
+                    f"{width}"
+                )
             if not frames or len(self.block[name]) < (frames + 1) * width:
                 room = np.zeros(max(_FIRST_ROOM, 2 * (frames + 1)) * row.size)
-                room[:frames * width] = self.array(name).ravel()
+                room[: frames * width] = self.array(name).ravel()
                 _set_array(self.block, name, room)
                 self.block[name + "_width"] = width = row.size
-            _values(self.block, name)[frames * width:(frames + 1) * width] = row
+            _values(self.block, name)[frames * width : (frames + 1) * width] = row
         self.block["frames"] = frames + 1
 
     def cut(self, frame):
@@ -143,7 +173,9 @@ class Cache:
             return
         for name in _ARRAYS:
             width = self.block[name + "_width"]
-            _set_array(self.block, name, self.array(name)[:keep].ravel().copy() if width else np.empty(0))
+            _set_array(
+                self.block, name, self.array(name)[:keep].ravel().copy() if width else np.empty(0)
+            )
         self.block["frames"] = keep
 
     def nbytes(self):
@@ -226,6 +258,7 @@ def settings_changed(obj):
 def controller_curves(obj):
     """The animation curves of obj's controllers, as (path, F-curve): path "controller:data_path[index]"."""
     from ..frame_keys import action_fcurves
+
     found = []
     for handle in obj.modal_deform.handles:
         controller = handle.controller

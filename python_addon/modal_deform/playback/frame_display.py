@@ -14,6 +14,7 @@ display's, and after a file is loaded or an undo while the timeline is still. Th
 posing.pose_key) and when the add-on is disabled. Why, and what a file written mid-playback holds:
 docs/design.md, "How a pose is shown and kept".
 """
+
 import bpy
 import numpy as np
 
@@ -57,7 +58,14 @@ def _geometry_group(name):
 def node_group():
     """The file's node group (made on first use): Geometry → Set Position (Position: ATTRIBUTE,
     Selection: where it exists) → Geometry."""
-    tree = next((g for g in bpy.data.node_groups if g.library is None and g.get(MARK) and not g.get(STAND_IN)), None)
+    tree = next(
+        (
+            g
+            for g in bpy.data.node_groups
+            if g.library is None and g.get(MARK) and not g.get(STAND_IN)
+        ),
+        None,
+    )
     if tree is not None:
         return tree
     tree = _geometry_group(NODE_GROUP)
@@ -92,8 +100,14 @@ def _add_modifier(obj):
 
 def modifier_of(obj):
     """obj's display modifier, or None."""
-    return next((m for m in obj.modifiers if m.type == "NODES" and m.node_group is not None and m.node_group.get(MARK)),
-                None)
+    return next(
+        (
+            m
+            for m in obj.modifiers
+            if m.type == "NODES" and m.node_group is not None and m.node_group.get(MARK)
+        ),
+        None,
+    )
 
 
 def positions(obj, stand_in=False):
@@ -110,7 +124,9 @@ def frame_mesh(obj, stand_in=False):
     found = _stand_in(modifier.node_group)
     # A stand-in replaces the geometry it is given: only first in the stack does it show what the attribute shows.
     first = obj.modifiers[0] == modifier
-    if modifier.node_group.get(STAND_IN) and (found is None or not first):  # its object deleted, or not first
+    if modifier.node_group.get(STAND_IN) and (
+        found is None or not first
+    ):  # its object deleted, or not first
         end_stand_in(obj)
         found = None
     if found is None and stand_in and first:
@@ -142,7 +158,9 @@ def _make_stand_in(obj, modifier):
     for name in (ATTRIBUTE, SHOWN):
         if name in mesh.attributes:
             mesh.attributes.remove(mesh.attributes[name])
-    if mesh.shape_keys is not None:  # the copy's own (Object.shape_key_clear leaves it in Blender 4.2 to 4.5)
+    if (
+        mesh.shape_keys is not None
+    ):  # the copy's own (Object.shape_key_clear leaves it in Blender 4.2 to 4.5)
         bpy.data.batch_remove([mesh.shape_keys])
     # Named with a leading "." as Blender's hidden datablocks: out of the artist's menus.
     stand_in = bpy.data.objects.new(f".{obj.name} (Modal Deform playback)", mesh)
@@ -173,14 +191,21 @@ def end_stand_in(obj):
     _delete_stand_ins()
     # In Edit Mode the mesh's arrays are not the ones edited: the next frame shown writes ATTRIBUTE.
     mesh = obj.data
-    if frame is not None and mesh.library is None and not mesh.is_editmode and len(frame) == len(mesh.vertices):
+    if (
+        frame is not None
+        and mesh.library is None
+        and not mesh.is_editmode
+        and len(frame) == len(mesh.vertices)
+    ):
         positions(obj)[...] = frame
         mesh.update()
 
 
 def end_stand_ins():
     """end_stand_in for every object of the file, and delete the stand-ins left without one."""
-    for obj in [o for o in bpy.data.objects if o.type == "MESH" and o.library is None and has_stand_in(o)]:
+    for obj in [
+        o for o in bpy.data.objects if o.type == "MESH" and o.library is None and has_stand_in(o)
+    ]:
         end_stand_in(obj)
     _delete_stand_ins()
 
@@ -202,14 +227,19 @@ def _stand_in(tree):
 def _delete_stand_ins():
     """Delete the stand-ins no modifier reads (node groups, then the objects and meshes they read)."""
     for collection in (bpy.data.node_groups, bpy.data.objects, bpy.data.meshes):
-        for block in [b for b in collection if b.library is None and b.get(STAND_IN) and not b.users]:
+        for block in [
+            b for b in collection if b.library is None and b.get(STAND_IN) and not b.users
+        ]:
             collection.remove(block)
 
 
 def _reads_shown(tree):
     """Whether the node group takes its selection from SHOWN (made in Blender 3.4)."""
-    return any(node.bl_idname == "GeometryNodeInputNamedAttribute" and node.inputs["Name"].default_value == SHOWN
-               for node in tree.nodes)
+    return any(
+        node.bl_idname == "GeometryNodeInputNamedAttribute"
+        and node.inputs["Name"].default_value == SHOWN
+        for node in tree.nodes
+    )
 
 
 def in_use():
@@ -234,7 +264,9 @@ def remove(obj):
         if stand_in:
             _delete_stand_ins()
     mesh = obj.data
-    if mesh.library is not None:  # a linked mesh's attribute is the library's: the modifier alone goes
+    if (
+        mesh.library is not None
+    ):  # a linked mesh's attribute is the library's: the modifier alone goes
         return
     for name in (ATTRIBUTE, SHOWN):
         attribute = mesh.attributes.get(name)
@@ -249,5 +281,7 @@ def remove_all():
         if obj.library is None:
             remove(obj)
     _delete_stand_ins()
-    for tree in [g for g in bpy.data.node_groups if g.library is None and g.get(MARK) and g.users == 0]:
+    for tree in [
+        g for g in bpy.data.node_groups if g.library is None and g.get(MARK) and g.users == 0
+    ]:
         bpy.data.node_groups.remove(tree)

@@ -1,6 +1,7 @@
 """The per-frame cache's operators: bake it (a frame per timer tick, progress, Esc restores the cache
 as it was), free it, and export it for machines without the add-on (shape keys, or a PC2 / MDD file
 for Blender's Mesh Cache modifier)."""
+
 import os
 
 import bpy
@@ -25,7 +26,9 @@ class CacheJob(FrameJob):
         if end < start:
             raise ValueError(f"frame range: the end ({end}) is before the start ({start})")
         super().__init__(range(start, end + 1))
-        self.player = timeline.player(obj, self.scene)  # raises for the artist before anything changes
+        self.player = timeline.player(
+            obj, self.scene
+        )  # raises for the artist before anything changes
         self.frame_before = self.scene.frame_current
         self.old = dynamics.cache
         dynamics.cache = None  # kept (0 users) until finish() or cancel()
@@ -45,8 +48,10 @@ class CacheJob(FrameJob):
         timeline.show(self.obj, self.scene)
         self.written = True
         what = "simulation" if self.cache.kind == "DYNAMIC" else "animation"
-        return "INFO", (f"Cached the {what} of {len(self.frames)} frames ({self.frames[0]} to {self.frames[-1]}) in "
-                        f"{self.cache.nbytes() / 1024:.1f} KB")
+        return "INFO", (
+            f"Cached the {what} of {len(self.frames)} frames ({self.frames[0]} to {self.frames[-1]}) in "
+            f"{self.cache.nbytes() / 1024:.1f} KB"
+        )
 
     def _take_back(self):
         dynamics = self.obj.modal_deform.dynamics
@@ -94,6 +99,7 @@ def cached_positions(obj, scene):
 
 class MODAL_DEFORM_OT_free_cache(bpy.types.Operator):
     """Forget the cached frames (the animation or simulation computes again when played)"""
+
     bl_idname = "modal_deform.free_cache"
     bl_label = "Free Cache"
     bl_options = {"REGISTER", "UNDO"}
@@ -108,6 +114,7 @@ class MODAL_DEFORM_OT_free_cache(bpy.types.Operator):
 class MODAL_DEFORM_OT_export_shape_keys(JobOperator, bpy.types.Operator):
     """Write the cached frames into shape keys, one per frame keyed to show on its frame only, that play \
 back and render without the add-on; the cache is then freed, as the keys take its place. Esc cancels"""
+
     bl_idname = "modal_deform.export_shape_keys"
     bl_label = "Export Shape Keys"
     bl_options = {"REGISTER", "UNDO"}
@@ -116,7 +123,9 @@ back and render without the add-on; the cache is then freed, as the keys take it
 
     def _job(self, context):
         obj = handles.owner(context.object)
-        return AnimationJob(context, obj, cached_frames(obj), positions=cached_positions(obj, context.scene))
+        return AnimationJob(
+            context, obj, cached_frames(obj), positions=cached_positions(obj, context.scene)
+        )
 
     def _status(self):
         return f"Modal Deform: exporting shape keys, frame {self.job.frames_done}/{len(self.job.frames)}"
@@ -131,15 +140,28 @@ back and render without the add-on; the cache is then freed, as the keys take it
 class MODAL_DEFORM_OT_export_mesh_cache(bpy.types.Operator):
     """Write the cached frames into a point-cache file (PC2 or MDD) that Blender's Mesh Cache modifier \
 and other packages read, for machines without the add-on"""
+
     bl_idname = "modal_deform.export_mesh_cache"
     bl_label = "Export Mesh Cache"
     bl_options = {"REGISTER"}
 
     filepath: bpy.props.StringProperty(subtype="FILE_PATH", options={"SKIP_SAVE"})
     file_format: bpy.props.EnumProperty(
-        name="Format", default="PC2",
-        items=(("PC2", "PC2", "Point Cache 2 (3ds Max, Blender's Mesh Cache): positions with the first frame"),
-               ("MDD", "MDD", "LightWave's MDD (Blender's Mesh Cache): positions with the time of each frame")))
+        name="Format",
+        default="PC2",
+        items=(
+            (
+                "PC2",
+                "PC2",
+                "Point Cache 2 (3ds Max, Blender's Mesh Cache): positions with the first frame",
+            ),
+            (
+                "MDD",
+                "MDD",
+                "LightWave's MDD (Blender's Mesh Cache): positions with the time of each frame",
+            ),
+        ),
+    )
 
     poll = classmethod(cache_poll)
 
@@ -148,7 +170,9 @@ and other packages read, for machines without the add-on"""
         if not self.filepath:
             blend = bpy.data.filepath
             folder = os.path.dirname(blend) if blend else os.path.expanduser("~")
-            self.filepath = os.path.join(folder, f"{bpy.path.clean_name(obj.name)}.{self.file_format.lower()}")
+            self.filepath = os.path.join(
+                folder, f"{bpy.path.clean_name(obj.name)}.{self.file_format.lower()}"
+            )
         context.window_manager.fileselect_add(self)
         return {"RUNNING_MODAL"}
 
@@ -161,17 +185,30 @@ and other packages read, for machines without the add-on"""
             return {"CANCELLED"}
         try:
             frames = cached_frames(obj)
-            point_cache.write(path, self.file_format, len(obj.data.vertices), frames,
-                              scene.render.fps / scene.render.fps_base, cached_positions(obj, scene))
+            point_cache.write(
+                path,
+                self.file_format,
+                len(obj.data.vertices),
+                frames,
+                scene.render.fps / scene.render.fps_base,
+                cached_positions(obj, scene),
+            )
         except (OSError, *FAILURES) as error:
             self.report({"ERROR"}, f"Export failed: {error}")
             return {"CANCELLED"}
-        self.report({"INFO"}, f"Wrote {len(frames)} frames ({frames[0]} to {frames[-1]}) to {path}: add a Mesh Cache "
-                              f"modifier with Frame Start {frames[0]} to play it")
+        self.report(
+            {"INFO"},
+            f"Wrote {len(frames)} frames ({frames[0]} to {frames[-1]}) to {path}: add a Mesh Cache "
+            f"modifier with Frame Start {frames[0]} to play it",
+        )
         return {"FINISHED"}
 
 
-CLASSES = (MODAL_DEFORM_OT_free_cache, MODAL_DEFORM_OT_export_shape_keys, MODAL_DEFORM_OT_export_mesh_cache)
+CLASSES = (
+    MODAL_DEFORM_OT_free_cache,
+    MODAL_DEFORM_OT_export_shape_keys,
+    MODAL_DEFORM_OT_export_mesh_cache,
+)
 
 
 register, unregister = bpy.utils.register_classes_factory(CLASSES)

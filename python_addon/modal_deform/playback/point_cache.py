@@ -8,6 +8,7 @@ points' float32 x y z.
 MDD (big-endian): int32 frames, int32 points, float32 time of each frame (seconds); then per frame
 the points' float32 x y z.
 """
+
 import struct
 
 import numpy as np
@@ -28,12 +29,18 @@ def write(path, fmt, num_points, frames, fps, positions):
     order = "<" if fmt == "PC2" else ">"
     with open(path, "wb") as out:
         if fmt == "PC2":
-            out.write(struct.pack("<12siiffi", b"POINTCACHE2\0", 1, num_points, float(frames[0]), 1.0, len(frames)))
+            out.write(
+                struct.pack(
+                    "<12siiffi", b"POINTCACHE2\0", 1, num_points, float(frames[0]), 1.0, len(frames)
+                )
+            )
         else:
             out.write(struct.pack(">ii", len(frames), num_points))
             out.write(np.array([f / fps for f in frames], order + "f4").tobytes())
         for frame in frames:
             co = np.asarray(positions(frame), np.float32)
             if co.shape != (num_points, 3):
-                raise ValueError(f"frame {frame}: expected positions of shape ({num_points}, 3), got {co.shape}")
+                raise ValueError(
+                    f"frame {frame}: expected positions of shape ({num_points}, 3), got {co.shape}"
+                )
             out.write(co.astype(order + "f4", copy=False).tobytes())

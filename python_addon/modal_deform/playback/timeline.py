@@ -14,13 +14,14 @@ Frames computed here are checked against what they were computed from each time 
 (frame_cache: settings, basis, keyframes, the controllers' transforms at that frame) and computed
 again from there when that changed.
 """
+
 import types
 
 import bpy
 import numpy as np
 
-from .. import core as mdc
 from .. import app_handlers, handles, mesh_io, posing, storage
+from .. import core as mdc
 from ..ops_common import FAILURES
 from . import frame_cache, frame_display
 
@@ -49,11 +50,17 @@ class Player:
         self.pose = pose or posing.Pose(types.SimpleNamespace(scene=scene), obj)
         self.basis, self.handles = self.pose.basis, self.pose.handles
         dynamics = settings.dynamics
-        self.simulation = mdc.Simulation(self.basis, [h.indices for h in self.handles], pull=settings.stiffness,
-                                         period=dynamics.period, damping=dynamics.damping,
-                                         fps=scene.render.fps / scene.render.fps_base, substeps=dynamics.substeps,
-                                         weights=[h.weight for h in self.handles],
-                                         energy=settings.status.energy.lower())
+        self.simulation = mdc.Simulation(
+            self.basis,
+            [h.indices for h in self.handles],
+            pull=settings.stiffness,
+            period=dynamics.period,
+            damping=dynamics.damping,
+            fps=scene.render.fps / scene.render.fps_base,
+            substeps=dynamics.substeps,
+            weights=[h.weight for h in self.handles],
+            energy=settings.status.energy.lower(),
+        )
         self.rest = self.basis.rest.astype(np.float32)
         # The mesh (address, vertex count) last found equal to rest; None again when Blender reports
         # a geometry update of it (_edits_reported). An undo makes every Player again (_undone).
@@ -143,8 +150,11 @@ def player(obj, scene, signature=None):
     `signature`: frame_cache.signature(obj, scene) when the caller has it."""
     found = _players.get(obj.name)
     if found is None or not found.fits(obj, signature or frame_cache.signature(obj, scene)):
-        same_pose = (found is not None and found.basis_id == frame_cache.basis_id(obj)
-                     and found.pose_signature == frame_cache.pose_signature(obj))
+        same_pose = (
+            found is not None
+            and found.basis_id == frame_cache.basis_id(obj)
+            and found.pose_signature == frame_cache.pose_signature(obj)
+        )
         found = _players[obj.name] = Player(obj, scene, pose=found.pose if same_pose else None)
     return found
 
@@ -152,7 +162,12 @@ def player(obj, scene, signature=None):
 def wants_playback(obj):
     """Whether the frame handler shows obj: a mesh of this file with a cache or dynamics on, in
     Object Mode (Edit, Sculpt and Paint Modes show the mesh being edited), not being posed."""
-    if obj.type != "MESH" or obj.library is not None or obj.mode != "OBJECT" or posing.is_posing(obj):
+    if (
+        obj.type != "MESH"
+        or obj.library is not None
+        or obj.mode != "OBJECT"
+        or posing.is_posing(obj)
+    ):
         return False
     return plays(obj)
 
@@ -218,7 +233,9 @@ def show(obj, scene, edits_reported=False):
     frame_cache.keyframes_changed(cache, curves)
     shown = max(frame, cache.start)
     index = cache.row(frame)
-    if index is not None and not np.array_equal(player_.transforms(obj).ravel(), cache.array("transforms")[index]):
+    if index is not None and not np.array_equal(
+        player_.transforms(obj).ravel(), cache.array("transforms")[index]
+    ):
         cache.cut(frame)
     mesh = frame_display.frame_mesh(obj, stand_in=_playing)
 
@@ -241,8 +258,11 @@ def free(obj):
 def _edits_reported(depsgraph):
     """Forget the comparisons (Player.check_mesh) of the meshes depsgraph reports a geometry update of,
     and end their objects' stand-ins: what the artist changed shows."""
-    edited = {update.id.original.as_pointer() for update in depsgraph.updates
-              if update.is_updated_geometry and isinstance(update.id, bpy.types.Mesh)}
+    edited = {
+        update.id.original.as_pointer()
+        for update in depsgraph.updates
+        if update.is_updated_geometry and isinstance(update.id, bpy.types.Mesh)
+    }
     if not edited:
         return
     for name, found in _players.items():
@@ -314,10 +334,16 @@ def _before_saving(*args):
 
 
 # Blender's handlers and ours; the playback handlers are Blender 4's.
-_HANDLERS = (("frame_change_post", _frame_changed), ("depsgraph_update_post", _geometry_updated),
-             ("undo_post", _undone), ("redo_post", _undone), ("load_post", _forget),
-             ("save_pre", _before_saving), ("animation_playback_pre", _playback_started),
-             ("animation_playback_post", _playback_stopped))
+_HANDLERS = (
+    ("frame_change_post", _frame_changed),
+    ("depsgraph_update_post", _geometry_updated),
+    ("undo_post", _undone),
+    ("redo_post", _undone),
+    ("load_post", _forget),
+    ("save_pre", _before_saving),
+    ("animation_playback_pre", _playback_started),
+    ("animation_playback_post", _playback_stopped),
+)
 
 
 def register():

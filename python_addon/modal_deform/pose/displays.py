@@ -7,6 +7,7 @@ Deform" shape key (ShapeKeyDisplay). Each offers array() (where the pose is writ
 and ends with the pose in the shape key (keep) or the mesh as it was (restore). The marks a display
 leaves on a mesh (POSING_FLAG, STAND_IN_OF) let recovery.py repair a mesh written mid-pose.
 """
+
 import bpy
 import numpy as np
 
@@ -159,14 +160,18 @@ class StandInDisplay(_TransientDisplay):
 
     def __init__(self, obj):
         self.obj, self.mesh = obj, obj.data
-        self.stand_in = self.mesh.copy()  # materials, attributes, vertex groups, UVs: what modifiers read
+        self.stand_in = (
+            self.mesh.copy()
+        )  # materials, attributes, vertex groups, UVs: what modifiers read
         self.stand_in.name = f"{self.mesh.name} (posing)"
         self.stand_in[STAND_IN_OF] = self.mesh
         copied_keys = self.stand_in.shape_keys.name
         obj.data = self.stand_in
         obj.shape_key_clear()
         left = bpy.data.shape_keys.get(copied_keys)
-        if left is not None:  # Blender 3.4 and 4.5 count the copy's Key twice and keep it (4.5 then refuses to save)
+        if (
+            left is not None
+        ):  # Blender 3.4 and 4.5 count the copy's Key twice and keep it (4.5 then refuses to save)
             bpy.data.batch_remove([left])
 
     def array(self):
@@ -195,7 +200,9 @@ def put_mesh_back(obj, stand_in):
             if block != added.reference_key:
                 carried = obj.shape_key_add(name=block.name, from_mix=False)
                 carried.value, carried.mute = block.value, block.mute
-                mesh_io.write_shape_key(mesh, carried, rest + (mesh_io.shape_key_co(stand_in, block) - start))
+                mesh_io.write_shape_key(
+                    mesh, carried, rest + (mesh_io.shape_key_co(stand_in, block) - start)
+                )
     bpy.data.meshes.remove(stand_in)
     mesh.update()
 

@@ -1,5 +1,6 @@
 """Posing operators: interactive (modal, timer-driven), solve (converged, for scripts), refine (the
 exact minimum on the full mesh, on a thread with progress and Esc), reset."""
+
 import time
 
 import bpy
@@ -14,6 +15,7 @@ from . import displays
 class MODAL_DEFORM_OT_pose(bpy.types.Operator):
     """Pose interactively: move the controllers (G, R) and the mesh follows. Enter or right-click > Apply \
 keeps the pose, Esc restores the mesh as it was"""
+
     bl_idname = "modal_deform.pose"
     bl_label = "Pose"
     bl_options = {"REGISTER", "UNDO"}
@@ -39,19 +41,24 @@ keeps the pose, Esc restores the mesh as it was"""
         self.budget = mdc.FrameBudget(obj.modal_deform.budget)
         self.written_at = self.drawn_at = None
         self.rest_ms = 0.0
-        self.draw_handler = bpy.types.SpaceView3D.draw_handler_add(self._drawn, (), "WINDOW", "POST_PIXEL")
+        self.draw_handler = bpy.types.SpaceView3D.draw_handler_add(
+            self._drawn, (), "WINDOW", "POST_PIXEL"
+        )
         wm = context.window_manager
         self.timer = wm.event_timer_add(1.0 / 60.0, window=context.window)
         wm.modal_handler_add(self)
         context.workspace.status_text_set(
-            "Modal Deform: move the controllers (G, R)   Enter: apply   Esc: cancel   Right-click: menu")
+            "Modal Deform: move the controllers (G, R)   Enter: apply   Esc: cancel   Right-click: menu"
+        )
         posing.running = self
         return {"RUNNING_MODAL"}
 
     def modal(self, context, event):
         if self.request is not None:
             return self.end(context, self.request)
-        if event.type == "TIMER":  # ours or another's: a tick either way (3.x events do not say whose)
+        if (
+            event.type == "TIMER"
+        ):  # ours or another's: a tick either way (3.x events do not say whose)
             return self._tick(context)
         if event.value == "PRESS":
             if event.type == "ESC":
@@ -71,7 +78,9 @@ keeps the pose, Esc restores the mesh as it was"""
             self.drawn_at = time.perf_counter()
 
     def _tick(self, context):
-        if self.drawn_at is not None:  # the last update was drawn: all it took besides the solve is known
+        if (
+            self.drawn_at is not None
+        ):  # the last update was drawn: all it took besides the solve is known
             self.budget.measured(self.rest_ms + 1e3 * (self.drawn_at - self.written_at))
             self.written_at = self.drawn_at = None
         obj = self.pose.obj
@@ -85,7 +94,9 @@ keeps the pose, Esc restores the mesh as it was"""
         start = time.perf_counter()
         try:
             moved = self.pose.follow_controllers()
-            if not self.shown.shows_pose():  # shape keys added mid-pose: the pose goes on in the key
+            if (
+                not self.shown.shows_pose()
+            ):  # shape keys added mid-pose: the pose goes on in the key
                 self.keep_in_shape_key()
             if moved or not self.pose.stats["converged"]:
                 solve_ms = self.pose.step(self.budget.ms)["ms"]
@@ -124,7 +135,9 @@ keeps the pose, Esc restores the mesh as it was"""
                 self.shown.restore()
             else:
                 self.keep_in_shape_key()
-        except ReferenceError:  # the object (or the screen) went away while posing: nothing to restore
+        except (
+            ReferenceError
+        ):  # the object (or the screen) went away while posing: nothing to restore
             return {"CANCELLED"}
         return {"CANCELLED"} if how == "CANCEL" else {"FINISHED"}
 
@@ -135,13 +148,18 @@ keeps the pose, Esc restores the mesh as it was"""
 
 class MODAL_DEFORM_OT_pose_end(bpy.types.Operator):
     """End the interactive pose"""
+
     bl_idname = "modal_deform.pose_end"
     bl_label = "End Pose"
     bl_options = {"INTERNAL"}
 
-    how: bpy.props.EnumProperty(items=(("APPLY", "Apply", "Keep the pose in the shape key"),
-                                       ("CANCEL", "Cancel", "Restore the mesh as it was before posing")),
-                                description="Whether the pose is kept or the mesh restored")
+    how: bpy.props.EnumProperty(
+        items=(
+            ("APPLY", "Apply", "Keep the pose in the shape key"),
+            ("CANCEL", "Cancel", "Restore the mesh as it was before posing"),
+        ),
+        description="Whether the pose is kept or the mesh restored",
+    )
 
     @classmethod
     def poll(cls, context):
@@ -158,21 +176,35 @@ class MODAL_DEFORM_MT_pose(bpy.types.Menu):
 
     def draw(self, context):
         layout = self.layout
-        layout.operator(MODAL_DEFORM_OT_pose_end.bl_idname, text="Apply", icon="CHECKMARK").how = "APPLY"
-        layout.operator(MODAL_DEFORM_OT_pose_end.bl_idname, text="Cancel", icon="CANCEL").how = "CANCEL"
+        layout.operator(
+            MODAL_DEFORM_OT_pose_end.bl_idname, text="Apply", icon="CHECKMARK"
+        ).how = "APPLY"
+        layout.operator(
+            MODAL_DEFORM_OT_pose_end.bl_idname, text="Cancel", icon="CANCEL"
+        ).how = "CANCEL"
 
 
 class MODAL_DEFORM_OT_solve(bpy.types.Operator):
     """Solve the pose for the controllers as they are, to convergence, into the "Modal Deform" shape key"""
+
     bl_idname = "modal_deform.solve"
     bl_label = "Solve"
     bl_options = {"REGISTER", "UNDO"}
 
-    max_iterations: bpy.props.IntProperty(name="Max Iterations", default=posing.CONVERGE_MAX_ITERATIONS, min=1,
-                                          description="BFGS iterations at most; fewer may leave the pose unfinished")
-    tolerance: bpy.props.FloatProperty(name="Tolerance", default=mdc.SOLVE_OPTIONS["tolerance"].default, min=1e-12, max=0.5,
-                                       description="Stopping tolerance of the Gill-Murray-Wright test: smaller "
-                                                   "solves more exactly and takes longer")
+    max_iterations: bpy.props.IntProperty(
+        name="Max Iterations",
+        default=posing.CONVERGE_MAX_ITERATIONS,
+        min=1,
+        description="BFGS iterations at most; fewer may leave the pose unfinished",
+    )
+    tolerance: bpy.props.FloatProperty(
+        name="Tolerance",
+        default=mdc.SOLVE_OPTIONS["tolerance"].default,
+        min=1e-12,
+        max=0.5,
+        description="Stopping tolerance of the Gill-Murray-Wright test: smaller "
+        "solves more exactly and takes longer",
+    )
 
     poll = classmethod(mesh_poll)
 
@@ -202,15 +234,25 @@ class MODAL_DEFORM_OT_solve(bpy.types.Operator):
 class MODAL_DEFORM_OT_refine(JobOperator, bpy.types.Operator):
     """Solve the pose for the controllers as they are, then polish it on the full mesh (Newton's method) into \
 the "Modal Deform" shape key: the exact physically based shape, for a final frame. Takes seconds; Esc cancels"""
+
     bl_idname = "modal_deform.refine"
     bl_label = "Refine"
     bl_options = {"REGISTER", "UNDO"}
 
-    max_iterations: bpy.props.IntProperty(name="Max Iterations", default=mdc.FULL_SOLVE_OPTIONS["max_iterations"].default, min=1,
-                                          description="Newton iterations at most; fewer may leave the pose unfinished")
-    tolerance: bpy.props.FloatProperty(name="Tolerance", default=mdc.FULL_SOLVE_OPTIONS["tolerance"].default, min=1e-12, max=0.5,
-                                       description="Factor by which the gradient must shrink: smaller solves more "
-                                                   "exactly and takes longer")
+    max_iterations: bpy.props.IntProperty(
+        name="Max Iterations",
+        default=mdc.FULL_SOLVE_OPTIONS["max_iterations"].default,
+        min=1,
+        description="Newton iterations at most; fewer may leave the pose unfinished",
+    )
+    tolerance: bpy.props.FloatProperty(
+        name="Tolerance",
+        default=mdc.FULL_SOLVE_OPTIONS["tolerance"].default,
+        min=1e-12,
+        max=0.5,
+        description="Factor by which the gradient must shrink: smaller solves more "
+        "exactly and takes longer",
+    )
 
     poll = classmethod(mesh_poll)
 
@@ -228,6 +270,7 @@ the "Modal Deform" shape key: the exact physically based shape, for a final fram
 
 class MODAL_DEFORM_OT_reset(bpy.types.Operator):
     """Back to rest: controllers return to where they were assigned and the "Modal Deform" shape key goes"""
+
     bl_idname = "modal_deform.reset"
     bl_label = "Reset Pose"
     bl_options = {"REGISTER", "UNDO"}
@@ -243,9 +286,14 @@ class MODAL_DEFORM_OT_reset(bpy.types.Operator):
         return {"FINISHED"}
 
 
-CLASSES = (MODAL_DEFORM_OT_pose, MODAL_DEFORM_OT_pose_end, MODAL_DEFORM_MT_pose, MODAL_DEFORM_OT_solve,
-           MODAL_DEFORM_OT_refine,
-           MODAL_DEFORM_OT_reset)
+CLASSES = (
+    MODAL_DEFORM_OT_pose,
+    MODAL_DEFORM_OT_pose_end,
+    MODAL_DEFORM_MT_pose,
+    MODAL_DEFORM_OT_solve,
+    MODAL_DEFORM_OT_refine,
+    MODAL_DEFORM_OT_reset,
+)
 
 
 register, _unregister_classes = bpy.utils.register_classes_factory(CLASSES)

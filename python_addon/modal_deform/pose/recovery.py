@@ -2,6 +2,7 @@
 the "Modal Deform" shape key (save_pre); after undo, redo or a file loaded, the pose under way ends
 and meshes written mid-pose (they carry a display's marks, displays.py) are repaired (recover).
 """
+
 import bpy
 
 from .. import app_handlers, mesh_io, posing, storage
@@ -35,7 +36,9 @@ def _recover_positions(obj):
         print(f"Modal Deform: '{obj.name}' was saved while posing and cannot be repaired: {error}")
         return
     if len(rest) != len(mesh.vertices):
-        print(f"Modal Deform: '{obj.name}' was saved while posing and its mesh no longer fits its basis")
+        print(
+            f"Modal Deform: '{obj.name}' was saved while posing and its mesh no longer fits its basis"
+        )
         return
     pose = mesh_io.vertex_positions(mesh).copy()
     displays.put_rest_back(mesh, rest)
@@ -60,8 +63,12 @@ def _recover_after_undo_or_load(*args):
     recover()
 
 
-_HANDLERS = (("save_pre", _keep_before_save), ("undo_post", _recover_after_undo_or_load),
-             ("redo_post", _recover_after_undo_or_load), ("load_post", _recover_after_undo_or_load))
+_HANDLERS = (
+    ("save_pre", _keep_before_save),
+    ("undo_post", _recover_after_undo_or_load),
+    ("redo_post", _recover_after_undo_or_load),
+    ("load_post", _recover_after_undo_or_load),
+)
 
 
 def register():

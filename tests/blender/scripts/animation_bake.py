@@ -3,6 +3,7 @@ what the per-frame solve gives, scrubbing reads it without solving, a changed ke
 the motion changed, Esc or a failure leaves it as it was; exported to PC2 and MDD files that
 Blender's Mesh Cache modifier plays and to shape keys (a cancelled export changes nothing); then
 saved with the shape keys."""
+
 import os
 
 import bpy
@@ -10,7 +11,13 @@ import numpy as np
 from support import blender as support
 
 frame_cache, jobs, operators, timeline, frame_display, posing = support.enable_addon(
-    "playback.frame_cache", "jobs", "playback.operators", "playback.timeline", "playback.frame_display", "posing")
+    "playback.frame_cache",
+    "jobs",
+    "playback.operators",
+    "playback.timeline",
+    "playback.frame_display",
+    "posing",
+)
 obj, V, controller = support.keyed_suzanne(10, 15, 20, 400)
 scene = bpy.context.scene
 scene.frame_set(3)
@@ -25,24 +32,40 @@ assert support.mesh_state(obj) == before and frame_cache.get(obj) is None
 # third, it leaves the cache (none here) and the mesh as they were, and the frame where it was.
 job = operators.CacheJob(bpy.context, obj, 1, 10)
 job.start()
-assert job.tick() and job.tick() and job.tick() and job.overall == 0.3 and len(frame_cache.get(obj)) == 3
+assert (
+    job.tick()
+    and job.tick()
+    and job.tick()
+    and job.overall == 0.3
+    and len(frame_cache.get(obj)) == 3
+)
 job.cancel()
 assert not job.tick()
-assert job.finish() == ("WARNING", "Cache bake cancelled: the cache is as it was") and not job.written
-assert support.mesh_state(obj) == before and scene.frame_current == 4 and frame_cache.get(obj) is None
+assert (
+    job.finish() == ("WARNING", "Cache bake cancelled: the cache is as it was") and not job.written
+)
+assert (
+    support.mesh_state(obj) == before and scene.frame_current == 4 and frame_cache.get(obj) is None
+)
 job = operators.CacheJob(bpy.context, obj, 1, 10)
 job.player.next = lambda *args, **kwargs: 1 / 0  # frame 2, after frame 1's first()
 job.run()
 level, message = job.finish()
-assert level == "ERROR" and message == "Cache bake failed: division by zero" and not job.written, message
-assert support.mesh_state(obj) == before and scene.frame_current == 4 and frame_cache.get(obj) is None
+assert level == "ERROR" and message == "Cache bake failed: division by zero" and not job.written, (
+    message
+)
+assert (
+    support.mesh_state(obj) == before and scene.frame_current == 4 and frame_cache.get(obj) is None
+)
 del job.player.next  # the player is kept for the object's next frames
 
 assert bpy.ops.modal_deform.bake_animation(frame_start=1, frame_end=10) == {"FINISHED"}
 cache = frame_cache.get(obj)
 assert cache.kind == "STATIC" and (cache.start, cache.end) == (1, 10) and scene.frame_current == 4
 assert cache.nbytes() < 20000, cache.nbytes()  # a shape key per frame would take 12 bytes a vertex
-assert obj.data.shape_keys is None and obj.modifiers[0].name == frame_display.MODIFIER, "not shown by the display"
+assert obj.data.shape_keys is None and obj.modifiers[0].name == frame_display.MODIFIER, (
+    "not shown by the display"
+)
 assert np.array_equal(support.positions(obj), V), "the artist's mesh changed"
 
 # Against the solve per frame as Bake Animation did it before the cache (a pose, converged frame
@@ -56,7 +79,9 @@ for frame in range(1, 11):
     pose.converge()
     shown[frame] = support.evaluated_positions(obj)
     error = np.abs(shown[frame] - pose.solver.positions()).max() / size
-    assert error < 1e-4, f"frame {frame}: the cache plays {error:.2e} of the size away from the solve"
+    assert error < 1e-4, (
+        f"frame {frame}: the cache plays {error:.2e} of the size away from the solve"
+    )
 moved = np.abs(shown[10] - V).max()
 assert moved > 0.3, f"the animated handle did not move the mesh ({moved})"
 
@@ -80,7 +105,9 @@ controller.keyframe_insert("location", frame=10)
 scene.frame_set(6)
 assert (cache.start, cache.end) == (1, 6), (cache.start, cache.end)
 assert cache.array("q")[:1].tobytes() == kept
-assert np.abs(support.evaluated_positions(obj) - shown[6]).max() > 0.05, "frame 6 kept the old motion"
+assert np.abs(support.evaluated_positions(obj) - shown[6]).max() > 0.05, (
+    "frame 6 kept the old motion"
+)
 # A jump forward solves every frame up to it.
 scene.frame_set(10)
 assert cache.end == 10 and np.abs(support.evaluated_positions(obj) - shown[10]).max() > 0.3
@@ -115,8 +142,9 @@ for fmt in ("PC2", "MDD"):
 # Shape keys: one per frame in place of the cache (the export cancelled after two frames changes
 # nothing), and the file saved for a Blender without the add-on.
 before = support.mesh_state(obj)
-job = jobs.AnimationJob(bpy.context, obj, operators.cached_frames(obj),
-                        positions=operators.cached_positions(obj, scene))
+job = jobs.AnimationJob(
+    bpy.context, obj, operators.cached_frames(obj), positions=operators.cached_positions(obj, scene)
+)
 assert job.tick() and job.tick() and len(obj.data.shape_keys.key_blocks) == 3
 job.cancel()
 assert job.finish() == ("WARNING", "Shape key export cancelled: nothing changed")

@@ -1,4 +1,5 @@
 """Without the add-on: the evaluated mesh at each frame is the shape key baked for it."""
+
 import addon_utils
 import bpy
 import numpy as np
@@ -16,6 +17,8 @@ for frame in (1, 5, 10):
     mesh.vertices.foreach_get("co", co)
     evaluated.to_mesh_clear()
     expected = np.load(support.tmp(f"frame{frame}.npy"))
-    assert np.abs(co.reshape(-1, 3) - expected).max() < 1e-6, f"frame {frame} does not show its shape key"
+    assert np.abs(co.reshape(-1, 3) - expected).max() < 1e-6, (
+        f"frame {frame} does not show its shape key"
+    )
 moved = np.abs(np.load(support.tmp("frame10.npy")) - rest).max()
 assert moved > 0.3, f"the animated handle did not move the mesh ({moved})"

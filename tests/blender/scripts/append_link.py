@@ -1,6 +1,6 @@
 """The stored basis follows an object appended or linked from a saved file (undo: tests/gui)."""
+
 import bpy
-import numpy as np
 from support import blender as support
 
 storage = support.enable_addon("storage")
@@ -25,4 +25,6 @@ for link in (False, True):
     assert (obj.modal_deform.basis.library is not None) == link
     assert storage.stale_reason(obj) == ""
     loaded = storage.load(obj).to_arrays()
-    assert all(baked[k].tobytes() == loaded[k].tobytes() for k in baked), f"link={link}: basis differs"
+    assert all(baked[k].tobytes() == loaded[k].tobytes() for k in baked), (
+        f"link={link}: basis differs"
+    )

@@ -3,6 +3,7 @@
 Arguments: suzanne | dragon PATH. Writes TEST_TMP/baked.blend, TEST_TMP/basis.npz (the basis as
 baked) and TEST_TMP/rest.npy (the base mesh's positions).
 """
+
 import bpy
 import numpy as np
 from support import blender as support
@@ -35,7 +36,9 @@ start = controller.location.copy()
 controller.location[(axis + 1) % 3] += 0.05 * np.ptp(V, axis=0).max()
 bpy.context.view_layer.update()
 assert bpy.ops.modal_deform.solve() == {"FINISHED"}
-assert np.abs(support.key_positions(obj, posing.POSE_KEY) - V).max() > 0.01 * np.ptp(V, axis=0).max(), "no pose"
+assert (
+    np.abs(support.key_positions(obj, posing.POSE_KEY) - V).max() > 0.01 * np.ptp(V, axis=0).max()
+), "no pose"
 controller.location = start
 
 np.savez(support.tmp("basis.npz"), **storage.load(obj).to_arrays())

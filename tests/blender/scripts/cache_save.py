@@ -1,5 +1,6 @@
 """Cache an animation of Suzanne (static, or simulated with `dynamic`), record what it holds and
 shows, and save the file."""
+
 import bpy
 import numpy as np
 from support import blender as support

@@ -1,5 +1,6 @@
 """Cancelling a bake (Esc: the progress callback says stop) leaves the object exactly as it was,
 with or without an earlier basis; so does a bake that fails."""
+
 import time
 
 import bpy

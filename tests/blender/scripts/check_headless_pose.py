@@ -2,6 +2,7 @@
 mesh is as bake_and_save.py left it, and with the controllers where they were bound the pose is rest.
 
 Arguments: DIMENSION, the basis's."""
+
 import bpy
 import numpy as np
 from support import blender as support

@@ -1,6 +1,7 @@
 """A basis damaged in the saved .blend (an array truncated, a shape resized, NaN, an index out of
 range, an array missing) is refused with a message when the add-on loads it after the file is
 opened, and neither the mesh nor the stored basis is touched by the refusal."""
+
 import bpy
 import numpy as np
 from support import blender as support
@@ -56,8 +57,13 @@ def missing(block):
     del block["rest"]
 
 
-for damage, fragment in [(truncated, "cannot reshape"), (resized, "vectors"), (nan, "ghost_vectors"),
-                         (out_of_range, "ghost_map[3] = 2147483647"), (missing, "rest")]:
+for damage, fragment in [
+    (truncated, "cannot reshape"),
+    (resized, "vectors"),
+    (nan, "ghost_vectors"),
+    (out_of_range, "ghost_map[3] = 2147483647"),
+    (missing, "rest"),
+]:
     bpy.ops.wm.open_mainfile(filepath=path)  # the add-on forgets its loaded bases (load_post)
     obj = bpy.data.objects["Suzanne"]
     bpy.context.view_layer.objects.active = obj

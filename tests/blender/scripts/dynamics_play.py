@@ -4,17 +4,21 @@ scrubbing back reads the cache; a jump forward simulates every frame in between 
 same bits as playing, and so do frames simulated again after a cut in the middle of a block of
 BFGS's memory; a changed keyframe or setting invalidates what follows; Bake gives the same
 bits again; Free empties the cache; a mesh edited between frames and a damaged cache are refused."""
+
 import bpy
 import numpy as np
 from support import blender as support
 
 frame_cache, frame_keys, timeline, frame_display, posing = support.enable_addon(
-    "playback.frame_cache", "frame_keys", "playback.timeline", "playback.frame_display", "posing")
+    "playback.frame_cache", "frame_keys", "playback.timeline", "playback.frame_display", "posing"
+)
 obj, V = support.baked_suzanne(2, 20, 52, 1000)  # the demo's Suzanne and the default basis
 size = np.ptp(V, axis=0).max()
 # The core of the head is held by the controller, tilted fast and stopped (as the demo does); the
 # ears and the chin are free to swing.
-controller = support.add_handle(obj, (np.hypot(V[:, 0], V[:, 1]) < 0.55) & (V[:, 2] > -0.35)).controller
+controller = support.add_handle(
+    obj, (np.hypot(V[:, 0], V[:, 1]) < 0.55) & (V[:, 2] > -0.35)
+).controller
 controller.keyframe_insert("rotation_euler", frame=1)
 controller.rotation_euler.y = 0.6
 controller.keyframe_insert("rotation_euler", frame=6)
@@ -44,7 +48,9 @@ pose.converge()
 static = pose.solver.positions()
 ears = np.abs(V[:, 0]) > 1.0
 way = (static[ears] - V[ears]).ravel()
-along = np.array([np.dot((played[f][ears] - V[ears]).ravel(), way) / np.dot(way, way) for f in range(1, 41)])
+along = np.array(
+    [np.dot((played[f][ears] - V[ears]).ravel(), way) / np.dot(way, way) for f in range(1, 41)]
+)
 assert along[4:12].max() > 1.05, f"no overshoot after the stop: {np.round(along, 3)}"
 assert np.abs(along[-5:] - 1).max() < 0.02, f"the motion does not settle: {np.round(along, 3)}"
 
@@ -61,7 +67,9 @@ assert bpy.ops.modal_deform.bake_animation() == {"FINISHED"}
 assert len(frame_cache.get(obj)) == 40 and scene.frame_current == 30
 for frame in (40, 7, 20):
     scene.frame_set(frame)
-    assert key().tobytes() == played[frame].tobytes(), f"the bake differs from playing at frame {frame}"
+    assert key().tobytes() == played[frame].tobytes(), (
+        f"the bake differs from playing at frame {frame}"
+    )
 
 # A cut in the middle of a block of BFGS's memory (memory_frames frames from the cache's start;
 # the simulation holds frame 40's): the frames after it simulated again, from the block's first
@@ -73,7 +81,9 @@ scene.frame_set(30)
 assert frame_cache.get(obj).end == 30
 for frame in (30, 2 + memory_frames + memory_frames // 2, 2 + 2 * memory_frames):
     scene.frame_set(frame)
-    assert key().tobytes() == played[frame].tobytes(), f"simulated again after a cut, frame {frame} differs"
+    assert key().tobytes() == played[frame].tobytes(), (
+        f"simulated again after a cut, frame {frame} differs"
+    )
 
 # Free, then a jump forward: every frame up to it simulated, the same bits as playing.
 assert bpy.ops.modal_deform.free_cache() == {"FINISHED"}
@@ -97,9 +107,13 @@ for point in points:
     point.handle_left_type = point.handle_right_type = "FREE"
 curves = [("Keys:location[2]", curve)]
 digests = {frame_cache.keys_digest(curves)}
-for change in (lambda: setattr(points[0], "interpolation", "LINEAR"), lambda: setattr(points[0], "easing", "EASE_IN"),
-               lambda: setattr(points[0].handle_right, "y", 0.3), lambda: setattr(points[1].co, "y", 0.7),
-               lambda: setattr(points[1].handle_left, "x", 4.5)):
+for change in (
+    lambda: setattr(points[0], "interpolation", "LINEAR"),
+    lambda: setattr(points[0], "easing", "EASE_IN"),
+    lambda: setattr(points[0].handle_right, "y", 0.3),
+    lambda: setattr(points[1].co, "y", 0.7),
+    lambda: setattr(points[1].handle_left, "x", 4.5),
+):
     change()
     digests.add(frame_cache.keys_digest(curves))
 assert len(digests) == 6, "a change of a keyframe left the digest as it was"
@@ -134,7 +148,9 @@ assert timeline.player(obj, scene).pose is not pose and key().tobytes() == kept.
 # between frames is refused either way, and undoing it plays again.
 compared = []
 same_positions = timeline.mesh_io.same_positions
-timeline.mesh_io.same_positions = lambda mesh, co: compared.append(mesh.name) or same_positions(mesh, co)
+timeline.mesh_io.same_positions = lambda mesh, co: (
+    compared.append(mesh.name) or same_positions(mesh, co)
+)
 for frame in (10, 11, 12):
     scene.frame_set(frame)
     bpy.context.view_layer.update()
@@ -153,7 +169,10 @@ for frame, reported in ((13, bpy.context.view_layer.update), (15, lambda: None))
     move_vertex(x + 0.1)
     reported()
     scene.frame_set(frame)
-    assert "edited after the bake" in timeline.problems.get(obj.name, ""), (frame, timeline.problems)
+    assert "edited after the bake" in timeline.problems.get(obj.name, ""), (
+        frame,
+        timeline.problems,
+    )
     move_vertex(x)
     scene.frame_set(frame + 1)
     assert obj.name not in timeline.problems, (frame, timeline.problems)

@@ -1,4 +1,5 @@
 """modal_deform.core imports inside Blender's Python and computes on a Blender mesh."""
+
 import bpy
 import numpy as np
 from support import blender as support

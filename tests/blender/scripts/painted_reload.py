@@ -1,6 +1,7 @@
 """Open the file painted_stiffness.py wrote: the painted basis is still fresh and poses as before; a
 deleted stiffness group makes the basis stale and the bake refuse; its middle third, painted stiff,
 stayed nearly rigid where a uniform bake bends it."""
+
 import bpy
 import numpy as np
 from support import blender as support

@@ -3,6 +3,7 @@ are painted anew, a missing group refused; posed, and saved for painted_reload.p
 
 Writes TEST_TMP/painted.blend and TEST_TMP/painted_pose.npy (the pose's shape key).
 """
+
 import math
 
 import bpy
@@ -23,21 +24,29 @@ group.add([int(i) for i in np.flatnonzero(middle)], 1.0, "REPLACE")
 # A group that does not exist: a clear error, and nothing changes.
 settings.stiffness_group = "Nowhere"
 state = support.mesh_state(obj)
-support.expect_error(bpy.ops.modal_deform.bake, "the stiffness vertex group 'Nowhere' does not exist")
+support.expect_error(
+    bpy.ops.modal_deform.bake, "the stiffness vertex group 'Nowhere' does not exist"
+)
 assert support.mesh_state(obj) == state
 
 settings.stiffness_group, settings.max_stiffness = "Stiff", 100.0
 assert bpy.ops.modal_deform.bake() == {"FINISHED"}
 basis = storage.load(obj)
-assert np.array_equal(basis.stiffness_weights, middle.astype(np.float64)) and basis.max_stiffness == 100.0
+assert (
+    np.array_equal(basis.stiffness_weights, middle.astype(np.float64))
+    and basis.max_stiffness == 100.0
+)
 assert storage.stale_reason(obj) == ""
 
 # The bar held at its bottom ring, its top ring turned by 40° and pushed down: an arc.
 bottom = support.add_handle(obj, V[:, 2] < 1e-6)
 bottom.controller = None
 top = support.add_handle(obj, V[:, 2] > 6 - 1e-6)
-top.controller.matrix_world = Matrix.Translation((0.0, -0.3, -0.4)) @ top.controller.matrix_world @ \
-    Matrix.Rotation(math.radians(40), 4, "X")
+top.controller.matrix_world = (
+    Matrix.Translation((0.0, -0.3, -0.4))
+    @ top.controller.matrix_world
+    @ Matrix.Rotation(math.radians(40), 4, "X")
+)
 bpy.context.view_layer.update()
 
 # Painted anew: stale until painted back.

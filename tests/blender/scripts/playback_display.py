@@ -3,6 +3,7 @@ modifier first in the stack (the artist's modifiers act on it), the artist's pos
 untouched, the rest in Edit Mode; a copy of the mesh is not written through; without the attribute
 the mesh shows its rest; a pose (Solve, the interactive pose) takes the display away, as do dynamics
 turned off, a cache that no longer fits and disabling the add-on."""
+
 import addon_utils
 import bpy
 import numpy as np
@@ -11,7 +12,13 @@ from support import blender as support
 
 package = support.enable_addon()
 frame_cache, mesh_io, timeline, frame_display, displays, posing = support.enable_addon(
-    "playback.frame_cache", "mesh_io", "playback.timeline", "playback.frame_display", "pose.displays", "posing")
+    "playback.frame_cache",
+    "mesh_io",
+    "playback.timeline",
+    "playback.frame_display",
+    "pose.displays",
+    "posing",
+)
 obj, V, controller = support.keyed_suzanne(8, 12, 10, 300)
 artist = obj.modifiers.new("Artist's Displace", "DISPLACE")
 scene = bpy.context.scene
@@ -42,14 +49,18 @@ assert np.abs(shown() - frame(6)).max() > 0.4, "the artist's modifier does not a
 artist.show_viewport = False
 assert shown().tobytes() == frame(6).tobytes(), "the evaluated mesh is not the cached frame"
 assert np.abs(frame(6) - V).max() > 0.3, "the controller did not move the mesh"
-assert np.array_equal(support.positions(obj), V) and obj.data.shape_keys is None, "the artist's mesh changed"
+assert np.array_equal(support.positions(obj), V) and obj.data.shape_keys is None, (
+    "the artist's mesh changed"
+)
 
 # One node group per file, reused by every object that plays.
 other = bpy.data.objects.new("Second Suzanne", obj.data.copy())
 scene.collection.objects.link(other)
 frame_display.positions(other)[...] = V
-assert other.modifiers[0].node_group == modifier.node_group and len(
-    [g for g in bpy.data.node_groups if g.name.startswith(frame_display.NODE_GROUP)]) == 1
+assert (
+    other.modifiers[0].node_group == modifier.node_group
+    and len([g for g in bpy.data.node_groups if g.name.startswith(frame_display.NODE_GROUP)]) == 1
+)
 bpy.data.objects.remove(other)
 # Renamed by the artist, the modifier and its group are still the display's (no second one).
 modifier.name, modifier.node_group.name = "Renamed", "Renamed too"
@@ -85,7 +96,9 @@ assert shown().tobytes() == frame(4).tobytes()
 controller.matrix_world = Matrix.Translation((0.0, 0.0, 0.3)) @ controller.matrix_world
 assert bpy.ops.modal_deform.solve() == {"FINISHED"}
 assert not frame_display.shows(obj)
-assert np.abs(shown() - support.key_positions(obj, posing.POSE_KEY)).max() < 1e-6, "the frame hides the solved pose"
+assert np.abs(shown() - support.key_positions(obj, posing.POSE_KEY)).max() < 1e-6, (
+    "the frame hides the solved pose"
+)
 scene.frame_set(5)
 assert shown().tobytes() == frame(5).tobytes()
 # The interactive pose's display, likewise (the mesh has shape keys now: the pose shows in the key).
@@ -117,6 +130,8 @@ obj.modal_deform.dynamics.enabled = True
 scene.frame_set(4)
 assert frame_display.shows(obj)
 addon_utils.disable(package.__name__, default_set=True)
-assert [m.name for m in obj.modifiers] == [artist.name] and frame_display.ATTRIBUTE not in obj.data.attributes
+assert [m.name for m in obj.modifiers] == [
+    artist.name
+] and frame_display.ATTRIBUTE not in obj.data.attributes
 assert not [g for g in bpy.data.node_groups if g.get(frame_display.MARK)]
 assert np.abs(shown() - support.key_positions(obj, posing.POSE_KEY)).max() < 1e-6

@@ -2,6 +2,7 @@
 the same frames bit for bit, the artist's mesh and shape keys untouched; it goes when playback stops,
 before a file is saved, in Edit Mode and when the artist changes the mesh, and a file written
 mid-playback, or an undo step, loads without it, showing the same frame."""
+
 import sys
 
 import bpy
@@ -12,8 +13,9 @@ if not hasattr(bpy.app.handlers, "animation_playback_pre"):
     print("STAND_IN_UNSUPPORTED")
     sys.exit(0)
 
-frame_cache, timeline, frame_display = support.enable_addon("playback.frame_cache", "playback.timeline",
-                                                             "playback.frame_display")
+frame_cache, timeline, frame_display = support.enable_addon(
+    "playback.frame_cache", "playback.timeline", "playback.frame_display"
+)
 obj, V, controller = support.keyed_suzanne(8, 12, 10, 300)
 # Shape keys of the artist's (at rest, as a bake needs): the stand-in has none, the artist keeps them.
 obj.shape_key_add(name="Basis")
@@ -27,7 +29,9 @@ scene.frame_set(1)
 
 def playback_handler(name):
     """Call the add-on's handler that Blender calls when the timeline starts or stops playing."""
-    handler = next(h for h in getattr(bpy.app.handlers, name) if h.__module__.endswith(".playback.timeline"))
+    handler = next(
+        h for h in getattr(bpy.app.handlers, name) if h.__module__.endswith(".playback.timeline")
+    )
     handler(scene, bpy.context.evaluated_depsgraph_get())
 
 
@@ -39,14 +43,20 @@ def frame(number):
 
 
 def stand_ins():
-    return [b.name for c in (bpy.data.objects, bpy.data.meshes, bpy.data.node_groups) for b in c
-            if b.get(frame_display.STAND_IN)]
+    return [
+        b.name
+        for c in (bpy.data.objects, bpy.data.meshes, bpy.data.node_groups)
+        for b in c
+        if b.get(frame_display.STAND_IN)
+    ]
 
 
 def untouched():
     assert np.array_equal(support.positions(obj), V), "the artist's positions changed"
     assert np.array_equal(support.key_positions(obj, "Basis"), V), "the artist's Basis key changed"
-    assert support.key_positions(obj, "Smile")[0, 2] == V[0, 2] + np.float32(0.2), "the artist's key changed"
+    assert support.key_positions(obj, "Smile")[0, 2] == V[0, 2] + np.float32(0.2), (
+        "the artist's key changed"
+    )
 
 
 # Frames simulated and read while playing show what the attribute shows, through the stand-in.
@@ -57,23 +67,31 @@ playback_handler("animation_playback_pre")
 for number in (2, 3, 4, 5, 2, 3):
     scene.frame_set(number)
     assert frame_display.has_stand_in(obj), f"frame {number}: no stand-in while playing"
-    assert support.evaluated_positions(obj).tobytes() == frame(number).tobytes(), f"frame {number} differs"
+    assert support.evaluated_positions(obj).tobytes() == frame(number).tobytes(), (
+        f"frame {number} differs"
+    )
 assert len(stand_ins()) == 3, stand_ins()
 stand_in = next(o for o in bpy.data.objects if o.get(frame_display.STAND_IN))
-assert stand_in.data.shape_keys is None and stand_in.users_scene == (), "the stand-in is drawn or has keys"
+assert stand_in.data.shape_keys is None and stand_in.users_scene == (), (
+    "the stand-in is drawn or has keys"
+)
 untouched()
 
 # The stand-in deleted by the artist (the Outliner's Blender File view shows it): the next frame has a new one.
 bpy.data.objects.remove(stand_in)
 scene.frame_set(2)
 assert frame_display.has_stand_in(obj) and len(stand_ins()) == 3, stand_ins()
-assert support.evaluated_positions(obj).tobytes() == frame(2).tobytes(), "a deleted stand-in hides the frame"
+assert support.evaluated_positions(obj).tobytes() == frame(2).tobytes(), (
+    "a deleted stand-in hides the frame"
+)
 scene.frame_set(3)
 
 # Saving: the file holds the mesh once; the next frame played has the stand-in again.
 bpy.ops.wm.save_as_mainfile(filepath=support.tmp("saved.blend"), copy=True)
 assert not stand_ins() and not frame_display.has_stand_in(obj)
-assert support.evaluated_positions(obj).tobytes() == frame(3).tobytes(), "saving changed the frame shown"
+assert support.evaluated_positions(obj).tobytes() == frame(3).tobytes(), (
+    "saving changed the frame shown"
+)
 scene.frame_set(4)
 assert frame_display.has_stand_in(obj)
 
@@ -102,7 +120,9 @@ assert support.evaluated_positions(obj).tobytes() == frame(6).tobytes()
 solidify = obj.modifiers.new("Artist's Solidify", "SOLIDIFY")
 bpy.ops.object.modifier_move_to_index(modifier=solidify.name, index=0)
 scene.frame_set(7)
-assert not stand_ins() and len(support.evaluated_positions(obj)) == 2 * len(V), "the stand-in hides a modifier"
+assert not stand_ins() and len(support.evaluated_positions(obj)) == 2 * len(V), (
+    "the stand-in hides a modifier"
+)
 obj.modifiers.remove(solidify)
 scene.frame_set(6)
 assert frame_display.has_stand_in(obj)
@@ -131,9 +151,13 @@ name = obj.name
 assert bpy.ops.ed.undo() == {"FINISHED"}
 obj, scene = bpy.data.objects[name], bpy.context.scene
 assert scene.frame_current == 4 and not stand_ins(), stand_ins()
-assert support.evaluated_positions(obj).tobytes() == frame(4).tobytes(), "the undo step's frame does not show"
+assert support.evaluated_positions(obj).tobytes() == frame(4).tobytes(), (
+    "the undo step's frame does not show"
+)
 scene.frame_set(6)
-assert support.evaluated_positions(obj).tobytes() == frame(6).tobytes(), "no frame plays after an undo"
+assert support.evaluated_positions(obj).tobytes() == frame(6).tobytes(), (
+    "no frame plays after an undo"
+)
 
 # Free mid-playback takes the display away, stand-in and all.
 playback_handler("animation_playback_pre")
@@ -156,5 +180,7 @@ bpy.app.handlers.save_pre.append(saving)
 bpy.ops.wm.open_mainfile(filepath=support.tmp("autosaved.blend"))
 obj = bpy.data.objects[name]
 assert not stand_ins() and not frame_display.has_stand_in(obj), stand_ins()
-assert support.evaluated_positions(obj).tobytes() == shown.tobytes(), "the loaded file shows another frame"
+assert support.evaluated_positions(obj).tobytes() == shown.tobytes(), (
+    "the loaded file shows another frame"
+)
 assert np.array_equal(support.positions(obj), V)

@@ -5,6 +5,7 @@ added mid-pose (a copy of the posed positions) gets the rest as its reference; a
 the artist's shape keys is posed in the key and gets them back untouched; a mesh written mid-pose
 by a path without save handlers (an undo step of a controller's move, autosave, a crash file) is
 repaired after undo and after loading: rest from the stored basis, pose into the key."""
+
 import bpy
 import numpy as np
 from mathutils import Matrix
@@ -73,7 +74,10 @@ pose_shown(shown)
 assert obj.data.shape_keys is None and obj.data.get(displays.POSING_FLAG)
 assert np.abs(support.positions(obj) - rest).max() > 0.05, "the pose is not in the vertex positions"
 shown.restore()
-assert support.positions(obj).tobytes() == rest.tobytes() and obj.data.get(displays.POSING_FLAG) is None
+assert (
+    support.positions(obj).tobytes() == rest.tobytes()
+    and obj.data.get(displays.POSING_FLAG) is None
+)
 
 # Kept: the rest back in the base mesh and in "Basis", the pose in the key, the same through the
 # modifiers as it was shown.
@@ -144,14 +148,20 @@ smile = artists_key(0.0)
 before = support.mesh_state(obj)
 shown = displays.display(obj)
 assert type(shown) is displays.StandInDisplay
-assert obj.data != mesh and obj.data.shape_keys is None and obj.data.get(displays.STAND_IN_OF) == mesh
+assert (
+    obj.data != mesh and obj.data.shape_keys is None and obj.data.get(displays.STAND_IN_OF) == mesh
+)
 controller.matrix_world = Matrix.Translation((0.0, 0.2, 0.0)) @ controller.matrix_world
 bpy.context.view_layer.update()
 pose = pose_shown(shown)
 assert support.mesh_state(obj) != before
 shown.restore()
-assert obj.data == mesh and support.mesh_state(obj) == before, "Esc did not put the artist's mesh back"
-assert not [m for m in bpy.data.meshes if m.get(displays.STAND_IN_OF)], "the stand-in is left behind"
+assert obj.data == mesh and support.mesh_state(obj) == before, (
+    "Esc did not put the artist's mesh back"
+)
+assert not [m for m in bpy.data.meshes if m.get(displays.STAND_IN_OF)], (
+    "the stand-in is left behind"
+)
 
 # Kept: the pose in the key, the artist's keys and the rest as they were, the same through the
 # modifiers as it was shown.
@@ -162,8 +172,10 @@ shown = keep_as_shown(shown, pose)
 assert type(shown) is displays.ShapeKeyDisplay and obj.data == mesh
 assert support.key_positions(obj, posing.POSE_KEY).tobytes() == posed.tobytes()
 for name in ("Basis", "Smile"):
-    assert support.key_positions(obj, name).tobytes() == dict(
-        (n, c) for n, _, _, c in before["shape_keys"])[name], f"keeping the pose changed '{name}'"
+    assert (
+        support.key_positions(obj, name).tobytes()
+        == dict((n, c) for n, _, _, c in before["shape_keys"])[name]
+    ), f"keeping the pose changed '{name}'"
 
 # The artist's key shown (at 0.5): posed in the key, as before.
 smile.value = 0.5
@@ -196,7 +208,9 @@ obj.shape_key_remove(obj.data.shape_keys.key_blocks["Frown"])
 # An undo step and a file written mid-pose hold the stand-in on the object: the artist's mesh comes
 # back on undo and on loading, with the pose in the key.
 obj, posed = undone_to_mid_pose(displays.StandInDisplay)
-assert obj.data.name == "Suzanne" and obj.data.get(displays.STAND_IN_OF) is None, "undo left the stand-in"
+assert obj.data.name == "Suzanne" and obj.data.get(displays.STAND_IN_OF) is None, (
+    "undo left the stand-in"
+)
 assert not [m for m in bpy.data.meshes if m.get(displays.STAND_IN_OF)]
 assert support.key_positions(obj, posing.POSE_KEY).tobytes() == posed.tobytes()
 shown = displays.display(obj)
@@ -206,7 +220,9 @@ bpy.ops.wm.save_as_mainfile(filepath=path, copy=True)
 shown.restore()
 bpy.ops.wm.open_mainfile(filepath=path)
 obj = bpy.data.objects["Suzanne"]
-assert obj.data.name == "Suzanne" and not [m for m in bpy.data.meshes if m.get(displays.STAND_IN_OF)]
+assert obj.data.name == "Suzanne" and not [
+    m for m in bpy.data.meshes if m.get(displays.STAND_IN_OF)
+]
 assert support.key_positions(obj, posing.POSE_KEY).tobytes() == posed.tobytes()
 assert support.positions(obj).tobytes() == rest.tobytes()
 assert storage.stale_reason(obj) == "", "the mesh put back does not fit its basis"

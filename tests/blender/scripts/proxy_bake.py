@@ -1,6 +1,7 @@
 """A dense mesh through the same Bake button: baked on a proxy (small thresholds here), the proxy
 size in the status the Basis panel shows, the proxy basis and its prolongation stored and read back
 bit for bit after a reload, posed into the fine shape key, and a mode previewed on every vertex."""
+
 import bpy
 import numpy as np
 from support import blender as support
@@ -14,7 +15,10 @@ settings.proxy_above, settings.proxy = 5000, 2000
 assert bpy.ops.modal_deform.bake() == {"FINISHED"}
 status = settings.status
 n = len(obj.data.vertices)
-assert status.num_vertices == n and 1800 <= status.proxy_vertices <= 2200, (n, status.proxy_vertices)
+assert status.num_vertices == n and 1800 <= status.proxy_vertices <= 2200, (
+    n,
+    status.proxy_vertices,
+)
 basis = storage.load(obj)
 assert basis.on_proxy and basis.vectors.shape == (3 * status.proxy_vertices, status.dimension)
 assert settings.basis["prolongation_weights"].typecode == "f"

@@ -1,4 +1,5 @@
 """Quads and n-gons are triangulated for the energy without touching the faces; mode preview."""
+
 import math
 
 import bpy
@@ -11,8 +12,16 @@ ops_preview, storage = support.enable_addon("ops_preview", "storage")
 around, rings = 24, 21
 angles = 2 * math.pi * np.arange(around) / around
 V = [(math.cos(a), math.sin(a), 4.0 * r / (rings - 1)) for r in range(rings) for a in angles]
-quads = [(r * around + i, r * around + (i + 1) % around, (r + 1) * around + (i + 1) % around, (r + 1) * around + i)
-         for r in range(rings - 1) for i in range(around)]
+quads = [
+    (
+        r * around + i,
+        r * around + (i + 1) % around,
+        (r + 1) * around + (i + 1) % around,
+        (r + 1) * around + i,
+    )
+    for r in range(rings - 1)
+    for i in range(around)
+]
 caps = [tuple(reversed(range(around))), tuple((rings - 1) * around + i for i in range(around))]
 obj = support.mesh_object("Tube", np.array(V), quads + caps)
 mesh = obj.data
@@ -45,6 +54,12 @@ basis = storage.load(obj)
 u = basis.vectors[:, settings.status.num_rigid].reshape(-1, 3)
 assert np.allclose(preview - rest, u * (0.4 / np.linalg.norm(u, axis=1).max()), atol=1e-5)
 settings.preview_amplitude = -0.2  # the key follows the slider
-assert abs(np.linalg.norm(support.key_positions(obj, ops_preview.PREVIEW_KEY) - rest, axis=1).max() - 0.8) < 1e-4
+assert (
+    abs(
+        np.linalg.norm(support.key_positions(obj, ops_preview.PREVIEW_KEY) - rest, axis=1).max()
+        - 0.8
+    )
+    < 1e-4
+)
 assert bpy.ops.modal_deform.preview_mode() == {"FINISHED"}
 assert not ops_preview.showing(obj)

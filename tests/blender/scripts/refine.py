@@ -1,12 +1,15 @@
 """Refine: the pose polished on the full mesh into the "Modal Deform" key (base mesh untouched), a
 cancelled refine that leaves the key as it was, and the refined animation bake."""
+
 import bpy
 import numpy as np
 from support import blender as support
 
 jobs, core = support.enable_addon("jobs", "core")
 # Suzanne unsubdivided (507 vertices): the full solves stay short in each of the four Blenders tested.
-obj, rest = support.baked_suzanne(0, 15, 40, 300)  # the eyes are free components: no handle holds them
+obj, rest = support.baked_suzanne(
+    0, 15, 40, 300
+)  # the eyes are free components: no handle holds them
 top = support.top_and_bottom_handles(obj, rest)
 top.controller.location.y += 0.15
 top.controller.rotation_euler.x += 0.2

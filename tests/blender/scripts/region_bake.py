@@ -3,6 +3,7 @@ pulled up; every vertex outside the ear stays exactly where it was. The ear alon
 than Proxy Above, so it is baked on a proxy of its own faces. Stale when the region is
 painted anew; a handle outside the region is refused. Saves TEST_TMP/region.blend for
 region_reload.py."""
+
 import bpy
 import numpy as np
 from mathutils import Matrix
@@ -22,12 +23,18 @@ settings.proxy_above, settings.proxy = int(ear.sum()) // 2, int(ear.sum()) // 3
 assert bpy.ops.modal_deform.bake() == {"FINISHED"}
 basis = storage.load(obj)
 np.testing.assert_array_equal(basis.region, np.flatnonzero(ear))
-assert basis.num_rigid == 0 and basis.on_proxy and settings.status.proxy_vertices == basis.num_basis_vertices
+assert (
+    basis.num_rigid == 0
+    and basis.on_proxy
+    and settings.status.proxy_vertices == basis.num_basis_vertices
+)
 
 # A handle outside the ear: refused, naming the region.
 outside = support.add_handle(obj, V[:, 2] < -0.7)
 outside.controller = None
-support.expect_error(bpy.ops.modal_deform.solve, "vertices outside the region the basis was baked with")
+support.expect_error(
+    bpy.ops.modal_deform.solve, "vertices outside the region the basis was baked with"
+)
 bpy.ops.modal_deform.remove_handle()
 tip = support.add_handle(obj, V[:, 0] > 1.25)
 tip.controller.matrix_world = Matrix.Translation((0.0, 0.0, 0.3)) @ tip.controller.matrix_world

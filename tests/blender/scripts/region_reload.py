@@ -1,5 +1,6 @@
 """Open the file region_bake.py wrote: the region bake is fresh, poses as before, and the ear's
 tip pulled further still leaves every vertex outside the ear exactly where it was, refined too."""
+
 import bpy
 import numpy as np
 from mathutils import Matrix

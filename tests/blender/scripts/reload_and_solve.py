@@ -1,5 +1,6 @@
 """Open the file bake_and_save.py wrote: the basis must be bit for bit what was baked; then move
 one controller, solve, and check the pose (handles on target, base mesh untouched)."""
+
 import math
 
 import bpy
@@ -27,7 +28,9 @@ moved, pinned = settings.handles
 pinned.controller = None  # pinned where it is
 size = np.ptp(rest, axis=0).max()
 turn = Matrix.Rotation(math.radians(30), 4, "X")
-moved.controller.matrix_world = Matrix.Translation((0.0, 0.1 * size, 0.05 * size)) @ moved.controller.matrix_world @ turn
+moved.controller.matrix_world = (
+    Matrix.Translation((0.0, 0.1 * size, 0.05 * size)) @ moved.controller.matrix_world @ turn
+)
 bpy.context.view_layer.update()
 assert bpy.ops.modal_deform.solve() == {"FINISHED"}
 
@@ -38,5 +41,7 @@ resolved, _ = handles.resolve(obj, bpy.context.scene, rest.astype(np.float64))
 for handle, T in zip(resolved, handles.transforms(obj, resolved)):
     target = rest[handle.indices] @ T[:3, :3].T + T[:3, 3]
     error = np.linalg.norm(pose[handle.indices] - target, axis=1).mean() / size
-    assert error < 0.01, f"handle {handle.name} misses its target by {error:.2%} of the model's size"
+    assert error < 0.01, (
+        f"handle {handle.name} misses its target by {error:.2%} of the model's size"
+    )
 print(obj.name, "posed: moved by", np.abs(pose - rest).max() / size, "of its size")

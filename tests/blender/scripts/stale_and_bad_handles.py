@@ -1,4 +1,5 @@
 """A mesh edited after the bake is detected and refused; bad handles get clear messages."""
+
 import bpy
 from support import blender as support
 

@@ -1,6 +1,7 @@
 """A solve that cannot make progress says so (issue 22): with the reduced solver reporting a stall
 (no step lowers the objective), Solve warns with the hint for the artist, and the interactive
 pose's header names the stall; a converged solve says neither."""
+
 import sys
 
 import bpy
@@ -21,11 +22,14 @@ assert "stalled" not in posing.header_text(stats, 1.0)
 
 # The solver as it ends at a stall: the call made no progress and did not converge.
 solve = core.ReducedSolver.solve
-core.ReducedSolver.solve = lambda self, *args, **kwargs: dict(solve(self, *args, **kwargs), converged=False,
-                                                               stalled=True)
+core.ReducedSolver.solve = lambda self, *args, **kwargs: dict(
+    solve(self, *args, **kwargs), converged=False, stalled=True
+)
 print("SOLVE_WITH_STALL")
 sys.stdout.flush()
-assert bpy.ops.modal_deform.solve() == {"FINISHED"}  # the pose so far stays in the key, with a warning
+assert bpy.ops.modal_deform.solve() == {
+    "FINISHED"
+}  # the pose so far stays in the key, with a warning
 sys.stdout.flush()
 stalled = posing.Pose(bpy.context, obj)
 stalled.follow_controllers()

@@ -1,6 +1,7 @@
 """Suzanne (subdivided twice, baked through the operator) under strong poses (issue 22): turns of
 90 and 170 degrees about her longest axis and bends of 90 and 180 degrees converge without a
 stall, with the objective continuous along the way (support.strong_poses, as the pytest cases)."""
+
 import bpy
 from support import blender as support
 from support import strong_poses

@@ -7,13 +7,24 @@ Each screenshot is of the whole window (OUTPUT/window-<state>.png) and of the si
 (OUTPUT/sidebar-<state>-<n>.png, scrolled down a screen at a time until its end). A panel whose
 draw() raises prints a traceback, which the test looks for. Writes OUTPUT/result.json (window.run).
 """
+
 import os
 
 import bpy
 import numpy as np
-
-from window import (click, enable_addon, output, override, run, say, screenshot, show_sidebar_tab, sidebar,
-                    subdivided_suzanne, view3d)
+from window import (
+    click,
+    enable_addon,
+    output,
+    override,
+    run,
+    say,
+    screenshot,
+    show_sidebar_tab,
+    sidebar,
+    subdivided_suzanne,
+    view3d,
+)
 
 # Seconds for the sidebar to settle after a change: Blender 4.x animates panels opening and moving.
 SETTLE = 1.0
@@ -24,10 +35,12 @@ def cut(path, window_size, x, y, width, height, cut_path):
     path; an X grab is of the whole screen, which the window fills (no window manager)."""
     image = bpy.data.images.load(path)
     full_width, full_height = image.size
-    assert (full_width, full_height) == window_size, f"{path}: {image.size[:]}, not the window's {window_size}"
+    assert (full_width, full_height) == window_size, (
+        f"{path}: {image.size[:]}, not the window's {window_size}"
+    )
     pixels = np.empty(full_width * full_height * 4, np.float32)
     image.pixels.foreach_get(pixels)
-    part = pixels.reshape(full_height, full_width, 4)[y:y + height, x:x + width]
+    part = pixels.reshape(full_height, full_width, 4)[y : y + height, x : x + width]
     bpy.data.images.remove(image)
     assert part.std() > 0.01, f"{path}: blank where the sidebar is"
     piece = bpy.data.images.new("sidebar", width, height, alpha=True)
@@ -52,14 +65,23 @@ def screenshots(state):
     while True:
         part += 1
         grab = screenshot("grab.png")
-        cut(grab, (window.width, window.height), region.x, region.y, region.width, region.height,
-            os.path.join(output, f"sidebar-{state}-{part}.png"))
+        cut(
+            grab,
+            (window.width, window.height),
+            region.x,
+            region.y,
+            region.width,
+            region.height,
+            os.path.join(output, f"sidebar-{state}-{part}.png"),
+        )
         os.remove(grab)
         before = scroll_offset(region)
         yield from scroll(region, "WHEELDOWNMOUSE", 12)
         if scroll_offset(region) == before:
             break
-    say(f"{state}: the window and {part} screens of the sidebar ({region.width} by {region.height} pixels)")
+    say(
+        f"{state}: the window and {part} screens of the sidebar ({region.width} by {region.height} pixels)"
+    )
     yield from scroll(region, "WHEELUPMOUSE", 12 * part)
 
 
@@ -81,13 +103,16 @@ def select_vertices(obj, mask):
 def check_tooltips():
     """Every property the add-on defines has a tooltip (those PropertyGroup brings, name, excepted)."""
     from modal_deform import properties
+
     inherited = set(bpy.types.PropertyGroup.bl_rna.properties.keys())
     for group in properties.CLASSES:
         for prop in group.bl_rna.properties:
             if prop.identifier not in inherited:
                 assert prop.description, f"{group.__name__}.{prop.identifier}: no tooltip"
             for item in getattr(prop, "enum_items", ()):
-                assert item.description, f"{group.__name__}.{prop.identifier}: {item.identifier} has no tooltip"
+                assert item.description, (
+                    f"{group.__name__}.{prop.identifier}: {item.identifier} has no tooltip"
+                )
     say("every property has a tooltip")
 
 
@@ -104,8 +129,10 @@ def steps():
     yield 0.5
     window, _, _ = view3d()
     region = sidebar()
-    say(f"window {window.width} by {window.height}, sidebar {region.width} pixels wide at UI scale "
-        f"{bpy.context.preferences.system.ui_scale:.2f}")
+    say(
+        f"window {window.width} by {window.height}, sidebar {region.width} pixels wide at UI scale "
+        f"{bpy.context.preferences.system.ui_scale:.2f}"
+    )
     yield from screenshots("not-baked")
 
     # Baked, two handles (the top of the head moved by an Empty, the chin pinned), stiffness painted.

@@ -11,6 +11,7 @@ shape key and from the positions).
 Each step runs from bpy.app.timers so Blender handles the simulated events in between (window.run).
 Writes OUTPUT/result.json ({"ok": bool, "log": [...]}) and screenshots, then quits.
 """
+
 import importlib
 import os
 import threading
@@ -20,10 +21,18 @@ import addon_utils
 import bpy
 import numpy as np
 from mathutils import Vector
-
 from support.blender import evaluated_positions
-from window import (enable_addon, override, output, run, say, screenshot, show_sidebar_tab,
-                    subdivided_suzanne, view3d)
+from window import (
+    enable_addon,
+    output,
+    override,
+    run,
+    say,
+    screenshot,
+    show_sidebar_tab,
+    subdivided_suzanne,
+    view3d,
+)
 
 
 def key_positions(obj, name):
@@ -70,7 +79,9 @@ def steps():
     window.event_simulate(type="ESC", value="RELEASE", x=region.x + 10, y=region.y + 10)
     yield from wait_until(lambda: not baking(), 60)
     yield 0.5  # the operator's next timer event ends it
-    assert obj.modal_deform.basis is None and not any(p.name.startswith(".Modal") for p in bpy.data.palettes)
+    assert obj.modal_deform.basis is None and not any(
+        p.name.startswith(".Modal") for p in bpy.data.palettes
+    )
     say("bake cancelled with Esc: nothing changed")
 
     # Undo takes a bake back (the bake's datablock and status go with it); redo brings it again.
@@ -136,7 +147,9 @@ def steps():
     window.event_simulate(type="LEFTMOUSE", value="PRESS", x=x + 120, y=y + 60)
     window.event_simulate(type="LEFTMOUSE", value="RELEASE", x=x + 120, y=y + 60)
     yield 0.2
-    moved = np.array(controller.matrix_world.translation) - np.array(obj.matrix_world @ Vector(rest[group].mean(axis=0)))
+    moved = np.array(controller.matrix_world.translation) - np.array(
+        obj.matrix_world @ Vector(rest[group].mean(axis=0))
+    )
     assert np.linalg.norm(moved) > 0.1, f"the grab did not move the controller ({moved})"
     say("controller moved by", np.round(moved, 3).tolist())
 
@@ -148,7 +161,12 @@ def steps():
     pose = base_positions(obj)
     followed = pose[group].mean(axis=0) - rest[group].mean(axis=0)
     assert np.linalg.norm(followed - moved) < 0.05 * np.linalg.norm(moved), (followed, moved)
-    say("mesh followed by", np.round(followed, 3).tolist(), "at", f"{posing.running.tick_ms:.1f} ms per update")
+    say(
+        "mesh followed by",
+        np.round(followed, 3).tolist(),
+        "at",
+        f"{posing.running.tick_ms:.1f} ms per update",
+    )
     yield from show_sidebar_tab()
     yield 0.5
     screenshot("pose.png")
@@ -178,13 +196,19 @@ def steps():
     with bpy.data.libraries.load(saved) as (data_from, data_to):
         data_to.objects = [obj.name]
     copy = data_to.objects[0]
-    assert base_positions(copy).tobytes() == rest.tobytes(), "the saved base mesh is not the rest mesh"
+    assert base_positions(copy).tobytes() == rest.tobytes(), (
+        "the saved base mesh is not the rest mesh"
+    )
     assert copy.data.get(displays.POSING_FLAG) is None
-    assert np.abs(key_positions(copy, posing.POSE_KEY) - posed).max() < 1e-5, "the saved pose is not the pose"
+    assert np.abs(key_positions(copy, posing.POSE_KEY) - posed).max() < 1e-5, (
+        "the saved pose is not the pose"
+    )
     bpy.data.objects.remove(copy)
     controller.location.x -= 0.1
     yield 0.5
-    assert np.abs(key_positions(obj, posing.POSE_KEY) - posed).max() > 0.01, "the pose stopped after saving"
+    assert np.abs(key_positions(obj, posing.POSE_KEY) - posed).max() > 0.01, (
+        "the pose stopped after saving"
+    )
     window.event_simulate(type="ESC", value="PRESS", x=x, y=y)
     window.event_simulate(type="ESC", value="RELEASE", x=x, y=y)
     yield 0.3
@@ -210,7 +234,9 @@ def steps():
     assert obj.mode == "EDIT"
     with override():
         bpy.ops.object.mode_set(mode="OBJECT")
-    assert base_positions(obj).tobytes() == rest.tobytes(), "Edit Mode took the pose for the rest mesh"
+    assert base_positions(obj).tobytes() == rest.tobytes(), (
+        "Edit Mode took the pose for the rest mesh"
+    )
     assert key_positions(obj, "Basis").tobytes() == rest.tobytes()
     assert np.abs(key_positions(obj, posing.POSE_KEY) - posed).max() < 0.05, "the pose was not kept"
     assert obj.data.get(displays.POSING_FLAG) is None
@@ -246,9 +272,16 @@ def steps():
     with bpy.data.libraries.load(saved) as (data_from, data_to):
         data_to.objects = [obj.name]
     copy = data_to.objects[0]
-    assert base_positions(copy).tobytes() == rest.tobytes(), "the saved base mesh is not the rest mesh"
-    assert np.abs(key_positions(copy, posing.POSE_KEY) - posed).max() < 0.05, "the saved pose is not the pose"
-    assert copy.modal_deform.basis is not None and copy.modal_deform.status.dimension == settings.status.dimension
+    assert base_positions(copy).tobytes() == rest.tobytes(), (
+        "the saved base mesh is not the rest mesh"
+    )
+    assert np.abs(key_positions(copy, posing.POSE_KEY) - posed).max() < 0.05, (
+        "the saved pose is not the pose"
+    )
+    assert (
+        copy.modal_deform.basis is not None
+        and copy.modal_deform.status.dimension == settings.status.dimension
+    )
     bpy.data.objects.remove(copy)
 
     # Enter applies; Ctrl+Z takes the applied pose back.
@@ -272,7 +305,9 @@ def steps():
     # puts the cache back as it was (none).
     keys = [(b.name, b.mute) for b in obj.data.shape_keys.key_blocks]
     with override():
-        assert bpy.ops.modal_deform.bake_animation("INVOKE_DEFAULT", frame_start=1, frame_end=1000) == {"RUNNING_MODAL"}
+        assert bpy.ops.modal_deform.bake_animation(
+            "INVOKE_DEFAULT", frame_start=1, frame_end=1000
+        ) == {"RUNNING_MODAL"}
     yield 0.5
     cache = obj.modal_deform.dynamics.cache
     assert cache is not None and cache["frames"] > 0, "the animation bake cached no frame"
@@ -280,7 +315,9 @@ def steps():
     window.event_simulate(type="ESC", value="RELEASE", x=x, y=y)
     yield 0.3
     assert obj.modal_deform.dynamics.cache is None, "Esc left the cache behind"
-    assert [(b.name, b.mute) for b in obj.data.shape_keys.key_blocks] == keys, "Esc changed the shape keys"
+    assert [(b.name, b.mute) for b in obj.data.shape_keys.key_blocks] == keys, (
+        "Esc changed the shape keys"
+    )
     assert base_positions(obj).tobytes() == rest.tobytes()
     say("animation bake cancelled with Esc: its cached frames went")
 
@@ -289,6 +326,7 @@ def steps():
     # time are simulated on the way), read through a stand-in while playing (Blender 4+); stopped, the
     # stand-in is gone and scrubbing back reads the cache.
     from modal_deform.playback import frame_cache, frame_display, timeline
+
     scene = bpy.context.scene
     scene.frame_start, scene.frame_end = 1, 48
     scene.frame_set(1)
@@ -304,13 +342,18 @@ def steps():
     with override():
         bpy.ops.screen.animation_cancel(restore_frame=False)
     yield 0.3
-    assert playing_stand_in == hasattr(bpy.app.handlers, "animation_playback_pre"), "no stand-in while playing"
+    assert playing_stand_in == hasattr(bpy.app.handlers, "animation_playback_pre"), (
+        "no stand-in while playing"
+    )
     assert not frame_display.has_stand_in(obj) and not [
-        o for o in bpy.data.objects if o.get(frame_display.STAND_IN)], "a stand-in after playback stopped"
+        o for o in bpy.data.objects if o.get(frame_display.STAND_IN)
+    ], "a stand-in after playback stopped"
     cache = frame_cache.get(obj)
     assert timeline.problems.get(obj.name) is None, timeline.problems
     assert cache is not None and cache.kind == "DYNAMIC", "playing made no cache"
-    assert cache.end >= 16, f"playing simulated frames {cache.start} to {cache.end} of {scene.frame_current}"
+    assert cache.end >= 16, (
+        f"playing simulated frames {cache.start} to {cache.end} of {scene.frame_current}"
+    )
     screenshot("dynamics.png")
     shown = evaluated_positions(obj)
     assert np.abs(shown - rest).max() > 0.1, "the played mesh did not follow the controller"
@@ -318,7 +361,9 @@ def steps():
     timeline.player(obj, scene).positions(cache.state(8)[0], expected)
     with override():
         scene.frame_set(8)
-    assert evaluated_positions(obj).tobytes() == expected.tobytes(), "scrubbing did not read the cache"
+    assert evaluated_positions(obj).tobytes() == expected.tobytes(), (
+        "scrubbing did not read the cache"
+    )
     assert base_positions(obj).tobytes() == rest.tobytes()
     played = cache.end
     with override():
@@ -328,7 +373,9 @@ def steps():
     controller.location.x -= 0.4
     scene.frame_set(1)
     yield 0.3
-    say(f"timeline played with Dynamics on: {played} frames simulated and cached, scrubbing reads them")
+    say(
+        f"timeline played with Dynamics on: {played} frames simulated and cached, scrubbing reads them"
+    )
 
     # Disabling the add-on while posing ends the pose as Esc does. Solve's key was there before, the
     # only key that moves the mesh: posed in a stand-in, and the artist's mesh is put back.
@@ -343,7 +390,9 @@ def steps():
     addon_utils.disable("modal_deform", default_set=True)
     assert posing.running is None, "disabling the add-on left the pose running"
     assert obj.data == mesh, "disabling did not put the artist's mesh back"
-    assert key_positions(obj, posing.POSE_KEY).tobytes() == before, "disabling changed the shape key"
+    assert key_positions(obj, posing.POSE_KEY).tobytes() == before, (
+        "disabling changed the shape key"
+    )
     assert base_positions(obj).tobytes() == rest.tobytes()
     # Blender frees the ended pose's modal handler at the next event it handles (the artist's next
     # click in Preferences); Blender 4.3 crashes when a modal operator starts before that.
@@ -364,7 +413,9 @@ def steps():
     assert np.abs(base_positions(obj) - rest).max() > 0.05, "the pose did not follow the controller"
     addon_utils.disable("modal_deform", default_set=True)
     assert posing.running is None, "disabling the add-on left the pose running"
-    assert base_positions(obj).tobytes() == rest.tobytes(), "disabling did not restore the vertex positions"
+    assert base_positions(obj).tobytes() == rest.tobytes(), (
+        "disabling did not restore the vertex positions"
+    )
     assert obj.data.shape_keys is None and obj.data.get(displays.POSING_FLAG) is None
     say("disabling the add-on mid-pose restored the vertex positions")
 

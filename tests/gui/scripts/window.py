@@ -5,6 +5,7 @@ the simulated events (run(steps)), ending in OUTPUT/result.json ({"ok": bool, "l
 Screenshots: Blender's own operator, or with MODAL_DEFORM_GRAB=x11 a grab of the X screen (xwd, then
 ImageMagick's convert): Blender 4.3's operator writes a black image under Xvfb.
 """
+
 import json
 import os
 import subprocess
@@ -27,7 +28,9 @@ def enable_addon():
     """Enable Modal Deform (the legacy zip Blender installed into the user folder, else the source
     tree's); fail if it does not register (addon_utils only prints why)."""
     module = blender.enable_addon()
-    say(f"Blender {bpy.app.version_string} (Python {sys.version.split()[0]}), add-on from {module.__file__}")
+    say(
+        f"Blender {bpy.app.version_string} (Python {sys.version.split()[0]}), add-on from {module.__file__}"
+    )
 
 
 def view3d():
@@ -97,7 +100,9 @@ def show_sidebar_tab():
         yield 0.2
         if region.active_panel_category == "Modal Deform":
             return
-    raise AssertionError(f"no Modal Deform tab at the sidebar's edge (on {region.active_panel_category})")
+    raise AssertionError(
+        f"no Modal Deform tab at the sidebar's edge (on {region.active_panel_category})"
+    )
 
 
 def run(steps):
