@@ -240,6 +240,6 @@ def bake(V, F, progress=None, **options):
             f"(mechanisms, e.g. large parts of the mesh joined at a single vertex, or the rigid motions of a part of "
             f"the region that touches nothing outside it); they are in the basis on top of the "
             f"{options.get('modes', BAKE_OPTIONS['modes'].default)} modes asked for, without modal derivatives",
-            stacklevel=2,
+            stacklevel=3,
         )
     return basis
