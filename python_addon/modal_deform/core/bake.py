@@ -182,16 +182,6 @@ for _field in _SCHEMA:
     setattr(Basis, _field["name"], _stored_field(_field["name"]))
 
 
-def _basis(basis):
-    """``basis`` once checked to be a Basis: what the solvers and the simulation take."""
-    if not isinstance(basis, Basis):
-        raise ValueError(
-            f"basis: expected a modal_deform.core.Basis (from bake or Basis.from_arrays), "
-            f"got {type(basis).__name__}"
-        )
-    return basis
-
-
 @_options.takes_options(BAKE_OPTIONS)
 def bake(V, F, progress=None, **options):
     """Bake the reduced space of the triangle mesh (V (n, 3), F (m, 3)) for posing.

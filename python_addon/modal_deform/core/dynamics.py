@@ -11,15 +11,14 @@ more). Both hold exactly for the lowest mode of small motions, whatever ``fps`` 
 import numpy as np
 
 from .. import _native
-from . import _arrays, _options
-from .bake import _basis
-from .solve import SOLVER_OPTIONS, _handles, _InBasis, _transforms, _weights
+from . import _arrays, _inputs, _options
+from .solve import SOLVER_OPTIONS
 
 #: Simulation's options, the native core's (cpp/solve/reduced_dynamics.h): {name: Option}.
 SIMULATION_OPTIONS = _options.table(_native.SIMULATION_OPTIONS)
 
 
-class Simulation(_InBasis):
+class Simulation(_inputs.InBasis):
     """Reduced dynamics of a baked basis driven by handles.
 
     ``basis``: from ``mdc.bake`` (kept alive). ``handles``: a list of vertex index arrays, one per
@@ -33,9 +32,9 @@ class Simulation(_InBasis):
     def __init__(
         self, basis, handles, weights=None, energy=SOLVER_OPTIONS["energy"].default, **options
     ):
-        basis = _basis(basis)
-        handles = [] if _is_empty(handles) else _handles(handles)
-        weights = np.zeros(0) if not handles else _weights(weights, len(handles))
+        basis = _inputs.basis(basis)
+        handles = [] if _inputs.is_empty(handles) else _inputs.handles(handles)
+        weights = np.zeros(0) if not handles else _inputs.weights(weights, len(handles))
         if not isinstance(energy, str):
             raise ValueError(f'energy: expected "shells" or "arap", got {energy!r}')
         self._native = _native.Simulation(basis._native, handles, weights, energy, **options)
@@ -136,11 +135,6 @@ class Simulation(_InBasis):
         return self._native.mass_scale
 
     def _checked_transforms(self, transforms):
-        if _is_empty(transforms):
+        if _inputs.is_empty(transforms):
             transforms = []
-        return _transforms(transforms, self._native.num_handles)
-
-
-def _is_empty(sequence):
-    """True for None, an empty list/tuple or an empty array."""
-    return sequence is None or (hasattr(sequence, "__len__") and len(sequence) == 0)
+        return _inputs.transforms(transforms, self._native.num_handles)

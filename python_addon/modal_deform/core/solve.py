@@ -15,8 +15,8 @@ weight.
 import numpy as np
 
 from .. import _native
-from . import _arrays, _options
-from .bake import BAKE_OPTIONS, _basis
+from . import _arrays, _inputs, _options
+from .bake import BAKE_OPTIONS
 
 #: The most vertices ReducedSolver.refine takes: the size bake takes without a proxy.
 REFINE_MAX_VERTICES = BAKE_OPTIONS["proxy_above"].default
@@ -25,55 +25,6 @@ REFINE_MAX_VERTICES = BAKE_OPTIONS["proxy_above"].default
 SOLVER_OPTIONS = _options.table(_native.REDUCED_SOLVER_OPTIONS)
 SOLVE_OPTIONS = _options.table(_native.REDUCED_SOLVE_OPTIONS)
 FULL_SOLVE_OPTIONS = _options.table(_native.FULL_SOLVE_OPTIONS)
-
-
-def _handles(handles):
-    """A non-empty list of non-empty 1-d int32 arrays (ranges and repeats are checked natively)."""
-    if isinstance(handles, np.ndarray) and handles.ndim == 1 and handles.dtype.kind in "iu":
-        raise ValueError(
-            "handles: expected a list of index arrays, one per handle, got a single index array "
-            "(wrap it in a list for one handle)"
-        )
-    try:
-        handles = list(handles)
-    except TypeError:
-        raise ValueError(
-            f"handles: expected a list of index arrays, got {type(handles).__name__}"
-        ) from None
-    if not handles:
-        raise ValueError("handles: no handle given; posing needs at least one")
-    arrays = []
-    for h, indices in enumerate(handles):
-        indices = np.asarray(indices)
-        if indices.ndim != 1 or indices.size == 0:
-            raise ValueError(
-                f"handles[{h}]: expected a non-empty 1-d array of vertex indices, got shape {indices.shape}"
-            )
-        if indices.dtype.kind not in "iu":
-            raise ValueError(
-                f"handles[{h}]: expected integer vertex indices, got dtype {indices.dtype}"
-            )
-        if indices.max() > np.iinfo(np.int32).max or indices.min() < np.iinfo(np.int32).min:
-            raise ValueError(f"handles[{h}]: an index does not fit in 32 bits")
-        arrays.append(np.ascontiguousarray(indices, dtype=np.int32))
-    return arrays
-
-
-def _transforms(transforms, count):
-    """One (4, 4) float64 matrix per handle (rigidity is checked natively)."""
-    transforms = [_arrays.reals(T, f"transforms[{h}]") for h, T in enumerate(transforms)]
-    if len(transforms) != count:
-        raise ValueError(f"transforms: expected {count} (one per handle), got {len(transforms)}")
-    for h, T in enumerate(transforms):
-        if T.shape != (4, 4):
-            raise ValueError(f"transforms[{h}]: expected a 4x4 matrix, got shape {T.shape}")
-    return transforms
-
-
-def _weights(weights, count):
-    if weights is None:
-        return np.ones(count)
-    return _arrays.values(weights, "weights", count)
 
 
 def nearest_rigid(matrix, centre):
@@ -90,31 +41,7 @@ def nearest_rigid(matrix, centre):
     return _native.nearest_rigid(M, _arrays.values(centre, "centre", 3))
 
 
-class _InBasis:
-    """What ReducedSolver and Simulation share: a native object (``self._native``) that moves the
-    mesh of ``self._basis`` by the reduced coordinates q."""
-
-    @property
-    def num_vertices(self):
-        return self._basis.num_vertices
-
-    @property
-    def dimension(self):
-        """r, the number of reduced coordinates (basis.vectors' columns)."""
-        return self._native.dimension
-
-    def positions(self, out=None):
-        """x̄ + U q on the fine mesh: (n, 3) float32, mesh units.
-
-        With ``out`` (a C-contiguous float32 array of shape (n, 3) or (3n,), e.g. the buffer passed
-        to Blender's ``foreach_set("co", ...)``) the result is written there and ``out`` returned.
-        """
-        out = _arrays.positions_out(out, self.num_vertices)
-        self._native.positions(out.reshape(-1))
-        return out
-
-
-class ReducedSolver(_InBasis):
+class ReducedSolver(_inputs.InBasis):
     """BFGS in a baked basis: x = x̄ + U q, energy on the ghost, handles exact on the fine mesh.
 
     ``basis``: from ``mdc.bake`` (kept alive by the solver). ``handles``: list of vertex index
@@ -125,9 +52,9 @@ class ReducedSolver(_InBasis):
 
     @_options.takes_options(SOLVER_OPTIONS)
     def __init__(self, basis, handles, weights=None, **options):
-        basis = _basis(basis)
-        handles = _handles(handles)
-        weights = _weights(weights, len(handles))
+        basis = _inputs.basis(basis)
+        handles = _inputs.handles(handles)
+        weights = _inputs.weights(weights, len(handles))
         self._native = _native.ReducedSolver(basis._native, handles, weights, **options)
         self._basis = basis
         # What refine() solves on the full mesh: the same objective.
@@ -146,7 +73,7 @@ class ReducedSolver(_InBasis):
         Raises ValueError naming the handle whose matrix is not rigid (scaled, sheared,
         mirrored, or a last row other than 0 0 0 1). Cheap: O(r) per handle.
         """
-        transforms = _transforms(transforms, self._native.num_handles)
+        transforms = _inputs.transforms(transforms, self._native.num_handles)
         self._native.set_transforms(transforms)
         self._transforms = transforms
 
@@ -286,7 +213,7 @@ def _on_full_mesh(native, V, F, transforms, *, handles, weights, initial, progre
     """``native`` (the core's solve_full or refine) called with solve_full's arguments, the arrays
     checked; the core checks the options."""
     V, F = _arrays.vertices(V), _arrays.faces(F)
-    handles = _handles(handles)
+    handles = _inputs.handles(handles)
     if options.get("held") is not None:
         options["held"] = _arrays.indices(options["held"], "held")
     if options.get("stiffness_weights") is not None:
@@ -299,8 +226,8 @@ def _on_full_mesh(native, V, F, transforms, *, handles, weights, initial, progre
         V,
         F,
         handles,
-        _transforms(transforms, len(handles)),
-        _weights(weights, len(handles)),
+        _inputs.transforms(transforms, len(handles)),
+        _inputs.weights(weights, len(handles)),
         initial=None if initial is None else _arrays.vertices(initial, "initial"),
         progress=progress,
         **options,
