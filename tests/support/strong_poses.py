@@ -9,6 +9,8 @@ of the objective at the end of each step. NumPy only: `follow` takes the modal_d
 
 import numpy as np
 
+from .poses import end_handles
+
 POSES = ("turn_90", "turn_170", "bend_90", "bend_180")
 STEP_DEGREES = 30.0
 STIFFNESS = 100.0
@@ -30,14 +32,8 @@ def _about(axis, angle, point):
 
 def ends(V, fraction=0.15):
     """(handles, long axis index, the two ends' centres, the length along the axis)."""
-    lo, hi = V.min(axis=0), V.max(axis=0)
-    a = int(np.argmax(hi - lo))
-    length = hi[a] - lo[a]
-    handles = [
-        np.flatnonzero(V[:, a] < lo[a] + fraction * length),
-        np.flatnonzero(V[:, a] > hi[a] - fraction * length),
-    ]
-    return handles, a, V[handles[0]].mean(axis=0), V[handles[1]].mean(axis=0), length
+    handles, axes, length, high = end_handles(V, fraction)
+    return handles, int(np.argmax(axes[0])), V[handles[0]].mean(axis=0), high, length
 
 
 def transforms(V, pose, degrees, shift=(0.0, 0.0)):
