@@ -27,10 +27,11 @@ def _limits(option, **ui):
     """A property's default and hard limits from the core's option (its closed bounds: an open one
     is the UI's to set, e.g. with `min`), with the UI's own soft limits and overrides `ui`."""
     limits = {"default": option.default}
+    number = type(option.default)  # an IntProperty takes int limits only (Blender 3.4)
     if option.min > -math.inf and not option.min_open:
-        limits["min"] = option.min
+        limits["min"] = number(option.min)
     if option.max < math.inf and not option.max_open:
-        limits["max"] = option.max
+        limits["max"] = number(option.max)
     return {**limits, **ui}
 
 
