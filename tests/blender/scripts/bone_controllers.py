@@ -1,5 +1,5 @@
-"""A bone as a handle's controller (issue 50, item 1): posed in Pose Mode it drives Solve and Pose as
-an Empty moved by the same world transform does; assigning binds, and moving the armature object
+"""A bone as a handle's controller (issue 50, item 1): posed in Pose Mode it drives Solve, Pose and
+Refine as an Empty moved by the same world transform does; assigning binds, and moving the armature object
 together with the mesh deforms nothing; its keyframes drive Bake Animation and Dynamics as those of
 an Empty that follows the bone, a changed keyframe of the bone or of a parent invalidates the cache
 and one of another bone does not; bad input (the armature that skins the mesh chosen as a whole, a
@@ -11,8 +11,8 @@ import numpy as np
 from mathutils import Matrix, Quaternion
 from support import blender as support
 
-handles, posing, frame_cache, timeline, frame_keys, mdc = support.enable_addon(
-    "handles", "posing", "playback.frame_cache", "playback.timeline", "frame_keys", "core"
+handles, posing, frame_cache, timeline, frame_keys, jobs, mdc = support.enable_addon(
+    "handles", "posing", "playback.frame_cache", "playback.timeline", "frame_keys", "jobs", "core"
 )
 scene, view_layer = bpy.context.scene, bpy.context.view_layer
 obj, V = support.baked_suzanne(1, 12, 10, 300)
@@ -61,6 +61,14 @@ def pose_positions():
     return pose.solver.positions()
 
 
+def refine():
+    """Refine (its job, run here) and the "Modal Deform" key it writes."""
+    job = jobs.RefineJob(bpy.context, obj)
+    job.run()
+    assert job.finish()[0] == "INFO" and job.written
+    return support.key_positions(obj, posing.POSE_KEY)
+
+
 def transforms():
     return handles.transforms(obj, handles.resolve(obj, scene, V)[0])
 
@@ -106,7 +114,7 @@ world_before = bone_world(rig, "Head")
 view_layer.update()
 motion = bone_world(rig, "Head") @ world_before.inverted()
 by_bone = transforms()
-solved_bone, posed_bone = solve(), pose_positions()
+solved_bone, posed_bone, refined_bone = solve(), pose_positions(), refine()
 assert away(solved_bone, V) > 0.05, "the posed bone did not move the mesh"
 assert away(posed_bone, solved_bone) < 1e-6, away(posed_bone, solved_bone)
 top.controller = empty
@@ -114,13 +122,14 @@ empty.matrix_world = motion @ empty.matrix_world
 view_layer.update()
 by_empty = transforms()
 assert np.abs(np.array(by_bone) - np.array(by_empty)).max() < 1e-5, (by_bone, by_empty)
-solved_empty, posed_empty = solve(), pose_positions()
+solved_empty, posed_empty, refined_empty = solve(), pose_positions(), refine()
 print(
     f"bone against Empty: transforms {np.abs(np.array(by_bone) - np.array(by_empty)).max():.1e}, "
-    f"Solve {away(solved_bone, solved_empty):.1e}, Pose {away(posed_bone, posed_empty):.1e} of "
-    f"the diagonal"
+    f"Solve {away(solved_bone, solved_empty):.1e}, Pose {away(posed_bone, posed_empty):.1e}, "
+    f"Refine {away(refined_bone, refined_empty):.1e} of the diagonal"
 )
 assert away(solved_bone, solved_empty) < 1e-6 and away(posed_bone, posed_empty) < 1e-6
+assert away(refined_bone, solved_bone) > 1e-5 and away(refined_bone, refined_empty) < 1e-6
 # Reset Pose puts the bone back where it was bound (its armature stays), and the Empty too.
 top.controller, top.bone = rig, "Head"  # binds the bone where it is now
 moved_to = bone_world(rig, "Head")
@@ -283,6 +292,22 @@ obj.modal_deform.dynamics.enabled = False
 timeline.free(obj)
 # Blender renames the bone's curves with it; the keyframes are the artist's as they were.
 assert [(p.replace("Skull", "Head"), i, k) for p, i, k in artist_keys()] == keys
+# Named back, the handle works again with its bind as it was; the bone chosen anew binds again.
+bound = Matrix(top.bind_matrix)
+
+
+def rename_bone(old, new):
+    view_layer.objects.active = rig
+    bpy.ops.object.mode_set(mode="EDIT")
+    rig.data.edit_bones[old].name = new
+    bpy.ops.object.mode_set(mode="OBJECT")
+    view_layer.objects.active = obj
+
+
+rename_bone("Skull", "Head")
+assert handles.notice(obj, top, scene) == ("", False) and Matrix(top.bind_matrix) == bound
+assert bpy.ops.modal_deform.solve() == {"FINISHED"}
+rename_bone("Head", "Skull")
 top.bone = "Skull"
 assert bpy.ops.modal_deform.solve() == {"FINISHED"}
 mesh_io.remove_shape_keys(obj, [posing.POSE_KEY])
