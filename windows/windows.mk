@@ -49,7 +49,11 @@ WIN_SUITE_3.11  := tests/python
 WIN_SUITE_3.13  := tests/python
 WIN_SUITE_3.11-numpy2 := tests/python
 WINE        := /usr/lib/wine/wine64
-WINE_ENV    := WINEPREFIX=$(CURDIR)/$(WIN)/wine WINEDEBUG=-all WINEDLLOVERRIDES="mscoree,mshtml="
+# OPENBLAS_CORETYPE: under Wine 8.0 the Haswell kernels of NumPy 2.5's OpenBLAS, which it picks on
+# an AMD EPYC, crash in a plain matrix product (access violation), extension loaded or not; the
+# Sandybridge (AVX) kernels run. Wine only: on Windows itself NumPy picks its kernels as it likes.
+WINE_BLAS   := OPENBLAS_CORETYPE=Sandybridge
+WINE_ENV    := WINEPREFIX=$(CURDIR)/$(WIN)/wine WINEDEBUG=-all WINEDLLOVERRIDES="mscoree,mshtml=" $(WINE_BLAS)
 # $(call wine_python,X.Y,ARGUMENTS): Windows CPython X.Y under Wine; its exit status is the
 # command's. It stops in init_sys_streams unless its standard input and output are pipes. The Wine
 # server is started first, apart from the pipe: Wine's services would hold it open otherwise.
@@ -209,7 +213,7 @@ win-bpy-env-%: $(WIN_ENV_PREREQUISITES)
 test-windows-bpy: $(WIN_BPY_VERSIONS:%=test-windows-bpy-%)
 test-windows-bpy-%: win-bpy-env-%
 	$(WINE_ENV) /usr/lib/wine/wineserver -p5 < /dev/null > /dev/null 2>&1; \
-	WINEPREFIX=$(CURDIR)/$(WIN)/wine WINDOWS_PYTHON=$(CURDIR)/$(WIN)/env-bpy-$*/python.exe \
+	WINEPREFIX=$(CURDIR)/$(WIN)/wine $(WINE_BLAS) WINDOWS_PYTHON=$(CURDIR)/$(WIN)/env-bpy-$*/python.exe \
 		BLENDER_PYTHON=$(CURDIR)/tests/windows/wine_python.py $(PYTHON) -m pytest -q -p no:cacheprovider $(WIN_BLENDER_SUITE_$*)
 
 # The 23k and 100k dragons baked and posed natively (the in-tree build) and under Wine (the cp311
