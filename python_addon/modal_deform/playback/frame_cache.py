@@ -257,7 +257,7 @@ def settings_changed(obj):
 
 def controller_curves(obj):
     """The animation curves of obj's controllers, as (path, F-curve): path "controller:data_path[index]"."""
-    from ..frame_keys import action_fcurves
+    from .frame_keys import action_fcurves
 
     found = []
     for handle in obj.modal_deform.handles:
