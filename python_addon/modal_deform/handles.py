@@ -1,10 +1,13 @@
-"""Handles: the vertices of a vertex group, moved rigidly by a controller object.
+"""Handles: the vertices of a vertex group, moved rigidly by a controller: an object, or a bone of
+an armature (the armature object and the handle's `bone`, as Constraint.subtarget names a bone).
 
 A handle's transform is its controller's matrix in the mesh object's space relative to that
 matrix when the controller was assigned (the bind matrix): moving the mesh object with its
-controllers deforms nothing. Controllers may be scaled or sheared; only the rotation (polar
-decomposition) and the motion of the handle's centre are kept, as the solver takes rigid motions.
-A handle without a controller is pinned where it is.
+controllers deforms nothing. A bone's matrix is the armature object's world matrix times the pose
+bone's (armature space, after its parents and constraints): the bone in Pose Mode moves the handle,
+and so does the armature object, unless the mesh moves with it. Controllers (bones too) may be
+scaled or sheared; only the rotation (polar decomposition) and the motion of the handle's centre
+are kept, as the solver takes rigid motions. A handle without a controller is pinned where it is.
 """
 
 import collections
@@ -15,7 +18,9 @@ from mathutils import Matrix
 from . import core as mdc
 from . import mesh_io
 
-Handle = collections.namedtuple("Handle", "name indices weight controller bind_inverse centre")
+Handle = collections.namedtuple(
+    "Handle", "name indices weight controller bind_inverse centre bone", defaults=("",)
+)
 
 
 class HandleError(Exception):
@@ -37,22 +42,90 @@ def owner(obj):
         and any(h.controller == obj for h in parent.modal_deform.handles)
     ):
         return parent
+    if obj.type == "ARMATURE":  # a rig the mesh is parented to, posed in Pose Mode
+        for child in obj.children:
+            if child.type == "MESH" and any(
+                h.controller == obj for h in child.modal_deform.handles
+            ):
+                return child
     return None
 
 
-def object_space(obj, other):
-    """other's world matrix in obj's space (obj's matrix may be singular: then its closest inverse)."""
-    return obj.matrix_world.inverted_safe() @ other.matrix_world
+def pose_bone(item):
+    """The pose bone a handle's controller names (`item`: a ModalDeformHandle or a Handle), None
+    for an object controller (no bone named, or not an armature) or a bone the armature lacks."""
+    controller = item.controller
+    if controller is None or not item.bone or controller.type != "ARMATURE":
+        return None
+    return controller.pose.bones.get(item.bone)
+
+
+def world_matrix(item):
+    """The controller's world matrix: the object's, or for a bone the armature object's times the
+    pose bone's (its armature-space matrix)."""
+    bone = pose_bone(item)
+    matrix = item.controller.matrix_world
+    return matrix if bone is None else matrix @ bone.matrix
 
 
 def bind(obj, handle):
-    """Make the controller's current placement the handle's rest (called when it is assigned)."""
+    """Make the controller's current placement the handle's rest, in obj's space (obj's matrix may
+    be singular: then its closest inverse); called when the controller or its bone is assigned."""
     if handle.controller is None:
         handle.bind_matrix = Matrix.Identity(4)
         handle.bound_controller = ""
     else:
-        handle.bind_matrix = object_space(obj, handle.controller)
+        handle.bind_matrix = obj.matrix_world.inverted_safe() @ world_matrix(handle)
         handle.bound_controller = handle.controller.name
+
+
+def skinning_modifier(obj, armature):
+    """The Armature modifier of obj that deforms it by `armature` (its name), or "Armature
+    parent" for a mesh parented with armature deform; "" when none does."""
+    for modifier in obj.modifiers:
+        if modifier.type == "ARMATURE" and modifier.object == armature:
+            return modifier.name
+    if obj.parent == armature and obj.parent_type == "ARMATURE":
+        return "Armature parent"
+    return ""
+
+
+def controller_problem(obj, item):
+    """What makes a handle's controller unusable, for the panel and the operators ("" when
+    nothing): a bone its armature lacks (deleted or renamed), or the armature that skins obj
+    chosen as a whole (obj would move twice: by its Armature modifier and by the handle)."""
+    controller = item.controller
+    if controller is None or controller.type != "ARMATURE":
+        return ""
+    if item.bone:
+        if controller.pose is None or controller.pose.bones.get(item.bone) is None:
+            return (
+                f"bone '{item.bone}' is not in armature '{controller.name}' (deleted or renamed?): "
+                f"name it back, or choose a bone again (the handle then binds to where that bone is)"
+            )
+        return ""
+    skinning = skinning_modifier(obj, controller)
+    if skinning:
+        return (
+            f"armature '{controller.name}' skins '{obj.name}' ({skinning}), so the whole armature "
+            f"cannot also move a handle: choose one of its bones"
+        )
+    return ""
+
+
+def notice(obj, item, scene):
+    """What the Handles panel says of a handle's controller: (text, is_error), ("", False) when
+    all is well: a problem that refuses the handle (a controller out of the scene,
+    controller_problem) or a controller deleted since it was assigned (the handle is pinned)."""
+    controller = item.controller
+    if controller is None:
+        if item.bound_controller:
+            return f"Controller '{item.bound_controller}' is gone: the handle is pinned", False
+        return "", False
+    if scene.objects.get(controller.name) != controller:
+        return f"Controller '{controller.name}' is not in the scene (deleted?)", True
+    problem = controller_problem(obj, item)
+    return (problem[0].upper() + problem[1:], True) if problem else ("", False)
 
 
 def resolve(obj, scene, rest, region=None):
@@ -61,7 +134,8 @@ def resolve(obj, scene, rest, region=None):
     rest: #V by 3 rest positions (for the handles' centres); region: the sorted vertices a region
     bake lets move (None or empty: all). Raises HandleError naming the first handle that cannot be
     used: no vertex group, a missing or empty group, a group covering every vertex (nothing left to
-    deform) or reaching outside the region, a controller no longer in the scene.
+    deform) or reaching outside the region, a controller no longer in the scene, a bone its
+    armature lacks, the armature that skins obj as a whole (controller_problem).
     """
     items = obj.modal_deform.handles
     if not items:
@@ -99,6 +173,9 @@ def resolve(obj, scene, rest, region=None):
                 f"{label}: controller '{controller.name}' is not in the scene (deleted?): assign "
                 f"another or clear it to pin the handle"
             )
+        problem = controller_problem(obj, item)
+        if problem:
+            raise HandleError(f"{label}: {problem}")
         if controller is None and item.bound_controller:
             warnings.append(
                 f"{label}: its controller '{item.bound_controller}' is gone, so the handle is pinned"
@@ -112,6 +189,7 @@ def resolve(obj, scene, rest, region=None):
                 controller,
                 bind_inverse,
                 rest[indices].mean(axis=0),
+                item.bone if pose_bone(item) is not None else "",
             )
         )
     for i, a in enumerate(handles):
@@ -134,9 +212,28 @@ def transforms(obj, handles):
         if handle.controller is None:
             result.append(np.eye(4))
         else:
-            relative = world_inverse @ handle.controller.matrix_world @ handle.bind_inverse
+            if handle.bone and pose_bone(handle) is None:  # renamed or deleted since resolve()
+                raise HandleError(
+                    f"handle '{handle.name}': bone '{handle.bone}' is not in armature "
+                    f"'{handle.controller.name}' any more (deleted or renamed?)"
+                )
+            relative = world_inverse @ world_matrix(handle) @ handle.bind_inverse
             result.append(mdc.nearest_rigid(relative, handle.centre))
     return result
+
+
+def restore(obj, item):
+    """Put a handle's controller back where it was assigned (Reset Pose): the object, or the pose
+    bone (its armature left where it is); nothing for a linked or unusable controller."""
+    controller = item.controller
+    if controller is None or controller.library is not None or controller_problem(obj, item):
+        return
+    target = obj.matrix_world @ Matrix(item.bind_matrix)
+    bone = pose_bone(item)
+    if bone is None:
+        controller.matrix_world = target
+    else:
+        bone.matrix = controller.matrix_world.inverted_safe() @ target
 
 
 def add_controller(context, obj, name, centre, size):

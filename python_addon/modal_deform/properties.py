@@ -27,10 +27,11 @@ def _limits(option, **ui):
     """A property's default and hard limits from the core's option (its closed bounds: an open one
     is the UI's to set, e.g. with `min`), with the UI's own soft limits and overrides `ui`."""
     limits = {"default": option.default}
+    number = type(option.default)  # an IntProperty takes int limits only (Blender 3.4)
     if option.min > -math.inf and not option.min_open:
-        limits["min"] = option.min
+        limits["min"] = number(option.min)
     if option.max < math.inf and not option.max_open:
-        limits["max"] = option.max
+        limits["max"] = number(option.max)
     return {**limits, **ui}
 
 
@@ -39,6 +40,19 @@ _SIMULATION = mdc.SIMULATION_OPTIONS
 
 
 def _controller_changed(handle, context):
+    from . import handles
+
+    controller = handle.controller
+    if handle.bone and (
+        controller is None
+        or controller.type != "ARMATURE"
+        or controller.pose.bones.get(handle.bone) is None
+    ):
+        handle.bone = ""  # binds (_bone_changed)
+    handles.bind(handle.id_data, handle)
+
+
+def _bone_changed(handle, context):
     from . import handles
 
     handles.bind(handle.id_data, handle)
@@ -55,7 +69,7 @@ def _preview_changed(settings, context):
 
 
 class ModalDeformHandle(bpy.types.PropertyGroup):
-    """One handle: the vertices of a vertex group, moved rigidly by a controller object."""
+    """One handle: the vertices of a vertex group, moved rigidly by a controller object or bone."""
 
     # `name` (the label in the list) comes with PropertyGroup.
     vertex_group: StringProperty(
@@ -67,8 +81,16 @@ class ModalDeformHandle(bpy.types.PropertyGroup):
         name="Controller",
         poll=_controller_poll,
         update=_controller_changed,
-        description="The object you move to move the handle's vertices (usually the Empty Add Handle made): they "
-        "follow its moves and turns, not its scale. Empty: the vertices stay where they are (pinned)",
+        description="The object you move to move the handle's vertices (usually the Empty Add Handle made), or "
+        "an armature whose bone moves them: they follow its moves and turns, not its scale. Empty: the "
+        "vertices stay where they are (pinned)",
+    )
+    bone: StringProperty(
+        name="Bone",
+        update=_bone_changed,
+        description="The bone of the controller armature that moves the handle's vertices as you pose it: they "
+        "follow its moves and turns, not its scale or shear. Empty: the armature object itself moves "
+        "them",
     )
     weight: FloatProperty(
         name="Weight",
@@ -89,8 +111,8 @@ class ModalDeformHandle(bpy.types.PropertyGroup):
         subtype="MATRIX",
         default=IDENTITY,
         options={"HIDDEN"},
-        description="The controller's matrix in the mesh object's space when it was assigned: the rest pose of "
-        "the handle",
+        description="The controller's matrix (its bone's, for a bone) in the mesh object's space when it was "
+        "assigned: the rest pose of the handle",
     )
 
 

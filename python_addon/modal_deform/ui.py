@@ -26,14 +26,15 @@ def wrapped_label(layout, context, text, icon="NONE"):
 
 
 class MODAL_DEFORM_UL_handles(bpy.types.UIList):
-    """A row per handle: "group → controller", the vertex group it moves and the controller that moves
-    it, or "group (pinned)"."""
+    """A row per handle: "group → controller" (or "group → armature: bone"), the vertex group it moves
+    and the controller that moves it, or "group (pinned)"."""
 
     def draw_item(
         self, context, layout, data, item, icon, active_data, active_property, index=0, flt_flag=0
     ):
         if item.controller is not None:
-            layout.label(text=f"{item.vertex_group} \u2192 {item.controller.name}")
+            bone = f": {item.bone}" if item.bone and item.controller.type == "ARMATURE" else ""
+            layout.label(text=f"{item.vertex_group} \u2192 {item.controller.name}{bone}")
         else:
             layout.label(text=f"{item.vertex_group} (pinned)")
 
@@ -170,7 +171,15 @@ class VIEW3D_PT_modal_deform_handles(_Panel, bpy.types.Panel):
             column.use_property_decorate = False
             column.prop_search(item, "vertex_group", obj, "vertex_groups", text="Group")
             column.prop(item, "controller")
+            controller = item.controller
+            if controller is not None and controller.type == "ARMATURE":
+                column.prop_search(item, "bone", controller.data, "bones", text="Bone")
             column.prop(item, "weight")
+            text, is_error = handles.notice(obj, item, context.scene)
+            if text:
+                column = layout.column()
+                column.alert = is_error
+                wrapped_label(column, context, text, icon="ERROR" if is_error else "INFO")
         layout.use_property_split = True
         layout.use_property_decorate = False
         layout.prop(settings, "stiffness")

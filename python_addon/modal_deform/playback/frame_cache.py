@@ -27,7 +27,7 @@ import json
 import bpy
 import numpy as np
 
-from .. import mesh_io, storage
+from .. import handles, mesh_io, storage
 
 PREFIX = ".Modal Deform Cache "
 _ARRAYS = ("q", "v", "transforms", "curves")
@@ -58,6 +58,7 @@ def _pose_fields(obj):
                     h.controller.name if h.controller else "",
                     tuple(value for row in h.bind_matrix for value in row),
                 )
+                + ((h.bone,) if h.bone else ())  # an object controller's as before bones came
                 for h in settings.handles
             ),
         ),
@@ -256,7 +257,9 @@ def settings_changed(obj):
 
 
 def controller_curves(obj):
-    """The animation curves of obj's controllers, as (path, F-curve): path "controller:data_path[index]"."""
+    """The animation curves of obj's controllers, as (path, F-curve): path "controller:data_path[index]".
+    A bone's are those of its armature's action that move it: the armature object's own (paths not
+    under pose.bones) and those of the bone and its parents (paths under pose.bones["name"])."""
     from .frame_keys import action_fcurves
 
     found = []
@@ -264,10 +267,26 @@ def controller_curves(obj):
         controller = handle.controller
         if controller is None:
             continue
+        moves = _moves_bone(handles.pose_bone(handle))
         for curve in action_fcurves(controller.animation_data) or ():
-            found.append((f"{controller.name}:{curve.data_path}[{curve.array_index}]", curve))
+            if moves(curve.data_path):
+                found.append((f"{controller.name}:{curve.data_path}[{curve.array_index}]", curve))
     found.sort(key=lambda item: item[0])
     return found
+
+
+def _moves_bone(bone):
+    """A test of a data path of the armature's action: whether it can move `bone` (a pose bone;
+    None: every path, as for an object)."""
+    if bone is None:
+        return lambda path: True
+    chain = [bone, *bone.parent_recursive]
+    prefixes = tuple(f'pose.bones["{bpy.utils.escape_identifier(b.name)}"]' for b in chain)
+
+    def moves(path):
+        return not path.startswith("pose.bones[") or path.startswith(prefixes)
+
+    return moves
 
 
 def curve_values(curves, frame):

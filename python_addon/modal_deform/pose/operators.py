@@ -280,8 +280,7 @@ class MODAL_DEFORM_OT_reset(bpy.types.Operator):
     def execute(self, context):
         obj = handles.owner(context.object)
         for item in obj.modal_deform.handles:
-            if item.controller is not None and item.controller.library is None:
-                item.controller.matrix_world = obj.matrix_world @ item.bind_matrix
+            handles.restore(obj, item)
         mesh_io.remove_shape_keys(obj, [posing.POSE_KEY])
         return {"FINISHED"}
 
