@@ -161,7 +161,7 @@ def time_updates(obj, controller, updates, steps, display, draw=None):
     FrameBudget gives it), write (the pose written by the solver into Blender's array where the
     posing display named `display` shows it, and mesh.update()); then Blender's evaluation
     ("evaluate", view_layer.update()) and, given `draw`, what draw() takes ("draw")."""
-    posing, displays, mdc = addon("posing", "pose.displays", "core")
+    posing, displays, mdc = addon("pose.posing", "pose.displays", "core")
     pose = posing.Pose(bpy.context, obj)
     budget = mdc.FrameBudget(obj.modal_deform.budget)
     shown = displays.ShapeKeyDisplay(obj) if display == "ShapeKeyDisplay" else displays.display(obj)
@@ -206,7 +206,7 @@ def time_updates(obj, controller, updates, steps, display, draw=None):
 def time_displays(obj, controller, updates, rounds=2, draw=None):
     """Medians of time_updates for each of DISPLAYS, taken in turn `rounds` times (A B C A B C), so
     that all see the shared machine alike."""
-    pose_key = addon("posing").POSE_KEY
+    pose_key = addon("pose.posing").POSE_KEY
     names = STEPS + (("draw",) if draw else ())
     steps = {name: {step: [] for step in names} for name in DISPLAYS}
     for _ in range(rounds):

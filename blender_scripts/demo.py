@@ -222,7 +222,7 @@ def main():
     addon = enable_addon().__name__
     posing, displays, mesh_io, mdc = (
         importlib.import_module(f"{addon}.{name}")
-        for name in ("posing", "pose.displays", "mesh_io", "core")
+        for name in ("pose.posing", "pose.displays", "mesh_io", "core")
     )
     output = pathlib.Path(args.output).resolve()
     output.mkdir(parents=True, exist_ok=True)
@@ -317,7 +317,8 @@ def main():
 
     start = time.perf_counter()
     modules = (
-        importlib.import_module(f"{addon}.{name}") for name in ("playback.frame_cache", "posing")
+        importlib.import_module(f"{addon}.{name}")
+        for name in ("playback.frame_cache", "pose.posing")
     )
     strip = demo_dynamics.secondary_motion(
         tuple(modules), output, args.dynamics_subdivisions, args.width // 2

@@ -1,28 +1,26 @@
-"""The work the long operators drive, apart from their Blender UI plumbing: a bake of the mesh on a
-thread (BakeJob), Refine on a thread (RefineJob) and an animation bake a frame at a time on the main
-thread (AnimationJob, on FrameJob). They read the object when made and change it only in finish() (AnimationJob:
-in tick(), taken back by cancel() and by a failure); cancel() leaves it as it was.
+"""The work the long operators drive, apart from their Blender UI plumbing, in two kinds: native
+work on a thread (ThreadJob: the bake of the mesh, BakeJob, here; Refine in pose/refine.py) and a
+frame per tick on the main thread (FrameJob: the cache bake in playback/operators.py; the refined
+animation bake and the shape key export, AnimationJob, in playback/frame_keys.py). They read the
+object when made and change it only in finish() (AnimationJob: in tick(), taken back by cancel() and
+by a failure); cancel() leaves it as it was.
 
 Every job offers what ops_common.JobOperator drives: start(); tick() on the operator's timer (every
 tick_seconds), False once the job has ended; overall (the fraction done); cancel(); run() (all of
 it at once, for execute); finish() on the main thread, returning (level, message) for the report and
 setting `written` when it changed the object.
-
-AnimationJob writes its frames as frame keys (frame_keys.py); refined, each frame starts from the
-previous frame's refined answer.
 """
 
 import threading
 import time
 
 import bpy
-import numpy as np
 
 from . import core as mdc
-from . import frame_keys, mesh_io, posing, storage
+from . import mesh_io, storage
 
 
-class _ThreadJob:
+class ThreadJob:
     """Native work run by run() here or on a thread by start(); the native call releases the GIL, so
     Blender stays responsive. cancel() makes the next progress report stop it (Cancelled).
     Subclasses name their thread (what it does, e.g. "modal_deform bake"), set self.stage,
@@ -76,7 +74,7 @@ class _ThreadJob:
         return obj
 
 
-class BakeJob(_ThreadJob):
+class BakeJob(ThreadJob):
     """One bake of obj's mesh as it is now (read on the calling thread)."""
 
     thread_name = "modal_deform bake"
@@ -149,71 +147,6 @@ class BakeJob(_ThreadJob):
         return "INFO", message
 
 
-class RefineJob(_ThreadJob):
-    """Refine the pose for the controllers as they are now: the reduced pose converged (here, on the
-    calling thread, in milliseconds), then Newton on the full mesh from it (run()/start()).
-
-    finish() writes the result into the "Modal Deform" shape key, where Solve and Pose put the
-    reduced pose: the refined shape is the same pose made exact, and one key per pose keeps the
-    artist's stack simple (a second key would add its offset on top unless muted). Until finish()
-    nothing changes, so a cancelled or failed refine leaves the key as it was.
-    """
-
-    thread_name = "modal_deform refine"
-
-    def __init__(
-        self,
-        context,
-        obj,
-        tolerance=mdc.FULL_SOLVE_OPTIONS["tolerance"].default,
-        max_iterations=mdc.FULL_SOLVE_OPTIONS["max_iterations"].default,
-    ):
-        self.object_name = obj.name
-        self.pose = posing.Pose(context, obj)
-        self.pose.follow_controllers()
-        self.reduced = self.pose.converge()
-        self.F = mesh_io.triangles(obj.data)
-        self.fingerprint = storage.fingerprint(obj.data)
-        self.tolerance, self.max_iterations = tolerance, max_iterations
-        self.stage, self.fraction = "starting", 0.0
-        self.X = self.stats = self.error = None
-        self.seconds = 0.0
-        self.cancelling = False
-
-    @property
-    def overall(self):
-        return self.fraction if self.stage == "solve" else 0.0
-
-    def _work(self):
-        self.X, self.stats = self.pose.solver.refine(
-            self.F,
-            tolerance=self.tolerance,
-            max_iterations=self.max_iterations,
-            progress=self._progress,
-        )
-
-    def finish(self):
-        """Write the refined pose into the "Modal Deform" key (main thread). Returns (level, message)."""
-        unfinished = self._unfinished("Refine")
-        if unfinished:
-            return unfinished
-        obj = self._object_as_read()
-        if obj is None:
-            return (
-                "WARNING",
-                f"'{self.object_name}' changed during Refine: the result was discarded",
-            )
-        mesh_io.write_shape_key(obj.data, posing.pose_key(obj)[0], self.X.astype(np.float32))
-        self.written = True
-        stats = self.stats
-        outcome = "Refined" if stats["converged"] else "Refine did not converge"
-        message = (
-            f"{outcome} in {self.seconds:.1f} s: {stats['iterations']} Newton iterations, objective "
-            f"{stats['initial_energy']:.5g} -> {stats['energy']:.5g}"
-        )
-        return ("INFO" if stats["converged"] else "WARNING"), message
-
-
 class FrameJob:
     """A job done a frame per tick() on the main thread (it changes the scene and the mesh): a subclass
     sets `frames` through __init__, does a frame in _frame(frame) and takes away what it added in
@@ -256,79 +189,3 @@ class FrameJob:
         """Take away everything this job added."""
         self.cancelling = True
         self._take_back()
-
-
-class AnimationJob(FrameJob):
-    """Writes the frames one per tick() into new shape keys: each frame's pose refined on the full
-    mesh (Newton's method from the reduced pose, then from the previous frame's answer), or with
-    `positions` (frame -> #V by 3 float32) what it gives (the cache's frames); finish() keys them,
-    cancel() (or a failure) takes them away."""
-
-    def __init__(self, context, obj, frames, positions=None):
-        super().__init__(frames)
-        self.positions = positions
-        self.action = "Animation bake" if positions is None else "Shape key export"
-        self.pose = posing.Pose(context, obj) if positions is None else None
-        self.triangles = mesh_io.triangles(obj.data) if positions is None else None
-        self.refined = None
-        self.obj, self.scene = obj, context.scene
-        self.frame_before = self.scene.frame_current
-        self.created = []  # (frame, key name as created: a new key may get a ".001" suffix)
-        self.basis_created = obj.data.shape_keys is None
-        self.unconverged = 0
-
-    def _frame(self, frame):
-        """Solve (or take) the frame's positions into a new shape key."""
-        if self.positions is None:
-            self.scene.frame_set(frame)
-            self.pose.follow_controllers()
-            self.pose.converge()
-            self.refined, stats = self.pose.solver.refine(self.triangles, initial=self.refined)
-            if not stats["converged"]:
-                self.unconverged += 1
-            co = self.refined.astype(np.float32)
-        else:
-            co = self.positions(frame)
-        mesh_io.ensure_reference_key(self.obj)
-        block = self.obj.shape_key_add(name=frame_keys.frame_key_name(frame), from_mix=False)
-        block.value = 0.0
-        self.created.append((frame, block.name))
-        mesh_io.write_shape_key(self.obj.data, block, co)
-
-    def finish(self):
-        """Replace the keys of an earlier animation bake with the new ones and key their values.
-        Returns (level, message) for a report."""
-        if self.cancelling:
-            return "WARNING", f"{self.action} cancelled: nothing changed"
-        if self.error is not None:
-            return "ERROR", f"{self.action} failed: {self.error}"
-        obj = self.obj
-        blocks = obj.data.shape_keys.key_blocks
-        new_names = {name for _, name in self.created}
-        old = [
-            b.name for b in blocks if frame_keys.is_frame_key(b.name) and b.name not in new_names
-        ]
-        frame_keys.remove_keys(obj, old)
-        pose_block = blocks.get(posing.POSE_KEY)
-        if pose_block is not None:
-            pose_block.mute = True  # the frame keys take its place; it would add on top
-        for frame, name in self.created:
-            block = blocks[name]
-            block.name = frame_keys.frame_key_name(frame)
-            frame_keys.show_on_its_frame(obj, block, frame)
-        self.scene.frame_set(self.frame_before)
-        self.written = True
-        message = (
-            f"{'Exported' if self.positions else 'Baked'} {len(self.frames)} frames into shape keys"
-        )
-        if self.unconverged:
-            return "WARNING", f"{message}; {self.unconverged} did not converge"
-        return "INFO", message
-
-    def _take_back(self):
-        names = [name for _, name in self.created]
-        if self.basis_created and self.obj.data.shape_keys is not None:
-            names.append(self.obj.data.shape_keys.reference_key.name)
-        mesh_io.remove_shape_keys(self.obj, names)
-        self.created = []
-        self.scene.frame_set(self.frame_before)

@@ -1,10 +1,27 @@
 """What the operators share: the poll of operators that act on a mesh (or a controller of one),
-and the errors they report to the artist instead of raising (playback's frame handler too)."""
+the errors they report to the artist instead of raising (playback's frame handler too), the
+lifecycle of the long ones (JobOperator) and the interactive pose under way, whose mesh the others
+leave alone (running, is_posing)."""
 
-from . import handles, posing, storage
+from . import handles, storage
 
 #: Errors with a message for the artist: not baked or stale, a bad handle, a bad option.
 FAILURES = (storage.NotReady, handles.HandleError, ValueError, RuntimeError)
+#: The interactive pose under way, or None: the Pose operator (pose/operators.py), set while it
+#: runs. Besides .pose (its posing.Pose) it offers keep_in_shape_key(), request_end(how) and
+#: end(context, how).
+running = None
+
+
+def is_posing(obj):
+    """Whether the interactive pose runs on obj: its mesh is then not to be baked, solved or
+    checked for staleness (its positions may hold the pose)."""
+    try:
+        return running is not None and running.pose.obj == obj
+    except (
+        ReferenceError
+    ):  # the pose's object went away (undo, file loaded): it ends at its next event
+        return False
 
 
 def mesh_poll(cls, context):
@@ -20,7 +37,7 @@ def mesh_poll(cls, context):
     if obj.library is not None or obj.data.library is not None:
         cls.poll_message_set("The object is linked from a library")
         return False
-    if posing.is_posing(obj):
+    if is_posing(obj):
         cls.poll_message_set("Posing: Enter applies the pose, Esc cancels it")
         return False
     return True

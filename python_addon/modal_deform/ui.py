@@ -8,7 +8,7 @@ import textwrap
 
 import bpy
 
-from . import handles, ops_preview, posing, storage
+from . import handles, ops_common, ops_preview, storage
 from .playback import frame_cache, timeline
 
 # Width of a character of the interface font at scale 1, in pixels, for wrapping text (a little above
@@ -42,7 +42,7 @@ class MODAL_DEFORM_UL_handles(bpy.types.UIList):
 def stale_reason(obj):
     """storage.stale_reason from the cache, or "" while obj is posed: the pose may be in its
     positions, and each update would make the panels hash the whole mesh again."""
-    return "" if posing.is_posing(obj) else storage.stale_reason(obj, cached=True)
+    return "" if ops_common.is_posing(obj) else storage.stale_reason(obj, cached=True)
 
 
 class _Panel:

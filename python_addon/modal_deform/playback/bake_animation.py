@@ -1,12 +1,12 @@
 """Bake animation: every frame of a range into the per-frame cache (operators.CacheJob: the pose
 of each frame, or the simulation with dynamics on), or refined on the full mesh into a shape key per
-frame (jobs.AnimationJob), a frame per timer tick."""
+frame (frame_keys.AnimationJob), a frame per timer tick."""
 
 import bpy
 
 from .. import handles
-from ..jobs import AnimationJob
 from ..ops_common import JobOperator, mesh_poll
+from .frame_keys import AnimationJob
 from .operators import CacheJob
 
 

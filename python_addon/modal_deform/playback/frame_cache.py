@@ -260,7 +260,7 @@ def controller_curves(obj):
     """The animation curves of obj's controllers, as (path, F-curve): path "controller:data_path[index]".
     A bone's are those of its armature's action that move it: the armature object's own (paths not
     under pose.bones) and those of the bone and its parents (paths under pose.bones["name"])."""
-    from ..frame_keys import action_fcurves
+    from .frame_keys import action_fcurves
 
     found = []
     for handle in obj.modal_deform.handles:

@@ -10,9 +10,9 @@ leaves the positions alone (the Named Attribute node's "Exists" is Set Position'
 the selection, and goes with it). The stand-in goes (end_stand_in) when playback stops, before a
 file is saved, when the artist edits the mesh, leaves Object Mode or puts a modifier before the
 display's, and after a file is loaded or an undo while the timeline is still. The display goes
-(remove) when the cache is freed or no longer plays, when a pose shows (pose.displays.display,
-posing.pose_key) and when the add-on is disabled. Why, and what a file written mid-playback holds:
-docs/design.md, "How a pose is shown and kept".
+(remove) when the cache is freed or no longer plays, when a pose shows (pose.posing.uncover, which
+timeline.register hands it) and when the add-on is disabled. Why, and what a file written
+mid-playback holds: docs/design.md, "How a pose is shown and kept".
 """
 
 import bpy

@@ -8,9 +8,10 @@ import bpy
 import numpy as np
 
 from .. import handles
-from ..jobs import AnimationJob, FrameJob
+from ..jobs import FrameJob
 from ..ops_common import FAILURES, JobOperator, mesh_poll
 from . import frame_cache, point_cache, timeline
+from .frame_keys import AnimationJob
 
 
 class CacheJob(FrameJob):

@@ -20,9 +20,10 @@ import types
 import bpy
 import numpy as np
 
-from .. import app_handlers, handles, mesh_io, posing, storage
+from .. import app_handlers, handles, mesh_io, storage
 from .. import core as mdc
-from ..ops_common import FAILURES
+from ..ops_common import FAILURES, is_posing
+from ..pose import posing
 from . import frame_cache, frame_display
 
 # Runtime state, by object name: the Player (solver or simulation kept between frames), and the
@@ -162,12 +163,7 @@ def player(obj, scene, signature=None):
 def wants_playback(obj):
     """Whether the frame handler shows obj: a mesh of this file with a cache or dynamics on, in
     Object Mode (Edit, Sculpt and Paint Modes show the mesh being edited), not being posed."""
-    if (
-        obj.type != "MESH"
-        or obj.library is not None
-        or obj.mode != "OBJECT"
-        or posing.is_posing(obj)
-    ):
+    if obj.type != "MESH" or obj.library is not None or obj.mode != "OBJECT" or is_posing(obj):
         return False
     return plays(obj)
 
@@ -348,9 +344,13 @@ _HANDLERS = (
 
 def register():
     app_handlers.register(_HANDLERS)
+    if frame_display.remove not in posing.covers:  # a frame shown would hide a pose shown after it
+        posing.covers.append(frame_display.remove)
 
 
 def unregister():
     app_handlers.unregister(_HANDLERS)
+    if frame_display.remove in posing.covers:
+        posing.covers.remove(frame_display.remove)
     _forget()
     frame_display.remove_all()

@@ -1,3 +1,3 @@
-"""The interactive pose: its operators (Pose, Solve, Refine, Reset), where it shows the pose while it
-runs (displays), and the repair of meshes written mid-pose (recovery). The posing session they share
-with playback and the jobs is ../posing.py."""
+"""Posing: the posing session of an object (posing), shared with playback; the operators (Pose,
+Solve, Refine, Reset), Refine's job on a thread (refine), where the interactive pose shows the pose
+while it runs (displays), and the repair of meshes written mid-pose (recovery)."""

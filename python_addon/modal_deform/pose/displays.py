@@ -11,8 +11,8 @@ leaves on a mesh (POSING_FLAG, STAND_IN_OF) let recovery.py repair a mesh writte
 import bpy
 import numpy as np
 
-from .. import mesh_io, posing
-from ..playback import frame_display
+from .. import mesh_io
+from . import posing
 
 #: A mesh ID property: while it is set, the mesh's positions hold a pose and its rest is the
 #: stored basis's. A file or undo step written mid-pose carries it, and recovery.py repairs them.
@@ -61,7 +61,7 @@ def display(obj):
     """Where the interactive pose shows the pose of obj: the vertex positions of a mesh without
     shape keys, a stand-in's when only the "Modal Deform" key moves the mesh, else that key. A frame
     playback shows goes first (it would hide the pose)."""
-    frame_display.remove(obj)
+    posing.uncover(obj)
     if obj.data.shape_keys is None:
         return PositionsDisplay(obj)
     return StandInDisplay(obj) if only_pose_key_moves(obj, obj.data) else ShapeKeyDisplay(obj)

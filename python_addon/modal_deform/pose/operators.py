@@ -6,10 +6,10 @@ import time
 import bpy
 
 from .. import core as mdc
-from .. import handles, mesh_io, posing
-from ..jobs import RefineJob
+from .. import handles, mesh_io, ops_common
 from ..ops_common import FAILURES, JobOperator, mesh_poll
-from . import displays
+from . import displays, posing
+from .refine import RefineJob
 
 
 class MODAL_DEFORM_OT_pose(bpy.types.Operator):
@@ -50,7 +50,7 @@ keeps the pose, Esc restores the mesh as it was"""
         context.workspace.status_text_set(
             "Modal Deform: move the controllers (G, R)   Enter: apply   Esc: cancel   Right-click: menu"
         )
-        posing.running = self
+        ops_common.running = self
         return {"RUNNING_MODAL"}
 
     def modal(self, context, event):
@@ -123,7 +123,7 @@ keeps the pose, Esc restores the mesh as it was"""
     def end(self, context, how):
         """End now: the timer, draw handler and texts go, and the pose is kept ("APPLY") or the mesh
         restored ("CANCEL"). Returns the operator's result."""
-        posing.running = None
+        ops_common.running = None
         context.window_manager.event_timer_remove(self.timer)
         bpy.types.SpaceView3D.draw_handler_remove(self.draw_handler, "WINDOW")
         if context.workspace is not None:
@@ -163,10 +163,10 @@ class MODAL_DEFORM_OT_pose_end(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return posing.running is not None
+        return ops_common.running is not None
 
     def execute(self, context):
-        posing.running.request_end(self.how)
+        ops_common.running.request_end(self.how)
         return {"FINISHED"}
 
 
@@ -302,6 +302,6 @@ def unregister():
     """Disabling the add-on mid-pose ends the pose as Esc does: Blender drops the modal handler of
     an unregistered operator without calling it, which would leave its timer, header text and
     half-made shape key (or posed vertex positions) behind."""
-    if posing.running is not None:
-        posing.running.end(bpy.context, "CANCEL")
+    if ops_common.running is not None:
+        ops_common.running.end(bpy.context, "CANCEL")
     _unregister_classes()

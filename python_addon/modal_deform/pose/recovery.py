@@ -5,8 +5,8 @@ and meshes written mid-pose (they carry a display's marks, displays.py) are repa
 
 import bpy
 
-from .. import app_handlers, mesh_io, posing, storage
-from . import displays
+from .. import app_handlers, mesh_io, ops_common, storage
+from . import displays, posing
 
 
 def recover():
@@ -17,7 +17,7 @@ def recover():
     had been kept. Meshes without a usable basis keep the flag and are reported."""
     for obj in bpy.data.objects:
         mesh = obj.data
-        if obj.type != "MESH" or mesh.library is not None or posing.is_posing(obj):
+        if obj.type != "MESH" or mesh.library is not None or ops_common.is_posing(obj):
             continue
         if mesh.get(displays.STAND_IN_OF) is not None:
             pose = mesh_io.vertex_positions(mesh).copy()
@@ -48,9 +48,9 @@ def _recover_positions(obj):
 def _keep_before_save(*args):
     """A file saved mid-pose holds the rest mesh and the pose in its shape key: a pose shown in the
     vertex positions moves into the key first, and the pose goes on there."""
-    if posing.running is not None:
+    if ops_common.running is not None:
         try:
-            posing.running.keep_in_shape_key()
+            ops_common.running.keep_in_shape_key()
         except ReferenceError:  # its object went away: the pose ends at its next event
             pass
 
@@ -58,8 +58,8 @@ def _keep_before_save(*args):
 def _recover_after_undo_or_load(*args):
     """Undo, redo or a file loaded replaced the data: a pose under way ends (its next event) and
     meshes written mid-pose are repaired (recover)."""
-    if posing.running is not None:
-        posing.running.request_end("CANCEL")
+    if ops_common.running is not None:
+        ops_common.running.request_end("CANCEL")
     recover()
 
 

@@ -10,13 +10,13 @@ import bpy
 import numpy as np
 from support import blender as support
 
-frame_cache, jobs, operators, timeline, frame_display, posing = support.enable_addon(
+frame_cache, frame_keys, operators, timeline, frame_display, posing = support.enable_addon(
     "playback.frame_cache",
-    "jobs",
+    "playback.frame_keys",
     "playback.operators",
     "playback.timeline",
     "playback.frame_display",
-    "posing",
+    "pose.posing",
 )
 obj, V, controller = support.keyed_suzanne(10, 15, 20, 400)
 scene = bpy.context.scene
@@ -142,7 +142,7 @@ for fmt in ("PC2", "MDD"):
 # Shape keys: one per frame in place of the cache (the export cancelled after two frames changes
 # nothing), and the file saved for a Blender without the add-on.
 before = support.mesh_state(obj)
-job = jobs.AnimationJob(
+job = frame_keys.AnimationJob(
     bpy.context, obj, operators.cached_frames(obj), positions=operators.cached_positions(obj, scene)
 )
 assert job.tick() and job.tick() and len(obj.data.shape_keys.key_blocks) == 3

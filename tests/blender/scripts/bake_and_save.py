@@ -8,7 +8,7 @@ import bpy
 import numpy as np
 from support import blender as support
 
-mdc, posing, storage = support.enable_addon("core", "posing", "storage")
+mdc, posing, storage = support.enable_addon("core", "pose.posing", "storage")
 
 args = support.arguments()
 if args[0] == "suzanne":

@@ -11,8 +11,14 @@ import numpy as np
 from mathutils import Matrix, Quaternion
 from support import blender as support
 
-handles, posing, frame_cache, timeline, frame_keys, jobs, mdc = support.enable_addon(
-    "handles", "posing", "playback.frame_cache", "playback.timeline", "frame_keys", "jobs", "core"
+handles, posing, frame_cache, timeline, frame_keys, refine_job, mdc = support.enable_addon(
+    "handles",
+    "pose.posing",
+    "playback.frame_cache",
+    "playback.timeline",
+    "playback.frame_keys",
+    "pose.refine",
+    "core",
 )
 scene, view_layer = bpy.context.scene, bpy.context.view_layer
 obj, V = support.baked_suzanne(1, 12, 10, 300)
@@ -63,7 +69,7 @@ def pose_positions():
 
 def refine():
     """Refine (its job, run here) and the "Modal Deform" key it writes."""
-    job = jobs.RefineJob(bpy.context, obj)
+    job = refine_job.RefineJob(bpy.context, obj)
     job.run()
     assert job.finish()[0] == "INFO" and job.written
     return support.key_positions(obj, posing.POSE_KEY)

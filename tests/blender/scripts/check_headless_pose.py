@@ -7,7 +7,7 @@ import bpy
 import numpy as np
 from support import blender as support
 
-posing = support.enable_addon("posing")
+posing = support.enable_addon("pose.posing")
 
 (dimension,) = support.arguments()
 obj = next(o for o in bpy.data.objects if o.type == "MESH")

@@ -10,7 +10,11 @@ import numpy as np
 from support import blender as support
 
 frame_cache, frame_keys, timeline, frame_display, posing = support.enable_addon(
-    "playback.frame_cache", "frame_keys", "playback.timeline", "playback.frame_display", "posing"
+    "playback.frame_cache",
+    "playback.frame_keys",
+    "playback.timeline",
+    "playback.frame_display",
+    "pose.posing",
 )
 obj, V = support.baked_suzanne(2, 20, 52, 1000)  # the demo's Suzanne and the default basis
 size = np.ptp(V, axis=0).max()

@@ -6,7 +6,7 @@ import bpy
 import numpy as np
 from support import blender as support
 
-posing, storage = support.enable_addon("posing", "storage")
+posing, storage = support.enable_addon("pose.posing", "storage")
 
 obj = bpy.data.objects["Bar"]
 bpy.context.view_layer.objects.active = obj

@@ -11,7 +11,7 @@ import numpy as np
 from mathutils import Matrix
 from support import blender as support
 
-mdc, posing, storage = support.enable_addon("core", "posing", "storage")
+mdc, posing, storage = support.enable_addon("core", "pose.posing", "storage")
 
 V, F = mdc.testing.cylinder(10, 30, 0.5, 6.0)
 obj = support.mesh_object("Bar", V, F)

@@ -17,7 +17,7 @@ frame_cache, mesh_io, timeline, frame_display, displays, posing = support.enable
     "playback.timeline",
     "playback.frame_display",
     "pose.displays",
-    "posing",
+    "pose.posing",
 )
 obj, V, controller = support.keyed_suzanne(8, 12, 10, 300)
 artist = obj.modifiers.new("Artist's Displace", "DISPLACE")

@@ -12,7 +12,7 @@ from mathutils import Matrix
 from support import blender as support
 from support.blender import evaluated_positions
 
-posing, displays, storage = support.enable_addon("posing", "pose.displays", "storage")
+posing, displays, storage = support.enable_addon("pose.posing", "pose.displays", "storage")
 
 obj, rest = support.baked_suzanne(1, 12, 10, 300)
 support.top_and_bottom_handles(obj, rest)

@@ -6,7 +6,7 @@ import bpy
 import numpy as np
 from support import blender as support
 
-ops_preview, posing, storage = support.enable_addon("ops_preview", "posing", "storage")
+ops_preview, posing, storage = support.enable_addon("ops_preview", "pose.posing", "storage")
 
 obj = support.suzanne(2)  # 7,958 vertices
 settings = obj.modal_deform

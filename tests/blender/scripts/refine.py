@@ -5,7 +5,7 @@ import bpy
 import numpy as np
 from support import blender as support
 
-jobs, core = support.enable_addon("jobs", "core")
+refine, core = support.enable_addon("pose.refine", "core")
 # Suzanne unsubdivided (507 vertices): the full solves stay short in each of the four Blenders tested.
 obj, rest = support.baked_suzanne(
     0, 15, 40, 300
@@ -18,7 +18,7 @@ reduced = support.key_positions(obj, "Modal Deform")
 
 # Cancelled (Esc before the first progress report): the key stays the reduced pose, bit for bit.
 before = support.mesh_state(obj)
-job = jobs.RefineJob(bpy.context, obj)
+job = refine.RefineJob(bpy.context, obj)
 job.cancel()
 job.run()
 level, message = job.finish()
@@ -26,7 +26,7 @@ assert level == "WARNING" and "cancelled" in message, (level, message)
 assert not job.written and support.mesh_state(obj) == before, "a cancelled refine changed the mesh"
 
 # Refined: a converged minimum below the reduced pose's objective, in the same key.
-job = jobs.RefineJob(bpy.context, obj)
+job = refine.RefineJob(bpy.context, obj)
 job.run()
 level, message = job.finish()
 assert level == "INFO" and job.written, (level, message)

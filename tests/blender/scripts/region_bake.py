@@ -9,7 +9,7 @@ import numpy as np
 from mathutils import Matrix
 from support import blender as support
 
-posing, storage = support.enable_addon("posing", "storage")
+posing, storage = support.enable_addon("pose.posing", "storage")
 
 obj = support.suzanne(1)
 settings = obj.modal_deform

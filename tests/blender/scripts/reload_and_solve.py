@@ -8,7 +8,7 @@ import numpy as np
 from mathutils import Matrix
 from support import blender as support
 
-handles, posing, storage = support.enable_addon("handles", "posing", "storage")
+handles, posing, storage = support.enable_addon("handles", "pose.posing", "storage")
 
 obj = next(o for o in bpy.data.objects if o.type == "MESH")
 bpy.context.view_layer.objects.active = obj

@@ -7,7 +7,7 @@ import sys
 import bpy
 from support import blender as support
 
-posing, core = support.enable_addon("posing", "core")
+posing, core = support.enable_addon("pose.posing", "core")
 obj, rest = support.baked_suzanne(0, 10, 20, 300)
 top = support.top_and_bottom_handles(obj, rest)
 top.controller.location.y += 0.15

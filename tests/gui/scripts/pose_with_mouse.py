@@ -58,8 +58,8 @@ def wait_until(condition, seconds):
 
 def steps():
     enable_addon()
-    from modal_deform import posing
-    from modal_deform.pose import displays
+    from modal_deform import ops_common
+    from modal_deform.pose import displays, posing
 
     # Scene: Suzanne (2 subdivision levels, 7,958 vertices) seen from the front, sidebar open.
     obj = subdivided_suzanne(2)
@@ -134,7 +134,7 @@ def steps():
         controller.select_set(True)
         bpy.context.view_layer.objects.active = controller
     yield 0.3
-    assert posing.running is not None
+    assert ops_common.running is not None
     x, y = region.x + region.width // 2, region.y + region.height // 2
     window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x, y=y)
     yield 0.1
@@ -155,8 +155,8 @@ def steps():
 
     # The timer solves until converged; the mesh follows the controller. Suzanne has no shape keys:
     # the pose is shown in its vertex positions, the mesh flagged as posed meanwhile.
-    yield from wait_until(lambda: posing.running.pose.stats["converged"], 30)
-    assert type(posing.running.shown) is displays.PositionsDisplay
+    yield from wait_until(lambda: ops_common.running.pose.stats["converged"], 30)
+    assert type(ops_common.running.shown) is displays.PositionsDisplay
     assert obj.data.shape_keys is None and obj.data.get(displays.POSING_FLAG)
     pose = base_positions(obj)
     followed = pose[group].mean(axis=0) - rest[group].mean(axis=0)
@@ -165,7 +165,7 @@ def steps():
         "mesh followed by",
         np.round(followed, 3).tolist(),
         "at",
-        f"{posing.running.tick_ms:.1f} ms per update",
+        f"{ops_common.running.tick_ms:.1f} ms per update",
     )
     yield from show_sidebar_tab()
     yield 0.5
@@ -175,7 +175,7 @@ def steps():
     window.event_simulate(type="ESC", value="PRESS", x=x, y=y)
     window.event_simulate(type="ESC", value="RELEASE", x=x, y=y)
     yield 0.3
-    assert posing.running is None, "Esc did not end the pose"
+    assert ops_common.running is None, "Esc did not end the pose"
     assert obj.data.shape_keys is None, "Esc left shape keys behind"
     assert base_positions(obj).tobytes() == rest.tobytes()
     assert obj.data.get(displays.POSING_FLAG) is None
@@ -212,7 +212,7 @@ def steps():
     window.event_simulate(type="ESC", value="PRESS", x=x, y=y)
     window.event_simulate(type="ESC", value="RELEASE", x=x, y=y)
     yield 0.3
-    assert posing.running is None and obj.data.shape_keys is None
+    assert ops_common.running is None and obj.data.shape_keys is None
     assert base_positions(obj).tobytes() == rest.tobytes()
     say("saving mid-pose wrote the rest mesh and the pose's key; Esc restored the mesh")
 
@@ -230,7 +230,7 @@ def steps():
     window.event_simulate(type="TAB", value="PRESS", x=x, y=y)
     window.event_simulate(type="TAB", value="RELEASE", x=x, y=y)
     yield 0.5
-    assert posing.running is None, "Edit Mode did not end the pose"
+    assert ops_common.running is None, "Edit Mode did not end the pose"
     assert obj.mode == "EDIT"
     with override():
         bpy.ops.object.mode_set(mode="OBJECT")
@@ -289,7 +289,7 @@ def steps():
     window.event_simulate(type="RET", value="PRESS", x=x, y=y)
     window.event_simulate(type="RET", value="RELEASE", x=x, y=y)
     yield 0.3
-    assert posing.running is None, "Enter did not end the pose"
+    assert ops_common.running is None, "Enter did not end the pose"
     assert key_positions(obj, posing.POSE_KEY).tobytes() != key_positions(obj, "Basis").tobytes()
     window.event_simulate(type="Z", value="PRESS", x=x, y=y, ctrl=True)
     window.event_simulate(type="Z", value="RELEASE", x=x, y=y, ctrl=True)
@@ -385,10 +385,10 @@ def steps():
         assert bpy.ops.modal_deform.pose("INVOKE_DEFAULT") == {"RUNNING_MODAL"}
     controller.location.z += 0.3
     yield 0.5
-    assert type(posing.running.shown) is displays.StandInDisplay and obj.data != mesh
+    assert type(ops_common.running.shown) is displays.StandInDisplay and obj.data != mesh
     assert base_positions(obj).tobytes() != rest.tobytes(), "the pose did not follow the controller"
     addon_utils.disable("modal_deform", default_set=True)
-    assert posing.running is None, "disabling the add-on left the pose running"
+    assert ops_common.running is None, "disabling the add-on left the pose running"
     assert obj.data == mesh, "disabling did not put the artist's mesh back"
     assert key_positions(obj, posing.POSE_KEY).tobytes() == before, (
         "disabling changed the shape key"
@@ -402,17 +402,17 @@ def steps():
 
     # And with the pose in the vertex positions (no shape keys): the rest mesh comes back exactly.
     addon_utils.enable("modal_deform", default_set=True)
-    posing = importlib.import_module("modal_deform.posing")
+    ops_common = importlib.import_module("modal_deform.ops_common")
     displays = importlib.import_module("modal_deform.pose.displays")
     obj.shape_key_clear()
     with override():
         assert bpy.ops.modal_deform.pose("INVOKE_DEFAULT") == {"RUNNING_MODAL"}
     controller.location.z -= 0.3
     yield 0.5
-    assert type(posing.running.shown) is displays.PositionsDisplay
+    assert type(ops_common.running.shown) is displays.PositionsDisplay
     assert np.abs(base_positions(obj) - rest).max() > 0.05, "the pose did not follow the controller"
     addon_utils.disable("modal_deform", default_set=True)
-    assert posing.running is None, "disabling the add-on left the pose running"
+    assert ops_common.running is None, "disabling the add-on left the pose running"
     assert base_positions(obj).tobytes() == rest.tobytes(), (
         "disabling did not restore the vertex positions"
     )

@@ -5,21 +5,19 @@ playback.
 Per update: controller matrices → set_transforms → solve (within a time budget) →
 positions(out=Blender's own array: a shape key's or the vertex positions) → mesh.update().
 
-Where the interactive pose shows the pose while it runs is a display (pose/displays.py); meshes
-written mid-pose are repaired by pose/recovery.py. The interactive pose under way, the add-on's one
-piece of posing state, is `running` here.
+Where the interactive pose shows the pose while it runs is a display (displays.py); meshes written
+mid-pose are repaired by recovery.py. The interactive pose under way is ops_common.running.
 """
 
 import numpy as np
 
-from . import core as mdc
-from . import handles, mesh_io, storage
-from .playback import frame_display
+from .. import core as mdc
+from .. import handles, mesh_io, storage
 
 POSE_KEY = "Modal Deform"
-#: The interactive pose under way, or None: the Pose operator (pose/operators.py), set while it
-#: runs. Besides .pose (its Pose) it offers keep_in_shape_key(), request_end(how) and end(context, how).
-running = None
+#: Functions of an object, each taking off it a display that would hide a pose shown there (playback
+#: adds its frame display's removal when registered: playback/timeline.py); uncover() calls them.
+covers = []
 #: The most BFGS iterations one update takes however much of its time budget is left: far more
 #: than a budget of milliseconds allows (bench/results/table1.json, "ms_per_iteration"), so the
 #: budget or convergence ends an update.
@@ -115,20 +113,15 @@ def header_text(stats, tick_ms):
 
 def pose_key(obj):
     """The "Modal Deform" shape key, created if needed (after a Basis key when the mesh has none),
-    shown at value 1 (a frame playback shows goes: it would hide the key); returns (key block,
-    names of the keys created here)."""
+    shown at value 1 (what would hide the key goes: uncover); returns (key block, names of the keys
+    created here)."""
     block, created = mesh_io.shape_key(obj, POSE_KEY)
     block.value, block.mute = 1.0, False
-    frame_display.remove(obj)
+    uncover(obj)
     return block, created
 
 
-def is_posing(obj):
-    """Whether the interactive pose runs on obj: its mesh is then not to be baked, solved or
-    checked for staleness (its positions may hold the pose)."""
-    try:
-        return running is not None and running.pose.obj == obj
-    except (
-        ReferenceError
-    ):  # the pose's object went away (undo, file loaded): it ends at its next event
-        return False
+def uncover(obj):
+    """Take off obj every display that would hide a pose shown there (covers): a frame of playback."""
+    for remove in covers:
+        remove(obj)
