@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <complex>
@@ -265,6 +266,18 @@ void ReducedDynamics::substep(const Transforms& start, const Transforms& middle,
   const Eigen::VectorXd& middle_state = midpoint_bfgs_.x();
   Eigen::VectorXd q_next = 2 * middle_state - q_;
   Eigen::VectorXd v_next = (4 / h_) * (middle_state - q_) - v_;
+  // The damping's work over the substep, h v_mᵀ F_d with F_d = (2β/h) ∇V(x, t_m) − damping_pull_
+  // (∇V(x, t_m) from Φ's stationarity at x: no evaluation there): for a quadratic potential, what
+  // the midpoint rule dissipates exactly. At least zero: damping gives no energy, even where V is
+  // not convex.
+  double dissipated = 0;
+  if (rayleigh_ > 0) {
+    const double ratio = (2 * rayleigh_ / h_) / damping_weight_;
+    Eigen::VectorXd& damping_force = work_gradient_;
+    damping_force = ratio * (damping_pull_ - (middle_state - prediction_) / potential_weight_);
+    damping_force -= damping_pull_;
+    dissipated = std::max(0.0, 2 * (middle_state - q_).dot(damping_force));
+  }
   // The handles' work over the substep, at the middle state.
   handle_term_.set_transforms(start);
   double work = -handle_term_.value_and_gradient(middle_state, handle_gradient_);
@@ -273,13 +286,15 @@ void ReducedDynamics::substep(const Transforms& start, const Transforms& middle,
   Eigen::VectorXd gradient_next(q_.size());
   double elastic_next = ghost_energy_.value_and_gradient(q_next, gradient_next);
   double potential_next = elastic_next + handle_term_.value_and_gradient(q_next, handle_gradient_);
+  // The energy the substep ends with: what it had, plus the handles' work, less the damping's.
+  double target = energy_before + work - dissipated;
   if (!(potential_next <= energy_before + work)) {
     // The end state holds more energy than the step had (a non-quadratic energy's error, amplified
     // by an unconverged minimisation in a violent motion): take the substep by implicit Euler
     // instead, Φ_E(x) = ½‖x − q_n − h v_n‖² + (h²/ρ) V(x, t_{n+1}), undamped, from q_n. BFGS only
     // decreases Φ_E (it ends at an evaluated point), so V(q_{n+1}, t_{n+1}) ≤ Φ_E(q_n) ρ/h² =
     // ½ρ‖v_n‖² + V(q_n, t_{n+1}): within the energy the step had plus the handles' work at q_n, and
-    // the velocity check below holds the total there.
+    // the correction below brings the total to the target from there.
     ++stats.implicit_euler;
     prediction_ = q_ + h_ * v_;
     damping_pull_.setZero();
@@ -294,15 +309,17 @@ void ReducedDynamics::substep(const Transforms& start, const Transforms& middle,
     work += handle_term_.value_and_gradient(q_, handle_gradient_);
     elastic_next = ghost_energy_.value_and_gradient(q_next, gradient_next);
     potential_next = elastic_next + handle_term_.value_and_gradient(q_next, handle_gradient_);
+    target = energy_before + work - dissipated;
   }
-  // The energy check: the excess over the energy the step had and the work done on it comes out of
-  // the kinetic energy.
+  // The energy correction: the velocity is scaled so that the total reaches the target, down by
+  // all the kinetic energy at most, up by at most the kinetic energy itself (a near-zero velocity
+  // is not blown up).
   const double kinetic_next = 0.5 * mass_scale_ * v_next.squaredNorm();
-  const double excess = kinetic_next + potential_next - (energy_before + work);
-  if (excess > 0) {
-    const double removed = std::min(excess, kinetic_next);
-    v_next *= kinetic_next > removed ? std::sqrt((kinetic_next - removed) / kinetic_next) : 0.0;
-    stats.energy_removed += removed;
+  const double change =
+      std::clamp(target - potential_next - kinetic_next, -kinetic_next, kinetic_next);
+  if (change != 0) {
+    v_next *= std::sqrt((kinetic_next + change) / kinetic_next);
+    (change > 0 ? stats.energy_added : stats.energy_removed) += std::abs(change);
   }
   q_ = std::move(q_next);
   v_ = std::move(v_next);

@@ -2,8 +2,8 @@
 
 The dynamics whose quasi-static limits are the poses (paper section 3), integrated in the reduced
 space x = x̄ + U q by the implicit midpoint rule written as a minimisation, each step solved by
-the warm-started BFGS of posing (docs/design.md, "Secondary motion", has the scheme and its reasons).
-The artist's parameters are in frames: ``period``, the period of the lowest flexible mode (it sets
+the warm-started BFGS of posing and its end velocity rescaled to the energy the step should have
+(docs/design.md, "Secondary motion", has the scheme and its reasons). The artist's parameters are in frames: ``period``, the period of the lowest flexible mode (it sets
 the mass), and ``damping``, that mode's damping ratio ζ (Rayleigh damping, stiffer modes damped
 more). Both hold exactly for the lowest mode of small motions, whatever ``fps`` and ``substeps``.
 """
@@ -50,11 +50,15 @@ class Simulation(_inputs.InBasis):
         a free body) at its end, moving there from the previous frame's (rotations by slerp, each
         handle's centre on a straight line). Returns the positions at the frame's end, as
         ``positions(out)``. ``self.stats`` then holds {"substeps", "iterations", "evaluations",
-        "converged", "stalled", "line_search_failures", "energy_removed", "ms"}: "converged" when
-        every substep's minimisation met its stopping test, "stalled" when one could not decrease
-        its objective (its state is taken all the same: the step never fails), "energy_removed"
-        the energy the energy check took from the motion (nonzero only where the midpoint rule
-        or an unconverged substep would have created energy).
+        "converged", "stalled", "line_search_failures", "implicit_euler", "energy_removed",
+        "energy_added", "ms"}: "converged" when every substep's minimisation met its stopping
+        test, "stalled" when one could not decrease its objective (its state is taken all the
+        same: the step never fails), "energy_removed" and "energy_added" what the energy
+        correction took from the motion and gave to it (each substep ends with the energy it had,
+        plus the handles' work, less the damping's: the midpoint rule alone drifts either way on a
+        nonlinear energy, and an unconverged substep may create energy), "implicit_euler" the
+        substeps a violent motion had taken by implicit Euler instead. No substep ends above the
+        energy it had plus the handles' work.
 
         BFGS keeps what it learnt of the curvature from step to step (far fewer evaluations a
         frame), and forgets it before a step when it holds ``memory_frames`` frames, at forget()
