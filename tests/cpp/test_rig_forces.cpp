@@ -40,7 +40,8 @@ Transforms random_bones(unsigned seed) {
   std::srand(seed);
   Transforms bones(4, Eigen::Matrix4d::Identity());
   for (Eigen::Matrix4d& B : bones)
-    B.topRows<3>() = Eigen::Matrix<double, 3, 4>::Random() + 2 * Eigen::Matrix<double, 3, 4>::Identity();
+    B.topRows<3>() =
+        Eigen::Matrix<double, 3, 4>::Random() + 2 * Eigen::Matrix<double, 3, 4>::Identity();
   return bones;
 }
 
@@ -59,7 +60,8 @@ TEST(RigForces, IsTheProjectionOfEachBonesAccelerationPulledBackByItsFrame) {
     Eigen::Vector3d felt = Eigen::Vector3d::Zero();
     for (SkinningWeights::InnerIterator it(W, i); it; ++it) {
       const int b = static_cast<int>(it.col());
-      const Eigen::Vector4d acceleration = (next[b] - 2 * current[b] + previous[b]) * point / (dt * dt);
+      const Eigen::Vector4d acceleration =
+          (next[b] - 2 * current[b] + previous[b]) * point / (dt * dt);
       felt += it.value() * current[b].topLeftCorner<3, 3>().inverse() * acceleration.head<3>();
     }
     expected -= std::pow(basis.scale, 4) * basis.mass[i] * basis.vertex_rows(i).transpose() * felt;
