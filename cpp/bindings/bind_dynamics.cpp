@@ -4,12 +4,14 @@
 #include <pybind11/stl.h>
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "bindings/bindings.h"
 #include "bindings/named_fields.h"
 #include "solve/reduced_dynamics.h"
+#include "solve/rig_forces.h"
 
 namespace py = pybind11;
 
@@ -18,33 +20,43 @@ namespace modal_deform {
 void bind_dynamics(py::module_& m) {
   const auto simulation_options = [](auto visit) { for_each_simulation_option(visit); };
   m.attr("SIMULATION_OPTIONS") = option_table<SimulationOptions>(simulation_options);
+  m.def("check_skinning_weights", &check_skinning_weights, py::arg("weights"),
+        py::arg("num_vertices"));
+  m.def("check_bone_matrices", &check_bone_matrices, py::arg("bones"), py::arg("num_bones"));
   py::class_<ReducedDynamics>(m, "Simulation")
-      .def(py::init([simulation_options](const Basis& basis,
-                                         const std::vector<Eigen::VectorXi>& handles,
-                                         const VectorRef& weights, const std::string& energy,
-                                         const py::kwargs& keywords) {
+      .def(py::init([simulation_options](
+                        const Basis& basis, const std::vector<Eigen::VectorXi>& handles,
+                        const VectorRef& weights, const std::string& energy,
+                        const std::optional<SkinningWeights>& rig, const py::kwargs& keywords) {
              const SimulationOptions options =
                  from_keywords<SimulationOptions>(keywords, simulation_options, "Simulation");
              const EnergyKind kind = energy_kind(energy);
              py::gil_scoped_release release;
              return std::make_unique<ReducedDynamics>(basis, to_handles(handles), weights, options,
-                                                      kind);
+                                                      kind, rig ? &*rig : nullptr);
            }),
            py::arg("basis"), py::arg("handles"), py::arg("weights"), py::arg("energy"),
-           py::keep_alive<1, 2>())
+           py::arg("rig"), py::keep_alive<1, 2>())
       .def(
           "step",
-          [](ReducedDynamics& simulation, const Transforms& transforms) {
+          [](ReducedDynamics& simulation, const Transforms& transforms, const Transforms& bones) {
             SimulationStepStats stats;
             {
               py::gil_scoped_release release;
-              stats = simulation.step(transforms);
+              stats = simulation.step(transforms, bones);
             }
             return to_dict(stats, [](auto visit) { for_each_simulation_stat(visit); });
           },
-          py::arg("transforms"))
+          py::arg("transforms"), py::arg("bones"))
       .def("set_state", &ReducedDynamics::set_state, py::arg("q"), py::arg("v"),
-           py::arg("transforms"))
+           py::arg("transforms"), py::arg("rig_previous"), py::arg("rig_current"))
+      .def_property_readonly("rig_previous", &ReducedDynamics::rig_previous)
+      .def_property_readonly("rig_current", &ReducedDynamics::rig_current)
+      .def_property_readonly("num_bones", &ReducedDynamics::num_bones)
+      .def_property_readonly("on_rig", &ReducedDynamics::on_rig)
+      .def_property_readonly(
+          "rig_acceleration",
+          [](const ReducedDynamics& s) { return Eigen::VectorXd(s.rig_acceleration()); })
       .def("forget", &ReducedDynamics::forget)
       .def_property_readonly("remembered_frames", &ReducedDynamics::remembered_frames)
       .def_property_readonly("memory_frames", &ReducedDynamics::memory_frames)

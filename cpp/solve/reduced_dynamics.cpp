@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <complex>
@@ -44,7 +45,7 @@ Eigen::VectorXd checked_weights(const Handles& handles, const VectorRef& weights
 
 ReducedDynamics::ReducedDynamics(const Basis& basis, const Handles& handles,
                                  const VectorRef& weights, const SimulationOptions& options,
-                                 EnergyKind energy)
+                                 EnergyKind energy, const SkinningWeights* rig)
     : basis_(checked(basis)),
       options_(checked(options)),
       ghost_energy_(basis, energy),
@@ -62,10 +63,20 @@ ReducedDynamics::ReducedDynamics(const Basis& basis, const Handles& handles,
     centres_.push_back(centre / static_cast<double>(handle.size()));
   }
   const Eigen::Index r = basis.dimension();
-  // K = U_sᵀ ∇²E(x̄_s) U_s and its lowest flexible mode.
+  if (rig) {
+    rig_ = std::make_unique<RigForces>(basis, *rig);
+    rig_acceleration_ = Eigen::VectorXd::Zero(r);
+  }
+  // K = U_sᵀ ∇²E(x̄_s) U_s and its lowest flexible mode; on a rig, the lowest of the mesh as
+  // attached, K plus the handles' term.
   Eigen::MatrixXd K = ghost_energy_.rest_hessian();
   K = 0.5 * (K + K.transpose()).eval();
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(K);
+  Eigen::MatrixXd attached;
+  if (rig_) {
+    attached = K + handle_term_.hessian();
+    attached = 0.5 * (attached + attached.transpose()).eval();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(rig_ ? attached : K);
   if (eigen.info() != Eigen::Success)
     throw NumericalError("simulation: the reduced rest Hessian has no eigenvalues");
   const double largest = eigen.eigenvalues().maxCoeff();
@@ -124,7 +135,8 @@ void ReducedDynamics::positions_of(const Eigen::VectorXd& q,
 }
 
 void ReducedDynamics::set_state(const Eigen::VectorXd& q, const Eigen::VectorXd& v,
-                                const Transforms& transforms) {
+                                const Transforms& transforms, const Transforms& rig_previous,
+                                const Transforms& rig_current) {
   const Eigen::Index r = dimension();
   if (q.size() != r)
     throw InputError(message("q: expected ", r, " reduced coordinates, got ", q.size()));
@@ -134,10 +146,20 @@ void ReducedDynamics::set_state(const Eigen::VectorXd& q, const Eigen::VectorXd&
   if (!v.allFinite() || !std::isfinite(0.5 * mass_scale_ * v.squaredNorm()))
     throw InputError("v: has non-finite entries, or a kinetic energy beyond double precision");
   if (!transforms.empty()) check_transforms(transforms, num_handles());
+  if (!rig_ && !(rig_previous.empty() && rig_current.empty()))
+    throw InputError("bones: given to a simulation without a rig");
+  if (rig_current.empty() && !rig_previous.empty())
+    throw InputError("bones: the previous frame's bones given without the current ones");
+  if (!rig_current.empty()) check_bone_matrices(rig_current, num_bones());
+  if (!rig_previous.empty()) check_bone_matrices(rig_previous, num_bones());
+  const Transforms& previous = rig_previous.empty() ? rig_current : rig_previous;
+  const bool own_rig =
+      rig_current.empty() || (rig_current == rig_current_ && previous == rig_previous_);
   // The simulation's own state (playback sets each frame's cached state before stepping from it)
   // is kept: its energy and gradient were evaluated there, at these transforms, by the last step,
   // and BFGS's memory is the one that step left.
-  if (q_.size() == r && q == q_ && v == v_ && (transforms.empty() || transforms == transforms_))
+  if (q_.size() == r && q == q_ && v == v_ && (transforms.empty() || transforms == transforms_) &&
+      own_rig)
     return;
   Eigen::VectorXd gradient(r);
   const double elastic_energy = ghost_energy_.value_and_gradient(q, gradient);
@@ -147,6 +169,10 @@ void ReducedDynamics::set_state(const Eigen::VectorXd& q, const Eigen::VectorXd&
   if (!transforms.empty()) {
     transforms_ = transforms;
     handle_term_.set_transforms(transforms_);
+  }
+  if (!rig_current.empty()) {
+    rig_previous_ = previous;
+    rig_current_ = rig_current;
   }
   forget();
   q_ = q;
@@ -196,9 +222,18 @@ Transforms ReducedDynamics::interpolated(const Transforms& target, double a) con
   return result;
 }
 
-SimulationStepStats ReducedDynamics::step(const Transforms& transforms) {
+SimulationStepStats ReducedDynamics::step(const Transforms& transforms, const Transforms& bones) {
   const auto start = std::chrono::steady_clock::now();
   check_transforms(transforms, num_handles());
+  if (rig_) {
+    if (bones.empty()) throw InputError("bones: required on a rig, one matrix per bone");
+    check_bone_matrices(bones, rig_->num_bones());
+    // Before the first frame given, the rig was still in that frame's pose.
+    if (rig_current_.empty()) rig_previous_ = rig_current_ = bones;
+    rig_->acceleration(rig_previous_, rig_current_, bones, 1 / options_.fps, rig_acceleration_);
+  } else if (!bones.empty()) {
+    throw InputError("bones: given to a simulation without a rig");
+  }
   SimulationStepStats stats;
   const int substeps = options_.substeps;
   Transforms substep_start = transforms_;
@@ -210,6 +245,10 @@ SimulationStepStats ReducedDynamics::step(const Transforms& transforms) {
     substep_start = end;
   }
   transforms_ = transforms;
+  if (rig_) {
+    rig_previous_ = std::move(rig_current_);
+    rig_current_ = bones;
+  }
   fine_positions_.set(q_);
   ++remembered_frames_;
   stats.ms =
@@ -255,6 +294,8 @@ void ReducedDynamics::substep(const Transforms& start, const Transforms& middle,
   const double energy_before = energy();
   // The midpoint rule: Φ over the middle state.
   prediction_ = q_ + (h_ / 2) * v_;
+  // The rig's force ρ g, a linear term of Φ: −(h²/4) gᵀx, folded into the prediction.
+  if (rig_) prediction_ += (h_ * h_ / 4) * rig_acceleration_;
   handle_term_.value_and_gradient(q_, handle_gradient_);
   damping_pull_ = (2 * rayleigh_ / h_) * (elastic_gradient_ + handle_gradient_);
   damping_weight_ = 1 + 2 * rayleigh_ / h_;
@@ -265,23 +306,41 @@ void ReducedDynamics::substep(const Transforms& start, const Transforms& middle,
   const Eigen::VectorXd& middle_state = midpoint_bfgs_.x();
   Eigen::VectorXd q_next = 2 * middle_state - q_;
   Eigen::VectorXd v_next = (4 / h_) * (middle_state - q_) - v_;
+  // The damping's work over the substep, h v_mᵀ F_d with F_d = (2β/h) ∇V(x, t_m) − damping_pull_
+  // (∇V(x, t_m) from Φ's stationarity at x: no evaluation there): for a quadratic potential, what
+  // the midpoint rule dissipates exactly. At least zero: damping gives no energy, even where V is
+  // not convex.
+  double dissipated = 0;
+  if (rayleigh_ > 0) {
+    const double ratio = (2 * rayleigh_ / h_) / damping_weight_;
+    Eigen::VectorXd& damping_force = work_gradient_;
+    damping_force = ratio * (damping_pull_ - (middle_state - prediction_) / potential_weight_);
+    damping_force -= damping_pull_;
+    dissipated = std::max(0.0, 2 * (middle_state - q_).dot(damping_force));
+  }
   // The handles' work over the substep, at the middle state.
   handle_term_.set_transforms(start);
   double work = -handle_term_.value_and_gradient(middle_state, handle_gradient_);
   handle_term_.set_transforms(end);
   work += handle_term_.value_and_gradient(middle_state, handle_gradient_);
+  // And the rig's force's, ρ gᵀ(q_{n+1} − q_n) (g constant over the substep).
+  if (rig_) work += mass_scale_ * rig_acceleration_.dot(q_next - q_);
   Eigen::VectorXd gradient_next(q_.size());
   double elastic_next = ghost_energy_.value_and_gradient(q_next, gradient_next);
   double potential_next = elastic_next + handle_term_.value_and_gradient(q_next, handle_gradient_);
+  // The energy the substep ends with: what it had, plus the handles' work, less the damping's.
+  double target = energy_before + work - dissipated;
   if (!(potential_next <= energy_before + work)) {
     // The end state holds more energy than the step had (a non-quadratic energy's error, amplified
     // by an unconverged minimisation in a violent motion): take the substep by implicit Euler
     // instead, Φ_E(x) = ½‖x − q_n − h v_n‖² + (h²/ρ) V(x, t_{n+1}), undamped, from q_n. BFGS only
     // decreases Φ_E (it ends at an evaluated point), so V(q_{n+1}, t_{n+1}) ≤ Φ_E(q_n) ρ/h² =
     // ½ρ‖v_n‖² + V(q_n, t_{n+1}): within the energy the step had plus the handles' work at q_n, and
-    // the velocity check below holds the total there.
+    // the correction below brings the total to the target from there. On a rig Φ_E has the
+    // force's term −h² gᵀx, and the bound gains its work ρ gᵀ(q_{n+1} − q_n).
     ++stats.implicit_euler;
     prediction_ = q_ + h_ * v_;
+    if (rig_) prediction_ += (h_ * h_) * rig_acceleration_;
     damping_pull_.setZero();
     damping_weight_ = 1;
     potential_weight_ = euler_weight_;
@@ -292,17 +351,20 @@ void ReducedDynamics::substep(const Transforms& start, const Transforms& middle,
     work = -handle_term_.value_and_gradient(q_, handle_gradient_);
     handle_term_.set_transforms(end);
     work += handle_term_.value_and_gradient(q_, handle_gradient_);
+    if (rig_) work += mass_scale_ * rig_acceleration_.dot(q_next - q_);
     elastic_next = ghost_energy_.value_and_gradient(q_next, gradient_next);
     potential_next = elastic_next + handle_term_.value_and_gradient(q_next, handle_gradient_);
+    target = energy_before + work - dissipated;
   }
-  // The energy check: the excess over the energy the step had and the work done on it comes out of
-  // the kinetic energy.
+  // The energy correction: the velocity is scaled so that the total reaches the target, down by
+  // all the kinetic energy at most, up by at most the kinetic energy itself (a near-zero velocity
+  // is not blown up).
   const double kinetic_next = 0.5 * mass_scale_ * v_next.squaredNorm();
-  const double excess = kinetic_next + potential_next - (energy_before + work);
-  if (excess > 0) {
-    const double removed = std::min(excess, kinetic_next);
-    v_next *= kinetic_next > removed ? std::sqrt((kinetic_next - removed) / kinetic_next) : 0.0;
-    stats.energy_removed += removed;
+  const double change =
+      std::clamp(target - potential_next - kinetic_next, -kinetic_next, kinetic_next);
+  if (change != 0) {
+    v_next *= std::sqrt((kinetic_next + change) / kinetic_next);
+    (change > 0 ? stats.energy_added : stats.energy_removed) += std::abs(change);
   }
   q_ = std::move(q_next);
   v_ = std::move(v_next);

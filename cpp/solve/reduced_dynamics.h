@@ -5,18 +5,41 @@
 // damping), written as the minimisation of an incremental potential Φ over the middle state, with
 // stiffness-proportional Rayleigh damping relative to the controllers' motion, and solved by the
 // warm-started Bfgs. ρ and the damping β come from the artist's `period` (frames at `fps`) and
-// damping ratio, exact for the lowest flexible mode. An energy check on every substep keeps a
-// simulation from gaining energy it was not given. The scheme, Φ, the parameters' derivation and
-// the check: docs/design.md, "Secondary motion (cpp/solve/reduced_dynamics.h)".
+// damping ratio, exact for the lowest flexible mode. The midpoint rule conserves the energy of a
+// quadratic potential only: on a nonlinear one it drifts either way (+48% in 13 periods of a bar
+// swinging at 15% of its length), and a check that only removes energy ratchets it down. So each
+// substep ends with an energy correction: the end velocity is rescaled, up or down, to the energy
+// the step should have, what it had plus the handles' work less the damping's (for a quadratic
+// potential the midpoint rule's own: there the correction vanishes). It needs no evaluation of the
+// energy, unlike a discrete-gradient step (Gonzalez 1996) that would evaluate it inside the solve,
+// and keeps the period and the decrement the midpoint rule sets. No substep ends above the energy
+// it had plus the handles' work (implicit Euler takes one whose potential alone would). The scheme,
+// Φ, the parameters' derivation and the correction: docs/design.md, "Secondary motion
+// (cpp/solve/reduced_dynamics.h)".
+//
+// On a rig (a constructor given skinning weights), q is a displacement of the mesh in its rest
+// space, skinned with it: the world shape is skin(x̄ + U q, W, B). Each frame's bones B drive it by
+// the inertial forces of the skinned motion felt in each vertex's frame (rig_forces.h): ρ q̈ gains
+// ρ g, g from the second difference of the bones over the previous two frames and this one,
+// constant over the frame (every substep sees the same g, so substeps change nothing in how the
+// rig's motion is read); the handles stay in rest space (identity: held where the rig puts them).
+// Before the first frame the rig counts as having been still in the pose of the first frame it is
+// given (set_state's or step's); the state carries the two frames' bones the next one needs
+// (rig_previous, rig_current), so a frame is the same bits however reached. ρ and β are set by
+// the lowest mode of the mesh as attached (K plus the handles' term) instead of K's: the wobble
+// the artist sees on the rig. A frame on the rig costs O(bones · r) more than one without.
 //
 // Not thread-safe: one simulation per thread.
 #pragma once
+
+#include <memory>
 
 #include "basis/basis.h"
 #include "energy/make_energy.h"
 #include "solve/bfgs.h"
 #include "solve/handle_term.h"
 #include "solve/reduced_map.h"
+#include "solve/rig_forces.h"
 
 namespace modal_deform {
 
@@ -85,8 +108,9 @@ struct SimulationStepStats {
   bool converged = true;  // every substep's minimisation converged (bfgs.h)
   bool stalled = false;   // a substep's BFGS could not decrease Φ (its state was still taken)
   int line_search_failures = 0;
-  int implicit_euler = 0;     // substeps the energy check took by implicit Euler instead
-  double energy_removed = 0;  // energy taken from the kinetic energy by the energy check
+  int implicit_euler = 0;     // substeps taken by implicit Euler instead (violent steps)
+  double energy_removed = 0;  // energy the energy correction took from the motion, all substeps
+  double energy_added = 0;    // energy the energy correction gave to the motion, all substeps
   double ms = 0;              // wall time of the step, milliseconds
 };
 
@@ -101,6 +125,7 @@ void for_each_simulation_stat(Visit&& visit) {
   visit("line_search_failures", [](auto& s) -> auto& { return s.line_search_failures; });
   visit("implicit_euler", [](auto& s) -> auto& { return s.implicit_euler; });
   visit("energy_removed", [](auto& s) -> auto& { return s.energy_removed; });
+  visit("energy_added", [](auto& s) -> auto& { return s.energy_added; });
   visit("ms", [](auto& s) -> auto& { return s.ms; });
 }
 
@@ -110,8 +135,11 @@ class ReducedDynamics {
   // (checked_handle_weights; may be empty: a free body), weights one per handle (empty: 1).
   // Starts at rest (q = v = 0) with identity transforms. Throws InputError when the basis has no
   // flexible mode to set the period by.
+  // rig: null, or #V by #bones skinning weights (check_skinning_weights): the simulation on a rig
+  // (the header says what changes).
   ReducedDynamics(const Basis& basis, const Handles& handles, const VectorRef& weights,
-                  const SimulationOptions& options, EnergyKind energy = EnergyKind::kShells);
+                  const SimulationOptions& options, EnergyKind energy = EnergyKind::kShells,
+                  const SkinningWeights* rig = nullptr);
   ReducedDynamics(const ReducedDynamics&) = delete;
   ReducedDynamics& operator=(const ReducedDynamics&) = delete;
 
@@ -126,7 +154,10 @@ class ReducedDynamics {
   // and of the frames its memory holds, which a caller reproduces bit for bit by forgetting at
   // fixed blocks of memory_frames frames and, to reach a frame in the middle of a block, stepping
   // again from the block's first state (playback.Player.next).
-  SimulationStepStats step(const Transforms& transforms);
+  //
+  // On a rig, `bones` are the bones' world skinning matrices at the frame's end (one per bone,
+  // check_bone_matrices; required there, refused without a rig).
+  SimulationStepStats step(const Transforms& transforms, const Transforms& bones = {});
   // Forgets BFGS's memory: the next step learns from the rest Hessian.
   void forget();
   // The frames stepped since the memory was last forgotten (at most memory_frames).
@@ -137,10 +168,22 @@ class ReducedDynamics {
   // (one per handle; empty keeps the current ones). Throws InputError for a wrong size, a
   // non-finite entry or a q whose ghost leaves the coordinates the energies take. Forgets BFGS's
   // memory unless the state is the simulation's own (the same q, v and transforms).
+  //
+  // On a rig, rig_previous and rig_current: the bones at the frame before the state and at the
+  // state; rig_current alone (rig_previous empty): the rig still in that pose until the state;
+  // both empty keep the current ones. The rig's history is part of what makes the state the
+  // simulation's own.
   void set_state(const Eigen::VectorXd& q, const Eigen::VectorXd& v,
-                 const Transforms& transforms = {});
+                 const Transforms& transforms = {}, const Transforms& rig_previous = {},
+                 const Transforms& rig_current = {});
   const Eigen::VectorXd& q() const { return q_; }
   const Eigen::VectorXd& v() const { return v_; }
+  // On a rig: the bones at the frame before the state and at the state (empty until the rig is
+  // first given: the next step takes it as still in the pose it is given).
+  const Transforms& rig_previous() const { return rig_previous_; }
+  const Transforms& rig_current() const { return rig_current_; }
+  bool on_rig() const { return rig_ != nullptr; }
+  int num_bones() const { return rig_ ? rig_->num_bones() : 0; }
 
   // H = ½ρ‖v‖² + E(q) + E_C(q) at the current transforms (normalised frame).
   double energy() const { return kinetic_energy() + potential_; }
@@ -155,8 +198,11 @@ class ReducedDynamics {
 
   int dimension() const { return ghost_energy_.dimension(); }
   int num_handles() const { return static_cast<int>(centres_.size()); }
-  double mass_scale() const { return mass_scale_; }                    // ρ
-  const Eigen::VectorXd& lowest_mode() const { return lowest_mode_; }  // λ₁'s unit eigenvector of K
+  double mass_scale() const { return mass_scale_; }  // ρ
+  // λ₁'s unit eigenvector of K (on a rig: of K plus the handles' term).
+  const Eigen::VectorXd& lowest_mode() const { return lowest_mode_; }
+  // On a rig, the last frame's g (rig_forces.h), per second squared.
+  const Eigen::VectorXd& rig_acceleration() const { return rig_acceleration_; }
 
  private:
   // Φ (above) for the current substep and scheme: ½‖x − prediction‖² + potential_weight
@@ -202,6 +248,11 @@ class ReducedDynamics {
   // term's pull ((2β/h) ∇V(q_n, t_n)) and the weights (κ, 1 + 2β/h).
   Eigen::VectorXd prediction_, damping_pull_;
   double damping_weight_ = 1, potential_weight_ = 0;
+  // On a rig: its forces, the bones at the frame before the state and at the state, and the
+  // current frame's g (zero without a rig).
+  std::unique_ptr<RigForces> rig_;
+  Transforms rig_previous_, rig_current_;
+  Eigen::VectorXd rig_acceleration_;
   // Work space, sized once.
   Eigen::VectorXd work_gradient_, handle_gradient_;
 };

@@ -18,6 +18,7 @@ from .frame_budget import FrameBudget as FrameBudget
 from .mesh import check, mass, read_mesh
 from .modes import rigid_motions, solve_in_range, vibration_modes
 from .reduction import ghost_mesh, restrict_to_ghost
+from .rig import skin
 from .solve import (
     FULL_SOLVE_OPTIONS,
     SOLVE_OPTIONS,
@@ -50,6 +51,7 @@ __all__ = [
     "mass",
     "read_mesh",
     "restrict_to_ghost",
+    "skin",
     "rigid_motions",
     "solve_full",
     "solve_in_range",
