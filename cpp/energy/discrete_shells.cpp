@@ -620,6 +620,63 @@ DiscreteShells::DiscreteShells(const VerticesRef& V, const FacesRef& F, double b
   finish_set(hinges_, sparsity_, partition_);
 }
 
+bool DiscreteShells::same_terms(const DiscreteShells& other) const {
+  bool same = rest_.size() == other.rest_.size();
+  const auto compare = [&same](const auto& a, const auto& b) {
+    same = same && a.terms.size() == b.terms.size();
+    for (size_t e = 0; same && e < a.terms.size(); ++e)
+      same = a.terms[e].vertices == b.terms[e].vertices;
+  };
+  compare(edges_, other.edges_);
+  compare(triangles_, other.triangles_);
+  compare(hinges_, other.hinges_);
+  return same;
+}
+
+void DiscreteShells::blend_rests(const std::vector<const DiscreteShells*>& rests,
+                                 const std::vector<double>& c) {
+  if (rests.size() != c.size())
+    throw InputError(message("blend_rests: ", rests.size(), " energies, ", c.size(), " weights"));
+  for (const DiscreteShells* rest : rests)
+    if (!same_terms(*rest)) throw InputError("blend_rests: the energies have different terms");
+  const size_t k = rests.size();
+  // Σ_j c_j ½ w_j (s − s̄_j)²: weight W = Σ c_j w_j, rest S = Σ c_j w_j s̄_j / W.
+  const auto blend_quadratic = [&](auto& terms, auto set_of_rest, auto rest_of) {
+    for (size_t e = 0; e < terms.size(); ++e) {
+      double weight = 0, moment = 0;
+      for (size_t j = 0; j < k; ++j) {
+        const auto& term = set_of_rest(*rests[j])[e];
+        weight += c[j] * term.weight;
+        moment += c[j] * term.weight * rest_of(term);
+      }
+      terms[e].weight = weight;
+      rest_of(terms[e]) = weight != 0 ? moment / weight : rest_of(set_of_rest(*rests[0])[e]);
+    }
+  };
+  blend_quadratic(
+      edges_.terms, [](const DiscreteShells& s) -> auto& { return s.edges_.terms; },
+      [](auto& term) -> auto& { return term.rest_length; });
+  blend_quadratic(
+      triangles_.terms, [](const DiscreteShells& s) -> auto& { return s.triangles_.terms; },
+      [](auto& term) -> auto& { return term.rest_area; });
+  // Σ_j c_j ½ w_j ‖(cos θ, sin θ) − (cos θ̄_j, sin θ̄_j)‖² = ½ |Z| ‖(cos θ, sin θ) − Z/|Z|‖² + const.
+  for (size_t e = 0; e < hinges_.terms.size(); ++e) {
+    double re = 0, im = 0;
+    for (size_t j = 0; j < k; ++j) {
+      const HingeTerm& term = rests[j]->hinges_.terms[e];
+      re += c[j] * term.weight * term.cos_rest;
+      im += c[j] * term.weight * term.sin_rest;
+    }
+    HingeTerm& term = hinges_.terms[e];
+    const double norm = std::hypot(re, im);
+    term.weight = norm;
+    if (norm > 0) {
+      term.cos_rest = re / norm;
+      term.sin_rest = im / norm;
+    }
+  }
+}
+
 DiscreteShells::TermCounts DiscreteShells::term_counts() const {
   return {static_cast<int>(edges_.terms.size()), static_cast<int>(triangles_.terms.size()),
           static_cast<int>(hinges_.terms.size())};
