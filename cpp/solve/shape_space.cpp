@@ -211,15 +211,12 @@ void ShapeSpace::prepare() {
     const RowMatrixX3d V = Eigen::Map<const RowMatrixX3d>(rest.data(), g, 3);
     energies_.push_back(std::make_unique<DiscreteShells>(V, basis.ghost_faces, material.bending,
                                                          material.membrane, material.paint));
-    if (j > 0 && !energies_[0]->same_terms(*energies_.back()))
-      throw InputError(message(
-          key_name(j - 1),
-          ": the key collapses part of the mesh (a triangle or an edge of the ghost has no size "
-          "in it), so it cannot serve as a rest shape; fix the key"));
   }
   blended_ = std::make_unique<DiscreteShells>(
       Eigen::Map<const RowMatrixX3d>(ghost_rest_.data(), g, 3), basis.ghost_faces, material.bending,
       material.membrane, material.paint);
+  matches_.clear();
+  for (const auto& energy : energies_) matches_.push_back(blended_->match_terms(*energy));
   const Eigen::MatrixXd free = ghost_vectors_.rightCols(r - num_rigid_);
   rest_hessians_.clear();
   for (Eigen::Index j = 0; j <= k; ++j) {
@@ -263,7 +260,7 @@ void ShapeSpace::blend(const VectorRef& weights, Eigen::Ref<Eigen::VectorXf> out
   c[0] = 1.0 - weights.sum();
   for (Eigen::Index i = 0; i < k; ++i) c[static_cast<size_t>(i) + 1] = weights[i];
   for (size_t j = 0; j < c.size(); ++j) rests[j] = energies_[j].get();
-  blended_->blend_rests(rests, c);
+  blended_->blend_rests(rests, matches_, c);
   // From the linear blend, rigid coordinates held, with (Σ |c_j| H_j)⁻¹.
   const Eigen::VectorXd linear = data_.coordinates * weights;
   q_ = linear;

@@ -93,8 +93,8 @@ class ShapeSpace {
  public:
   // basis: of the rest mesh, validated here; keys: k ≥ 1 arrays #V by 3 (mesh units), finite, in
   // range. Throws InputError naming the key that is wrong: another vertex count, a non-finite
-  // coordinate, a key whose ghost shape has a triangle or edge collapsed (no rest for the energy
-  // there), more than kMaxKeys keys, a region basis, or a basis baked for ARAP.
+  // coordinate, more than kMaxKeys keys, a region basis. A key's element of zero size (its rest
+  // has no term there) leaves the key out of that element's blend.
   ShapeSpace(const Basis& basis, const std::vector<RowMatrixX3d>& keys);
   // A space stored as `data` (validated: InputError naming what is wrong).
   explicit ShapeSpace(ShapeSpaceData data);
@@ -131,6 +131,7 @@ class ShapeSpace {
   // Energies of the ghost with the rest (0) and each key (1 … k) as the rest, and the blend.
   std::vector<std::unique_ptr<DiscreteShells>> energies_;
   std::unique_ptr<DiscreteShells> blended_;
+  std::vector<DiscreteShells::TermMatch> matches_;  // the blend's terms in each energy
   // Reduced Hessians at each rest over the non-rigid coordinates ((r − num_rigid)², k + 1).
   std::vector<Eigen::MatrixXd> rest_hessians_;
   std::unique_ptr<FinePositions> map_;

@@ -78,8 +78,9 @@ class ShapeSpace:
     ``V`` (n, 3), ``F`` (m, 3): the basis mesh (the weight-0 shape); ``shapes``: the keys, a list of
     (n, 3) arrays. The rest mesh's basis is baked with the options below (``bake``'s), or
     ``basis`` is one baked for (V, F) already (an object's stored basis). Raises ValueError naming
-    a key of another vertex count, a non-finite coordinate, a key that collapses part of the mesh
-    (no rest for the energy there), or more than ``MAX_KEYS`` keys; a region basis is refused.
+    a key of another vertex count, a non-finite coordinate, or more than ``MAX_KEYS`` keys; a
+    region basis is refused. A key may equal the basis or other keys (it adds no column) and may
+    fold or collapse the mesh (an element of zero size in a key adds nothing to its term's blend).
     """
 
     @_options.takes_options(BAKE_OPTIONS, exclude=("region",))
