@@ -5,6 +5,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numeric>
 #include <type_traits>
 
@@ -618,6 +619,72 @@ DiscreteShells::DiscreteShells(const VerticesRef& V, const FacesRef& F, double b
   finish_set(edges_, sparsity_, partition_);
   finish_set(triangles_, sparsity_, partition_);
   finish_set(hinges_, sparsity_, partition_);
+}
+
+DiscreteShells::TermMatch DiscreteShells::match_terms(const DiscreteShells& other) const {
+  const auto match = [](const auto& mine, const auto& theirs) {
+    using Vertices = decltype(mine.terms[0].vertices);
+    std::map<Vertices, int> index;
+    for (size_t e = 0; e < theirs.terms.size(); ++e)
+      index.emplace(theirs.terms[e].vertices, static_cast<int>(e));
+    std::vector<int> found(mine.terms.size(), -1);
+    for (size_t e = 0; e < mine.terms.size(); ++e)
+      if (const auto it = index.find(mine.terms[e].vertices); it != index.end())
+        found[e] = it->second;
+    return found;
+  };
+  return {match(edges_, other.edges_), match(triangles_, other.triangles_),
+          match(hinges_, other.hinges_)};
+}
+
+void DiscreteShells::blend_rests(const std::vector<const DiscreteShells*>& rests,
+                                 const std::vector<TermMatch>& matches,
+                                 const std::vector<double>& c) {
+  if (rests.size() != c.size() || matches.size() != c.size())
+    throw InputError(message("blend_rests: ", rests.size(), " energies, ", matches.size(),
+                             " matches, ", c.size(), " weights"));
+  const size_t k = rests.size();
+  // Σ_j c_j ½ w_j (s − s̄_j)²: weight W = Σ c_j w_j, rest S = Σ c_j w_j s̄_j / W.
+  const auto blend_quadratic = [&](auto& terms, auto set_of, auto match_of, auto rest_of) {
+    for (size_t e = 0; e < terms.size(); ++e) {
+      double weight = 0, moment = 0;
+      for (size_t j = 0; j < k; ++j) {
+        const int m = match_of(matches[j])[e];
+        if (m < 0 || c[j] == 0) continue;
+        const auto& term = set_of(*rests[j])[static_cast<size_t>(m)];
+        weight += c[j] * term.weight;
+        moment += c[j] * term.weight * rest_of(term);
+      }
+      terms[e].weight = weight;
+      if (weight != 0) rest_of(terms[e]) = moment / weight;
+    }
+  };
+  blend_quadratic(
+      edges_.terms, [](const DiscreteShells& s) -> auto& { return s.edges_.terms; },
+      [](const TermMatch& m) -> auto& { return m.edges; },
+      [](auto& term) -> auto& { return term.rest_length; });
+  blend_quadratic(
+      triangles_.terms, [](const DiscreteShells& s) -> auto& { return s.triangles_.terms; },
+      [](const TermMatch& m) -> auto& { return m.triangles; },
+      [](auto& term) -> auto& { return term.rest_area; });
+  // Σ_j c_j ½ w_j ‖(cos θ, sin θ) − (cos θ̄_j, sin θ̄_j)‖² = ½ |Z| ‖(cos θ, sin θ) − Z/|Z|‖² + const.
+  for (size_t e = 0; e < hinges_.terms.size(); ++e) {
+    double re = 0, im = 0;
+    for (size_t j = 0; j < k; ++j) {
+      const int m = matches[j].hinges[e];
+      if (m < 0 || c[j] == 0) continue;
+      const HingeTerm& term = rests[j]->hinges_.terms[static_cast<size_t>(m)];
+      re += c[j] * term.weight * term.cos_rest;
+      im += c[j] * term.weight * term.sin_rest;
+    }
+    HingeTerm& term = hinges_.terms[e];
+    const double norm = std::hypot(re, im);
+    term.weight = norm;
+    if (norm > 0) {
+      term.cos_rest = re / norm;
+      term.sin_rest = im / norm;
+    }
+  }
 }
 
 DiscreteShells::TermCounts DiscreteShells::term_counts() const {

@@ -106,6 +106,26 @@ class DiscreteShells final : public Energy {
   RowMatrixXd third_batch(const VectorRef& x, const Eigen::Ref<const Eigen::MatrixXd>& Phi,
                           const std::vector<std::array<int, 2>>& pairs) const;
 
+  // For each term of this energy, the index of the term of `other` (an energy of the same faces at
+  // another rest) over the same vertices, or −1 where `other` has none (an element degenerate in
+  // one rest and not in the other has a term in one only).
+  struct TermMatch {
+    std::vector<int> edges, triangles, hinges;
+  };
+  TermMatch match_terms(const DiscreteShells& other) const;
+
+  // The blend of energies of one mesh at several rests (shape_space.h): Σ_j c_j E_j with E_j =
+  // *rests[j] and matches[j] = match_terms(*rests[j]), up to a constant, is again a shells energy:
+  // per term, Σ_j c_j ½ w_j (s − s̄_j)² = ½ W (s − S)² + const with W = Σ_j c_j w_j and
+  // S = Σ_j c_j w_j s̄_j / W, and for a hinge Σ_j c_j ½ w_j (2 sin((θ − θ̄_j)/2))² =
+  // ½ |Z| (2 sin((θ − arg Z)/2))² + const with Z = Σ_j c_j w_j e^{iθ̄_j}. This energy's terms take
+  // those rests and weights (a rest without the term adds nothing to it; collapse thresholds and
+  // hinge fades stay this energy's): one evaluation costs what one energy's does, however many
+  // rests are blended. W ≤ 0 (negative c_j) makes a term concave; W = 0 leaves it out.
+  // O(#rests · #terms). Not thread-safe with evaluations.
+  void blend_rests(const std::vector<const DiscreteShells*>& rests,
+                   const std::vector<TermMatch>& matches, const std::vector<double>& c);
+
   struct TermCounts {
     int edges, triangles, hinges;
   };

@@ -5,7 +5,7 @@
 The pipeline, one module per stage: ``mesh`` (check, mass, reading), ``energy`` (discrete
 shells, ARAP), ``modes`` (vibration modes, rigid motions, modal-derivative solves), ``reduction``
 (the ghost), ``bake`` (the whole preprocess, mesh to Basis), ``solve`` (posing), ``dynamics``
-(secondary motion); ``testing`` holds the generated test shapes.
+(secondary motion), ``shapes`` (shape keys blended as shapes); ``testing`` holds the generated test shapes.
 """
 
 from .._native import Cancelled, OutOfMemoryError
@@ -19,6 +19,7 @@ from .mesh import check, mass, read_mesh
 from .modes import rigid_motions, solve_in_range, vibration_modes
 from .reduction import ghost_mesh, restrict_to_ghost
 from .rig import skin
+from .shapes import BLEND_OPTIONS, ShapeSpace
 from .solve import (
     FULL_SOLVE_OPTIONS,
     SOLVE_OPTIONS,
@@ -34,6 +35,7 @@ __all__ = [
     "Arap",
     "BAKE_OPTIONS",
     "BAKE_STAGES",
+    "BLEND_OPTIONS",
     "Basis",
     "Cancelled",
     "DiscreteShells",
@@ -44,6 +46,7 @@ __all__ = [
     "SIMULATION_OPTIONS",
     "SOLVER_OPTIONS",
     "SOLVE_OPTIONS",
+    "ShapeSpace",
     "Simulation",
     "bake",
     "check",

@@ -1,0 +1,86 @@
+"""Shape blending (issue 52): per-blend time and the space's bake time per key count on the dragon.
+
+    PYTHONPATH=python_addon python3 bench/shape_space.py [res3|res2 ...]
+
+Keys are smooth deformations of the rest mesh (a part beyond a plane across the longest axis swung
+about an axis through the centre, by an angle that rises smoothly across the plane). Prints one
+JSON line per mesh: the basis bake's seconds, the space's bake seconds per key count, and the
+median blend milliseconds (map included) over fixed random weights, with BFGS iterations.
+"""
+
+import json
+import os
+import sys
+import time
+
+import numpy as np
+
+import modal_deform.core as mdc
+
+MESHES = os.path.join(os.path.dirname(__file__), "..", "..", "shared", "meshes")
+
+
+def smooth_keys(V, count, seed=1):
+    rng = np.random.default_rng(seed)
+    centre = V.mean(0)
+    extent = V.max(0) - V.min(0)
+    long = int(np.argmax(extent))
+    t = (V[:, long] - V[:, long].min()) / extent[long]
+    keys = []
+    for j in range(count):
+        cut = 0.3 + 0.4 * rng.random()
+        side = 1 if j % 2 else -1
+        s = np.clip((side * (t - cut)) / 0.2 + 0.5, 0, 1)
+        s = s * s * (3 - 2 * s)
+        axis = rng.normal(size=3)
+        angle = (0.6 + 0.6 * rng.random()) * (1 if rng.random() < 0.5 else -1)
+        pivot = centre.copy()
+        pivot[long] = V[:, long].min() + cut * extent[long]
+        # each vertex turned by its own fraction s of the angle about the pivot (Rodrigues)
+        angles = angle * s
+        a = axis / np.linalg.norm(axis)
+        P = V - pivot
+        cos, sin = np.cos(angles)[:, None], np.sin(angles)[:, None]
+        X = P * cos + np.cross(a, P) * sin + a * (P @ a)[:, None] * (1 - cos) + pivot
+        keys.append(X)
+    return keys
+
+
+def main(names):
+    for name in names:
+        V, F = mdc.read_mesh(os.path.join(MESHES, f"dragon_vrip_{name}.ply.gz"))
+        t = time.perf_counter()
+        basis = mdc.bake(V, F)
+        bake_s = time.perf_counter() - t
+        keys = smooth_keys(V, 8)
+        result = {"mesh": name, "vertices": len(V), "basis_bake_s": bake_s, "space_bake_s": {}}
+        for k in (1, 2, 4, 8):
+            t = time.perf_counter()
+            space = mdc.ShapeSpace(V, F, keys[:k], basis=basis)
+            result["space_bake_s"][k] = time.perf_counter() - t
+        rng = np.random.default_rng(2)
+        out = np.empty((len(V), 3), np.float32)
+        ms, solve_ms, iterations, converged = [], [], [], 0
+        for _ in range(30):
+            w = rng.random(8) * (rng.random(8) < 0.5)
+            t = time.perf_counter()
+            space.blend(w, out=out)
+            ms.append(1e3 * (time.perf_counter() - t))
+            st = space.stats
+            solve_ms.append(st["solve_ms"])
+            iterations.append(st["iterations"])
+            converged += st["converged"]
+        result.update(
+            dimension=space.dimension,
+            blend_ms_median=float(np.median(ms)),
+            blend_ms_min=float(np.min(ms)),
+            solve_ms_median=float(np.median(solve_ms)),
+            iterations_median=float(np.median(iterations)),
+            iterations_max=int(np.max(iterations)),
+            converged=f"{converged}/30",
+        )
+        print(json.dumps(result), flush=True)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:] or ["res3", "res2"])
