@@ -6,8 +6,8 @@
 // stiffness-proportional Rayleigh damping relative to the controllers' motion, and solved by the
 // warm-started Bfgs. ρ and the damping β come from the artist's `period` (frames at `fps`) and
 // damping ratio, exact for the lowest flexible mode. The midpoint rule conserves the energy of a
-// quadratic potential only: on a nonlinear one it drifts either way (+48% in 13 periods of a bar
-// swinging at 15% of its length), and a check that only removes energy ratchets it down. So each
+// quadratic potential only: on a nonlinear one it drifts either way (bench/results/dynamics.json,
+// "energy"), and a check that only removes energy ratchets it down. So each
 // substep ends with an energy correction: the end velocity is rescaled, up or down, to the energy
 // the step should have, what it had plus the handles' work less the damping's (for a quadratic
 // potential the midpoint rule's own: there the correction vanishes). It needs no evaluation of the

@@ -29,11 +29,9 @@ no linearised rotation from it, so it does not drift.
 
 Cost of a blend, with k keys and r = basis dimension + k: O(k · ghost terms) to blend the rests,
 O(k r²) + r³/3 for the initial inverse Hessian, O(ghost vertices · r + r²) per BFGS iteration
-(15 to 30 on the bar's bend and twist, 35 to 100 on the dragon with 8 smooth keys: the one cost
-that is not yet where the issue wants it), and the map to the fine mesh O(n r) (16-bit vectors, as
-``ReducedSolver``), plus O(n) per key with a non-zero weight on a proxy. Measured on 2 busy cores
-(bench/shape_space.py, 8 keys, r = 80): 23k vertices 9.5 ms a blend (median), 100k 35 ms; the
-space's bake for 8 keys 0.44 s and 6.5 s, against 2.5 s and 13.4 s for the basis's bake. Weights outside [0, 1] (a negative weight
+(tens of them: the count, not an iteration's cost, keeps a blend above its target), and the map to
+the fine mesh O(n r) (16-bit vectors, as ``ReducedSolver``), plus O(n) per key with a non-zero
+weight on a proxy. bench/shape_space.py times blends and bakes. Weights outside [0, 1] (a negative weight
 makes the energy unbounded below) give the stationary point BFGS reaches from the linear blend;
 ``stats["converged"]`` says when none was reached.
 """
