@@ -7,8 +7,7 @@ constructor's time beside the one without a rig (the rig's projection on the bas
 step's median time per frame on the moving rig, and on the rig held still (the force computed, the
 solve at rest) beside the same still frame without a rig: the rig's own share; and the map.
 
-    PYTHONPATH=python_addon:tests /usr/bin/python3 bench/rig.py [--quick]
-    (MODAL_DEFORM_MESHES=<folder> when the scans are not in ../shared/meshes)
+    PYTHONPATH=python_addon /usr/bin/python3 bench/run.py --only rig [--quick]
 """
 
 import json
@@ -25,8 +24,6 @@ from support import SHARED_MESHES as MESHES
 import modal_deform.core as mdc
 
 FRAMES = 60
-# The shared scans; MODAL_DEFORM_MESHES for a checkout elsewhere (a git worktree).
-MESHES = pathlib.Path(os.environ.get("MODAL_DEFORM_MESHES", MESHES))
 
 
 def chain_weights(t, bones):
@@ -127,18 +124,3 @@ def run(quick=False):
         "bones": runs,
     }
     return {"frames": frames}, figures
-
-
-if __name__ == "__main__":
-    quick = "--quick" in sys.argv
-    start = time.perf_counter()
-    parameters, figures = run(quick)
-    print(json.dumps(figures, indent=1))
-    if not quick:
-        write(
-            "rig",
-            "PYTHONPATH=python_addon:tests /usr/bin/python3 bench/rig.py",
-            parameters,
-            figures,
-            time.perf_counter() - start,
-        )

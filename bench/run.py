@@ -32,6 +32,10 @@ Experiments (each writes bench/results/<name>.json: machine, commit, command, pa
   dynamics     secondary motion (issue 40): a free bar's period and decrement against the ones set, the
                step's cost per frame on the 23k and 100k dragons and the 1.6M one on a proxy, 1000 frames of
                fast random controllers, BFGS's tolerance (bench/dynamics.py)
+  rig          secondary motion on a rig: the 100k dragon on chains of 3, 30 and 100 bones, the step's
+               and the rig forces' cost per frame (bench/rig.py)
+  shape_space  shape blending: the blend's and the space's bake time per key count on the 23k and 100k
+               dragons, 8 smooth keys (bench/shape_space.py)
   blender      the add-on's pose update in headless Blender and Blender's Laplacian Deform
                (bench/blender_pose.py), in Debian's 3.4.1 app from the source tree
   bpy_pose     the pose update alone at 100k, 400k, 1.6M and 3.2M vertices in bpy 4.5 and 5.3 (.venv/bpy-<version>,
@@ -75,6 +79,8 @@ PYTHON_EXPERIMENTS = (
     "refine",
     "region",
     "dynamics",
+    "rig",
+    "shape_space",
 )
 EXPERIMENTS = (
     ("native",)
