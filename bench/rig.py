@@ -10,15 +10,10 @@ solve at rest) beside the same still frame without a rig: the rig's own share; a
     PYTHONPATH=python_addon /usr/bin/python3 bench/run.py --only rig [--quick]
 """
 
-import json
-import os
-import pathlib
-import sys
 import time
 
 import numpy as np
 import scipy.sparse
-from common import write
 from support import SHARED_MESHES as MESHES
 
 import modal_deform.core as mdc
