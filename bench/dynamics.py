@@ -331,6 +331,7 @@ def run(quick=False):
         print(f"   {name}: {time.perf_counter() - start:.0f} s", flush=True)
     parameters = {
         "defaults": {name: o.default for name, o in mdc.SIMULATION_OPTIONS.items()},
+        "pull": PULL,
         "bar_bake": BAR,
         "amplitude": AMPLITUDE,
     }

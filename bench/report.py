@@ -1679,7 +1679,8 @@ def section_dynamics(result):
         "## Secondary motion (issue 40)",
         "",
         f"`mdc.Simulation` with its defaults (period {d['period']:g} frames, damping ratio {d['damping']:g}, "
-        f"{d['fps']:g} fps, {d['substeps']} substeps, stiffness {d['stiffness']:g}, BFGS tolerance "
+        f"{d['fps']:g} fps, {d['substeps']} substeps, the handles' pull {p.get('pull', d.get('stiffness')):g}, "
+        f"BFGS tolerance "
         f"{d['tolerance']:g}, at most {d['max_iterations']} iterations a substep) unless said otherwise.",
         "",
         f"A free bar ({bar['vertices']} vertices, {bar['dimension']} dimensions) released from rest at "
@@ -1708,6 +1709,44 @@ def section_dynamics(result):
             ],
         )
     )
+    if "energy" in bar:
+        e = bar["energy"]
+        out += [
+            "",
+            f"Large undamped swings ({e['dimension']} dimensions, period {e['period']:g} frames): the total "
+            "energy over 10 periods, as a fraction of its start, with the energy correction's removals and "
+            "additions, at 2 substeps and at 32 (tolerance 1e-12):",
+            "",
+        ]
+        out.append(
+            table(
+                [
+                    "swing (of the length)",
+                    "substeps",
+                    "energy at the end",
+                    "lowest, highest",
+                    "removed",
+                    "added",
+                    "period measured",
+                    "amplitude after 10 periods",
+                ],
+                [
+                    [
+                        f"{100 * r['fraction_of_length']:g}%",
+                        name.split("_")[1],
+                        f"{run['energy_end']:.6f}",
+                        f"{run['energy_min']:.6f}, {run['energy_max']:.6f}",
+                        f"{run['energy_removed']:.2e}",
+                        f"{run['energy_added']:.2e}",
+                        f"{run['measured_period']:.3f}",
+                        f"{100 * run['amplitude_after_10_periods']:.2f}%",
+                    ]
+                    for r in e["rows"]
+                    for name, run in r.items()
+                    if name.startswith("substeps_")
+                ],
+            )
+        )
     out += ["", "Damped (the damped period is the set one over √(1−ζ²)):", ""]
     out.append(
         table(
@@ -1824,6 +1863,78 @@ def section_dynamics(result):
     return "\n".join(out)
 
 
+def section_rig(result):
+    p, f = result["parameters"], result["figures"]
+    plain = f["without_rig"]
+    rows = [
+        [
+            bones,
+            f"{r['construct_s']:.2f}",
+            f"{r['step_ms']:.2f} ({r['step_ms_p95']:.2f})",
+            f"{r['still_step_ms']:.3f}",
+            f"{r['map_ms']:.2f}",
+        ]
+        for bones, r in f["bones"].items()
+    ]
+    out = [
+        "## Secondary motion on a rig",
+        "",
+        f"`mdc.Simulation(..., rig=W)`, the {f['mesh']} ({f['vertices']} vertices, {f['dimension']} "
+        f"dimensions) on chains of bones, {p['frames']} frames. Per frame, medians: the step with the rig "
+        "moving (95th percentile), the step with it still at rest, and the map to the fine mesh. Without a "
+        f"rig: made in {plain['construct_s']:.2f} s, a still step {plain['step_ms']:.3f} ms.",
+        "",
+        table(["bones", "made in (s)", "step, moving (ms)", "step, still (ms)", "map (ms)"], rows),
+        "",
+        provenance(result),
+    ]
+    return "\n".join(out)
+
+
+def section_shape_space(result):
+    p, f = result["parameters"], result["figures"]
+    rows = [
+        [
+            r["mesh"],
+            r["vertices"],
+            r["dimension"],
+            f"{r['basis_bake_s']:.2f}",
+            ", ".join(f"{k}: {s:.2f}" for k, s in r["space_bake_s"].items()),
+            f"{r['blend_ms_median']:.1f} ({r['blend_ms_min']:.1f})",
+            f"{r['solve_ms_median']:.1f}",
+            f"{r['iterations_median']:g} / {r['iterations_max']}",
+            f"{r['converged']}/{p['blends']}",
+        ]
+        for r in f.values()
+    ]
+    out = [
+        "## Shape blending (issue 52)",
+        "",
+        f"`mdc.ShapeSpace` of {p['keys']} smooth keys of the dragon, {p['blends']} blends of random "
+        "weights: the basis's bake, the space's bake per key count (s), a blend with the map (ms, median "
+        "and least), its minimisation alone, BFGS's iterations. The issue's target: a blend at 100k with "
+        "8 keys in at most 4 ms.",
+        "",
+        table(
+            [
+                "mesh",
+                "vertices",
+                "dimension",
+                "basis bake (s)",
+                "space bake by keys (s)",
+                "blend (ms)",
+                "solve (ms)",
+                "iterations",
+                "converged",
+            ],
+            rows,
+        ),
+        "",
+        provenance(result),
+    ]
+    return "\n".join(out)
+
+
 SECTIONS = (
     ("table1", section_table1),
     ("accuracy", section_accuracy),
@@ -1842,6 +1953,8 @@ SECTIONS = (
     ("refine", section_refine),
     ("region", section_region),
     ("dynamics", section_dynamics),
+    ("rig", section_rig),
+    ("shape_space", section_shape_space),
     ("playback", section_playback),
 )
 
