@@ -68,12 +68,15 @@ void from_python(pybind11::handle value, T& field, const char* name) {
     field = energy_kind(value.cast<std::string>());
     return;
   } else {
-    // A flag takes only True or False (numpy's too); an integer no float, and no flag.
+    // A flag takes only True or False (numpy's too); an integer only what has __index__ (no float
+    // of any kind, which pybind11 would truncate) and no flag.
     const std::string type = pybind11::str(value.get_type().attr("__name__"));
     const bool flag = type == "bool" || type == "bool_";
     bool fits = true;
     if constexpr (std::is_same_v<T, bool>)
       fits = flag;
+    else if constexpr (std::is_integral_v<T>)
+      fits = !flag && PyIndex_Check(value.ptr());
     else if constexpr (std::is_arithmetic_v<T>)
       fits = !flag && !pybind11::isinstance<pybind11::str>(value);
     try {

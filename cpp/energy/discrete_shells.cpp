@@ -698,11 +698,26 @@ double DiscreteShells::value(const VectorRef& x) const {
   for_each_set([&](const auto& set) {
     using Term = typename std::decay_t<decltype(set.terms)>::value_type;
     const int count = static_cast<int>(set.terms.size());
-#pragma omp parallel for reduction(+ : energy) schedule(static) if (parallel())
-    for (int e = 0; e < count; ++e) {
-      double r[kDofsOf<Term>];
-      energy += respond_at(set.terms[e], x.data(), r).f;
+    if (!parallel()) {
+      for (int e = 0; e < count; ++e) {
+        double r[kDofsOf<Term>];
+        energy += respond_at(set.terms[e], x.data(), r).f;
+      }
+      return;
     }
+    // Blocks of a fixed size summed in their order: the same bits whatever the threads.
+    constexpr int kBlock = 4096;
+    std::vector<double> partial((count + kBlock - 1) / kBlock, 0.0);
+#pragma omp parallel for schedule(static)
+    for (int b = 0; b < static_cast<int>(partial.size()); ++b) {
+      double sum = 0;
+      for (int e = b * kBlock; e < std::min(count, (b + 1) * kBlock); ++e) {
+        double r[kDofsOf<Term>];
+        sum += respond_at(set.terms[e], x.data(), r).f;
+      }
+      partial[b] = sum;
+    }
+    for (double sum : partial) energy += sum;
   });
   return energy;
 }
@@ -721,15 +736,18 @@ double DiscreteShells::value_and_gradient(const VectorRef& x,
     });
     return energy;
   }
-#pragma omp parallel for reduction(+ : energy) schedule(static, 1)
+  // Each part's energy apart, summed in the parts' order: the same bits whatever the threads.
+  std::vector<double> part_energy(partition_.parts(), 0.0);
+#pragma omp parallel for schedule(static, 1)
   for (int part = 0; part < partition_.parts(); ++part) {
     const VertexPartition::Range owned = partition_.range(part);
     gradient.segment(3 * owned.first, 3 * (owned.last - owned.first)).setZero();
     for_each_term(part, [&](const auto& term, int) {
       const double f = add_gradient(term, x.data(), owned, gradient.data());
-      if (owned.contains(term.vertices[0])) energy += f;
+      if (owned.contains(term.vertices[0])) part_energy[part] += f;
     });
   }
+  for (double e : part_energy) energy += e;
   return energy;
 }
 

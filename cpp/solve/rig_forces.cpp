@@ -12,6 +12,18 @@ void check_skinning_weights(const SkinningWeights& weights, int num_vertices) {
     throw InputError(message("rig: expected skinning weights for ", num_vertices,
                              " vertices (one row each), got ", weights.rows(), " rows"));
   if (weights.cols() < 1) throw InputError("rig: expected at least one bone (column), got none");
+  // The structure first: every later loop indexes by it.
+  const auto* outer = weights.outerIndexPtr();
+  if (!weights.isCompressed() || outer[0] != 0 || outer[weights.outerSize()] != weights.nonZeros())
+    throw InputError("rig: the sparse matrix's row pointers do not span its entries");
+  for (int i = 0; i < weights.outerSize(); ++i) {
+    if (outer[i + 1] < outer[i])
+      throw InputError(message("rig: the sparse matrix's row pointers decrease at row ", i));
+    for (auto k = outer[i]; k < outer[i + 1]; ++k)
+      if (weights.innerIndexPtr()[k] < 0 || weights.innerIndexPtr()[k] >= weights.cols())
+        throw InputError(message("rig: row ", i, " names bone ", weights.innerIndexPtr()[k],
+                                 ", not one of the ", weights.cols(), " columns"));
+  }
   for (int i = 0; i < weights.outerSize(); ++i) {
     double sum = 0;
     for (SkinningWeights::InnerIterator it(weights, i); it; ++it) {

@@ -264,6 +264,12 @@ void ShapeSpace::blend(const VectorRef& weights, Eigen::Ref<Eigen::VectorXf> out
   // From the linear blend, rigid coordinates held, with (Σ |c_j| H_j)⁻¹.
   const Eigen::VectorXd linear = data_.coordinates * weights;
   q_ = linear;
+  stats_ = {};
+  if (free == 0) {  // nothing but rigid coordinates: the linear blend is the blend
+    stats_.converged = true;
+    write_positions(weights, out, start);
+    return;
+  }
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(free, free);
   for (size_t j = 0; j < c.size(); ++j)
     if (c[j] != 0) H += std::abs(c[j]) * rest_hessians_[j];
@@ -283,7 +289,6 @@ void ShapeSpace::blend(const VectorRef& weights, Eigen::Ref<Eigen::VectorXf> out
                     options.max_iterations, options.tolerance);
   q_.head(num_rigid_) = linear.head(num_rigid_);
   q_.tail(free) = bfgs.x();
-  stats_ = {};
   stats_.iterations = result.iterations;
   stats_.evaluations = result.evaluations;
   stats_.converged = result.converged;
@@ -291,6 +296,20 @@ void ShapeSpace::blend(const VectorRef& weights, Eigen::Ref<Eigen::VectorXf> out
   stats_.energy = bfgs.value();
   stats_.gradient_norm = bfgs.gradient().norm();
   stats_.solve_ms = milliseconds_since(solve_start);
+  // Weights whose rest weight 1 − Σ w_i is negative can leave the energy without a minimum (two
+  // keys at 1 that stretch the same elements): a blend that ran off farther than the model's size
+  // from the linear blend is none, and the linear blend is returned instead.
+  const double moved = (ghost_vectors_ * (q_ - linear)).cwiseAbs().maxCoeff();
+  if (!(moved <= kMaxBlendDeparture)) {
+    q_ = linear;
+    stats_.converged = false;
+    stats_.diverged = true;
+  }
+  write_positions(weights, out, start);
+}
+
+void ShapeSpace::write_positions(const VectorRef& weights, Eigen::Ref<Eigen::VectorXf> out,
+                                 std::chrono::steady_clock::time_point start) {
   map_->write(q_.cast<float>(), out);
   for (Eigen::Index i = 0; i < data_.residuals.rows(); ++i)
     if (weights[i] != 0) out += static_cast<float>(weights[i]) * data_.residuals.row(i).transpose();

@@ -28,6 +28,7 @@
 // Not thread-safe: one space per thread.
 #pragma once
 
+#include <chrono>
 #include <memory>
 #include <vector>
 
@@ -41,11 +42,16 @@ namespace modal_deform {
 // Keys a space takes at most.
 constexpr int kMaxKeys = 1000;
 
+// The farthest a blend may move a ghost vertex from the linear blend, in the normalised frame
+// (the model's longest side is 10): beyond, the blend has run off (BlendStats::diverged).
+constexpr double kMaxBlendDeparture = 20.0;
+
 struct BlendStats {
   int iterations = 0;        // BFGS steps of the last blend
   int evaluations = 0;       // evaluations of the blended energy
   bool converged = false;    // the stopping test holds at the blend returned
   bool stalled = false;      // not converged, and no step decreases the energy
+  bool diverged = false;     // ran off with no minimum in reach: the linear blend was returned
   double energy = 0;         // the blended energy at the blend (up to a constant)
   double gradient_norm = 0;  // ‖∇f‖ over the non-rigid coordinates
   double solve_ms = 0;       // the minimisation, milliseconds
@@ -62,6 +68,7 @@ void for_each_blend_stat(Visit&& visit) {
   visit("energy", [](auto& s) -> auto& { return s.energy; });
   visit("gradient_norm", [](auto& s) -> auto& { return s.gradient_norm; });
   visit("stalled", [](auto& s) -> auto& { return s.stalled; });
+  visit("diverged", [](auto& s) -> auto& { return s.diverged; });
 }
 
 // What one blend may spend.
@@ -120,6 +127,9 @@ class ShapeSpace {
   int num_vertices() const { return data_.basis.num_vertices(); }
 
  private:
+  // x̄ + U q_ (+ the weighted residuals on a proxy) into `out`; the time since `start` in stats_.
+  void write_positions(const VectorRef& weights, Eigen::Ref<Eigen::VectorXf> out,
+                       std::chrono::steady_clock::time_point start);
   void prepare();
   double objective(const Eigen::VectorXd& z, Eigen::VectorXd& gradient);
 

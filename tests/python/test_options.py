@@ -73,6 +73,9 @@ def test_the_core_names_the_option_it_refuses(tube):
         mdc.bake(V, F, modes=0)
     with pytest.raises(ValueError, match="modes: expected an integer, got 2.5"):
         mdc.bake(V, F, modes=2.5)
+    for not_whole in (np.float32(3.9), np.float64(3.0)):
+        with pytest.raises(ValueError, match="substeps: expected an integer"):
+            mdc.Simulation(basis, handles, substeps=not_whole)
     with pytest.raises(ValueError, match="rotation_pairs: expected True or False, got 1"):
         mdc.bake(V, F, rotation_pairs=1)
     with pytest.raises(ValueError, match="energy"):

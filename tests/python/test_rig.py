@@ -302,3 +302,17 @@ def test_bad_rigs_are_refused_with_a_message(tube):
     assert sim.rig_state is None  # nothing taken from a refused frame
     with pytest.raises(ValueError, match="without a rig"):
         mdc.Simulation(basis, [attach]).step([np.eye(4)], bones=bad)
+
+
+def test_sparse_weights_naming_no_column_are_refused(tube):
+    V, basis, W, attach, top = tube
+    n = len(V)
+    rows = np.arange(n + 1, dtype=np.int32)
+    for column in (5_000_000, -7):
+        built = scipy.sparse.csr_matrix(
+            (np.ones(n), np.full(n, column, np.int32), rows), shape=(n, 3)
+        )
+        with pytest.raises(ValueError, match="rig"):
+            mdc.Simulation(basis, [attach], rig=built)
+        with pytest.raises(ValueError, match="rig"):
+            mdc.skin(V, built, chain())

@@ -248,3 +248,32 @@ def test_many_keys(bar, basis):
     assert np.isfinite(X).all()
     with pytest.raises(ValueError, match="up to"):
         mdc.ShapeSpace(V, F, [V] * (mdc.shapes.MAX_KEYS + 1), basis=basis)
+
+
+def test_weights_with_no_minimum_give_the_linear_blend_and_say_so(bar, basis):
+    V, F = bar
+    stretched = V.copy()
+    stretched[:, 2] *= 2.0
+    also = stretched.copy()
+    also[:, 0] += 0.05 * (V[:, 2] / 4) ** 2
+    space = mdc.ShapeSpace(V, F, [stretched, also], basis=basis)
+    for weights in ([1.0, 1.0], [1.0, 0.999]):
+        X = space.blend(weights)
+        linear = V + sum(w * (k - V) for w, k in zip(weights, (stretched, also)))
+        assert np.ptp(X[:, 2]) < 2 * np.ptp(linear[:, 2])
+        if space.stats["diverged"]:
+            assert not space.stats["converged"]
+            assert np.abs(X - linear).max() < 1e-4 * np.ptp(V)
+    assert space.blend([0.5, 0.0]) is not None and not space.stats["diverged"]
+
+
+def test_a_space_with_only_rigid_coordinates_blends_linearly(bar):
+    V, F = bar
+    arrays = mdc.bake(V, F, modes=7, derivatives=0).to_arrays()
+    arrays["vectors"] = np.ascontiguousarray(arrays["vectors"][:, :6])
+    arrays["ghost_vectors"] = np.ascontiguousarray(arrays["ghost_vectors"][:, :6])
+    arrays["num_modes"] = np.array(6, dtype=np.int32)
+    arrays["eigenvalues"] = arrays["eigenvalues"][:6].copy()
+    space = mdc.ShapeSpace(V, F, [V.copy()], basis=mdc.Basis.from_arrays(arrays))
+    X = space.blend([0.5])
+    assert np.abs(X - V).max() < 1e-4 * np.ptp(V) and space.stats["converged"]

@@ -29,6 +29,10 @@ def skinning_weights(W, num_vertices):
         raise ValueError(
             f"rig: expected ({num_vertices}, bones) weights (one row per vertex), got {W.shape}"
         )
+    try:  # the index arrays of a matrix built from them are not checked by scipy
+        W.check_format(full_check=True)
+    except ValueError as error:
+        raise ValueError(f"rig: not a valid sparse matrix ({error})") from None
     W.sum_duplicates()
     W.sort_indices()
     _native.check_skinning_weights(W, num_vertices)

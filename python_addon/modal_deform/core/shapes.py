@@ -131,7 +131,10 @@ class ShapeSpace:
     def stats(self):
         """The last blend's {"iterations", "converged", "ms" (the whole blend, the map included),
         "solve_ms" (the minimisation), "evaluations", "energy" (the blended energy, up to a
-        constant), "gradient_norm", "stalled"}; empty before the first blend."""
+        constant), "gradient_norm", "stalled", "diverged"}; empty before the first blend.
+        "diverged": the minimisation ran off farther than the model's size from the linear blend
+        (weights whose rest weight 1 - sum(w) is negative can leave the energy without a minimum,
+        such as two keys at 1 that stretch the same part); the linear blend is returned then."""
         return dict(self._stats)
 
     @_options.takes_options(BLEND_OPTIONS)
