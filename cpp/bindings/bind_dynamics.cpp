@@ -17,23 +17,41 @@ namespace py = pybind11;
 
 namespace modal_deform {
 
+namespace {
+
+// Skinning weights as the core keeps them, made from the compressed-row arrays that
+// modal_deform.core.rig passes: pybind11 reads Eigen's sparse matrices from SciPy's, and Blender's
+// Python has no SciPy.
+struct RigWeights {
+  SkinningWeights weights;
+};
+
+}  // namespace
+
 void bind_dynamics(py::module_& m) {
   const auto simulation_options = [](auto visit) { for_each_simulation_option(visit); };
   m.attr("SIMULATION_OPTIONS") = option_table<SimulationOptions>(simulation_options);
-  m.def("check_skinning_weights", &check_skinning_weights, py::arg("weights"),
-        py::arg("num_vertices"));
+  py::class_<RigWeights>(m, "SkinningWeights")
+      .def(py::init([](int num_vertices, int num_bones, const Eigen::VectorXi& row_pointers,
+                       const Eigen::VectorXi& columns, const Eigen::VectorXd& values) {
+             return RigWeights{skinning_weights_from_rows(num_vertices, num_bones, row_pointers,
+                                                          columns, values)};
+           }),
+           py::arg("num_vertices"), py::arg("num_bones"), py::arg("row_pointers"),
+           py::arg("columns"), py::arg("values"))
+      .def_property_readonly("num_bones", [](const RigWeights& rig) { return rig.weights.cols(); });
   m.def("check_bone_matrices", &check_bone_matrices, py::arg("bones"), py::arg("num_bones"));
   py::class_<ReducedDynamics>(m, "Simulation")
-      .def(py::init([simulation_options](
-                        const Basis& basis, const std::vector<Eigen::VectorXi>& handles,
-                        const VectorRef& weights, const std::string& energy,
-                        const std::optional<SkinningWeights>& rig, const py::kwargs& keywords) {
+      .def(py::init([simulation_options](const Basis& basis,
+                                         const std::vector<Eigen::VectorXi>& handles,
+                                         const VectorRef& weights, const std::string& energy,
+                                         const RigWeights* rig, const py::kwargs& keywords) {
              const SimulationOptions options =
                  from_keywords<SimulationOptions>(keywords, simulation_options, "Simulation");
              const EnergyKind kind = energy_kind(energy);
              py::gil_scoped_release release;
              return std::make_unique<ReducedDynamics>(basis, to_handles(handles), weights, options,
-                                                      kind, rig ? &*rig : nullptr);
+                                                      kind, rig ? &rig->weights : nullptr);
            }),
            py::arg("basis"), py::arg("handles"), py::arg("weights"), py::arg("energy"),
            py::arg("rig"), py::keep_alive<1, 2>())

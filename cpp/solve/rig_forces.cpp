@@ -44,6 +44,39 @@ void check_skinning_weights(const SkinningWeights& weights, int num_vertices) {
   }
 }
 
+SkinningWeights skinning_weights_from_rows(int num_vertices, int num_bones,
+                                           const Eigen::VectorXi& row_pointers,
+                                           const Eigen::VectorXi& columns,
+                                           const Eigen::VectorXd& values) {
+  if (num_vertices < 0 || num_bones < 1)
+    throw InputError(message("rig: expected (vertices, bones) weights with a bone at least, got (",
+                             num_vertices, ", ", num_bones, ")"));
+  if (row_pointers.size() != num_vertices + 1 || columns.size() != values.size())
+    throw InputError(message("rig: expected ", num_vertices + 1,
+                             " row pointers and as many column "
+                             "indices as values, got ",
+                             row_pointers.size(), ", ", columns.size(), " and ", values.size()));
+  if (row_pointers[0] != 0 || row_pointers[num_vertices] != values.size())
+    throw InputError("rig: the row pointers do not span the values");
+  for (int i = 0; i < num_vertices; ++i)
+    if (row_pointers[i + 1] < row_pointers[i])
+      throw InputError(message("rig: the row pointers decrease at row ", i));
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(static_cast<size_t>(values.size()));
+  for (int i = 0; i < num_vertices; ++i)
+    for (int k = row_pointers[i]; k < row_pointers[i + 1]; ++k) {
+      if (columns[k] < 0 || columns[k] >= num_bones)
+        throw InputError(message("rig: row ", i, " names bone ", columns[k], ", not one of the ",
+                                 num_bones, " columns"));
+      entries.emplace_back(i, columns[k], values[k]);
+    }
+  SkinningWeights weights(num_vertices, num_bones);
+  weights.setFromTriplets(entries.begin(), entries.end());
+  weights.makeCompressed();
+  check_skinning_weights(weights, num_vertices);
+  return weights;
+}
+
 void check_bone_matrices(const Transforms& bones, int num_bones) {
   if (static_cast<int>(bones.size()) != num_bones)
     throw InputError(message("bones: expected ", num_bones,

@@ -51,6 +51,14 @@ constexpr double kSingularBone = 1e-9;
 // their own, the object's world matrix, as the Armature modifier leaves them there).
 void check_skinning_weights(const SkinningWeights& weights, int num_vertices);
 
+// Skinning weights from compressed-row arrays (row pointers #V + 1, column indices and values
+// alike long): the structure is checked before anything indexes by it (InputError naming what is
+// wrong), repeated entries of a row are summed; then check_skinning_weights.
+SkinningWeights skinning_weights_from_rows(int num_vertices, int num_bones,
+                                           const Eigen::VectorXi& row_pointers,
+                                           const Eigen::VectorXi& columns,
+                                           const Eigen::VectorXd& values);
+
 // Throws InputError unless there is one bone matrix per bone, finite, affine (last row 0 0 0 1)
 // and invertible.
 void check_bone_matrices(const Transforms& bones, int num_bones);

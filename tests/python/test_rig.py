@@ -2,6 +2,10 @@
 mdc.skin (cpp/solve/rig_forces.h). A tube along z on a chain of three bones, weighted linearly
 between the bones' centres, attached at its bottom."""
 
+import os
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 import scipy.sparse
@@ -316,3 +320,18 @@ def test_sparse_weights_naming_no_column_are_refused(tube):
             mdc.Simulation(basis, [attach], rig=built)
         with pytest.raises(ValueError, match="rig"):
             mdc.skin(V, built, chain())
+
+
+def test_the_rig_needs_no_scipy():
+    # Blender's Python has NumPy but no SciPy: the core must import and run a rig without it.
+    code = (
+        "import sys; sys.modules['scipy'] = None\n"
+        "import numpy as np, modal_deform.core as mdc\n"
+        "V, F = mdc.testing.cylinder(8, 10, radius=1.0, length=4.0)\n"
+        "W = np.c_[1 - V[:, 2] / 4, V[:, 2] / 4]\n"
+        "sim = mdc.Simulation(mdc.bake(V, F, modes=10, derivatives=4, ghost=60), [[0, 1, 2]], rig=W)\n"
+        "B = np.repeat(np.eye(4)[None], 2, axis=0)\n"
+        "X = sim.step([np.eye(4)], bones=B)\n"
+        "assert np.allclose(mdc.skin(X, W, B), X)\n"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True, env=dict(os.environ))

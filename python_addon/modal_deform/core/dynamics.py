@@ -84,7 +84,7 @@ class Simulation(_inputs.InBasis):
         if not isinstance(energy, str):
             raise ValueError(f'energy: expected "shells" or "arap", got {energy!r}')
         if rig is not None:
-            rig = _rig.skinning_weights(rig, basis.num_vertices)
+            rig = _rig.skinning_weights(rig, basis.num_vertices).native
         self._native = _native.Simulation(basis._native, handles, weights, energy, rig, **options)
         self._basis = basis
         self.stats = None  #: the last step's: see step()

@@ -8,35 +8,49 @@ object's world matrix, which is where the Armature modifier leaves them). A fram
 inverse), affine and invertible, scale and shear allowed.
 """
 
+from typing import NamedTuple
+
 import numpy as np
-import scipy.sparse
 
 from .. import _native
 from . import _arrays
 
 
+class SkinningWeights(NamedTuple):
+    """Checked skinning weights: the compressed rows (``row_pointers`` (n + 1,), ``columns`` and
+    ``values`` alike long; a repeated column of a row adds) and the core's copy (``native``)."""
+
+    shape: tuple
+    row_pointers: np.ndarray
+    columns: np.ndarray
+    values: np.ndarray
+    native: object
+
+
 def skinning_weights(W, num_vertices):
-    """W as a (num_vertices, b) CSR matrix of float64 (dense arrays and any scipy sparse format
-    taken), checked: ValueError naming what is wrong."""
-    if scipy.sparse.issparse(W):
-        W = scipy.sparse.csr_matrix(W, dtype=np.float64)
+    """W, (num_vertices, b), checked: a dense array, or a SciPy sparse matrix (read by its
+    compressed rows; the add-on itself needs no SciPy, which Blender does not ship). Returns
+    SkinningWeights; ValueError naming what is wrong."""
+    if hasattr(W, "tocsr"):  # a SciPy sparse matrix
+        W = W.tocsr()
+        shape = tuple(W.shape)
+        row_pointers, columns, values = W.indptr, W.indices, _arrays.reals(W.data, "rig")
     else:
         W = _arrays.reals(W, "rig")
         if W.ndim != 2:
             raise ValueError(f"rig: expected an (n, bones) matrix of weights, got shape {W.shape}")
-        W = scipy.sparse.csr_matrix(W)
-    if W.ndim != 2 or W.shape[0] != num_vertices:
+        shape = W.shape
+        rows, columns = np.nonzero(W)
+        values = W[rows, columns]
+        row_pointers = np.concatenate(([0], np.cumsum(np.bincount(rows, minlength=shape[0]))))
+    if len(shape) != 2 or shape[0] != num_vertices:
         raise ValueError(
-            f"rig: expected ({num_vertices}, bones) weights (one row per vertex), got {W.shape}"
+            f"rig: expected ({num_vertices}, bones) weights (one row per vertex), got {shape}"
         )
-    try:  # the index arrays of a matrix built from them are not checked by scipy
-        W.check_format(full_check=True)
-    except ValueError as error:
-        raise ValueError(f"rig: not a valid sparse matrix ({error})") from None
-    W.sum_duplicates()
-    W.sort_indices()
-    _native.check_skinning_weights(W, num_vertices)
-    return W
+    row_pointers = _arrays.indices(row_pointers, "rig's row pointers")
+    columns = _arrays.indices(columns, "rig's column indices")
+    native = _native.SkinningWeights(shape[0], shape[1], row_pointers, columns, values)
+    return SkinningWeights(shape, row_pointers, columns, values, native)
 
 
 def bone_matrices(B, num_bones, name="bones"):
@@ -61,6 +75,8 @@ def skin(X, W, B):
         raise ValueError(f"X: expected (n, 3) positions, got shape {X.shape}")
     W = skinning_weights(W, X.shape[0])
     B = np.asarray(bone_matrices(B, W.shape[1]))
-    # Each vertex's blended 3x4 matrix A_i = Σ_b W_ib B_b[:3], then A_i (X_i, 1).
-    A = (W @ B[:, :3, :].reshape(W.shape[1], 12)).reshape(-1, 3, 4)
+    # Each vertex's blended 3x4 matrix A_i = Σ_b W_ib B_b[:3] (every row has a weight: checked),
+    # then A_i (X_i, 1).
+    terms = W.values[:, None] * B[W.columns, :3, :].reshape(-1, 12)
+    A = np.add.reduceat(terms, W.row_pointers[:-1], axis=0).reshape(-1, 3, 4)
     return np.einsum("nij,nj->ni", A[:, :, :3], X) + A[:, :, 3]
