@@ -12,18 +12,6 @@ void check_skinning_weights(const SkinningWeights& weights, int num_vertices) {
     throw InputError(message("rig: expected skinning weights for ", num_vertices,
                              " vertices (one row each), got ", weights.rows(), " rows"));
   if (weights.cols() < 1) throw InputError("rig: expected at least one bone (column), got none");
-  // The structure first: every later loop indexes by it.
-  const auto* outer = weights.outerIndexPtr();
-  if (!weights.isCompressed() || outer[0] != 0 || outer[weights.outerSize()] != weights.nonZeros())
-    throw InputError("rig: the sparse matrix's row pointers do not span its entries");
-  for (int i = 0; i < weights.outerSize(); ++i) {
-    if (outer[i + 1] < outer[i])
-      throw InputError(message("rig: the sparse matrix's row pointers decrease at row ", i));
-    for (auto k = outer[i]; k < outer[i + 1]; ++k)
-      if (weights.innerIndexPtr()[k] < 0 || weights.innerIndexPtr()[k] >= weights.cols())
-        throw InputError(message("rig: row ", i, " names bone ", weights.innerIndexPtr()[k],
-                                 ", not one of the ", weights.cols(), " columns"));
-  }
   for (int i = 0; i < weights.outerSize(); ++i) {
     double sum = 0;
     for (SkinningWeights::InnerIterator it(weights, i); it; ++it) {
@@ -80,7 +68,7 @@ SkinningWeights skinning_weights_from_rows(int num_vertices, int num_bones,
 void check_bone_matrices(const Transforms& bones, int num_bones) {
   if (static_cast<int>(bones.size()) != num_bones)
     throw InputError(message("bones: expected ", num_bones,
-                             " matrices (one per column of rig), got ", bones.size()));
+                             " matrices (one per bone, a column of rig each), got ", bones.size()));
   for (int b = 0; b < num_bones; ++b) {
     const Eigen::Matrix4d& B = bones[b];
     if (!B.allFinite()) throw InputError(message("bones[", b, "]: has non-finite entries"));

@@ -182,14 +182,12 @@ class Simulation(_inputs.InBasis):
         v = _arrays.values(v, "v", r)
         previous, current = [], []
         if bones is not None:
-            if not self._native.on_rig:
-                raise ValueError("bones: given to a simulation without a rig")
             B = _arrays.reals(bones, "bones")
             if B.ndim == 4 and B.shape[0] == 2:
-                previous = _rig.bone_matrices(B[0], self.num_bones, "bones[0]")
-                current = _rig.bone_matrices(B[1], self.num_bones, "bones[1]")
+                previous = _rig.bone_matrices(B[0], "bones[0]")
+                current = _rig.bone_matrices(B[1], "bones[1]")
             else:
-                current = _rig.bone_matrices(B, self.num_bones)
+                current = _rig.bone_matrices(B)
         self._native.set_state(
             q,
             v,
@@ -228,13 +226,8 @@ class Simulation(_inputs.InBasis):
         return self._native.rig_acceleration if self._native.on_rig else np.zeros(self.dimension)
 
     def _bones(self, bones):
-        if not self._native.on_rig:
-            if bones is not None:
-                raise ValueError("bones: given to a simulation without a rig")
-            return []
-        if bones is None:
-            raise ValueError("bones: required on a rig, (b, 4, 4), one matrix per bone")
-        return _rig.bone_matrices(bones, self.num_bones)
+        """The frame's bones for the core, which checks them (one per bone on a rig, none off it)."""
+        return [] if bones is None else _rig.bone_matrices(bones)
 
     def _checked_transforms(self, transforms):
         if _inputs.is_empty(transforms):

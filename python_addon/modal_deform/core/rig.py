@@ -53,16 +53,13 @@ def skinning_weights(W, num_vertices):
     return SkinningWeights(shape, row_pointers, columns, values, native)
 
 
-def bone_matrices(B, num_bones, name="bones"):
-    """B as a list of num_bones (4, 4) float64 matrices, checked (finite, affine, invertible)."""
+def bone_matrices(B, name="bones"):
+    """B as a list of (4, 4) float64 matrices; their count and contents (finite, affine,
+    invertible) are the core's to check (check_bone_matrices)."""
     B = _arrays.reals(B, name)
-    if B.ndim != 3 or B.shape[1:] != (4, 4) or B.shape[0] != num_bones:
-        raise ValueError(
-            f"{name}: expected ({num_bones}, 4, 4) matrices (one per bone), got shape {B.shape}"
-        )
-    B = list(B)
-    _native.check_bone_matrices(B, num_bones)
-    return B
+    if B.ndim != 3 or B.shape[1:] != (4, 4):
+        raise ValueError(f"{name}: expected (bones, 4, 4) matrices (one per bone), got {B.shape}")
+    return list(B)
 
 
 def skin(X, W, B):
@@ -74,7 +71,9 @@ def skin(X, W, B):
     if X.ndim != 2 or X.shape[1] != 3:
         raise ValueError(f"X: expected (n, 3) positions, got shape {X.shape}")
     W = skinning_weights(W, X.shape[0])
-    B = np.asarray(bone_matrices(B, W.shape[1]))
+    B = bone_matrices(B)
+    _native.check_bone_matrices(B, W.shape[1])
+    B = np.asarray(B)
     # Each vertex's blended 3x4 matrix A_i = Σ_b W_ib B_b[:3] (every row has a weight: checked),
     # then A_i (X_i, 1).
     terms = W.values[:, None] * B[W.columns, :3, :].reshape(-1, 12)
