@@ -60,12 +60,10 @@ def pose_bone(item):
     return controller.pose.bones.get(item.bone)
 
 
-def world_matrix(item):
-    """The controller's world matrix: the object's, or for a bone the armature object's times the
-    pose bone's (its armature-space matrix)."""
-    bone = pose_bone(item)
-    matrix = item.controller.matrix_world
-    return matrix if bone is None else matrix @ bone.matrix
+def world_matrix(controller, bone):
+    """The controller's world matrix: the object's, or for a pose bone of it (pose_bone) the
+    armature object's times the bone's armature-space matrix."""
+    return controller.matrix_world if bone is None else controller.matrix_world @ bone.matrix
 
 
 def bind(obj, handle):
@@ -75,7 +73,9 @@ def bind(obj, handle):
         handle.bind_matrix = Matrix.Identity(4)
         handle.bound_controller = ""
     else:
-        handle.bind_matrix = obj.matrix_world.inverted_safe() @ world_matrix(handle)
+        handle.bind_matrix = obj.matrix_world.inverted_safe() @ world_matrix(
+            handle.controller, pose_bone(handle)
+        )
         handle.bound_controller = handle.controller.name
 
 
@@ -212,12 +212,13 @@ def transforms(obj, handles):
         if handle.controller is None:
             result.append(np.eye(4))
         else:
-            if handle.bone and pose_bone(handle) is None:  # renamed or deleted since resolve()
+            bone = pose_bone(handle)
+            if handle.bone and bone is None:  # renamed or deleted since resolve()
                 raise HandleError(
                     f"handle '{handle.name}': bone '{handle.bone}' is not in armature "
                     f"'{handle.controller.name}' any more (deleted or renamed?)"
                 )
-            relative = world_inverse @ world_matrix(handle) @ handle.bind_inverse
+            relative = world_inverse @ world_matrix(handle.controller, bone) @ handle.bind_inverse
             result.append(mdc.nearest_rigid(relative, handle.centre))
     return result
 

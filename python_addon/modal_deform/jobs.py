@@ -57,21 +57,19 @@ class ThreadJob:
     def tick(self):
         return not self.done
 
-    def _unfinished(self, action):
-        """(level, message) when the job was cancelled or failed (`action` names it, e.g. "Bake"),
-        else None."""
+    def _finished_object(self, action, changed):
+        """(the job's object, None) for finish() to write to, or (None, (level, message)) for the
+        report when there is nothing to write: the job was cancelled or failed (`action` names it,
+        e.g. "Bake"), or its object was deleted or its mesh changed since the job read it
+        (`changed` says so)."""
         if isinstance(self.error, mdc.Cancelled):
-            return "WARNING", f"{action} cancelled: nothing changed"
+            return None, ("WARNING", f"{action} cancelled: nothing changed")
         if self.error is not None:
-            return "ERROR", f"{action} failed: {self.error}"
-        return None
-
-    def _object_as_read(self):
-        """The job's object, or None when it was deleted or its mesh changed since the job read it."""
+            return None, ("ERROR", f"{action} failed: {self.error}")
         obj = bpy.data.objects.get(self.object_name)
         if obj is None or obj.type != "MESH" or storage.fingerprint(obj.data) != self.fingerprint:
-            return None
-        return obj
+            return None, ("WARNING", changed)
+        return obj, None
 
 
 class BakeJob(ThreadJob):
@@ -121,15 +119,12 @@ class BakeJob(ThreadJob):
 
     def finish(self):
         """Store the basis on the object (main thread). Returns (level, message) for a report."""
-        unfinished = self._unfinished("Bake")
-        if unfinished:
-            return unfinished
-        obj = self._object_as_read()
-        if obj is None:
-            return (
-                "WARNING",
-                f"'{self.object_name}' changed during the bake: the result was discarded, bake again",
-            )
+        obj, report = self._finished_object(
+            "Bake",
+            f"'{self.object_name}' changed during the bake: the result was discarded, bake again",
+        )
+        if report:
+            return report
         storage.store(
             obj, self.basis, self.fingerprint, self.vertex_groups, self.seconds, self.energy
         )

@@ -54,15 +54,11 @@ class RefineJob(ThreadJob):
 
     def finish(self):
         """Write the refined pose into the "Modal Deform" key (main thread). Returns (level, message)."""
-        unfinished = self._unfinished("Refine")
-        if unfinished:
-            return unfinished
-        obj = self._object_as_read()
-        if obj is None:
-            return (
-                "WARNING",
-                f"'{self.object_name}' changed during Refine: the result was discarded",
-            )
+        obj, report = self._finished_object(
+            "Refine", f"'{self.object_name}' changed during Refine: the result was discarded"
+        )
+        if report:
+            return report
         mesh_io.write_shape_key(obj.data, posing.pose_key(obj)[0], self.X.astype(np.float32))
         self.written = True
         stats = self.stats
