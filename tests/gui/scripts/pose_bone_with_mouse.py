@@ -64,7 +64,7 @@ def steps():
     group, pinned = np.flatnonzero(rest[:, 2] > 0.5), np.flatnonzero(rest[:, 2] < -0.5)
     bone = rig.pose.bones["Head"]
 
-    window, area, region = view3d()
+    _, _, region = view3d()
     with override():
         obj.select_set(False)
         rig.select_set(True)
@@ -83,8 +83,9 @@ def steps():
     yield 0.3
     assert ops_common.running is not None and ops_common.running.pose.obj == obj
 
-    # Click the bone, then turn it about its head: R, the mouse from the bone's upper part to its
-    # right, a click.
+    # Click the bone (none selected before), then turn it about its head: R, the mouse from the
+    # bone's upper part to its right, a click.
+    bone.bone.select, rig.data.bones.active = False, None
     world = rig.matrix_world
     head, tail = world @ bone.head, world @ bone.tail
     grip = on_screen(head.lerp(tail, 0.8))
