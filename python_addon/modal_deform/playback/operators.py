@@ -185,14 +185,14 @@ and other packages read, for machines without the add-on"""
             self.report({"ERROR"}, "No file to write: choose a file path")
             return {"CANCELLED"}
         try:
-            frames = cached_frames(obj)
+            frames = self._frames(obj, scene)
             point_cache.write(
                 path,
                 self.file_format,
                 len(obj.data.vertices),
                 frames,
                 scene.render.fps / scene.render.fps_base,
-                cached_positions(obj, scene),
+                self._positions(obj, scene),
             )
         except (OSError, *FAILURES) as error:
             self.report({"ERROR"}, f"Export failed: {error}")
@@ -203,6 +203,14 @@ and other packages read, for machines without the add-on"""
             f"modifier with Frame Start {frames[0]} to play it",
         )
         return {"FINISHED"}
+
+    # What is exported (a subclass exports other frames: shapes.operators): the frames, and
+    # frame -> positions (called once per frame in order).
+    def _frames(self, obj, scene):
+        return cached_frames(obj)
+
+    def _positions(self, obj, scene):
+        return cached_positions(obj, scene)
 
 
 CLASSES = (
