@@ -136,7 +136,7 @@ def stale_reason(obj):
         return ""
     _checked.pop(obj.name, None)
     if keys.digest(obj, space_names(obj)) != settings.keys_digest:
-        return "a shape key, its Relative To, the basis or the faces changed since the bake"
+        return "a key, its Relative To, the basis or the faces were edited"
     _checked[obj.name] = (bake_id, counts, [a.copy() for a in arrays], relatives)
     return ""
 

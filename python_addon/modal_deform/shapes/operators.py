@@ -131,24 +131,28 @@ keep their size. Bakes the keys first when needed (Esc cancels); again: back to 
     poll = classmethod(shapes_poll)
 
     def _toggled(self, context):
-        """Turn off, or on with the stored space when it fits: True; False when a bake is needed."""
+        """Turn off, or on with the stored space when it fits: the operator's result; None when a
+        bake is needed. Refused while Dynamics plays on the object (it would show instead)."""
         obj = handles.owner(context.object)
         settings = obj.modal_deform.shapes
         if settings.enabled:
             settings.enabled = False
-            return True
+            return {"FINISHED"}
+        if timeline.plays(obj):
+            self.report({"ERROR"}, blending.DYNAMICS_WINS)
+            return {"CANCELLED"}
         try:
             blending.ready(obj)
         except storage.NotReady:
-            return False
+            return None
         settings.enabled = True
-        return True
+        return {"FINISHED"}
 
     def execute(self, context):
-        return {"FINISHED"} if self._toggled(context) else super().execute(context)
+        return self._toggled(context) or super().execute(context)
 
     def invoke(self, context, event):
-        return {"FINISHED"} if self._toggled(context) else super().invoke(context, event)
+        return self._toggled(context) or super().invoke(context, event)
 
 
 class MODAL_DEFORM_OT_bake_shapes(_BakeShapes, bpy.types.Operator):
