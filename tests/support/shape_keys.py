@@ -53,3 +53,39 @@ def bar_with_bend(modes=12, derivatives=20, ghost=300):
     settings = obj.modal_deform
     settings.modes, settings.derivatives, settings.ghost = modes, derivatives, ghost
     return obj, V, F, bent
+
+
+class _Layout:
+    """A stand-in for Blender's UILayout that records the labels and operators drawn (headless
+    Blender draws no panel)."""
+
+    def __init__(self, drawn):
+        self.drawn = drawn
+
+    def __getattr__(self, name):  # column(), row(), box(), prop(), ...: a layout again
+        return lambda *args, **kwargs: self
+
+    def label(self, text="", **kwargs):
+        self.drawn.append(text)
+
+    def operator(self, idname, text="", **kwargs):
+        self.drawn.append(f"[{text or idname}]")
+        return self
+
+
+def draw_panels(obj):
+    """The text of Blend as Shapes's panels drawn for obj (the sidebar's, then the Shape Keys'
+    addition), one string."""
+    import sys
+    import types
+
+    # The enabled add-on's module (enabling again would re-register it and forget its problems).
+    panel = next(m for name, m in sys.modules.items() if name.endswith("modal_deform.shapes.panel"))
+    drawn = []
+    region = types.SimpleNamespace(width=400)
+    preferences = types.SimpleNamespace(system=types.SimpleNamespace(ui_scale=1.0))
+    context = types.SimpleNamespace(object=obj, region=region, preferences=preferences)
+    layout = _Layout(drawn)
+    panel.VIEW3D_PT_modal_deform_shapes.draw(types.SimpleNamespace(layout=layout), context)
+    panel._draw_in_shape_keys(types.SimpleNamespace(layout=layout), context)
+    return " ".join(drawn)

@@ -8,10 +8,10 @@ import time
 import bpy
 import numpy as np
 from support import blender as support
-from support.shape_keys import add_key, bar_with_bend
+from support.shape_keys import add_key, bar_with_bend, bend, draw_panels
 
 blending, frame_display = support.enable_addon("shapes.blending", "playback.frame_display")
-obj, V, F, bend = bar_with_bend()
+obj, V, F, bent = bar_with_bend()
 scene = bpy.context.scene
 keys = obj.data.shape_keys
 size = np.ptp(V, axis=0).max()
@@ -51,8 +51,8 @@ keys.key_blocks["Bend"].vertex_group = ""
 
 # A key equal to the basis, a key relative to another key, a key that folds the bar flat.
 same = add_key(obj, "Same", V)
-half = add_key(obj, "Half", 0.5 * (V + bend))
-tip = add_key(obj, "Tip", 0.5 * (V + bend) + [0.0, 0.0, 0.5] * (V[:, 2:] > 3.9))
+half = add_key(obj, "Half", 0.5 * (V + bent))
+tip = add_key(obj, "Tip", 0.5 * (V + bent) + [0.0, 0.0, 0.5] * (V[:, 2:] > 3.9))
 tip.relative_key = half  # adds (Tip − Half): the tip stretched by 0.5
 flat = V.copy()
 flat[:, 0] = 0.5
@@ -95,6 +95,7 @@ state = support.mesh_state(obj)
 keys.key_blocks["Bend"].value = float("nan")
 update()
 assert "has the weight nan" in problem(), problem()
+assert "has the weight nan" in draw_panels(obj), draw_panels(obj)
 assert not frame_display.shows(obj)
 weights(Bend=0.5)
 assert not problem() and shown().tobytes() == at_half.tobytes()
@@ -125,8 +126,6 @@ for i, angle in enumerate(angles):
     X[:, :2] -= 0.5
     c, s = np.cos(i), np.sin(i)
     X[:, :2] = X[:, :2] @ np.array([[c, -s], [s, c]])
-    from support.shape_keys import bend  # noqa: E402
-
     X = bend(X + [0.5, 0.5, 0.0], angle if angle else 0.1)
     add_key(obj, f"Key {i}", X)
 start = time.perf_counter()

@@ -8,6 +8,7 @@ import time
 import bpy
 import numpy as np
 from support import blender as support
+from support.shape_keys import draw_panels
 
 mdc, blending, storage, frame_display = support.enable_addon(
     "core", "shapes.blending", "storage", "playback.frame_display"
@@ -33,6 +34,10 @@ w6 = block.value
 at6 = space.blend([w6])
 assert shown().tobytes() == at6.tobytes(), "the reloaded space shows another blend"
 assert settings.space["bake_id"] == bake_id, "reloading baked again"
+panels = draw_panels(obj)
+assert "1 keys" in panels and "Stale" not in panels and "[modal_deform.keep_blend]" in panels, (
+    panels
+)
 
 
 # A render of frame 6 as `blender -b shapes.blend -f 6` makes it (a one-frame animation render,
@@ -108,6 +113,8 @@ reason = blending.stale_reason(obj)
 assert "were edited" in reason, reason
 assert "re-bake" in blending.problems[obj.name], blending.problems
 assert not frame_display.shows(obj), "a stale space still shows"
+panels = draw_panels(obj)
+assert "Stale (a key" in panels and "[Re-bake]" in panels, panels
 assert support.key_positions(obj, "Bend").tobytes() == edited.tobytes()
 # Saved and reloaded stale, it says so too (the digest, not the copies in memory).
 blending._forget()
