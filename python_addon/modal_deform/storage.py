@@ -81,6 +81,7 @@ def _group_hash(obj, group, cached):
 
 
 def digest(*arrays):
+    """A hash (32 hex digits) of the arrays' bytes, one after another."""
     h = hashlib.blake2b(digest_size=16)
     for a in arrays:
         h.update(memoryview(np.ascontiguousarray(a)).cast("B"))

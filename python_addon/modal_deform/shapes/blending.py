@@ -5,8 +5,8 @@ Stored as the basis is (storage.write_arrays: a hidden Palette that ``Object.mod
 points to), with the names of its keys and a digest of the faces, basis and keys at the bake
 (keys.digest): reloading costs milliseconds, no bake. Stale when a key of the space, its Relative To,
 the basis or the faces changed since (checked each time the blend is shown: the keys are compared
-with copies of what matched the digest last, the digest computed again only when they differ); a
-key of the space removed or renamed, too. A key added after the bake stays out of the space: at
+with copies of the keys last hashed, the digest computed again only when they differ); a key of
+the space removed or renamed, too. A key added after the bake stays out of the space: at
 weight 0 it changes nothing, at another weight the blend is refused until a re-bake takes it in.
 
 Shown as Dynamics shows its frames (playback/frame_display.py: a Geometry Nodes modifier sets the
@@ -41,9 +41,10 @@ DYNAMICS_WINS = (
 # Loaded spaces by bake id, most recent last.
 _spaces = collections.OrderedDict()
 _CACHED_SPACES = 2
-# By object name: (bake id, weights bytes) of the blend shown; the copies of the keys that matched
-# the digest last (bake id, vertex count, faces count, arrays, Relative To names); the problem
-# that keeps the blend from showing, and a note on the blend shown (it diverged, or stopped early).
+# By object name: (bake id, weights bytes) of the blend shown; the keys last compared with the
+# digest (bake id, vertex and corner counts, copies of the arrays, Relative To names) and the stale
+# reason found then; the problem that keeps the blend from showing, and a note on the blend shown
+# (it diverged, or stopped early).
 _shown = {}
 _checked = {}
 problems = {}
@@ -133,12 +134,12 @@ def stale_reason(obj):
         and found[3] == relatives
         and all(np.array_equal(a, b) for a, b in zip(arrays, found[2]))
     ):
-        return ""
-    _checked.pop(obj.name, None)
+        return found[4]
+    reason = ""
     if keys.digest(obj, space_names(obj)) != settings.keys_digest:
-        return "a key, its Relative To, the basis or the faces were edited"
-    _checked[obj.name] = (bake_id, counts, [a.copy() for a in arrays], relatives)
-    return ""
+        reason = "a key, its Relative To, the basis or the faces were edited"
+    _checked[obj.name] = (bake_id, counts, [a.copy() for a in arrays], relatives, reason)
+    return reason
 
 
 def ready(obj):
