@@ -11,7 +11,7 @@ from ..jobs import BakeJob
 from ..ops_common import FAILURES, JobOperator, mesh_poll
 from ..playback import timeline
 from ..playback.frame_keys import AnimationJob
-from ..playback.operators import MODAL_DEFORM_OT_export_mesh_cache
+from ..playback.operators import ExportMeshCache
 from . import blending, keys
 
 #: The name of the key Keep as Shape Key writes (Blender adds ".001" to a second one).
@@ -275,7 +275,7 @@ as Shapes is then turned off, as the keys take its place. Esc cancels"""
         return result
 
 
-class MODAL_DEFORM_OT_export_blend_mesh_cache(_FrameRange, MODAL_DEFORM_OT_export_mesh_cache):
+class MODAL_DEFORM_OT_export_blend_mesh_cache(_FrameRange, ExportMeshCache, bpy.types.Operator):
     """Write the blend of each frame of the range into a point-cache file (PC2 or MDD) that Blender's \
 Mesh Cache modifier and other packages read, for machines without the add-on"""
 
