@@ -10,7 +10,9 @@ import numpy as np
 from support import blender as support
 from support.shape_keys import add_key, bar_with_bend, bend, draw_panels
 
-blending, frame_display = support.enable_addon("shapes.blending", "playback.frame_display")
+blending, operators, frame_display = support.enable_addon(
+    "shapes.blending", "shapes.operators", "playback.frame_display"
+)
 obj, V, F, bent = bar_with_bend()
 scene = bpy.context.scene
 keys = obj.data.shape_keys
@@ -40,6 +42,31 @@ def refused(text):
         raise AssertionError(f"not refused ({result}): expected {text!r}")
     assert not obj.modal_deform.shapes.enabled and support.mesh_state(obj) == before
 
+
+# The bake on a thread (the toggle's invoke, with a progress bar): cancelled, nothing changes;
+# run to its end, it stores the space and turns Blend as Shapes on.
+before = support.mesh_state(obj)
+job = operators.ShapesJob(obj)
+job.cancel()
+job.start()
+while job.tick():
+    time.sleep(0.01)
+level, message = job.finish()
+assert level == "WARNING" and "cancelled" in message, message
+assert support.mesh_state(obj) == before and obj.modal_deform.shapes.space is None
+job = operators.ShapesJob(obj)
+job.start()
+progress = [job.overall]
+while job.tick():
+    progress.append(job.overall)
+    time.sleep(0.01)
+level, message = job.finish()
+assert level == "INFO" and obj.modal_deform.shapes.enabled, message
+assert progress == sorted(progress), progress
+print("JOB", message, len(progress), progress[-1])
+assert bpy.ops.modal_deform.clear_shapes() == {"FINISHED"}
+assert obj.modal_deform.shapes.space is None and not frame_display.shows(obj)
+assert support.mesh_state(obj) == before
 
 # Absolute keys and a key with a vertex group are refused.
 keys.use_relative = False
