@@ -218,6 +218,43 @@ class ModalDeformDynamics(bpy.types.PropertyGroup):
     )
 
 
+# Shape keys blended as shapes: shapes/.
+def _shapes_changed(shapes, context):
+    from .shapes import blending
+
+    blending.refresh(shapes.id_data)
+
+
+class ModalDeformShapes(bpy.types.PropertyGroup):
+    """Blend as Shapes: the mesh shows the rotation-aware blend of its shape keys (shapes/), from
+    the shape space baked of them (kept in ``space``, storage.write_arrays) and the keys' values."""
+
+    enabled: BoolProperty(
+        name="Blend as Shapes",
+        default=False,
+        update=_shapes_changed,
+        description="Show the shape keys blended as shapes: where a part turns between the basis and a key "
+        "(a jaw opening, a finger curling) the in-between turns too and keeps its size, where "
+        "Blender's linear mix cuts through and shrinks it. The keys' values (keyframed, driven or "
+        "moved) are the weights",
+    )
+    space: PointerProperty(
+        type=bpy.types.Palette,
+        name="Shape Space",
+        description="Datablock holding the baked shape space (hidden: its name starts with a dot)",
+    )
+    key_names: StringProperty(
+        name="Keys", description="The shape keys of the space, one per line, in the mesh's order"
+    )
+    keys_digest: StringProperty(
+        name="Keys Digest",
+        description="Faces, basis and keys (coordinates and Relative To) at the bake",
+    )
+    dimension: IntProperty(name="Dimension", description="Reduced coordinates of the space")
+    baked_at: StringProperty(name="Baked At", description="Local date and time of the bake")
+    seconds: FloatProperty(name="Seconds", description="Wall time of the bake")
+
+
 class ModalDeformSettings(bpy.types.PropertyGroup):
     modes: IntProperty(
         name="Modes",
@@ -343,6 +380,11 @@ class ModalDeformSettings(bpy.types.PropertyGroup):
         name="Dynamics",
         description="Secondary motion and the per-frame cache of the pose",
     )
+    shapes: PointerProperty(
+        type=ModalDeformShapes,
+        name="Blend as Shapes",
+        description="The shape keys blended as shapes",
+    )
     preview_amplitude: FloatProperty(
         name="Amplitude",
         default=0.1,
@@ -353,7 +395,13 @@ class ModalDeformSettings(bpy.types.PropertyGroup):
     )
 
 
-CLASSES = (ModalDeformHandle, ModalDeformBakeStatus, ModalDeformDynamics, ModalDeformSettings)
+CLASSES = (
+    ModalDeformHandle,
+    ModalDeformBakeStatus,
+    ModalDeformDynamics,
+    ModalDeformShapes,
+    ModalDeformSettings,
+)
 
 
 _register_classes, _unregister_classes = bpy.utils.register_classes_factory(CLASSES)

@@ -138,11 +138,12 @@ back and render without the add-on; the cache is then freed, as the keys take it
         return result
 
 
-class MODAL_DEFORM_OT_export_mesh_cache(bpy.types.Operator):
-    """Write the cached frames into a point-cache file (PC2 or MDD) that Blender's Mesh Cache modifier \
-and other packages read, for machines without the add-on"""
+class ExportMeshCache:
+    """An export to a point-cache file: the file's path and format, the file browser, the writing.
+    What is exported comes from _frames(obj, scene) and _positions(obj, scene) (frame -> positions,
+    called once per frame in order): the cached frames (MODAL_DEFORM_OT_export_mesh_cache), or
+    others (shapes.operators)."""
 
-    bl_idname = "modal_deform.export_mesh_cache"
     bl_label = "Export Mesh Cache"
     bl_options = {"REGISTER"}
 
@@ -164,8 +165,6 @@ and other packages read, for machines without the add-on"""
         ),
     )
 
-    poll = classmethod(cache_poll)
-
     def invoke(self, context, event):
         obj = handles.owner(context.object)
         if not self.filepath:
@@ -185,14 +184,14 @@ and other packages read, for machines without the add-on"""
             self.report({"ERROR"}, "No file to write: choose a file path")
             return {"CANCELLED"}
         try:
-            frames = cached_frames(obj)
+            frames = self._frames(obj, scene)
             point_cache.write(
                 path,
                 self.file_format,
                 len(obj.data.vertices),
                 frames,
                 scene.render.fps / scene.render.fps_base,
-                cached_positions(obj, scene),
+                self._positions(obj, scene),
             )
         except (OSError, *FAILURES) as error:
             self.report({"ERROR"}, f"Export failed: {error}")
@@ -203,6 +202,21 @@ and other packages read, for machines without the add-on"""
             f"modifier with Frame Start {frames[0]} to play it",
         )
         return {"FINISHED"}
+
+
+class MODAL_DEFORM_OT_export_mesh_cache(ExportMeshCache, bpy.types.Operator):
+    """Write the cached frames into a point-cache file (PC2 or MDD) that Blender's Mesh Cache modifier \
+and other packages read, for machines without the add-on"""
+
+    bl_idname = "modal_deform.export_mesh_cache"
+
+    poll = classmethod(cache_poll)
+
+    def _frames(self, obj, scene):
+        return cached_frames(obj)
+
+    def _positions(self, obj, scene):
+        return cached_positions(obj, scene)
 
 
 CLASSES = (

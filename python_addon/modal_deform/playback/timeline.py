@@ -278,7 +278,8 @@ def _frame_changed(scene, depsgraph=None):
         if not wants_playback(obj):
             if displayed and obj.type == "MESH" and obj.library is None:
                 if not plays(obj):  # freed, dynamics off
-                    frame_display.remove(obj)
+                    if not obj.modal_deform.shapes.enabled:  # a blend of shapes shows (shapes/)
+                        frame_display.remove(obj)
                 elif _playing:  # Edit, Sculpt or Paint Mode: the mesh itself shows there
                     frame_display.end_stand_in(obj)
             continue
