@@ -194,6 +194,8 @@ back and render without the add-on; the cache is then freed, as the keys take it
         result = super()._finish()
         if self.job.written:
             timeline.free(self.job.obj)
+            if rig.follows(self.job.obj):  # the keys carry the offset the rig's playback added
+                self.job.obj.modal_deform.dynamics.enabled = False
         return result
 
 

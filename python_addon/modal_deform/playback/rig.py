@@ -28,6 +28,8 @@ without deforming bones, no or an empty Attach group. Bones with scale or shear 
 Armature modifier skins them (the core takes affine bones; a singular one is refused by it).
 """
 
+import hashlib
+
 import bpy
 import numpy as np
 
@@ -39,6 +41,10 @@ from .. import mesh_io
 ATTACH_WEIGHT = 0.5
 #: Fill Attach from Armature's default reach: a fraction of each bone's length around its segment.
 ATTACH_REACH = 0.25
+
+
+#: The cache's field holding the digest of the weights and Attach group its frames were made with.
+WEIGHTS = "rig_weights"
 
 
 class RigError(ValueError):
@@ -233,6 +239,10 @@ class Rig:
         self._rest_inverse = np.linalg.inv(rest)
         self._matrices = np.empty(16 * len(pose_bones), np.float32)
         self._counts, self._pointers, self._columns = counts, pointers, cols
+        digest = hashlib.blake2b(repr(self.bones).encode(), digest_size=16)
+        for array in (pointers, cols, values, self.attach):
+            digest.update(np.ascontiguousarray(array).tobytes())
+        self.digest = digest.hexdigest()  #: of the weights as read, for the cache (WEIGHTS)
 
     def frame(self, obj):
         """The rig now, (bones + 1, 4, 4) float64: each used bone's world skinning matrix, then the

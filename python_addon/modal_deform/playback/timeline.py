@@ -275,6 +275,8 @@ def fill(obj, scene, cache, frame, player_, out=None, curves=None):
             transforms = player_.transforms(obj, rig_frame)
             if not len(cache):
                 q, v = player_.first(transforms)
+                if player_.rig is not None:  # the weights its frames are made with
+                    cache.block[rig.WEIGHTS] = player_.rig.digest
             else:
                 shown = out if f == frame else None
                 q, v, mapped = player_.next(cache, f, transforms, shown, rig_frame)
@@ -303,6 +305,8 @@ def show(obj, scene, edits_reported=False):
         cache = frame_cache.create(obj, scene, start)
     player_ = player(obj, scene, signature)
     player_.check_mesh(obj, edits_reported)
+    if on_rig and len(cache) and cache.block.get(rig.WEIGHTS) != player_.rig.digest:
+        cache.cut(cache.start)  # weights painted since its frames were made
     curves = frame_cache.controller_curves(obj)
     frame_cache.keyframes_changed(cache, curves)
     shown = max(frame, cache.start)
@@ -351,11 +355,13 @@ def _edits_reported(depsgraph):
     }
     if not edited:
         return
-    for name, found in _players.items():
+    for name, found in list(_players.items()):
         obj = bpy.data.objects.get(name)
         if obj is not None and obj.type == "MESH" and obj.data.as_pointer() in edited:
             found.compared = None
             frame_display.end_stand_in(obj)
+            if found.rig is not None:  # weights painted: the next frame reads the rig again
+                del _players[name]
 
 
 def _frame_changed(scene, depsgraph=None):

@@ -14,8 +14,13 @@ import bpy
 import numpy as np
 from support import blender as support
 
-timeline, frame_cache, frame_display, rig_module, mdc = support.enable_addon(
-    "playback.timeline", "playback.frame_cache", "playback.frame_display", "playback.rig", "core"
+timeline, frame_cache, frame_display, frame_keys, rig_module, mdc = support.enable_addon(
+    "playback.timeline",
+    "playback.frame_cache",
+    "playback.frame_display",
+    "playback.frame_keys",
+    "playback.rig",
+    "core",
 )
 scene, view_layer = bpy.context.scene, bpy.context.view_layer
 LENGTH, BONES = 3.0, 3
@@ -122,10 +127,8 @@ def group_weights():
 
 
 def keyframes():
-    curves = (
-        rig.animation_data.action.fcurves if hasattr(rig.animation_data.action, "fcurves") else []
-    )
-    return [tuple(p.co) for c in curves for p in c.keyframe_points]
+    curves = frame_keys.action_fcurves(rig.animation_data)
+    return [(c.data_path, tuple(p.co)) for c in curves for p in c.keyframe_points]
 
 
 weights_before, keys_before = group_weights(), keyframes()
@@ -182,6 +185,24 @@ for frame in (90, 8, 44):
     scene.frame_set(frame)
     assert offset().tobytes() == played[frame].tobytes(), f"the bake differs at {frame}"
     assert support.evaluated_positions(obj).tobytes() == shown[frame].tobytes(), frame
+# As after an undo (which makes every Player again): stepped on from the cache alone.
+cache = frame_cache.get(obj)
+cache.cut(70)
+timeline._players.clear()
+scene.frame_set(75)
+assert offset().tobytes() == played[75].tobytes(), "after the Players were made again"
+# Weights painted (the Attach group grown): the cache is made again from its start.
+scene.frame_set(20)
+attach.add([int(np.flatnonzero(V[:, 2] > 0.4)[0])], 1.0, "REPLACE")
+timeline._players.clear()
+scene.frame_set(21)
+assert frame_cache.get(obj).end == 21 and frame_cache.get(obj).row(1) == 0
+assert offset().tobytes() != played[21].tobytes()
+attach.remove([int(np.flatnonzero(V[:, 2] > 0.4)[0])])
+timeline._players.clear()
+scene.frame_set(22)
+assert offset().tobytes() == played[22].tobytes()
+assert bpy.ops.modal_deform.bake_animation() == {"FINISHED"}
 
 # Exports, played by Blender's Mesh Cache modifier on copies without the add-on.
 for space in ("REST", "SKINNED"):
@@ -203,6 +224,17 @@ for space in ("REST", "SKINNED"):
         assert error < 1e-6 * size, f"{space} export at frame {frame}: {error}"
     corrective.mute = False
     bpy.data.objects.remove(copy)
+# Shape keys in rest space: they add to the corrective before the Armature modifier, as the
+# offset did; the cache goes and Dynamics is turned off (the keys take their place).
+assert bpy.ops.modal_deform.export_shape_keys() == {"FINISHED"}
+assert frame_cache.get(obj) is None and not dynamics.enabled
+for frame in (8, 12, 30):
+    scene.frame_set(frame)
+    error = np.abs(support.evaluated_positions(obj) - shown[frame]).max()
+    assert error < 1e-6 * size, f"shape key export at frame {frame}: {error}"
+frame_keys.remove_keys(obj, [f"Modal Deform {f:04d}" for f in range(1, 91)])
+obj.active_shape_key_index = 1
+dynamics.enabled = True
 
 # Bad input: each refused with a message while the timeline plays on; nothing of the artist's
 # changes, and the display goes (the mesh is the Armature modifier's).
@@ -298,6 +330,7 @@ scene.frame_set(36)
 assert frame_display.OFFSET_ATTRIBUTE not in obj.data.attributes
 dynamics.follow_rig = True
 dynamics.period = 8.0
+assert keyframes() == keys_before, "the rig's keyframes changed"
 # The armature deleted.
 bpy.data.objects.remove(rig)
 refused("has no armature", 37)
