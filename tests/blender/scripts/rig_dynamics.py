@@ -12,6 +12,7 @@ import time
 
 import bpy
 import numpy as np
+from mathutils import Quaternion
 from support import blender as support
 
 timeline, frame_cache, frame_display, frame_keys, rig_module, mdc = support.enable_addon(
@@ -116,6 +117,11 @@ free_end = V[:, 2] > LENGTH - 0.3
 rig.keyframe_insert("location", frame=6)
 rig.location.x += 1.5
 rig.keyframe_insert("location", frame=10)
+# Then the middle bone bends fast (the chain's free end follows through) and stops.
+bend = rig.pose.bones["Bone1"]
+bend.keyframe_insert("rotation_quaternion", frame=30)
+bend.rotation_quaternion = Quaternion((1.0, 0.0, 0.0), 0.6)
+bend.keyframe_insert("rotation_quaternion", frame=34)
 scene.frame_start, scene.frame_end = 1, 90
 frozen = support.mesh_state(obj)
 
@@ -154,6 +160,9 @@ for frame in range(1, 91):
 along = np.array([played[f][free_end, 0].mean() for f in range(1, 91)]) / size
 assert along[6:11].min() < -0.01, np.round(along[:30], 4)
 assert along[10:30].max() > 0.005, np.round(along[:30], 4)
+bent = np.array([np.abs(played[f][free_end]).max() for f in range(28, 60)]) / size
+assert bent[3:10].max() > 10 * bent[:3].max(), np.round(bent, 4)  # follow-through
+assert bent[-5:].max() < 0.1 * bent.max(), np.round(bent, 4)  # and it decays
 assert np.abs(played[90]).max() < 1e-5 * size, np.abs(played[90]).max()
 scene.frame_set(90)
 settled = np.abs(support.evaluated_positions(obj) - support.evaluated_positions(reference)).max()
@@ -218,7 +227,7 @@ for space in ("REST", "SKINNED"):
     else:  # the skinned mesh itself, without the shape key and the Armature modifier
         copy.modifiers.remove(copy.modifiers["Armature"])
     corrective.mute = True  # a file holds positions: the shape key is not in them
-    for frame in (3, 8, 12, 30):
+    for frame in (3, 8, 12, 33):
         scene.frame_set(frame)
         error = np.abs(support.evaluated_positions(copy) - support.evaluated_positions(obj)).max()
         assert error < 1e-6 * size, f"{space} export at frame {frame}: {error}"
