@@ -4,6 +4,10 @@ timeline plays (Blender 4+), a stand-in mesh without shape keys whose positions 
 the modifier reads instead (frame_mesh(stand_in=True)) because Blender evaluates it faster
 (bench/results/playback.json, "evaluate_ms" of "dynamic_step" against "dynamic_step_still").
 
+On a rig (Follow Rig, rig.py) the display is an offset instead (offset_mesh): Set Position adds
+a rest-space displacement to the positions as the shape keys leave them, first in the stack and so
+before the Armature modifier, which skins it; no stand-in there.
+
 The artist's positions and shape keys are never written. Where the attribute is missing the modifier
 leaves the positions alone (the Named Attribute node's "Exists" is Set Position's selection; Blender
 3.4 has no such output: there a BOOLEAN point attribute, SHOWN, written True with the attribute, is

@@ -233,26 +233,29 @@ class Rig:
         self.weights = CompressedRows(
             (num_vertices, len(self.bones) + self.unskinned), pointers, cols, values
         )
-        pose_bones = armature.pose.bones
-        self._pose_index = np.array([pose_bones.find(name) for name in self.bones])
         rest = np.array([np.array(armature.data.bones[name].matrix_local) for name in self.bones])
         self._rest_inverse = np.linalg.inv(rest)
-        self._matrices = np.empty(16 * len(pose_bones), np.float32)
+        self._index_pose(armature.pose.bones)
         self._counts, self._pointers, self._columns = counts, pointers, cols
         digest = hashlib.blake2b(repr(self.bones).encode(), digest_size=16)
         for array in (pointers, cols, values, self.attach):
             digest.update(np.ascontiguousarray(array).tobytes())
         self.digest = digest.hexdigest()  #: of the weights as read, for the cache (WEIGHTS)
 
+    def _index_pose(self, pose_bones):
+        """Where the used bones are among the pose's (pose_bones.keys(): their names in order)."""
+        self._pose_names = pose_bones.keys()
+        self._pose_index = np.array([self._pose_names.index(name) for name in self.bones])
+        self._matrices = np.empty(16 * len(self._pose_names), np.float32)
+
     def frame(self, obj):
         """The rig now, (bones + 1, 4, 4) float64: each used bone's world skinning matrix, then the
-        mesh object's world matrix. RigError when a bone is gone (renamed or deleted since)."""
+        mesh object's world matrix. A deforming bone renamed or deleted changes signature(): the
+        Player reads a new Rig; other bones added, deleted or renamed are indexed again here."""
         armature = self.armature
         pose_bones = armature.pose.bones
-        if len(pose_bones) * 16 != self._matrices.size:  # a rename changes signature(): a new Rig
-            raise RigError(
-                f"Follow Rig: the bones of '{armature.name}' changed (renamed or deleted)"
-            )
+        if pose_bones.keys() != self._pose_names:
+            self._index_pose(pose_bones)
         pose_bones.foreach_get("matrix", self._matrices)
         pose = self._matrices.reshape(-1, 4, 4).transpose(0, 2, 1)[self._pose_index]
         armature_world = np.array(armature.matrix_world)

@@ -10,6 +10,9 @@ only the frame it shows). Before the cache's first frame the mesh holds that fra
 The result is shown by frame_display.py: mapped straight into a point attribute that a Geometry
 Nodes modifier sets the positions from, or while the timeline plays into a stand-in mesh the modifier
 reads (the artist's positions and shape keys are not written).
+On a rig (rig.py) the simulation steps with each frame's bones, which the cache keeps beside the
+state, and the frame shows as a rest-space offset before the Armature modifier
+(frame_display.offset_mesh).
 Frames computed here are checked against what they were computed from each time they are shown
 (frame_cache: settings, basis, keyframes, the controllers' transforms at that frame) and computed
 again from there when that changed.
