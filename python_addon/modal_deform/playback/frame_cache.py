@@ -274,7 +274,8 @@ def settings_changed(obj):
 
 
 def controller_curves(obj):
-    """The animation curves of obj's controllers, as (path, F-curve): path "controller:data_path[index]".
+    """The animation curves of obj's controllers, as (path, F-curve): path "controller:data_path[index]";
+    on a rig, then those that move the rig (rig.action_curves).
     A bone's are those of its armature's action that move it: the armature object's own (paths not
     under pose.bones) and those of the bone and its parents (paths under pose.bones["name"])."""
     from .frame_keys import action_fcurves

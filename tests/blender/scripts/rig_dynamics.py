@@ -9,18 +9,20 @@ weights and keyframes never change. A rig of 200 bones plays."""
 
 import os
 import time
+import types
 
 import bpy
 import numpy as np
 from mathutils import Quaternion
 from support import blender as support
 
-timeline, frame_cache, frame_display, frame_keys, rig_module, mdc = support.enable_addon(
+timeline, frame_cache, frame_display, frame_keys, rig_module, ui, mdc = support.enable_addon(
     "playback.timeline",
     "playback.frame_cache",
     "playback.frame_display",
     "playback.frame_keys",
     "playback.rig",
+    "ui",
     "core",
 )
 scene, view_layer = bpy.context.scene, bpy.context.view_layer
@@ -148,6 +150,9 @@ played, shown = {}, {}
 for frame in range(1, 91):
     scene.frame_set(frame)
     assert obj.name not in timeline.problems, timeline.problems[obj.name]
+    if frame == 1:
+        player = timeline.player(obj, scene)  # the rig is read once: playback's writes keep it
+    assert timeline.player(obj, scene) is player
     played[frame], shown[frame] = offset(), support.evaluated_positions(obj)
     if frame <= 6:  # before the jump: exactly the Armature modifier's result, shape key included
         assert not played[frame].any(), frame
@@ -249,10 +254,42 @@ dynamics.enabled = True
 # changes, and the display goes (the mesh is the Armature modifier's).
 
 
+class Layout:
+    """A stand-in for a panel's layout (headless Blender draws no panel): records what it shows."""
+
+    def __init__(self, shown):
+        self.shown = shown
+
+    def __getattr__(self, name):
+        def record(*args, **kwargs):
+            self.shown.append((name, args, kwargs))
+            return self
+
+        return record
+
+
+def dynamics_panel():
+    """What the Dynamics panel draws for obj: (call, args, kwargs) of its layout."""
+    drawn = []
+    context = types.SimpleNamespace(
+        object=obj,
+        scene=scene,
+        region=types.SimpleNamespace(width=400),
+        preferences=types.SimpleNamespace(system=types.SimpleNamespace(ui_scale=1.0)),
+    )
+    ui.VIEW3D_PT_modal_deform_dynamics.draw(types.SimpleNamespace(layout=Layout(drawn)), context)
+    return drawn
+
+
+def panel_text(drawn):
+    return " ".join(kwargs.get("text", "") for name, _, kwargs in drawn if name == "label")
+
+
 def refused(fragment, frame=31):
     scene.frame_set(frame)
     problem = timeline.problems.get(obj.name, "")
     assert fragment in problem, f"expected {fragment!r}, got {problem!r}"
+    assert fragment in panel_text(dynamics_panel())
     assert not frame_display.shows(obj) or not frame_display.offset_values(obj.data).any()
     print("refused:", problem)
 
@@ -340,6 +377,13 @@ plays(35)
 warnings = timeline.rig_warnings(obj)
 assert any("weighted to no bone" in w for w in warnings), warnings
 print("warned:", warnings)
+
+drawn = dynamics_panel()
+props = [args[1] for name, args, _ in drawn if name in ("prop", "prop_search")]
+assert "follow_rig" in props and "attach_group" in props, props
+operators = [args[0] for name, args, _ in drawn if name == "operator"]
+assert "modal_deform.fill_attach" in operators, operators
+assert "weighted to no bone" in panel_text(drawn)
 for b in range(BONES):
     W = chain_weights(V[top_ring, 2])
     for i, w in zip(top_ring, W[:, b]):
@@ -351,11 +395,15 @@ scene.frame_set(36)
 assert frame_display.OFFSET_ATTRIBUTE not in obj.data.attributes
 dynamics.follow_rig = True
 dynamics.period = 8.0
+plays(36)  # and the offset display in its place
+assert frame_display.shows_offset(obj) and frame_display.ATTRIBUTE not in obj.data.attributes
 assert keyframes() == keys_before, "the rig's keyframes changed"
 # The armature deleted.
 bpy.data.objects.remove(rig)
 refused("has no armature", 37)
-assert support.mesh_state(obj) == frozen, "the artist's mesh changed"
+for state in (frozen, now := support.mesh_state(obj)):  # the caches come and go
+    state["palettes"] = [p for p in state["palettes"] if not p.startswith(frame_cache.PREFIX)]
+assert now == frozen, "the artist's mesh changed"
 after = group_weights()
 assert all(after[name] == weights_before[name] for name in weights_before), "weights changed"
 
