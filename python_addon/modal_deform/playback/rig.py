@@ -39,6 +39,9 @@ from .. import mesh_io
 #: Attach group membership: the vertices whose weight is above this (a painted falloff of small
 #: weights does not hold them).
 ATTACH_WEIGHT = 0.5
+#: The Armature modifier leaves a vertex whose weights sum to no more than this where it is
+#: (armature_deform.cc's threshold).
+MIN_WEIGHT = 1e-4
 #: Fill Attach from Armature's default reach: a fraction of each bone's length around its segment.
 ATTACH_REACH = 0.25
 
@@ -201,6 +204,9 @@ class Rig:
                 f"Follow Rig: the Attach group '{group_name}' holds no vertex (none of weight above "
                 f"{ATTACH_WEIGHT:g}): Fill Attach from Armature, or paint it"
             )
+        # As the Armature modifier, a vertex whose weights sum to at most MIN_WEIGHT is not skinned.
+        kept = (np.bincount(rows, values, minlength=num_vertices) > MIN_WEIGHT)[rows]
+        rows, cols, values = rows[kept], cols[kept], values[kept]
         # Bones no vertex is weighted to are left out; the used ones keep the armature's order.
         used = np.unique(cols)
         if not used.size:
