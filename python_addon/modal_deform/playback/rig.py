@@ -18,8 +18,12 @@ skinning carries it and the mesh as shape keys leave it (correctives included) s
   (zero displacement: where the rig puts them). Fill Attach from Armature (fill_attach) puts in it
   the vertices within a fraction of each deforming bone's length of the bone's segment.
 - The artist's handles map into rest space: a handle with a controller by the inverse of the
-  skinning at its vertices (their mean weights), so a controller that follows the rig holds its
-  vertices where the rig puts them; a handle without one is held there (as Attach).
+  skinning at its vertices (their mean weights), A⁻¹ x mesh world x T (T its object-space
+  transform, handles.transforms); a handle without one is held where the rig puts its vertices
+  (as Attach). A controller's motion counts from where it was bound, which is taken as the rig's
+  rest pose: a bone of the rig bound in the rest pose holds its vertices where that bone puts
+  them (its transform in rest space is the identity whatever the pose); bound in another pose, it
+  holds them where that pose's inverse puts them.
 
 Refused with a message (RigError): no Armature modifier, two of them, one without an armature, one
 disabled in the viewport, with Preserve Volume (dual quaternions, not linear blend skinning), with
@@ -266,7 +270,13 @@ class Rig:
         pose = self._matrices.reshape(-1, 4, 4).transpose(0, 2, 1)[self._pose_index]
         armature_world = np.array(armature.matrix_world)
         mesh_world = np.array(obj.matrix_world)
-        to_armature = np.linalg.solve(armature_world, mesh_world)  # armature world⁻¹ x mesh world
+        try:
+            to_armature = np.linalg.solve(armature_world, mesh_world)  # armature⁻¹ x mesh world
+        except np.linalg.LinAlgError:
+            raise RigError(
+                f"Follow Rig: armature '{armature.name}' is scaled to nothing (its matrix is "
+                f"singular)"
+            ) from None
         bones = armature_world @ (pose @ self._rest_inverse) @ to_armature
         return np.concatenate((bones, mesh_world[None]))
 

@@ -83,6 +83,8 @@ class Player:
             rig=None if self.rig is None else self.rig.weights,
         )
         self.rest = self.basis.rest.astype(np.float32)
+        # On a rig, True when its mesh was edited since its weights were read (_edits_reported).
+        self.rig_edited = False
         # The mesh (address, vertex count) last found equal to rest; None again when Blender reports
         # a geometry update of it (_edits_reported). An undo makes every Player again (_undone).
         self.compared = None
@@ -129,8 +131,13 @@ class Player:
         self.compared = compared
 
     def fits(self, obj, signature):
-        """Whether this Player is for obj's basis and settings (`signature`: frame_cache.signature)."""
-        return self.signature == signature and self.basis_id == frame_cache.basis_id(obj)
+        """Whether this Player is for obj's basis and settings (`signature`: frame_cache.signature)
+        and, on a rig, its weights as read."""
+        return (
+            self.signature == signature
+            and self.basis_id == frame_cache.basis_id(obj)
+            and not self.rig_edited
+        )
 
     def transforms(self, obj, rig_frame=None):
         """The handles' transforms now, (handles, 4, 4) float64; on a rig in rest space at
@@ -358,13 +365,12 @@ def _edits_reported(depsgraph):
     }
     if not edited:
         return
-    for name, found in list(_players.items()):
+    for name, found in _players.items():
         obj = bpy.data.objects.get(name)
         if obj is not None and obj.type == "MESH" and obj.data.as_pointer() in edited:
             found.compared = None
             frame_display.end_stand_in(obj)
-            if found.rig is not None:  # weights painted: the next frame reads the rig again
-                del _players[name]
+            found.rig_edited = found.rig is not None  # weights painted: read again (fits())
 
 
 def _frame_changed(scene, depsgraph=None):
