@@ -376,15 +376,25 @@ rig.pose.bones["Bone1"].scale = (1.0, 1.0, 1.0)
 rig.scale = (0.0, 1.0, 1.0)
 refused("scaled to nothing", 34)
 rig.scale = (1.0, 1.0, 1.0)
-# Vertices weighted to no bone: a warning, and they stay where the Armature modifier leaves them.
-top_ring = np.flatnonzero(V[:, 2] > LENGTH - 1e-6)
-for b in range(BONES):
-    obj.vertex_groups[f"Bone{b}"].remove([int(i) for i in top_ring])
-dynamics.period = 8.5  # a setting changed: a new Player reads the weights again
+# A weighted bone deleted: the vertices weighted to it alone are weighted to no bone, which the
+# panel says, and stay where the Armature modifier leaves them (unskinned); the bone made again,
+# all is as before (the vertex groups were never touched).
+view_layer.objects.active = rig
+bpy.ops.object.mode_set(mode="EDIT")
+rig.data.edit_bones.remove(rig.data.edit_bones["Bone2"])
+bpy.ops.object.mode_set(mode="OBJECT")
 plays(35)
 warnings = timeline.rig_warnings(obj)
-assert any("weighted to no bone" in w for w in warnings), warnings
+alone = np.count_nonzero(chain_weights(V[:, 2])[:, 2] == 1)
+assert any(f"{alone} vertices are weighted to no bone" in w for w in warnings), (alone, warnings)
 print("warned:", warnings)
+scene.frame_set(36)
+unskinned = np.flatnonzero(chain_weights(V[:, 2])[:, 2] == 1)
+error = np.abs(
+    support.evaluated_positions(obj)[unskinned] - support.evaluated_positions(reference)[unskinned]
+).max()
+offset_there = np.abs(offset()[unskinned]).max()
+assert error <= offset_there + 1e-6, (error, offset_there)
 
 drawn = dynamics_panel()
 props = [args[1] for name, args, _ in drawn if name in ("prop", "prop_search")]
@@ -392,18 +402,20 @@ assert "follow_rig" in props and "attach_group" in props, props
 operators = [args[0] for name, args, _ in drawn if name == "operator"]
 assert "modal_deform.fill_attach" in operators, operators
 assert "weighted to no bone" in panel_text(drawn)
-for b in range(BONES):
-    W = chain_weights(V[top_ring, 2])
-    for i, w in zip(top_ring, W[:, b]):
-        if w > 0:
-            obj.vertex_groups[f"Bone{b}"].add([int(i)], float(w), "REPLACE")
+bpy.ops.object.mode_set(mode="EDIT")
+bone = rig.data.edit_bones.new("Bone2")
+bone.head, bone.tail = (0, 0, 2 * LENGTH / 3), (0, 0, LENGTH)
+bone.parent, bone.use_connect = rig.data.edit_bones["Bone1"], True
+bpy.ops.object.mode_set(mode="OBJECT")
+view_layer.objects.active = obj
+plays(37)
+assert not timeline.rig_warnings(obj)
 # Follow Rig off: the display of positions again, the offset attribute gone.
 dynamics.follow_rig = False
-scene.frame_set(36)
+scene.frame_set(38)
 assert frame_display.OFFSET_ATTRIBUTE not in obj.data.attributes
 dynamics.follow_rig = True
-dynamics.period = 8.0
-plays(36)  # and the offset display in its place
+plays(38)  # and the offset display in its place
 assert frame_display.shows_offset(obj) and frame_display.ATTRIBUTE not in obj.data.attributes
 assert keyframes() == keys_before, "the rig's keyframes changed"
 # The armature deleted.
