@@ -211,6 +211,22 @@ class ModalDeformDynamics(bpy.types.PropertyGroup):
         description="Frame the simulation starts on, at rest in the pose of the controllers there; before it "
         "the mesh holds that pose",
     )
+    # On a rig: playback/rig.py.
+    follow_rig: BoolProperty(
+        name="Follow Rig",
+        default=False,
+        update=_dynamics_changed,
+        description="The mesh's Armature modifier drives the dynamics: parts not attached to the bones lag, "
+        "overshoot and settle as the rig moves, shown before the Armature modifier so that its skinning "
+        "and your corrective shape keys still apply; with the rig still the mesh is exactly the "
+        "Armature modifier's",
+    )
+    attach_group: StringProperty(
+        name="Attach",
+        update=_dynamics_changed,
+        description="Vertex group of the vertices held where the rig puts them (weight above 0.5), as Cloth's "
+        "Pin Group: Fill Attach from Armature makes it from the vertices near the bones, then paint it",
+    )
     cache: PointerProperty(
         type=bpy.types.Palette,
         name="Cache",
