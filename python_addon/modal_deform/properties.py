@@ -114,6 +114,15 @@ class ModalDeformHandle(bpy.types.PropertyGroup):
         description="The controller's matrix (its bone's, for a bone) in the mesh object's space when it was "
         "assigned: the rest pose of the handle",
     )
+    bind_skinning: FloatVectorProperty(
+        name="Bind Skinning",
+        size=(4, 4),
+        subtype="MATRIX",
+        default=IDENTITY,
+        options={"HIDDEN"},
+        description="How the mesh's Armature modifier placed the handle's vertices (in the mesh object's "
+        "space) when the controller was assigned: Follow Rig holds them there until the controller moves",
+    )
 
 
 class ModalDeformBakeStatus(bpy.types.PropertyGroup):

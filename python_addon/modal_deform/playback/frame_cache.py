@@ -26,11 +26,13 @@ import json
 
 import bpy
 import numpy as np
+from mathutils import Matrix
 
 from .. import handles, mesh_io, storage
 from . import rig
 
 PREFIX = ".Modal Deform Cache "
+_IDENTITY = Matrix.Identity(4)
 #: "rig", on a rig only (playback/rig.py): each frame's rig (Rig.frame), the bones whose motion the
 #: next frame's step needs (Simulation.rig_state: the frame's and the one before's).
 _ARRAYS = ("q", "v", "transforms", "curves", "rig")
@@ -67,6 +69,11 @@ def _pose_fields(obj):
                     tuple(value for row in h.bind_matrix for value in row),
                 )
                 + ((h.bone,) if h.bone else ())  # an object controller's as before bones came
+                + (  # a handle bound in the rig's rest pose as before bind_skinning came
+                    ()
+                    if h.bind_skinning == _IDENTITY
+                    else (tuple(value for row in h.bind_skinning for value in row),)
+                )
                 for h in settings.handles
             ),
         ),

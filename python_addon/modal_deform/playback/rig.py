@@ -18,12 +18,15 @@ skinning carries it and the mesh as shape keys leave it (correctives included) s
   (zero displacement: where the rig puts them). Fill Attach from Armature (fill_attach) puts in it
   the vertices within a fraction of each deforming bone's length of the bone's segment.
 - The artist's handles map into rest space: a handle with a controller by the inverse of the
-  skinning at its vertices (their mean weights), A⁻¹ x mesh world x T (T its object-space
-  transform, handles.transforms); a handle without one is held where the rig puts its vertices
-  (as Attach). A controller's motion counts from where it was bound, which is taken as the rig's
-  rest pose: a bone of the rig bound in the rest pose holds its vertices where that bone puts
-  them (its transform in rest space is the identity whatever the pose); bound in another pose, it
-  holds them where that pose's inverse puts them.
+  skinning at its vertices (their mean weights) A, A⁻¹ x mesh world x T x S (T its object-space
+  transform, handles.transforms; S the skinning in object space when it was bound,
+  bind_skinning); a handle without one is held where the rig puts its vertices (as Attach). So a
+  controller counts its motion from where it was bound, and the vertices from where the rig put
+  them then: bound in any pose of the rig, a handle holds its vertices where the rig puts them
+  until its controller moves (an Empty that stays put then holds them where they were in the
+  world; a bone of the rig that the vertices are weighted to holds them where that bone puts
+  them, whatever the pose); moving the controller moves them from there, as it moves them off
+  the rig.
 
 Refused with a message (RigError): no Armature modifier, two of them, one without an armature, one
 disabled in the viewport, with Preserve Volume (dual quaternions, not linear blend skinning), with
@@ -147,6 +150,19 @@ def action_curves(obj):
     return sorted(found, key=lambda item: item[0])
 
 
+def world_skinning(armature, pose, rest_inverse, mesh_world):
+    """Bones' world skinning matrices (b, 4, 4): armature world x pose x rest⁻¹ x armature world⁻¹
+    x mesh world, from their pose matrices `pose` and inverse rest matrices (armature space)."""
+    armature_world = np.array(armature.matrix_world)
+    try:
+        to_armature = np.linalg.solve(armature_world, mesh_world)  # armature⁻¹ x mesh world
+    except np.linalg.LinAlgError:
+        raise RigError(
+            f"Follow Rig: armature '{armature.name}' is scaled to nothing (its matrix is singular)"
+        ) from None
+    return armature_world @ (pose @ rest_inverse) @ to_armature
+
+
 class CompressedRows:
     """Skinning weights as compressed rows, read by the core as a sparse matrix's (tocsr())."""
 
@@ -268,16 +284,8 @@ class Rig:
             self._index_pose(pose_bones)
         pose_bones.foreach_get("matrix", self._matrices)
         pose = self._matrices.reshape(-1, 4, 4).transpose(0, 2, 1)[self._pose_index]
-        armature_world = np.array(armature.matrix_world)
         mesh_world = np.array(obj.matrix_world)
-        try:
-            to_armature = np.linalg.solve(armature_world, mesh_world)  # armature⁻¹ x mesh world
-        except np.linalg.LinAlgError:
-            raise RigError(
-                f"Follow Rig: armature '{armature.name}' is scaled to nothing (its matrix is "
-                f"singular)"
-            ) from None
-        bones = armature_world @ (pose @ self._rest_inverse) @ to_armature
+        bones = world_skinning(armature, pose, self._rest_inverse, mesh_world)
         return np.concatenate((bones, mesh_world[None]))
 
     def bones_of(self, frame):
@@ -294,19 +302,20 @@ class Rig:
         )
         return total / len(indices)
 
-    def to_rest(self, transforms, frame, handle_weights, centres):
-        """The handles' object-space transforms (handles.transforms) in rest space on the rig at
-        `frame`: A⁻¹ x mesh world x T, A the skinning blended by the handle's mean weights, made
-        rigid about its centre; the identity for a handle without a controller (None in
-        `handle_weights`)."""
+    def to_rest(self, transforms, frame, handle_weights, handles):
+        """The handles' object-space transforms T (handles.transforms) in rest space on the rig at
+        `frame`: A⁻¹ x mesh world x T x S, A the skinning blended by the handle's mean weights, S
+        the skinning it was bound in (Handle.bind_skinning), made rigid about its centre; the
+        identity for a handle without a controller (None in `handle_weights`)."""
         bones, mesh_world = self.bones_of(frame), frame[-1]
         result = []
-        for T, weights, centre in zip(transforms, handle_weights, centres):
+        for T, weights, handle in zip(transforms, handle_weights, handles):
             if weights is None:
                 result.append(np.eye(4))
                 continue
             A = np.einsum("b,bij->ij", weights, bones)
-            result.append(mdc.nearest_rigid(np.linalg.solve(A, mesh_world @ T), centre))
+            target = mesh_world @ T @ handle.bind_skinning
+            result.append(mdc.nearest_rigid(np.linalg.solve(A, target), handle.centre))
         return result
 
     def skinned(self, X, frame):
@@ -315,6 +324,49 @@ class Rig:
         mesh_world = frame[-1]
         bones = np.linalg.solve(mesh_world, self.bones_of(frame))
         return mdc.skin(X, self.weights, bones)
+
+
+def bind_skinning(obj, indices):
+    """The skinning a handle bound now records (handles.bind): obj's Armature modifier's in obj's
+    space, the bones' matrices blended by the mean weights of the handle's vertices `indices` as
+    Rig.handle_weights blends them (4x4 float64). The identity when no usable Armature modifier
+    skins obj, and when it moves no vertex of the handle by more than float32 rounding (the rig's
+    rest pose read back through Blender's float matrices)."""
+    try:
+        armature = armature_modifier(obj).object
+        names = deform_bones(armature)
+        mesh_world = np.array(obj.matrix_world)
+        columns = {}
+        for column, name in enumerate(names):
+            group = obj.vertex_groups.get(name)
+            if group is not None:
+                columns[group.index] = column
+        mean = np.zeros(len(names) + 1)  # the last: unskinned vertices, left where they are
+        for i in indices:
+            row = np.zeros(len(names) + 1)
+            for g in obj.data.vertices[int(i)].groups:
+                if columns.get(g.group, -1) >= 0 and g.weight > 0.0:
+                    row[columns[g.group]] += g.weight
+            total = row.sum()
+            if total > MIN_WEIGHT:
+                mean += row / total
+            else:
+                mean[-1] += 1.0
+        mean /= len(indices)
+        used = np.flatnonzero(mean[:-1])
+        pose = np.array([np.array(armature.pose.bones[names[b]].matrix) for b in used])
+        rest = np.array([np.array(armature.data.bones[names[b]].matrix_local) for b in used])
+        bones = world_skinning(armature, pose, np.linalg.inv(rest), mesh_world)
+        skinning = mean[-1] * np.eye(4) + np.linalg.solve(
+            mesh_world, np.einsum("b,bij->ij", mean[used], bones)
+        )
+    except (RigError, np.linalg.LinAlgError):
+        return np.eye(4)
+    rest_positions = mesh_io.positions(obj.data)[indices].astype(np.float64)
+    moved = rest_positions @ (skinning[:3, :3] - np.eye(3)).T + skinning[:3, 3]
+    if np.abs(moved).max() <= 1e-6 * (1.0 + np.abs(rest_positions).max()):
+        return np.eye(4)
+    return skinning
 
 
 def fill_attach(obj, reach=ATTACH_REACH):

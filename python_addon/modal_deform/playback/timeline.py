@@ -144,8 +144,7 @@ class Player:
         `rig_frame` (rig_frame()), the Attach group's identity last."""
         found = handles.transforms(obj, self.handles)
         if self.rig is not None:
-            centres = [h.centre for h in self.handles]
-            found = self.rig.to_rest(found, rig_frame, self.handle_weights, centres)
+            found = self.rig.to_rest(found, rig_frame, self.handle_weights, self.handles)
             found.append(np.eye(4))
         return np.array(found).reshape(-1, 4, 4)
 
