@@ -12,6 +12,9 @@ where it was.
 
 Then secondary motion (issue 40, demo_dynamics.py): a Suzanne whose head tilts fast and stops, her
 ears overshooting and settling, as a strip of frames, OUTPUT/demo_dynamics.png.
+And on a rig (issue 50, demo_rig.py): Suzanne on a round body, skinned to two bones, jumps and
+tilts her head with Dynamics > Follow Rig, above the same frames with the Armature modifier alone,
+OUTPUT/demo_rig.png.
 
 Writes OUTPUT/demo.png (Cycles on the CPU: rest, Modal Deform, Laplacian Deform side by side; below
 them the uniform and the painted finger and the ear) and OUTPUT/demo.blend (Suzanne alone), ready to
@@ -33,6 +36,7 @@ from mathutils import Matrix, Vector
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import demo_dynamics  # noqa: E402
+import demo_rig  # noqa: E402
 from headless import add_handle, bind_laplacian_deform, enable_addon, evaluated_positions  # noqa: E402
 from rendering import render, side_by_side, stage  # noqa: E402
 
@@ -324,6 +328,11 @@ def main():
         tuple(modules), output, args.dynamics_subdivisions, args.width // 2
     )
     print(f"rendered {strip} (secondary motion) in {time.perf_counter() - start:.1f} s")
+
+    start = time.perf_counter()
+    frame_cache = importlib.import_module(f"{addon}.playback.frame_cache")
+    strip = demo_rig.rig_dynamics(frame_cache, output, args.width * 3 // 10, args.samples)
+    print(f"rendered {strip} (secondary motion on a rig) in {time.perf_counter() - start:.1f} s")
 
 
 main()
