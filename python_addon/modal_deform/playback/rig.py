@@ -354,6 +354,8 @@ def bind_skinning(obj, indices):
                 mean[-1] += 1.0
         mean /= len(indices)
         used = np.flatnonzero(mean[:-1])
+        if not used.size:  # every vertex unskinned
+            return np.eye(4)
         pose = np.array([np.array(armature.pose.bones[names[b]].matrix) for b in used])
         rest = np.array([np.array(armature.data.bones[names[b]].matrix_local) for b in used])
         bones = world_skinning(armature, pose, np.linalg.inv(rest), mesh_world)
@@ -362,7 +364,7 @@ def bind_skinning(obj, indices):
         )
     except (RigError, np.linalg.LinAlgError):
         return np.eye(4)
-    rest_positions = mesh_io.positions(obj.data)[indices].astype(np.float64)
+    rest_positions = mesh_io.positions(obj.data)[indices]
     moved = rest_positions @ (skinning[:3, :3] - np.eye(3)).T + skinning[:3, 3]
     if np.abs(moved).max() <= 1e-6 * (1.0 + np.abs(rest_positions).max()):
         return np.eye(4)
