@@ -1945,10 +1945,11 @@ def section_shape_keys_blender(result):
         'made by formula (support.poses.smooth_keys), Blend as Shapes turned on with its operator ("bake": '
         "the space's bake, a basis baked first), then one key's value changed per update and the view layer "
         'updated, as moving a slider in the Shape Keys panel does. "linear" is that update with Blend as '
-        "Shapes off (Blender's own mix); with it on, the update's whole time, and its parts: \"before\" "
-        "Blender's evaluation up to the add-on's depsgraph handler, \"handler\" the handler (of it, in brackets, "
-        '"blend": the core\'s blend with its map, ShapeSpace.stats), "after" Blender\'s evaluation of the '
-        "display the handler wrote. Each figure is the median over the updates of each update's least over "
+        "Shapes off (Blender's own mix); with it on, the update's whole time, and its parts: \"handlers\" the "
+        "add-on's depsgraph handlers before and after Blender's evaluation (of it, in brackets, \"blend\": the "
+        "core's blend with its map, ShapeSpace.stats), \"evaluate\" the rest, Blender's evaluation, of which "
+        '"after" follows the add-on\'s last handler (a second evaluation, of a display written after the '
+        "first). Each figure is the median over the updates of each update's least over "
         f"{runs[0]['blend']['rounds']} rounds of the same changes (each round from every key at 0). The "
         "issue's targets for the blend with its map: "
         + ", ".join(
@@ -1962,7 +1963,7 @@ def section_shape_keys_blender(result):
     for run in runs:
         blend = run["blend"]
         target = common.FRAME_TARGETS_MS.get(run["vertices"])
-        met = "" if target is None else (" (met)" if blend["blend_ms"] <= target else " (NOT met)")
+        met = "" if target is None else (", met" if blend["blend_ms"] <= target else ", NOT met")
         rows.append(
             [
                 run["blender"],
@@ -1972,8 +1973,8 @@ def section_shape_keys_blender(result):
                 f"{run['bake_seconds']:.1f}",
                 f"{run['linear']['update_ms']:.1f}",
                 f"{blend['update_ms']:.1f}",
-                f"{blend['before_ms']:.1f} + {blend['handler_ms']:.1f} ({blend['blend_ms']:.1f}{met}) + "
-                f"{blend['after_ms']:.1f}",
+                f"{blend['handlers_ms']:.1f} ({blend['blend_ms']:.1f}{met}) + {blend['evaluate_ms']:.1f} "
+                f"({blend['after_ms']:.2f})",
                 "{:.1f} / {:.1f}".format(*loads) if (loads := load_range(run)) else "",
             ]
         )
@@ -1986,7 +1987,7 @@ def section_shape_keys_blender(result):
                 "bake s",
                 "linear update ms",
                 "blend update ms",
-                "before + handler (blend) + after ms",
+                "handlers (blend) + evaluate (after) ms",
                 "load before / after",
             ],
             rows,
