@@ -12,7 +12,9 @@ weight 0 it changes nothing, at another weight the blend is refused until a re-b
 Shown as Dynamics shows its frames (playback/frame_display.py: a Geometry Nodes modifier sets the
 positions from a point attribute, a stand-in while the timeline plays), recomputed when the weights
 change: at a frame change (a render's too, from the render's evaluated keys) and at any update of
-the scene (a key's value moved, keyed or driven). A blend is a function of the weights alone
+the scene (a key's value moved, keyed or driven): before Blender evaluates it, from the keys'
+values as set (a value moved in the panel: that one evaluation shows the blend), and after, from
+the evaluated keys (drivers, keyframes: the blend written then is evaluated a second time). A blend is a function of the weights alone
 (core.shapes), so the weights last shown are all that is remembered. When the blend cannot be shown
 (stale, a weight that is not a number, a key added after the bake with a weight) the display goes,
 so the mesh shows Blender's own mix, and the panel says why (problems). Dynamics on the same object
@@ -47,6 +49,8 @@ _CACHED_SPACES = 2
 # (it diverged, or stopped early).
 _shown = {}
 _checked = {}
+# Whether the handler before Blender's evaluation ran in this update (_update_after).
+_shown_before = False
 problems = {}
 notes = {}
 
@@ -258,6 +262,39 @@ def _update(scene, depsgraph=None):
             refresh(obj, depsgraph)
 
 
+def _update_before(scene, depsgraph=None):
+    """Before Blender evaluates an update: the blend for the keys' values as set, so that the
+    evaluation shows it (written after it, it would take a second evaluation)."""
+    global _shown_before
+    _update(scene)
+    _shown_before = True
+
+
+def _update_after(scene, depsgraph=None):
+    """After Blender evaluated an update: the blend for the evaluated keys (drivers, keyframes).
+    Where the handler before the evaluation showed the blend for these weights already, nothing
+    (the keys themselves cannot change during an evaluation: they were checked then)."""
+    global _shown_before
+    checked, _shown_before = _shown_before, False
+    for obj in scene.objects:
+        if obj.type == "MESH" and obj.modal_deform.shapes.enabled:
+            if checked and _shows_weights(obj, depsgraph):
+                continue
+            refresh(obj, depsgraph)
+
+
+def _shows_weights(obj, depsgraph):
+    """Whether the blend shown on obj is the one for its keys' weights in `depsgraph`."""
+    shown, block = _shown.get(obj.name), obj.modal_deform.shapes.space
+    if shown is None or block is None:
+        return False
+    try:
+        w = weights(obj, depsgraph)
+    except ValueError:
+        return False
+    return shown == (block[storage.BAKE_ID], w.tobytes())
+
+
 def _undone(*args):
     """An undo reads the meshes back: the blends shown are computed again."""
     _shown.clear()
@@ -274,7 +311,8 @@ def _forget(*args):
 
 _HANDLERS = (
     ("frame_change_post", _update),
-    ("depsgraph_update_post", _update),
+    ("depsgraph_update_pre", _update_before),
+    ("depsgraph_update_post", _update_after),
     ("undo_post", _undone),
     ("redo_post", _undone),
     ("load_post", _forget),

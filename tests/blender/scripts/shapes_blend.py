@@ -83,6 +83,23 @@ if playback:
     assert not frame_display.has_stand_in(obj)
     assert shown().tobytes() == at6.tobytes()
 
+# A driven value reaches the keys in Blender's evaluation: the blend for it shows after it.
+scene["Weight"] = 0.25
+fcurve = block.driver_add("value")
+fcurve.driver.type = "AVERAGE"
+variable = fcurve.driver.variables.new()
+variable.targets[0].id_type = "SCENE"
+variable.targets[0].id = scene
+variable.targets[0].data_path = '["Weight"]'
+for weight in (0.25, 0.75, 0.5):
+    scene["Weight"] = weight
+    scene.update_tag()
+    bpy.context.view_layer.update()
+    assert shown().tobytes() == space.blend([weight]).tobytes(), f"driven to {weight}"
+block.driver_remove("value")
+scene.frame_set(6)
+assert shown().tobytes() == at6.tobytes()
+
 # Keep as Shape Key: the blend shown, a new key at 0 relative to the basis.
 assert bpy.ops.modal_deform.keep_blend() == {"FINISHED"}
 kept = obj.data.shape_keys.key_blocks["Blended Shape"]
