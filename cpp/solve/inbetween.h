@@ -1,0 +1,174 @@
+// Physics in-betweens (spacetime constraints: Hildebrandt et al. 2012; Schulz et al. 2014): the
+// animator keys where handles must be at a few frames, and the motion between is the one that
+// needs the least control force to hit those keys under Simulation's dynamics, in the same basis,
+// mass scale ρ, Rayleigh damping β and midpoint rule (reduced_dynamics.h).
+//
+// Unknowns: q_1 … q_N, the reduced states at every substep boundary (node) from the first key
+// (node 0, q_0 fixed) to the last (node N = (last − first frame) · substeps). Each substep n is
+// the midpoint rule's: with x_n = (q_n + q_{n+1})/2 and the substep's force
+//   F_n = (1 + 2β/h) ∇V(x_n) − (2β/h) ∇V(q_n)    (V = E + E_C of the handles never keyed)
+// (Φ's stationarity, reduced_dynamics.h), a free substep leaves node n with velocity
+// v_n⁻ = (q_{n+1} − q_n)/h + (h/2ρ) F_n and reaches node n+1 with v_{n+1}⁺ = (q_{n+1} − q_n)/h −
+// (h/2ρ) F_n. The control is an impulse at each node, the jump ρ(v_n⁻ − v_n⁺) (v_0⁺ = 0: the motion
+// starts at rest); in h²/ρ units
+//   R_0 = q_1 − q_0 + (h²/2ρ) F_0,   R_n = q_{n+1} − 2q_n + q_{n−1} + (h²/2ρ)(F_{n−1} + F_n),
+// i.e. (h²/ρ) times the midpoint equation's control force averaged over the two substeps at the
+// node: ∇Φ at each substep is its control force, and the midpoint rule reads one only through
+// such sums. The problem:
+//   minimise ½ Σ_{n<N} ‖R_n‖² + ½ w Σ_keys E_key(q at the key)
+// with E_key the posing handle term (handle_term.h) of the handles keyed there at their keyed
+// transforms: a penalty, w set so that it outweighs the motion's own terms at the key node by
+// kKeyDominance, which hits the keys as closely as the basis can reach them (at least as closely as
+// posing, which trades the handle term against the deformation energy). ‖·‖ is the mass metric's
+// (the reduced mass is ρI). A keyed handle acts only at its keys; a handle never keyed is a spring
+// at the identity throughout (in V). A free motion of Simulation needs no impulse: R = 0, and the
+// solve reproduces it where Simulation's energy correction (a rescaling of the end velocity, not
+// smooth) does nothing, i.e. for motions small enough that the energy is quadratic (bench:
+// the reproduction error); the in-betweens measure the control on the midpoint equation alone.
+//
+// Solved by Gauss-Newton over all nodes at once: the model is the linearisation at rest (∇²V ≈ K̃,
+// K plus the never-keyed handles' term), whose normal matrix is block-banded in time (r by r
+// blocks, two blocks either side of the diagonal), constant, and factored once by a banded block
+// Cholesky; the gradient is exact (∇²V products by differences of ghost gradients) and a
+// backtracking line search on the objective keeps each step a descent, so the iteration reaches
+// the true minimiser at the rate the model's fit allows (quadratic energies: one step). Starting
+// guess: the static poses at the keys (posing's minima) interpolated linearly per coordinate.
+// Cost: the factorisation O(N r³) once; an iteration O(N) ghost gradients (4 a substep, each
+// O(#ghost vertices · r)) and O(N r²) for the solve, N = frames × substeps.
+//
+// Before the first key the motion holds the static pose of that key (ReducedSolver's minimum with
+// the handles keyed there at their transforms, the never-keyed at the identity, the others free)
+// at rest; after the last key it is Simulation's from the state reached there, each keyed handle a
+// spring at its last keyed transform, the never-keyed at the identity: frames are stepped in order
+// from there and cached, so a frame is the same bits however it is reached.
+//
+// Not thread-safe: one in-between per thread.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "solve/reduced_dynamics.h"
+
+namespace modal_deform {
+
+// One key: a frame ≥ 0 and, per handle, its rigid transform there or none (not keyed there).
+struct InbetweenKey {
+  int frame = 0;
+  std::vector<std::optional<Eigen::Matrix4d>> transforms;
+};
+
+// The most keys, and the longest span from the first key to the last, in frames: the unknowns
+// are (span × substeps) states of r coordinates.
+constexpr int kMaxKeys = 100;
+constexpr int kMaxInbetweenFrames = 10000;
+// The latest frame that positions() and state() take (Simulation steps there from the last key).
+constexpr int kMaxInbetweenFrame = 1000000;
+
+struct InbetweenOptions {
+  SimulationOptions simulation;  // the dynamics, and Simulation's after the last key
+  int solve_iterations = 100;    // quasi-Newton iterations at most
+  double solve_tolerance = 1e-5;
+};
+
+// The options as the Python API takes them: Simulation's (the same names and meanings) and the
+// solve's.
+template <typename Visit>
+void for_each_inbetween_option(Visit&& visit) {
+  for_each_simulation_option([&](const Option& option, auto field) {
+    visit(option, [field](auto& o) -> auto& { return field(o.simulation); });
+  });
+  visit(Option{"solve_iterations", "Gauss-Newton iterations of the whole motion at most.",
+               at_least(1)},
+        [](auto& o) -> auto& { return o.solve_iterations; });
+  visit(Option{"solve_tolerance",
+               "The solve has converged when a full Gauss-Newton step moves no reduced "
+               "coordinate by more than this (normalised frame: the mesh about unit size).",
+               between_open(0, 1)},
+        [](auto& o) -> auto& { return o.solve_tolerance; });
+}
+
+struct InbetweenStats {
+  bool converged = false;      // the last Gauss-Newton step met solve_tolerance
+  bool stalled = false;        // the line search found no decrease before convergence
+  int iterations = 0;          // Gauss-Newton iterations
+  int evaluations = 0;         // ghost gradients, posing's excepted
+  int nodes = 0;               // N: substeps from the first key to the last
+  double control = 0;          // ½ Σ ‖R_n‖² at the end
+  double initial_control = 0;  // the same for the starting guess
+  double ms = 0;               // wall time of solve(), milliseconds
+};
+
+template <typename Visit>
+void for_each_inbetween_stat(Visit&& visit) {
+  visit("converged", [](auto& s) -> auto& { return s.converged; });
+  visit("stalled", [](auto& s) -> auto& { return s.stalled; });
+  visit("iterations", [](auto& s) -> auto& { return s.iterations; });
+  visit("evaluations", [](auto& s) -> auto& { return s.evaluations; });
+  visit("nodes", [](auto& s) -> auto& { return s.nodes; });
+  visit("control", [](auto& s) -> auto& { return s.control; });
+  visit("initial_control", [](auto& s) -> auto& { return s.initial_control; });
+  visit("ms", [](auto& s) -> auto& { return s.ms; });
+}
+
+class Inbetween {
+ public:
+  // basis: validated, must outlive this. handles: fine vertex indices, weights one per handle
+  // (empty: 1), as Simulation's. keys: at least one, at most kMaxKeys, at distinct frames in
+  // [0, kMaxInbetweenFrame] spanning at most kMaxInbetweenFrames, in any order; each with one
+  // entry per handle, rigid where given (check_transforms), keying at least one handle. Throws
+  // InputError naming what is wrong.
+  Inbetween(const Basis& basis, const Handles& handles, const VectorRef& weights,
+            std::vector<InbetweenKey> keys, const InbetweenOptions& options,
+            EnergyKind energy = EnergyKind::kShells);
+  ~Inbetween();
+  Inbetween(const Inbetween&) = delete;
+  Inbetween& operator=(const Inbetween&) = delete;
+
+  // Solves the whole motion (the header says how); again after a solve, the same bits.
+  InbetweenStats solve();
+  bool solved() const { return solved_; }
+
+  // The state at `frame` in [0, kMaxInbetweenFrame]: q and v (per second). Solves first if
+  // solve() has not run; beyond the last key, steps Simulation up to the frame once.
+  void state(int frame, Eigen::VectorXd& q, Eigen::VectorXd& v);
+  // x̄ + U q at `frame`, written into `out` (FinePositions::write).
+  void positions(int frame, Eigen::Ref<Eigen::VectorXf> out);
+
+  int dimension() const { return simulation_->dimension(); }
+  int num_handles() const { return num_handles_; }
+  int first_frame() const { return keys_.front().frame; }
+  int last_frame() const { return keys_.back().frame; }
+  double mass_scale() const { return parameters_.mass_scale; }
+
+ private:
+  class Problem;
+
+  // The state at frame ≥ last_frame(), from the cache, stepping Simulation as far as needed.
+  const std::pair<Eigen::VectorXd, Eigen::VectorXd>& after(int frame);
+  // Posing's minimum for `key` (the header says which handles hold it).
+  Eigen::VectorXd static_pose(const InbetweenKey& key) const;
+
+  const Basis& basis_;
+  Handles handles_;
+  int num_handles_;
+  Eigen::VectorXd weights_;
+  std::vector<InbetweenKey> keys_;  // by frame
+  InbetweenOptions options_;
+  EnergyKind energy_;
+  DynamicsParameters parameters_;
+  std::unique_ptr<Problem> problem_;
+  // Simulation after the last key: its handles' transforms there, the states it has stepped
+  // (frame last_frame() + i), and the map to the fine mesh it holds.
+  std::unique_ptr<ReducedDynamics> simulation_;
+  Transforms last_transforms_;
+  std::vector<std::pair<Eigen::VectorXd, Eigen::VectorXd>> after_;
+  bool solved_ = false;
+  // The solved nodes' states (q_n, v_n⁺), node 0 the first key's.
+  std::vector<Eigen::VectorXd> q_, v_;
+  InbetweenStats stats_;
+};
+
+}  // namespace modal_deform
