@@ -16,10 +16,11 @@
 namespace modal_deform {
 namespace {
 
-// The key penalty's weight against the motion's own terms at a key node (trace of the normal
-// matrix's block): large enough that the keys are hit as closely as the basis reaches them, small
-// enough that the banded factorisation stays well conditioned in double precision.
-constexpr double kKeyDominance = 1e6;
+// The key penalty's weight against the motion's own terms at a key node (traces of the normal
+// matrix's blocks): the keys' fits are met within about its inverse of what the motion would
+// rather do; higher slows the quasi-Newton iteration on large motions (1e6 stalled where 1e4
+// converges in 20 iterations: the bar, its end moved by 5% of its length in 6 frames).
+constexpr double kKeyDominance = 1e4;
 // The static poses (posing's minima): BFGS iterations at most.
 constexpr int kPoseIterations = 1000;
 // ∇²V u by a forward difference of ghost gradients, the step moving no coordinate by more than this
@@ -28,6 +29,9 @@ constexpr double kDifferenceStep = 1e-7;
 // Armijo's sufficient decrease, and the backtracking's halvings at most.
 constexpr double kArmijo = 1e-4;
 constexpr int kMaxHalvings = 40;
+// The objective at this fraction of the starting guess's, when no step decreases it further: as
+// low as the differenced gradient lets it go (converged).
+constexpr double kFloor = 1e-6;
 // L-BFGS pairs kept.
 constexpr int kCorrections = 8;
 // A key's penalty curvature below this fraction of its largest is a direction the keyed handles
@@ -59,7 +63,7 @@ class BandedCholesky {
         block.noalias() -= lower(i, k) * lower(i, k).transpose();
       diagonal_[i].compute(block);
       if (diagonal_[i].info() != Eigen::Success)
-        throw NumericalError("in-betweens: the Gauss-Newton matrix is not positive definite");
+        throw NumericalError("in-betweens: the banded model matrix is not positive definite");
     }
   }
 
@@ -169,27 +173,19 @@ class Inbetween::Problem {
         s_(parameters.substep * parameters.substep / (2 * parameters.mass_scale)) {
     const int substeps = options.simulation.substeps;
     N_ = (keys.back().frame - keys.front().frame) * substeps;
-    // Each key after the first: its node and its penalty ½ qᵀ H q + gᵀ q + e (the keyed handles'
-    // terms, each handle's alone at its transform).
+    // Each key after the first: its node and its penalty on the keyed handles' rigid fits.
     for (size_t k = 1; k < keys.size(); ++k) {
       KeyTerm term;
       term.node = (keys[k].frame - keys.front().frame) * substeps;
       term.hessian = Eigen::MatrixXd::Zero(r_, r_);
       term.gradient = Eigen::VectorXd::Zero(r_);
-      Eigen::VectorXd gradient(r_);
-      for (size_t h = 0; h < handles.size(); ++h) {
-        if (!keys[k].transforms[h]) continue;
-        ReducedHandleTerm handle = dynamics_handle_term(
-            basis, {handles[h]}, Eigen::VectorXd::Constant(1, weights[h]), options.simulation.pull);
-        handle.set_transforms({*keys[k].transforms[h]});
-        handle.value_and_gradient(Eigen::VectorXd::Zero(r_), gradient);
-        term.gradient += gradient;
-        term.hessian += handle.hessian();
-      }
+      for (size_t h = 0; h < handles.size(); ++h)
+        if (keys[k].transforms[h])
+          add_rigid_fit_term(basis, handles[h], weights[static_cast<Eigen::Index>(h)],
+                             *keys[k].transforms[h], term);
       term.hessian = 0.5 * (term.hessian + term.hessian.transpose()).eval();
-      // The penalty less its minimum, ½ (q − q*)ᵀ H (q − q*) with q* the basis's closest fit of
-      // the targets (H⁺ on the directions the keyed handles see): the rigid targets are out of
-      // the basis's reach by a residual that, weighted, would drown the control in rounding.
+      // The penalty as ½ (q − q*)ᵀ H (q − q*), q* a fit that meets it (H⁺ on the directions
+      // the keyed handles' fits see), evaluated without the cancellation of ½ qᵀHq + gᵀq + e.
       const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(term.hessian);
       const Eigen::VectorXd& lambda = eigen.eigenvalues();
       const double cutoff = kZeroCurvature * std::max(0.0, lambda.maxCoeff());
@@ -262,7 +258,7 @@ class Inbetween::Problem {
       g[key.node - 1] += key_weight_ * (key.hessian * (q[key.node] - key.fit));
   }
 
-  // The Gauss-Newton step's solve: x ← B⁻¹ x.
+  // The model's solve: x ← B⁻¹ x.
   void solve(std::vector<Eigen::VectorXd>& x) const { cholesky_.solve(x); }
 
   // v_n⁺ = (q_n − q_{n−1})/h − (h/2ρ) F_{n−1} at the nodes of the last objective() (v_0 = 0).
@@ -281,6 +277,55 @@ class Inbetween::Problem {
     Eigen::VectorXd gradient;
     Eigen::VectorXd fit;  // q*
   };
+
+  // Adds to `term` a handle's rigid-fit penalty, the squared mass-metric norm of the rigid part
+  // of its vertices' residual e_i = x̄_i + U_i q − T x̄_i: with y_i = T x̄_i about their mass
+  // centroid c (r_i = y_i − c), total mass m and inertia I, the fit's translation moment
+  // Σ m_i e_i and rotation moment Σ m_i r_i × e_i weigh |·|²/m and I⁺: zero exactly when the
+  // handle's rigid fit (to first order in e) is T, whatever the handle's own deformation.
+  static void add_rigid_fit_term(const Basis& basis, const std::vector<int>& handle, double weight,
+                                 const Eigen::Matrix4d& T, KeyTerm& term) {
+    const Eigen::Index r = term.gradient.size();
+    const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
+    const Eigen::Vector3d t = T.topRightCorner<3, 1>();
+    double mass = 0;
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (int v : handle) {
+      mass += basis.mass[v];
+      centre += basis.mass[v] * (R * basis.rest.row(v).transpose() + t);
+    }
+    if (!(mass > 0) || !(weight > 0)) return;
+    centre /= mass;
+    Eigen::Matrix<double, 6, Eigen::Dynamic> A = Eigen::MatrixXd::Zero(6, r);
+    Eigen::Matrix<double, 6, 1> offset = Eigen::Matrix<double, 6, 1>::Zero();
+    Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
+    for (int v : handle) {
+      const double m = basis.mass[v];
+      const Eigen::Vector3d rest = basis.rest.row(v).transpose();
+      const Eigen::Vector3d arm = R * rest + t - centre;
+      Eigen::Matrix3d cross;
+      cross << 0, -arm.z(), arm.y(), arm.z(), 0, -arm.x(), -arm.y(), arm.x(), 0;
+      const Eigen::Matrix<double, 3, Eigen::Dynamic> rows = basis.vertex_rows(v);
+      A.topRows<3>() += m * rows;
+      A.bottomRows<3>() += m * cross * rows;
+      const Eigen::Vector3d miss = rest - (R * rest + t);
+      offset.head<3>() += m * miss;
+      offset.tail<3>() += m * arm.cross(miss);
+      inertia += m * (arm.squaredNorm() * Eigen::Matrix3d::Identity() - arm * arm.transpose());
+    }
+    // The metric: 1/m on the translation moment, I⁺ on the rotation moment (a handle on a line
+    // has no moment about it).
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(inertia);
+    const double cutoff = kZeroCurvature * std::max(0.0, eigen.eigenvalues().maxCoeff());
+    const Eigen::Vector3d inverse =
+        eigen.eigenvalues().unaryExpr([cutoff](double l) { return l > cutoff ? 1 / l : 0.0; });
+    Eigen::Matrix<double, 6, 6> metric = Eigen::Matrix<double, 6, 6>::Zero();
+    metric.topLeftCorner<3, 3>() = Eigen::Matrix3d::Identity() / mass;
+    metric.bottomRightCorner<3, 3>() =
+        eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose();
+    term.hessian += weight * (A.transpose() * metric * A);
+    term.gradient += weight * (A.transpose() * (metric * offset));
+  }
 
   // The handles' weights in V: each handle never keyed keeps its own, the keyed ones none.
   static Eigen::VectorXd never_keyed_weights(Eigen::VectorXd weights,
@@ -452,13 +497,14 @@ InbetweenStats Inbetween::solve() {
           "keys: the static poses of the keys move the mesh beyond the coordinates "
           "the energies take");
     stats.initial_control = problem_->control();
+    const double initial_value = value;
     // Quasi-Newton: L-BFGS whose initial inverse Hessian is the banded Gauss-Newton model's, so
     // that the steps learn how the curvature departs from the rest's along the motion.
     std::vector<Eigen::VectorXd> gradient, previous_gradient, step, trial(q);
     std::deque<Correction> corrections;
     for (stats.iterations = 0; stats.iterations < options_.solve_iterations; ++stats.iterations) {
       problem_->gradient(q, gradient);
-      if (stats.iterations > 0) {
+      if (!step.empty()) {
         Correction correction{step, gradient, 0};
         for (int i = 0; i < N; ++i) correction.y[i] -= previous_gradient[i];
         const double curvature = dot(correction.y, correction.s);
@@ -501,7 +547,16 @@ InbetweenStats Inbetween::solve() {
         }
       }
       if (!decreased) {
-        stats.stalled = true;
+        // L-BFGS's pairs may have learnt the differenced gradient's noise: the model's own step
+        // next; failing that, the objective is at the precision its gradient has.
+        if (!corrections.empty()) {
+          corrections.clear();
+          problem_->objective(q);
+          step.clear();
+          continue;
+        }
+        stats.converged = value <= kFloor * initial_value;
+        stats.stalled = !stats.converged;
         problem_->objective(q);
         break;
       }

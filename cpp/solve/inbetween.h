@@ -15,26 +15,32 @@
 // i.e. (h²/ρ) times the midpoint equation's control force averaged over the two substeps at the
 // node: ∇Φ at each substep is its control force, and the midpoint rule reads one only through
 // such sums. The problem:
-//   minimise ½ Σ_{n<N} ‖R_n‖² + ½ w Σ_keys E_key(q at the key)
-// with E_key the posing handle term (handle_term.h) of the handles keyed there at their keyed
-// transforms: a penalty, w set so that it outweighs the motion's own terms at the key node by
-// kKeyDominance, which hits the keys as closely as the basis can reach them (at least as closely as
-// posing, which trades the handle term against the deformation energy). ‖·‖ is the mass metric's
-// (the reduced mass is ρI). A keyed handle acts only at its keys; a handle never keyed is a spring
-// at the identity throughout (in V). A free motion of Simulation needs no impulse: R = 0, and the
-// solve reproduces it where Simulation's energy correction (a rescaling of the end velocity, not
-// smooth) does nothing, i.e. for motions small enough that the energy is quadratic (bench:
-// the reproduction error); the in-betweens measure the control on the midpoint equation alone.
+//   minimise ½ Σ_{n<N} ‖R_n‖² + ½ w Σ_keys P_key(q at the key)
+// ‖·‖ the mass metric's (the reduced mass is ρI). P_key is a penalty on each keyed handle's rigid
+// fit: the squared mass-metric norm of the rigid part (translation and rotation moments about the
+// target's centroid) of its vertices' miss x̄_i + U_i q − T x̄_i, zero when the fit is T to first
+// order, whatever the handle's own deformation (which stays the physics'); w makes it outweigh
+// the motion's own terms at the key node by kKeyDominance, so the keys are met well within
+// posing's precision (which trades its handle term against the energy). A keyed handle acts only
+// at its keys; a handle never keyed is a spring at the identity throughout (in V).
 //
-// Solved by Gauss-Newton over all nodes at once: the model is the linearisation at rest (∇²V ≈ K̃,
-// K plus the never-keyed handles' term), whose normal matrix is block-banded in time (r by r
-// blocks, two blocks either side of the diagonal), constant, and factored once by a banded block
-// Cholesky; the gradient is exact (∇²V products by differences of ghost gradients) and a
-// backtracking line search on the objective keeps each step a descent, so the iteration reaches
-// the true minimiser at the rate the model's fit allows (quadratic energies: one step). Starting
-// guess: the static poses at the keys (posing's minima) interpolated linearly per coordinate.
-// Cost: the factorisation O(N r³) once; an iteration O(N) ghost gradients (4 a substep, each
-// O(#ghost vertices · r)) and O(N r²) for the solve, N = frames × substeps.
+// A free motion of Simulation needs no impulse and meets keys taken as its handles' rigid fits:
+// R = 0 and P = 0, and the solve reproduces it where Simulation's energy correction (a rescaling
+// of the end velocity, not smooth) does nothing, i.e. where the energy is quadratic over a substep
+// (small motions; bench: the reproduction error). The in-betweens measure the control on the
+// midpoint equation alone.
+//
+// Solved by L-BFGS over all nodes at once, its initial inverse Hessian the inverse of the
+// Gauss-Newton matrix of
+// the dynamics linearised at rest (∇²V ≈ K̃, K plus the never-keyed handles' term) plus the keys'
+// penalty: block-banded in time (r by r blocks, two either side of the diagonal), constant, and
+// factored once by a banded block Cholesky. The gradient is exact (∇²V products by differences of
+// ghost gradients) and a backtracking line search keeps each step a descent. Small motions
+// converge in a few iterations (the model is their Hessian), large ones as the pairs learn how the
+// curvature departs from the rest's. Starting guess: the static poses at the keys (posing's
+// minima) interpolated linearly per coordinate. Cost: the factorisation O(N r³) once; an
+// iteration O(N) ghost gradients (4 a substep with damping, 2 without, each O(#ghost vertices ·
+// r)) and O(N r²) for the banded solve and the pairs, N = frames × substeps.
 //
 // Before the first key the motion holds the static pose of that key (ReducedSolver's minimum with
 // the handles keyed there at their transforms, the never-keyed at the identity, the others free)
@@ -69,7 +75,7 @@ constexpr int kMaxInbetweenFrame = 1000000;
 
 struct InbetweenOptions {
   SimulationOptions simulation;  // the dynamics, and Simulation's after the last key
-  int solve_iterations = 100;    // quasi-Newton iterations at most
+  int solve_iterations = 100;    // L-BFGS iterations at most
   double solve_tolerance = 1e-5;
 };
 
@@ -80,20 +86,23 @@ void for_each_inbetween_option(Visit&& visit) {
   for_each_simulation_option([&](const Option& option, auto field) {
     visit(option, [field](auto& o) -> auto& { return field(o.simulation); });
   });
-  visit(Option{"solve_iterations", "Gauss-Newton iterations of the whole motion at most.",
+  visit(Option{"solve_iterations", "Quasi-Newton iterations over the whole motion at most.",
                at_least(1)},
         [](auto& o) -> auto& { return o.solve_iterations; });
   visit(Option{"solve_tolerance",
-               "The solve has converged when a full Gauss-Newton step moves no reduced "
+               "The solve has converged when a full quasi-Newton step moves no reduced "
                "coordinate by more than this (normalised frame: the mesh about unit size).",
                between_open(0, 1)},
         [](auto& o) -> auto& { return o.solve_tolerance; });
 }
 
 struct InbetweenStats {
-  bool converged = false;      // the last Gauss-Newton step met solve_tolerance
+  // The last step met solve_tolerance, or no step decreases the objective any more and it is
+  // below kFloor (inbetween.cpp) of the starting guess's: as low as the differenced gradient lets
+  // it go.
+  bool converged = false;
   bool stalled = false;        // the line search found no decrease before convergence
-  int iterations = 0;          // Gauss-Newton iterations
+  int iterations = 0;          // L-BFGS iterations
   int evaluations = 0;         // ghost gradients, posing's excepted
   int nodes = 0;               // N: substeps from the first key to the last
   double control = 0;          // ½ Σ ‖R_n‖² at the end

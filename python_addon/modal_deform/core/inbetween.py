@@ -7,15 +7,16 @@ How it is solved (cpp/solve/inbetween.h has the equations): the unknowns are the
 every substep from the first key to the last. Each substep is a free step of Simulation's implicit
 midpoint rule; the control is the velocity impulse needed at each substep boundary (the midpoint
 equation's control force there), and the solve minimises the sum of its squares in the mass metric,
-with each keyed handle pulled to its keyed transform at its key by a penalty (the posing handle
-term, weighted to dominate the motion's terms there a million-fold: keys are hit as closely as the
-basis reaches them, at least as closely as posing hits its handles). Gauss-Newton over all frames at
-once, from the keys' static poses interpolated linearly: the normal matrix of the dynamics
-linearised at rest is block-banded in time (two r-by-r blocks either side of the diagonal) and
-factored once; the gradient is exact and a line search keeps every step a descent. Cost, with N =
-frames × substeps between the first key and the last and r = basis.dimension: O(N r³) once for the
-factorisation, then per iteration O(N) ghost gradient evaluations (each O(ghost vertices × r)) and
-O(N r²) for the banded solve.
+with each keyed handle's rigid fit pulled to its keyed transform at its key by a penalty (on the
+rigid part of the handle's miss only: the handle's own deformation stays the physics'), weighted to
+outweigh the motion's terms there ten thousand-fold: keys are met well within posing's precision.
+L-BFGS over all frames at once, from the keys' static poses interpolated linearly, its initial
+inverse Hessian the inverse of the Gauss-Newton matrix of the dynamics linearised at rest, block-banded in time
+(two r-by-r blocks either side of the diagonal) and factored once; the gradient is exact and a line
+search keeps every step a descent. Cost, with N = frames × substeps between the first key and the
+last and r = basis.dimension: O(N r³) once for the factorisation, then per iteration O(N) ghost
+gradient evaluations (each O(ghost vertices × r)) and O(N r²) for the banded solve; small motions
+take a few iterations, large ones tens.
 
 Simulation's energy correction (a rescaling of each substep's end velocity) is not smooth: the
 in-betweens measure the control on the midpoint equation alone, so a free motion of Simulation is
@@ -86,8 +87,9 @@ class Inbetween(_inputs.InBasis):
         return self._native.mass_scale
 
     def solve(self):
-        """Solves the whole motion and returns ``self.stats``: {"converged" (the last Gauss-Newton
-        step met ``solve_tolerance``), "stalled" (no step decreased the objective before that),
+        """Solves the whole motion and returns ``self.stats``: {"converged" (the last step met
+        ``solve_tolerance``, or the objective is a millionth of the starting guess's and no step
+        decreases it further), "stalled" (no step decreases it, and it is not that low),
         "iterations", "evaluations" (ghost gradients), "nodes" (substeps solved for), "control"
         and "initial_control" (half the sum of the squared control impulses, in h²/ρ units, at the
         end and for the starting guess), "ms"}. Solving again gives the same bits."""
