@@ -2,7 +2,8 @@
 
 This file only registers the Blender layer, once native_loader made the compiled core importable.
 ``modal_deform.core`` is the bpy-free API and imports without Blender, so the Blender modules are
-imported inside register(). The interactive pose is in pose/, playback on the timeline in playback/.
+imported inside register(). The interactive pose is in pose/, playback on the timeline in playback/, in-betweens in
+inbetweens/.
 Every import is relative: installed as an extension the package is ``bl_ext.<repository>.modal_deform``.
 """
 
@@ -33,6 +34,7 @@ _MODULES = (
     "pose.recovery",
     "playback.operators",
     "playback.bake_animation",
+    "inbetweens.operators",
     "ops_preview",
     "ui",
 )

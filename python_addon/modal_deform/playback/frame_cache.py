@@ -40,8 +40,12 @@ _FIELDS = (
 
 
 def kind(obj):
-    """The kind of cache obj's settings call for: "DYNAMIC" with dynamics enabled, else "STATIC"."""
-    return "DYNAMIC" if obj.modal_deform.dynamics.enabled else "STATIC"
+    """The kind of cache obj's settings call for: "INBETWEEN" with dynamics and its in-betweens
+    enabled (inbetweens/), "DYNAMIC" with dynamics enabled, else "STATIC"."""
+    dynamics = obj.modal_deform.dynamics
+    if not dynamics.enabled:
+        return "STATIC"
+    return "INBETWEEN" if dynamics.inbetweens else "DYNAMIC"
 
 
 def _pose_fields(obj):
@@ -82,7 +86,10 @@ def signature(obj, scene):
             ("period", dynamics.period),
             ("damping", dynamics.damping),
             ("substeps", dynamics.substeps),
-            ("start", dynamics.frame_start),
+            # In-betweens start at the first key and are cached over the scene's frames.
+            ("range", scene.frame_start, scene.frame_end)
+            if dynamics.inbetweens
+            else ("start", dynamics.frame_start),
             ("fps", scene.render.fps / scene.render.fps_base),
         )
     return repr(fields)
@@ -252,7 +259,9 @@ def outdated(cache, obj, signature_now):
 def settings_changed(obj):
     """A dynamics setting changed: the cache no longer holds (a static cache does not depend on them)."""
     cache = get(obj)
-    if cache is not None and cache.kind == "DYNAMIC" or obj.modal_deform.dynamics.enabled:
+    if kind(obj) == "INBETWEEN" and cache is not None and cache.kind == "INBETWEEN":
+        return  # the motion plays until the one for the new settings is solved (inbetweens/)
+    if cache is not None and cache.kind != "STATIC" or obj.modal_deform.dynamics.enabled:
         free(obj)
 
 
@@ -267,7 +276,7 @@ def controller_curves(obj):
         controller = handle.controller
         if controller is None:
             continue
-        moves = _moves_bone(handles.pose_bone(handle))
+        moves = moves_bone(handles.pose_bone(handle))
         for curve in action_fcurves(controller.animation_data) or ():
             if moves(curve.data_path):
                 found.append((f"{controller.name}:{curve.data_path}[{curve.array_index}]", curve))
@@ -275,7 +284,7 @@ def controller_curves(obj):
     return found
 
 
-def _moves_bone(bone):
+def moves_bone(bone):
     """A test of a data path of the armature's action: whether it can move `bone` (a pose bone;
     None: every path, as for an object)."""
     if bone is None:

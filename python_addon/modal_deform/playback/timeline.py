@@ -213,6 +213,10 @@ def fill(obj, scene, cache, frame, player_, out=None, curves=None):
 def show(obj, scene, edits_reported=False):
     """Show obj's state at the scene's frame, computing what the cache lacks up to it.
     `edits_reported`: as Player.check_mesh takes it."""
+    if frame_cache.kind(obj) == "INBETWEEN":  # solved whole, not frame by frame
+        from ..inbetweens import motion
+
+        return motion.show(obj, scene, edits_reported, stand_in=_playing)
     frame = scene.frame_current
     cache = frame_cache.get(obj)
     signature = frame_cache.signature(obj, scene)
