@@ -12,3 +12,7 @@ def test_inbetweens_play_through_the_keys_reload_and_render_a_frame_alone(run_bl
         "frames [17] are the timeline's"
         in run_blender("inbetweens_reload.py", 17, blend=blend).stdout
     )
+
+
+def test_inbetweens_take_partial_keys_and_bones_and_export(run_blender):
+    print(run_blender("inbetweens_partial.py").stdout)

@@ -137,8 +137,8 @@ class InbetweenJob(ThreadJob):
             )
         if not stats["converged"]:
             self.notes.append(
-                f"the solve stopped after {stats['iterations']} iterations without converging: "
-                f"the motion may need more force than it shows"
+                f"the solve stopped after {stats['iterations']} iterations before converging: "
+                f"the motion between the keys is close to, not at, the one of least force"
             )
 
     def finish(self):
