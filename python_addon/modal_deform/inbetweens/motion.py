@@ -137,8 +137,8 @@ class InbetweenJob(ThreadJob):
             )
         if not stats["converged"]:
             self.notes.append(
-                f"the solve stopped after {stats['iterations']} iterations before converging: "
-                f"the motion between the keys is close to, not at, the one of least force"
+                f"solve stopped at {stats['iterations']} iterations, short of converging: the "
+                f"motion is near the one of least force"
             )
 
     def finish(self):
@@ -222,7 +222,7 @@ def show(obj, scene, edits_reported=False, stand_in=False):
     "INBETWEEN"; `stand_in` while the timeline plays), asking for them again when the keys or the
     settings changed: meanwhile, and when that fails for a handle that cannot be used now, the
     motion solved last plays on. Raises storage.NotReady when the mesh changed since the bake,
-    ValueError when there is no motion to show."""
+    ValueError when there is no motion to show and none is being solved."""
     cache = frame_cache.get(obj)
     try:
         player = timeline.player(obj, scene)
@@ -244,7 +244,10 @@ def show(obj, scene, edits_reported=False, stand_in=False):
         cache = frame_cache.get(obj)
         usable = cache is not None and cache.kind == "INBETWEEN" and len(cache)
     if not usable or player.basis_id != cache.basis_id:
-        raise ValueError(problem(obj) or "In-betweens: solving")
+        if obj.name in running:  # the panel says it is solving; the mesh shows itself meanwhile
+            frame_display.remove(obj)
+            return
+        raise ValueError(problem(obj) or "In-betweens: not solved")
     frame = min(max(scene.frame_current, cache.start), cache.end)
     mesh = frame_display.frame_mesh(obj, stand_in=stand_in)
     player.positions(cache.array("q")[cache.row(frame)], frame_display.frame_positions(mesh))
