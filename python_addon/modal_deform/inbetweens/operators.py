@@ -96,9 +96,12 @@ def _keys_changed(scene, depsgraph=None):
     for obj in scene.objects:
         if frame_cache.kind(obj) != "INBETWEEN" or not timeline.wants_playback(obj):
             continue
-        cache = frame_cache.get(obj) if obj.modal_deform.dynamics.cache else None
-        if cache is None or not motion.is_fresh(cache, motion.freshness(obj, scene)):
-            motion.request(obj, scene)
+        try:
+            cache = frame_cache.get(obj)
+            if cache is None or not motion.is_fresh(cache, motion.freshness(obj, scene)):
+                motion.request(obj, scene)
+        except FAILURES:  # a damaged cache: the frame shown says so
+            continue
 
 
 _HANDLERS = (("depsgraph_update_post", _keys_changed), ("load_post", motion.forget))

@@ -6,8 +6,9 @@ vectors) and, for a simulation, of its velocity; a few hundred bytes a frame whe
 frame costs 12 bytes a vertex. Beside them, what each frame was computed from, to tell when it no
 longer holds: the controllers' transforms at that frame (the handles' 4x4 matrices) and the values
 of the controllers' animation curves there; and, for the whole cache, its kind ("STATIC": the
-pose of each frame; "DYNAMIC": the simulation), the bake id of the basis and a signature of the
-settings (dynamics parameters, stiffness, handles).
+pose of each frame; "DYNAMIC": the simulation; "INBETWEEN": the in-betweens, solved whole by
+inbetweens/motion.py), the bake id of the basis and a signature of the settings (dynamics
+parameters, stiffness, handles).
 
 Where: like the basis (storage.py), a Palette datablock named with a leading "." that
 ``Object.modal_deform.dynamics.cache`` points to, each array one flat float64 ID property (Blender
