@@ -190,4 +190,11 @@ np.save(support.tmp("inbetweens.npy"), shown_frames)
 with open(support.tmp("digest.txt"), "w") as f:
     f.write(frame_cache.digest(frame_cache.get(obj)))
 scene.frame_set(1)
+scene.render.engine = "BLENDER_WORKBENCH"  # a small, quick render for inbetweens_render.py
+scene.render.resolution_x = scene.render.resolution_y = 32
+scene.render.filepath = support.tmp("render_")
+scene.camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+scene.collection.objects.link(scene.camera)
+scene.camera.location = (0.0, -8.0, 0.0)
+scene.camera.rotation_euler = (1.5708, 0.0, 0.0)
 bpy.ops.wm.save_as_mainfile(filepath=support.tmp("inbetweens.blend"))
