@@ -57,6 +57,20 @@ assert layout == [
     (20, [True, False]),
 ], layout
 
+# A controller without keys holds its place: keyed there at every key frame when moved off its
+# bind, none of its own at its bind (a spring at rest, as a pinned handle).
+still = support.add_handle(obj, V[:, 0] < -1.1)
+for moved in (False, True):
+    still.controller.location.z += 0.1 * moved
+    found = keys_.read(obj, scene, timeline.player(obj, scene).handles)
+    placed = handles.transforms(obj, timeline.player(obj, scene).handles)[2]
+    if moved:
+        assert all(np.array_equal(transforms[2], placed) for _, transforms in found), found
+    else:
+        assert all(transforms[2] is None for _, transforms in found), found
+bpy.data.objects.remove(still.controller)
+obj.modal_deform.handles.remove(2)
+
 shown = {}
 for frame in range(1, 31):
     scene.frame_set(frame)
