@@ -36,6 +36,9 @@ Experiments (each writes bench/results/<name>.json: machine, commit, command, pa
                and the rig forces' cost per frame (bench/rig.py)
   shape_space  shape blending: the blend's and the space's bake time per key count on the 23k and 100k
                dragons, 8 smooth keys (bench/shape_space.py)
+  inbetween    physics in-betweens (issue 51): the solve through 5 keys over 120 frames and a frame's
+               positions on the 100k dragon at 67 dimensions, the solve against frames and
+               dimensions, a free motion reproduced from its keys (bench/inbetween.py)
   blender      the add-on's pose update in headless Blender and Blender's Laplacian Deform
                (bench/blender_pose.py), in Debian's 3.4.1 app from the source tree
   bpy_pose     the pose update alone at 100k, 400k, 1.6M and 3.2M vertices in bpy 4.5 and 5.3 (.venv/bpy-<version>,
@@ -81,6 +84,7 @@ PYTHON_EXPERIMENTS = (
     "dynamics",
     "rig",
     "shape_space",
+    "inbetween",
 )
 EXPERIMENTS = (
     ("native",)

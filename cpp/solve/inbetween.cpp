@@ -32,6 +32,10 @@ constexpr int kMaxHalvings = 40;
 // The objective at this fraction of the starting guess's, when no step decreases it further: as
 // low as the differenced gradient lets it go (converged).
 constexpr double kFloor = 1e-6;
+// The model's least curvature, this fraction of its largest block's mean: directions the
+// dynamics at rest leave free (a free body's rigid motions, modes no key sees) stiffen as the part
+// turns, and a step along them from a model that lacks it overshoots by orders of magnitude.
+constexpr double kProximity = 1e-2;
 // L-BFGS pairs kept.
 constexpr int kCorrections = 8;
 // A key's penalty curvature below this fraction of its largest is a direction the keyed handles
@@ -195,7 +199,10 @@ class Inbetween::Problem {
                    (inverse.asDiagonal() * (eigen.eigenvectors().transpose() * term.gradient)));
       key_terms_.push_back(std::move(term));
     }
-    factor_normal_matrix();
+    hessian_ = ghost_energy_.rest_hessian() + never_keyed_.hessian();
+    hessian_ = 0.5 * (hessian_ + hessian_.transpose()).eval();
+    for (const InbetweenKey& key : keys)
+      key_nodes_.push_back((key.frame - keys.front().frame) * substeps);
     work_.resize(r_);
     gx_.assign(N_, Eigen::VectorXd(r_));
     gq_.assign(N_, Eigen::VectorXd(r_));
@@ -258,7 +265,7 @@ class Inbetween::Problem {
       g[key.node - 1] += key_weight_ * (key.hessian * (q[key.node] - key.fit));
   }
 
-  // The model's solve: x ← B⁻¹ x.
+  // The model's solve: x ← B⁻¹ x (factor() first).
   void solve(std::vector<Eigen::VectorXd>& x) const { cholesky_.solve(x); }
 
   // v_n⁺ = (q_n − q_{n−1})/h − (h/2ρ) F_{n−1} at the nodes of the last objective() (v_0 = 0).
@@ -369,33 +376,61 @@ class Inbetween::Problem {
     product = (product - gradient) / step;
   }
 
-  // B = Σ JᵀJ of the linearisation at rest plus the keys' penalty, factored. With K̃ = ∇²V at
-  // rest, R_n's blocks on q_{n−1}, q_n, q_{n+1} are C₋ = I + s(a/2 − b)K̃, C₀ = −2I + s(a − b)K̃,
-  // C₊ = I + s(a/2)K̃ (R_0 only C₊ on q_1), which commute.
-  void factor_normal_matrix() {
-    hessian_ = ghost_energy_.rest_hessian() + never_keyed_.hessian();
-    hessian_ = 0.5 * (hessian_ + hessian_.transpose()).eval();
+  // ∇²V at q by differences of ghost gradients, symmetrised (r + 1 gradients).
+  Eigen::MatrixXd hessian_at(const Eigen::VectorXd& q) {
+    Eigen::VectorXd base(r_), moved(r_);
+    if (!potential_gradient(q, base)) return hessian_;
+    const double step = kDifferenceStep * std::max(1.0, q.cwiseAbs().maxCoeff());
+    Eigen::MatrixXd H(r_, r_);
+    Eigen::VectorXd x = q;
+    for (Eigen::Index j = 0; j < r_; ++j) {
+      x[j] += step;
+      if (!potential_gradient(x, moved)) return hessian_;
+      H.col(j) = (moved - base) / step;
+      x[j] = q[j];
+    }
+    return 0.5 * (H + H.transpose());
+  }
+
+ public:
+  // B = Σ JᵀJ of the dynamics linearised along the motion plus the keys' penalty, factored: each
+  // substep's ∇²V is K_n, interpolated linearly in time between its keys' ∇²V at their static
+  // `poses` (the geometric stiffening a turned part shows, which the rest's K̃ lacks). With
+  // F_n ≈ K_n ((a/2)(q_n + q_{n+1}) − b q_n), R_n's blocks on q_{n−1}, q_n, q_{n+1} are
+  // I + s(a/2 − b)K_{n−1}, −2I + s(a/2)K_{n−1} + s(a/2 − b)K_n and I + s(a/2)K_n (R_0 only
+  // the last, on q_1).
+  void factor(const std::vector<Eigen::VectorXd>& poses) {
+    std::vector<Eigen::MatrixXd> key_hessians;
+    for (const Eigen::VectorXd& pose : poses) key_hessians.push_back(hessian_at(pose));
+    const auto substep_hessian = [&](int n) {
+      size_t k = 0;
+      while (k + 2 < key_nodes_.size() && key_nodes_[k + 1] <= n) ++k;
+      const double t = (n + 0.5 - key_nodes_[k]) / (key_nodes_[k + 1] - key_nodes_[k]);
+      return Eigen::MatrixXd((1 - t) * key_hessians[k] + t * key_hessians[k + 1]);
+    };
     const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(r_, r_);
-    const Eigen::MatrixXd C_minus = I + (s_ * (a_ / 2 - b_)) * hessian_;
-    const Eigen::MatrixXd C_zero = -2 * I + (s_ * (a_ - b_)) * hessian_;
-    const Eigen::MatrixXd C_plus = I + (s_ * (a_ / 2)) * hessian_;
-    const Eigen::MatrixXd plus_plus = C_plus * C_plus, zero_zero = C_zero * C_zero,
-                          minus_minus = C_minus * C_minus, plus_zero = C_plus * C_zero,
-                          zero_minus = C_zero * C_minus, plus_minus = C_plus * C_minus;
     // Block m − 1 is q_m's (m = 1 … N).
-    std::vector<Eigen::MatrixXd> diagonal(N_);
+    std::vector<Eigen::MatrixXd> diagonal(N_, Eigen::MatrixXd::Zero(r_, r_));
     std::array<std::vector<Eigen::MatrixXd>, BandedCholesky::kBand> below;
     for (auto& blocks : below) blocks.assign(N_, Eigen::MatrixXd::Zero(r_, r_));
-    for (int m = 1; m <= N_; ++m) {
-      Eigen::MatrixXd& block = diagonal[m - 1];
-      block = plus_plus;
-      if (m <= N_ - 1) block += zero_zero;
-      if (m + 1 <= N_ - 1) block += minus_minus;
-      if (m + 1 <= N_) {
-        if (m <= N_ - 1) below[0][m - 1] += plus_zero;
-        if (m + 1 <= N_ - 1) below[0][m - 1] += zero_minus;
-      }
-      if (m + 2 <= N_) below[1][m - 1] = plus_minus;
+    Eigen::MatrixXd previous;  // K_{n−1}
+    for (int n = 0; n < N_; ++n) {
+      const Eigen::MatrixXd K = substep_hessian(n);
+      // (node, block) of R_n on the unknowns q_1 … q_N.
+      std::vector<std::pair<int, Eigen::MatrixXd>> blocks;
+      if (n >= 2) blocks.emplace_back(n - 1, I + (s_ * (a_ / 2 - b_)) * previous);
+      if (n >= 1)
+        blocks.emplace_back(n, -2 * I + (s_ * (a_ / 2)) * previous + (s_ * (a_ / 2 - b_)) * K);
+      blocks.emplace_back(n + 1, I + (s_ * (a_ / 2)) * K);
+      for (const auto& [i, A] : blocks)
+        for (const auto& [j, C] : blocks) {
+          if (j > i) continue;
+          if (i == j)
+            diagonal[i - 1].noalias() += A.transpose() * A;
+          else
+            below[i - j - 1][j - 1].noalias() += A.transpose() * C;
+        }
+      previous = K;
     }
     // One weight for every key: kKeyDominance times the largest block's trace over the keys'.
     double motion = 0, keys = 0;
@@ -403,9 +438,11 @@ class Inbetween::Problem {
     for (const KeyTerm& key : key_terms_) keys = std::max(keys, key.hessian.trace());
     key_weight_ = keys > 0 ? kKeyDominance * motion / keys : 0;
     for (const KeyTerm& key : key_terms_) diagonal[key.node - 1] += key_weight_ * key.hessian;
+    for (Eigen::MatrixXd& block : diagonal) block.diagonal().array() += kProximity * motion / r_;
     cholesky_.factor(diagonal, below);
   }
 
+ private:
   GhostEnergy ghost_energy_;
   ReducedHandleTerm never_keyed_;
   Eigen::Index r_;
@@ -413,7 +450,8 @@ class Inbetween::Problem {
   int N_ = 0;
   std::vector<KeyTerm> key_terms_;
   double key_weight_ = 0;
-  Eigen::MatrixXd hessian_;  // K̃
+  Eigen::MatrixXd hessian_;  // K̃ = ∇²V at rest, where a difference leaves the energies' range
+  std::vector<int> key_nodes_;
   BandedCholesky cholesky_;
   // At the last objective(): ∇V(x_n), ∇V(q_n), R_n, ½ Σ ‖R_n‖².
   std::vector<Eigen::VectorXd> gx_, gq_, R_;
@@ -491,6 +529,7 @@ InbetweenStats Inbetween::solve() {
   q[0] = poses.front();
 
   if (N > 0) {
+    problem_->factor(poses);
     double value = problem_->objective(q);
     if (!std::isfinite(value))
       throw InputError(
