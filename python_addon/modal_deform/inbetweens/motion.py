@@ -151,6 +151,11 @@ class InbetweenJob(ThreadJob):
             return report
         if frame_cache.basis_id(obj) != self.basis_id:
             return "WARNING", "the basis was baked again during the solve: the motion was discarded"
+        if frame_cache.kind(obj) != "INBETWEEN":
+            return (
+                "WARNING",
+                "In-betweens were turned off during the solve: the motion was discarded",
+            )
         scene = bpy.context.scene
         cache = frame_cache.create(obj, scene, self.frames[0])
         cache.block["kind"] = "INBETWEEN"
