@@ -7,7 +7,8 @@ controller's transform evaluated at exactly that frame (constraints and parents 
 frame where only other handles are keyed it is None (a partial key: free there). A handle whose
 controller has no transform keyframes holds its placement: at its bind it is a spring at rest
 throughout (as a pinned handle), elsewhere it is keyed where it stands at every key frame. Keys on
-no whole frame, before frame 0 or more than MAX_KEYS are refused with a message; so is having none.
+no whole frame, before frame 0, more than MAX_KEYS or spanning more than MAX_SPAN frames are
+refused with a message; so is having none.
 """
 
 import numpy as np
@@ -19,6 +20,9 @@ from ..playback.frame_keys import action_fcurves
 #: Keyframes a motion takes at most: a controller keyed on most frames is an animation already,
 #: for Dynamics to follow; and the solve's cost grows with the frames between the first key and the last.
 MAX_KEYS = 200
+#: Frames from the first key to the last at most: the solve's time and memory grow with them (every
+#: substep between is an unknown).
+MAX_SPAN = 2000
 #: The last components of the data paths that move an object or a bone.
 TRANSFORM_PATHS = (
     "location",
@@ -80,6 +84,11 @@ def read(obj, scene, handles):
             f"{len(frames)} keyed frames (from {frames[0]} to {frames[-1]}): in-betweens take at "
             f"most {MAX_KEYS}; key only the poses that matter (a motion keyed on most frames plays "
             f"with Dynamics alone, In-betweens off)"
+        )
+    if frames[-1] - frames[0] > MAX_SPAN:
+        raise ValueError(
+            f"keys from frame {frames[0]} to {frames[-1]}: in-betweens span at most {MAX_SPAN} "
+            f"frames; split the shot, or move the stray key"
         )
     here = scene.frame_current
     keys = []

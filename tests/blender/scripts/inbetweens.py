@@ -125,6 +125,10 @@ curve = keys_.transform_curves(timeline.player(obj, scene).handles[0])[0]
 point = curve.keyframe_points.insert(25.5, curve.evaluate(25.5))
 refused("between two frames")
 curve.keyframe_points.remove(point)
+# A stray key far away.
+point = curve.keyframe_points.insert(5000, 0.0)
+refused("from frame 1 to 5000")
+curve.keyframe_points.remove(point)
 # A thousand keys.
 many = curve.keyframe_points
 count = len(many)
