@@ -4,6 +4,8 @@ a timer); a key moved with the timeline still starts it again, and the motion so
 until the new one is ready; Esc cancels it and the old motion stays, with a message in the panel.
 The Dynamics panel is screenshotted solving and solved. Writes OUTPUT/result.json (window.run)."""
 
+import threading
+
 import bpy
 import numpy as np
 from support import blender as support
@@ -35,6 +37,16 @@ def steps():
     from modal_deform.inbetweens import motion
     from modal_deform.playback import frame_cache
 
+    # Each solve waits for the step to let it go (gate.release()), so that a quick solve cannot end
+    # before the step has seen it running.
+    gate, work = threading.Semaphore(0), motion.InbetweenJob._work
+
+    def held(job):
+        gate.acquire(timeout=60)
+        work(job)
+
+    motion.InbetweenJob._work = held
+
     with override():
         obj, V = support.baked_suzanne(1, 12, 20, 400)
         head = support.add_handle(obj, (np.hypot(V[:, 0], V[:, 1]) < 0.55) & (V[:, 2] > -0.35))
@@ -52,6 +64,7 @@ def steps():
     yield from wait_for(lambda: obj.name in motion.running, "the solve to start", 10)
     say("the first frame shown started Solve In-betweens")
     screenshot("inbetweens-solving.png")
+    gate.release()
     yield from wait_for(lambda: obj.name not in motion.running, "the solve to end")
     cache = frame_cache.get(obj)
     assert cache is not None and cache.kind == "INBETWEEN" and len(cache) == 30, cache
@@ -70,6 +83,7 @@ def steps():
     controller.animation_data.action.update_tag()
     yield from wait_for(lambda: obj.name in motion.running, "a moved key to start a solve", 10)
     assert frame_cache.digest(frame_cache.get(obj)) == first, "the old motion went before the new"
+    gate.release()
     yield from wait_for(lambda: obj.name not in motion.running, "the solve to end")
     second = frame_cache.digest(frame_cache.get(obj))
     assert second != first and not motion.problem(obj), motion.problem(obj)
@@ -87,6 +101,8 @@ def steps():
     x, y = region.x + region.width // 2, region.y + region.height // 2
     window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x, y=y)
     window.event_simulate(type="ESC", value="PRESS", x=x, y=y)
+    yield 0.3
+    gate.release()
     yield from wait_for(lambda: obj.name not in motion.running, "the cancelled solve to end")
     assert frame_cache.digest(frame_cache.get(obj)) == second, "a cancel changed the motion"
     assert "cancelled" in motion.problem(obj), motion.problem(obj)
