@@ -279,10 +279,12 @@ class VIEW3D_PT_modal_deform_dynamics(_Panel, bpy.types.Panel):
                 box, context, f"Cache empty: {empty if inbetweens else 'play or Bake'}", icon="INFO"
             )
         else:
-            what = {"DYNAMIC": "Simulation", "INBETWEEN": "In-betweens"}.get(
-                cache.kind, "Animation"
-            )
-            box.label(text=f"{what}: frames {cache.start}-{cache.end}", icon="FILE_CACHE")
+            if cache.kind == "INBETWEEN":  # the sidebar's default width has no room for more
+                text = f"In-betweens {cache.start}-{cache.end}"
+            else:
+                what = "Simulation" if cache.kind == "DYNAMIC" else "Animation"
+                text = f"{what}: frames {cache.start}-{cache.end}"
+            box.label(text=text, icon="FILE_CACHE")
             box.label(text=f"{cache.nbytes() / 1024:.1f} KB in the file")
             if cache.kind == "INBETWEEN":
                 for note in motion.notes(cache):
