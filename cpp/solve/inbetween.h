@@ -30,17 +30,18 @@
 // (small motions; bench: the reproduction error). The in-betweens measure the control on the
 // midpoint equation alone.
 //
-// Solved by L-BFGS over all nodes at once, its initial inverse Hessian the inverse of the
-// Gauss-Newton matrix of
-// the dynamics linearised at rest (∇²V ≈ K̃, K plus the never-keyed handles' term) plus the keys'
-// penalty: block-banded in time (r by r blocks, two either side of the diagonal), constant, and
-// factored once by a banded block Cholesky. The gradient is exact (∇²V products by differences of
-// ghost gradients) and a backtracking line search keeps each step a descent. Small motions
-// converge in a few iterations (the model is their Hessian), large ones as the pairs learn how the
-// curvature departs from the rest's. Starting guess: the static poses at the keys (posing's
-// minima) interpolated linearly per coordinate. Cost: the factorisation O(N r³) once; an
-// iteration O(N) ghost gradients (4 a substep with damping, 2 without, each O(#ghost vertices ·
-// r)) and O(N r²) for the banded solve and the pairs, N = frames × substeps.
+// Solved by L-BFGS over all nodes at once (a quasi-Newton method on the whole motion), its initial
+// inverse Hessian the inverse of a Gauss-Newton matrix: that of the dynamics linearised along the
+// motion (each substep's ∇²V interpolated in time between the ∇²V at its keys' static poses, by
+// differences of ghost gradients) plus the keys' penalty and a least curvature (kProximity),
+// block-banded in time (r by r blocks, two either side of the diagonal), built and factored once
+// by a banded block Cholesky. The gradient is exact (∇²V products by differences of ghost
+// gradients) and a backtracking line search keeps each step a descent; the pairs learn how the
+// curvature departs from the model's. Starting guess: the static poses at the keys (posing's
+// minima) interpolated linearly per coordinate. Cost, N = frames × substeps: O(N r³) once for the
+// model (and r + 1 ghost gradients a key); an iteration O(N) ghost gradients (4 a substep with
+// damping, 2 without, each O(#ghost vertices · r)) and O(N r²) for the banded solve and the
+// pairs; tens of iterations (bench/results/inbetween.json).
 //
 // Before the first key the motion holds the static pose of that key (ReducedSolver's minimum with
 // the handles keyed there at their transforms, the never-keyed at the identity, the others free)

@@ -11,12 +11,12 @@ with each keyed handle's rigid fit pulled to its keyed transform at its key by a
 rigid part of the handle's miss only: the handle's own deformation stays the physics'), weighted to
 outweigh the motion's terms there ten thousand-fold: keys are met well within posing's precision.
 L-BFGS over all frames at once, from the keys' static poses interpolated linearly, its initial
-inverse Hessian the inverse of the Gauss-Newton matrix of the dynamics linearised at rest, block-banded in time
-(two r-by-r blocks either side of the diagonal) and factored once; the gradient is exact and a line
+inverse Hessian the inverse of a Gauss-Newton matrix of the dynamics linearised along the motion
+(the energy's Hessian at the keys' static poses, interpolated in time), block-banded in time (two
+r-by-r blocks either side of the diagonal) and factored once; the gradient is exact and a line
 search keeps every step a descent. Cost, with N = frames × substeps between the first key and the
-last and r = basis.dimension: O(N r³) once for the factorisation, then per iteration O(N) ghost
-gradient evaluations (each O(ghost vertices × r)) and O(N r²) for the banded solve; small motions
-take a few iterations, large ones tens.
+last and r = basis.dimension: O(N r³) once for the model, then per iteration O(N) ghost gradient
+evaluations (each O(ghost vertices × r)) and O(N r²) for the banded solve; tens of iterations.
 
 Simulation's energy correction (a rescaling of each substep's end velocity) is not smooth: the
 in-betweens measure the control on the midpoint equation alone, so a free motion of Simulation is
