@@ -213,6 +213,14 @@ class ModalDeformDynamics(bpy.types.PropertyGroup):
         description="Simulation steps per frame: more follow fast controllers more closely and cost more per "
         "frame",
     )
+    inbetweens: BoolProperty(
+        name="In-betweens",
+        default=False,
+        update=_dynamics_changed,
+        description="Key the controllers only at the poses that matter: the mesh moves through them the way "
+        "that needs the least force, overshooting and following through on its own, solved in the "
+        "background whenever a key changes (the keyframes count, not the curves between them)",
+    )
     frame_start: IntProperty(
         name="Start",
         default=1,

@@ -9,6 +9,7 @@ import textwrap
 import bpy
 
 from . import handles, ops_common, ops_preview, storage
+from .inbetweens import motion
 from .playback import frame_cache, timeline
 
 # Width of a character of the interface font at scale 1, in pixels, for wrapping text (a little above
@@ -258,7 +259,10 @@ class VIEW3D_PT_modal_deform_dynamics(_Panel, bpy.types.Panel):
         column.prop(dynamics, "period")
         column.prop(dynamics, "damping")
         column.prop(dynamics, "substeps")
-        column.prop(dynamics, "frame_start")
+        column.prop(dynamics, "inbetweens")
+        row = column.row()
+        row.active = not dynamics.inbetweens  # in-betweens start at the first key
+        row.prop(dynamics, "frame_start")
         _draw_rig(layout, context, obj)
         box = layout.box()
         try:
@@ -267,18 +271,36 @@ class VIEW3D_PT_modal_deform_dynamics(_Panel, bpy.types.Panel):
             cache, problem = None, str(error)
         else:
             problem = timeline.problems.get(obj.name)
+        inbetweens = frame_cache.kind(obj) == "INBETWEEN"
+        if inbetweens:
+            problem = motion.problem(obj) or problem
         if cache is None or not len(cache):
-            wrapped_label(box, context, "Cache empty: play or Bake", icon="INFO")
+            empty = "solving" if obj.name in motion.running else "key the controllers, then play"
+            wrapped_label(
+                box, context, f"Cache empty: {empty if inbetweens else 'play or Bake'}", icon="INFO"
+            )
         else:
-            what = "Simulation" if cache.kind == "DYNAMIC" else "Animation"
-            box.label(text=f"{what}: frames {cache.start}-{cache.end}", icon="FILE_CACHE")
+            if cache.kind == "INBETWEEN":  # the sidebar's default width has no room for more
+                text = f"In-betweens {cache.start}-{cache.end}"
+            else:
+                what = "Simulation" if cache.kind == "DYNAMIC" else "Animation"
+                text = f"{what}: frames {cache.start}-{cache.end}"
+            box.label(text=text, icon="FILE_CACHE")
             box.label(text=f"{cache.nbytes() / 1024:.1f} KB in the file")
+            if cache.kind == "INBETWEEN":
+                for note in motion.notes(cache):
+                    wrapped_label(box, context, note, icon="INFO")
+                if obj.name in motion.running:
+                    box.label(text="Solving again for the keys now", icon="TIME")
         if problem:
             column = box.column()
             column.alert = True
             wrapped_label(column, context, problem, icon="ERROR")
         row = layout.row(align=True)
-        row.operator("modal_deform.bake_animation", text="Bake", icon="RENDER_ANIMATION")
+        if inbetweens:
+            row.operator("modal_deform.solve_inbetweens", text="Solve", icon="RENDER_ANIMATION")
+        else:
+            row.operator("modal_deform.bake_animation", text="Bake", icon="RENDER_ANIMATION")
         row.operator("modal_deform.free_cache", text="Free", icon="TRASH")
         column = layout.column(align=True)
         column.operator(

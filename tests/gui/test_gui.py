@@ -224,3 +224,10 @@ def test_debian13_blender_enables_no_extension_zip(blenders, tmp_path):
         if blenders == "blender_4.2_to_5.0"
         else "doesn't meet the minimum supported version (5.1.0)"
     ) in output, output[-4000:]
+
+
+def test_inbetweens_solve_in_the_background(window):
+    """In-betweens asked by a frame shown and by a moved key, solved by the modal operator from a
+    timer while the old motion plays, and Esc (scripts/inbetweens_window.py)."""
+    result = run_script(window, SCRIPTS / "inbetweens_window.py")
+    print("\n".join(result["log"]))

@@ -6,8 +6,9 @@ vectors) and, for a simulation, of its velocity; a few hundred bytes a frame whe
 frame costs 12 bytes a vertex. Beside them, what each frame was computed from, to tell when it no
 longer holds: the controllers' transforms at that frame (the handles' 4x4 matrices) and the values
 of the controllers' animation curves there; and, for the whole cache, its kind ("STATIC": the
-pose of each frame; "DYNAMIC": the simulation), the bake id of the basis and a signature of the
-settings (dynamics parameters, stiffness, handles).
+pose of each frame; "DYNAMIC": the simulation; "INBETWEEN": the in-betweens, solved whole by
+inbetweens/motion.py), the bake id of the basis and a signature of the settings (dynamics
+parameters, stiffness, handles).
 
 Where: like the basis (storage.py), a Palette datablock named with a leading "." that
 ``Object.modal_deform.dynamics.cache`` points to, each array one flat float64 ID property (Blender
@@ -50,8 +51,12 @@ _FIELDS = (
 
 
 def kind(obj):
-    """The kind of cache obj's settings call for: "DYNAMIC" with dynamics enabled, else "STATIC"."""
-    return "DYNAMIC" if obj.modal_deform.dynamics.enabled else "STATIC"
+    """The kind of cache obj's settings call for: "INBETWEEN" with dynamics and its in-betweens
+    enabled (inbetweens/), "DYNAMIC" with dynamics enabled, else "STATIC"."""
+    dynamics = obj.modal_deform.dynamics
+    if not dynamics.enabled:
+        return "STATIC"
+    return "INBETWEEN" if dynamics.inbetweens else "DYNAMIC"
 
 
 def _pose_fields(obj):
@@ -97,7 +102,10 @@ def signature(obj, scene):
             ("period", dynamics.period),
             ("damping", dynamics.damping),
             ("substeps", dynamics.substeps),
-            ("start", dynamics.frame_start),
+            # In-betweens start at the first key and are cached over the scene's frames.
+            ("range", scene.frame_start, scene.frame_end)
+            if dynamics.inbetweens
+            else ("start", dynamics.frame_start),
             ("fps", scene.render.fps / scene.render.fps_base),
         )
         if dynamics.follow_rig:
@@ -276,7 +284,9 @@ def outdated(cache, obj, signature_now):
 def settings_changed(obj):
     """A dynamics setting changed: the cache no longer holds (a static cache does not depend on them)."""
     cache = get(obj)
-    if cache is not None and cache.kind == "DYNAMIC" or obj.modal_deform.dynamics.enabled:
+    if kind(obj) == "INBETWEEN" and cache is not None and cache.kind == "INBETWEEN":
+        return  # the motion plays until the one for the new settings is solved (inbetweens/)
+    if cache is not None and cache.kind != "STATIC" or obj.modal_deform.dynamics.enabled:
         free(obj)
 
 
@@ -292,7 +302,7 @@ def controller_curves(obj):
         controller = handle.controller
         if controller is None:
             continue
-        moves = _moves_bone(handles.pose_bone(handle))
+        moves = moves_bone(handles.pose_bone(handle))
         for curve in action_fcurves(controller.animation_data) or ():
             if moves(curve.data_path):
                 found.append((f"{controller.name}:{curve.data_path}[{curve.array_index}]", curve))
@@ -300,7 +310,7 @@ def controller_curves(obj):
     return found + (rig.action_curves(obj) if rig.follows(obj) else [])
 
 
-def _moves_bone(bone):
+def moves_bone(bone):
     """A test of a data path of the armature's action: whether it can move `bone` (a pose bone;
     None: every path, as for an object)."""
     if bone is None:

@@ -22,6 +22,8 @@ class CacheJob(FrameJob):
     def __init__(self, context, obj, start, end):
         self.obj, self.scene = obj, context.scene
         dynamics = obj.modal_deform.dynamics
+        if frame_cache.kind(obj) == "INBETWEEN":
+            raise ValueError("in-betweens are solved whole, not frame by frame: Solve In-betweens")
         if dynamics.enabled:
             start = dynamics.frame_start
         if end < start:

@@ -299,6 +299,10 @@ def fill(obj, scene, cache, frame, player_, out=None, curves=None):
 def show(obj, scene, edits_reported=False):
     """Show obj's state at the scene's frame, computing what the cache lacks up to it.
     `edits_reported`: as Player.check_mesh takes it."""
+    if frame_cache.kind(obj) == "INBETWEEN":  # solved whole, not frame by frame
+        from ..inbetweens import motion
+
+        return motion.show(obj, scene, edits_reported, stand_in=_playing)
     frame = scene.frame_current
     on_rig = rig.follows(obj)
     if on_rig:  # the Armature modifier as the offset needs it, checked every frame
