@@ -14,7 +14,8 @@ void add_columns(const Eigen::VectorXd& rest, const Eigen::MatrixXd& U, const Ei
   const Eigen::Index r = U.cols(), panels = r - r % 4;
   x = rest;
   for (Eigen::Index j = 0; j < panels; j += 4)
-    x += U.col(j) * q[j] + U.col(j + 1) * q[j + 1] + U.col(j + 2) * q[j + 2] + U.col(j + 3) * q[j + 3];
+    x += U.col(j) * q[j] + U.col(j + 1) * q[j + 1] + U.col(j + 2) * q[j + 2] +
+         U.col(j + 3) * q[j + 3];
   for (Eigen::Index j = panels; j < r; ++j) x += U.col(j) * q[j];
 }
 

@@ -314,6 +314,7 @@ void ShapeSpace::blend(const VectorRef& weights, Eigen::Ref<Eigen::VectorXf> out
 
 void ShapeSpace::write_positions(const VectorRef& weights, Eigen::Ref<Eigen::VectorXf> out,
                                  std::chrono::steady_clock::time_point start) {
+  const auto map_start = std::chrono::steady_clock::now();
   map_->write(q_.cast<float>(), out);
   // On a proxy, Σ_i w_i r_i over the keys of non-zero weight in one pass over `out`, in blocks
   // split over threads: the sum is memory-bound (each residual is 3#V floats).
@@ -333,6 +334,7 @@ void ShapeSpace::write_positions(const VectorRef& weights, Eigen::Ref<Eigen::Vec
       }
     }
   }
+  stats_.map_ms = milliseconds_since(map_start);
   stats_.ms = milliseconds_since(start);
 }
 
