@@ -36,6 +36,9 @@ Experiments (each writes bench/results/<name>.json: machine, commit, command, pa
                and the rig forces' cost per frame (bench/rig.py)
   shape_space  shape blending: the blend's and the space's bake time per key count on the 23k and 100k
                dragons, 8 smooth keys (bench/shape_space.py)
+  inbetween    physics in-betweens (issue 51): the solve through 5 keys over 120 frames and a frame's
+               positions on the 100k dragon at 67 dimensions, the solve against frames and
+               dimensions, a free motion reproduced from its keys (bench/inbetween.py)
   blender      the add-on's pose update in headless Blender and Blender's Laplacian Deform
                (bench/blender_pose.py), in Debian's 3.4.1 app from the source tree
   bpy_pose     the pose update alone at 100k, 400k, 1.6M and 3.2M vertices in bpy 4.5 and 5.3 (.venv/bpy-<version>,
@@ -47,6 +50,11 @@ Experiments (each writes bench/results/<name>.json: machine, commit, command, pa
                at 100k vertices (and 1.6M on a proxy unless --quick); the cache's and the .blend's sizes
                for 250 frames of the 100k dragon against a shape key per frame and a PC2 file
                (bench/playback.py)
+  shape_keys_blender  Blend as Shapes in bpy 4.5 and 5.3 on the extension zips: the 100k dragon with 8 keys
+               made by formula, driven by changing key values; per update the add-on's handler, the core's
+               blend with its map and Blender's evaluation, against Blender's linear mix of the same keys
+               (and the dragon subdivided twice, 1.6M vertices on a proxy, unless --quick)
+               (bench/shape_keys_blender.py)
   renders      Cycles renders of the accuracy experiment's bar and cylinder poses
                (blender_scripts/render_figures.py; needs accuracy's meshes from the same run)
 --quick runs tiny sizes (the smoke test): results go to bench/results/tmp/, the report is not
@@ -81,11 +89,12 @@ PYTHON_EXPERIMENTS = (
     "dynamics",
     "rig",
     "shape_space",
+    "inbetween",
 )
 EXPERIMENTS = (
     ("native",)
     + PYTHON_EXPERIMENTS
-    + ("blender", "bpy_pose", "viewport_frames", "playback", "renders")
+    + ("blender", "bpy_pose", "viewport_frames", "playback", "shape_keys_blender", "renders")
 )
 NATIVE_IN_TABLE1 = "BM_Bake|BM_BfgsIteration|BM_Positions"
 BLENDER = ["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python"]
@@ -233,6 +242,25 @@ def playback(quick):
                 common.in_bpy(
                     version,
                     common.ROOT / "bench" / "playback.py",
+                    ["--output", str(out), *size, *(["--quick"] if quick else [])],
+                    folder,
+                )
+                runs.append(json.loads(out.read_text()))
+    return {"blenders": common.BPY_VERSIONS, "sizes": sizes}, {"runs": runs}
+
+
+def shape_keys_blender(quick):
+    """bench/shape_keys_blender.py in each of common.BPY_VERSIONS: the 100k dragon, then (not quick)
+    the dragon subdivided twice (1.6M vertices, on a proxy)."""
+    runs = []
+    sizes = [[]] if quick else [[], ["--subdivide", "2", "--updates", "10"]]
+    with tempfile.TemporaryDirectory() as folder:
+        for version in common.BPY_VERSIONS:
+            for i, size in enumerate(sizes):
+                out = pathlib.Path(folder) / f"shape-keys-{version}-{i}.json"
+                common.in_bpy(
+                    version,
+                    common.ROOT / "bench" / "shape_keys_blender.py",
                     ["--output", str(out), *size, *(["--quick"] if quick else [])],
                     folder,
                 )

@@ -17,6 +17,7 @@ import time
 
 import numpy as np
 from support import SHARED_MESHES
+from support.poses import smooth_keys
 from support.subdivision import midpoint_subdivide
 
 import modal_deform.core as mdc
@@ -29,32 +30,6 @@ BLENDS = 30
 REPEATS = 3
 # Issue 52's targets: a blend's median milliseconds (map included) by mesh.
 TARGETS = {"res2": 4.0, "proxy": 16.0}
-
-
-def smooth_keys(V, count, seed=1):
-    rng = np.random.default_rng(seed)
-    centre = V.mean(0)
-    extent = V.max(0) - V.min(0)
-    long = int(np.argmax(extent))
-    t = (V[:, long] - V[:, long].min()) / extent[long]
-    keys = []
-    for j in range(count):
-        cut = 0.3 + 0.4 * rng.random()
-        side = 1 if j % 2 else -1
-        s = np.clip((side * (t - cut)) / 0.2 + 0.5, 0, 1)
-        s = s * s * (3 - 2 * s)
-        axis = rng.normal(size=3)
-        angle = (0.6 + 0.6 * rng.random()) * (1 if rng.random() < 0.5 else -1)
-        pivot = centre.copy()
-        pivot[long] = V[:, long].min() + cut * extent[long]
-        # each vertex turned by its own fraction s of the angle about the pivot (Rodrigues)
-        angles = angle * s
-        a = axis / np.linalg.norm(axis)
-        P = V - pivot
-        cos, sin = np.cos(angles)[:, None], np.sin(angles)[:, None]
-        X = P * cos + np.cross(a, P) * sin + a * (P @ a)[:, None] * (1 - cos) + pivot
-        keys.append(X)
-    return keys
 
 
 def mesh(name, quick):

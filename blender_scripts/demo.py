@@ -12,6 +12,13 @@ where it was.
 
 Then secondary motion (issue 40, demo_dynamics.py): a Suzanne whose head tilts fast and stops, her
 ears overshooting and settling, as a strip of frames, OUTPUT/demo_dynamics.png.
+And on a rig (issue 50, demo_rig.py): Suzanne on a round body, skinned to two bones, jumps and
+tilts her head with Dynamics > Follow Rig, above the same frames with the Armature modifier alone,
+OUTPUT/demo_rig.png.
+
+Last, shape keys blended as shapes (issue 52, demo_shapes.py): a Suzanne with a jaw-open and an
+ears-fold key, both at 0.5, as Blender mixes them and as Blend as Shapes blends them, with the keys at
+1, OUTPUT/demo_shapes.png.
 
 Writes OUTPUT/demo.png (Cycles on the CPU: rest, Modal Deform, Laplacian Deform side by side; below
 them the uniform and the painted finger and the ear) and OUTPUT/demo.blend (Suzanne alone), ready to
@@ -33,6 +40,8 @@ from mathutils import Matrix, Vector
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import demo_dynamics  # noqa: E402
+import demo_rig  # noqa: E402
+import demo_shapes  # noqa: E402
 from headless import add_handle, bind_laplacian_deform, enable_addon, evaluated_positions  # noqa: E402
 from rendering import render, side_by_side, stage  # noqa: E402
 
@@ -67,6 +76,12 @@ def arguments():
         type=int,
         default=2,
         help="Catmull-Clark levels of the secondary motion's Suzanne (2: ~8k vertices)",
+    )
+    parser.add_argument(
+        "--shapes-subdivisions",
+        type=int,
+        default=2,
+        help="Catmull-Clark levels of the shape keys' Suzanne (2: ~8k vertices)",
     )
     return parser.parse_args(argv)
 
@@ -324,6 +339,20 @@ def main():
         tuple(modules), output, args.dynamics_subdivisions, args.width // 2
     )
     print(f"rendered {strip} (secondary motion) in {time.perf_counter() - start:.1f} s")
+
+    start = time.perf_counter()
+    frame_cache = importlib.import_module(f"{addon}.playback.frame_cache")
+    strip = demo_rig.rig_dynamics(frame_cache, output, args.width * 3 // 10, args.samples)
+    print(f"rendered {strip} (secondary motion on a rig) in {time.perf_counter() - start:.1f} s")
+
+    start = time.perf_counter()
+    modules = (
+        importlib.import_module(f"{addon}.{name}") for name in ("mesh_io", "shapes.blending")
+    )
+    strip = demo_shapes.shapes_blended(
+        tuple(modules), output, args.shapes_subdivisions, args.width // 2
+    )
+    print(f"rendered {strip} (shape keys blended as shapes) in {time.perf_counter() - start:.1f} s")
 
 
 main()

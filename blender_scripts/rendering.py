@@ -16,9 +16,7 @@ def stage(target, eye, lens=50, samples=16, resolution=(480, 270)):
     scene = bpy.context.scene
     camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
     scene.collection.objects.link(camera)
-    camera.location = eye
-    view = (Vector(target) - Vector(eye)).normalized()
-    camera.rotation_euler = view.to_track_quat("-Z", "Y").to_euler()
+    view = look_at(camera, eye, target)
     camera.data.lens = lens
     camera.data.clip_end = 10 * (Vector(target) - Vector(eye)).length
     scene.camera = camera
@@ -39,6 +37,14 @@ def stage(target, eye, lens=50, samples=16, resolution=(480, 270)):
     scene.render.resolution_percentage = 100
     scene.render.image_settings.file_format = "PNG"
     return camera
+
+
+def look_at(camera, eye, target):
+    """Place `camera` at `eye` looking at `target`, its up the world's z; returns the unit view direction."""
+    camera.location = eye
+    view = (Vector(target) - Vector(eye)).normalized()
+    camera.rotation_euler = view.to_track_quat("-Z", "Y").to_euler()
+    return view
 
 
 def render(path):

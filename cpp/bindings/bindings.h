@@ -18,6 +18,7 @@ void bind_modes(pybind11::module_& m);
 void bind_solve(pybind11::module_& m);
 void bind_bake(pybind11::module_& m);
 void bind_dynamics(pybind11::module_& m);
+void bind_inbetween(pybind11::module_& m);
 void bind_shapes(pybind11::module_& m);
 
 // Handles as the core takes them, from the list of int32 arrays the Python layer checked

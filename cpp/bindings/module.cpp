@@ -11,5 +11,6 @@ PYBIND11_MODULE(_native, m) {
   modal_deform::bind_solve(m);
   modal_deform::bind_bake(m);
   modal_deform::bind_dynamics(m);
+  modal_deform::bind_inbetween(m);
   modal_deform::bind_shapes(m);
 }

@@ -43,17 +43,56 @@ Eigen::VectorXd checked_weights(const Handles& handles, const VectorRef& weights
 
 }  // namespace
 
+DynamicsParameters dynamics_parameters(const Eigen::MatrixXd& hessian,
+                                       const SimulationOptions& options) {
+  const Eigen::Index r = hessian.rows();
+  DynamicsParameters parameters;
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(hessian);
+  if (eigen.info() != Eigen::Success)
+    throw NumericalError("simulation: the reduced rest Hessian has no eigenvalues");
+  const double largest = eigen.eigenvalues().maxCoeff();
+  Eigen::Index lowest = 0;
+  while (lowest < r && !(eigen.eigenvalues()[lowest] > kZeroEigenvalue * largest)) ++lowest;
+  if (lowest == r || !(largest > 0))
+    throw InputError(
+        "basis: no flexible mode (every direction of the basis is a rigid motion or a mechanism); "
+        "the period is that of the lowest flexible mode");
+  const double lowest_eigenvalue = eigen.eigenvalues()[lowest];
+  parameters.lowest_mode = eigen.eigenvectors().col(lowest);
+
+  // The poles the artist asks for, and the model's that the midpoint rule maps onto them.
+  const double h = 1.0 / (options.fps * options.substeps);
+  const double omega = 2 * kPi * options.fps / options.period;
+  const std::complex<double> root =
+      std::sqrt(std::complex<double>(options.damping * options.damping - 1, 0));
+  std::complex<double> product = 1, sum = 0;
+  for (const double sign : {1.0, -1.0}) {
+    const std::complex<double> pole = omega * (-options.damping + sign * root);
+    const std::complex<double> model_pole = (2 / h) * std::tanh(pole * (h / 2));
+    product *= model_pole;
+    sum += model_pole;
+  }
+  parameters.substep = h;
+  parameters.mass_scale = lowest_eigenvalue / product.real();
+  parameters.rayleigh = -sum.real() / product.real();
+  return parameters;
+}
+
+ReducedHandleTerm dynamics_handle_term(const Basis& basis, const Handles& handles,
+                                       const Eigen::VectorXd& weights, double pull) {
+  return ReducedHandleTerm(
+      HandleTerm(basis.rest, basis.mass, handles, weights, pull * std::pow(basis.scale, 4)),
+      [&basis](int v) { return basis.vertex_rows(v); }, basis.dimension());
+}
+
 ReducedDynamics::ReducedDynamics(const Basis& basis, const Handles& handles,
                                  const VectorRef& weights, const SimulationOptions& options,
                                  EnergyKind energy, const SkinningWeights* rig)
     : basis_(checked(basis)),
       options_(checked(options)),
       ghost_energy_(basis, energy),
-      handle_term_(
-          HandleTerm(basis.rest, basis.mass, handles,
-                     checked_weights(handles, weights, basis.num_vertices()),
-                     options.pull * std::pow(basis.scale, 4)),
-          [&basis](int v) { return basis.vertex_rows(v); }, basis.dimension()),
+      handle_term_(dynamics_handle_term(
+          basis, handles, checked_weights(handles, weights, basis.num_vertices()), options.pull)),
       transforms_(handles.size(), Eigen::Matrix4d::Identity()),
       fine_positions_(basis) {
   require_handles_in_region(handles, basis.region);
@@ -76,33 +115,11 @@ ReducedDynamics::ReducedDynamics(const Basis& basis, const Handles& handles,
     attached = K + handle_term_.hessian();
     attached = 0.5 * (attached + attached.transpose()).eval();
   }
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(rig_ ? attached : K);
-  if (eigen.info() != Eigen::Success)
-    throw NumericalError("simulation: the reduced rest Hessian has no eigenvalues");
-  const double largest = eigen.eigenvalues().maxCoeff();
-  Eigen::Index lowest = 0;
-  while (lowest < r && !(eigen.eigenvalues()[lowest] > kZeroEigenvalue * largest)) ++lowest;
-  if (lowest == r || !(largest > 0))
-    throw InputError(
-        "basis: no flexible mode (every direction of the basis is a rigid motion or a mechanism); "
-        "the period is that of the lowest flexible mode");
-  const double lowest_eigenvalue = eigen.eigenvalues()[lowest];
-  lowest_mode_ = eigen.eigenvectors().col(lowest);
-
-  // The poles the artist asks for, and the model's that the midpoint rule maps onto them.
-  h_ = 1.0 / (options.fps * options.substeps);
-  const double omega = 2 * kPi * options.fps / options.period;
-  const std::complex<double> root =
-      std::sqrt(std::complex<double>(options.damping * options.damping - 1, 0));
-  std::complex<double> product = 1, sum = 0;
-  for (const double sign : {1.0, -1.0}) {
-    const std::complex<double> pole = omega * (-options.damping + sign * root);
-    const std::complex<double> model_pole = (2 / h_) * std::tanh(pole * (h_ / 2));
-    product *= model_pole;
-    sum += model_pole;
-  }
-  mass_scale_ = lowest_eigenvalue / product.real();
-  rayleigh_ = -sum.real() / product.real();
+  DynamicsParameters parameters = dynamics_parameters(rig_ ? attached : K, options);
+  mass_scale_ = parameters.mass_scale;
+  rayleigh_ = parameters.rayleigh;
+  h_ = parameters.substep;
+  lowest_mode_ = std::move(parameters.lowest_mode);
   midpoint_weight_ = h_ * h_ / (4 * mass_scale_);
   euler_weight_ = h_ * h_ / mass_scale_;
   midpoint_inverse_hessian_ = inverse_rest_hessian(K, midpoint_weight_, 1 + 2 * rayleigh_ / h_);

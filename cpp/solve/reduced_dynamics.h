@@ -101,6 +101,26 @@ void for_each_simulation_option(Visit&& visit) {
         [](auto& o) -> auto& { return o.memory_frames; });
 }
 
+// The midpoint rule's parameters that give the lowest flexible mode of a reduced rest Hessian the
+// artist's period and damping ratio (the header says how), and the substep; Simulation and
+// Inbetween alike.
+struct DynamicsParameters {
+  double mass_scale = 0;        // ρ: the reduced mass is ρI
+  double rayleigh = 0;          // β, seconds: the damping is β times the stiffness
+  double substep = 0;           // h, seconds
+  Eigen::VectorXd lowest_mode;  // the lowest flexible mode's unit eigenvector
+};
+
+// From `hessian` (r by r, symmetric: K, or on a rig K plus the handles' term) and the options
+// (checked). Throws InputError when it has no flexible mode to set the period by.
+DynamicsParameters dynamics_parameters(const Eigen::MatrixXd& hessian,
+                                       const SimulationOptions& options);
+
+// The handles' term as the dynamics use it: μs⁴ on the fine mesh, restricted to the basis
+// (handle_term.h); weights checked (checked_handle_weights) by the caller.
+ReducedHandleTerm dynamics_handle_term(const Basis& basis, const Handles& handles,
+                                       const Eigen::VectorXd& weights, double pull);
+
 struct SimulationStepStats {
   int substeps = 0;
   int iterations = 0;     // BFGS iterations, all substeps

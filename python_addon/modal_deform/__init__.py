@@ -2,7 +2,8 @@
 
 This file only registers the Blender layer, once native_loader made the compiled core importable.
 ``modal_deform.core`` is the bpy-free API and imports without Blender, so the Blender modules are
-imported inside register(). The interactive pose is in pose/, playback on the timeline in playback/.
+imported inside register(). The interactive pose is in pose/, playback on the timeline in playback/,
+shape keys blended as shapes in shapes/.
 Every import is relative: installed as an extension the package is ``bl_ext.<repository>.modal_deform``.
 """
 
@@ -34,7 +35,10 @@ _MODULES = (
     "playback.operators",
     "playback.bake_animation",
     "ops_preview",
+    "shapes.blending",
+    "shapes.operators",
     "ui",
+    "shapes.panel",
 )
 
 

@@ -17,9 +17,12 @@ from mathutils import Matrix
 
 from . import core as mdc
 from . import mesh_io
+from .playback import rig
 
 Handle = collections.namedtuple(
-    "Handle", "name indices weight controller bind_inverse centre bone", defaults=("",)
+    "Handle",
+    "name indices weight controller bind_inverse bind_skinning centre bone",
+    defaults=("",),
 )
 
 
@@ -68,7 +71,10 @@ def world_matrix(controller, bone):
 
 def bind(obj, handle):
     """Make the controller's current placement the handle's rest, in obj's space (obj's matrix may
-    be singular: then its closest inverse); called when the controller or its bone is assigned."""
+    be singular: then its closest inverse), and record the skinning of the handle's vertices by
+    obj's rig now (rig.bind_skinning: Follow Rig counts the controller's motion from there); called
+    when the controller or its bone is assigned."""
+    handle.bind_skinning = Matrix.Identity(4)
     if handle.controller is None:
         handle.bind_matrix = Matrix.Identity(4)
         handle.bound_controller = ""
@@ -77,6 +83,9 @@ def bind(obj, handle):
             handle.controller, pose_bone(handle)
         )
         handle.bound_controller = handle.controller.name
+        indices = mesh_io.group_vertices(obj, handle.vertex_group) if handle.vertex_group else None
+        if indices is not None and indices.size:
+            handle.bind_skinning = Matrix(rig.bind_skinning(obj, indices).tolist())
 
 
 def skinning_modifier(obj, armature):
@@ -188,6 +197,7 @@ def resolve(obj, scene, rest, region=None):
                 item.weight,
                 controller,
                 bind_inverse,
+                np.array(Matrix(item.bind_skinning), np.float64),
                 rest[indices].mean(axis=0),
                 item.bone if pose_bone(item) is not None else "",
             )

@@ -114,6 +114,15 @@ class ModalDeformHandle(bpy.types.PropertyGroup):
         description="The controller's matrix (its bone's, for a bone) in the mesh object's space when it was "
         "assigned: the rest pose of the handle",
     )
+    bind_skinning: FloatVectorProperty(
+        name="Bind Skinning",
+        size=(4, 4),
+        subtype="MATRIX",
+        default=IDENTITY,
+        options={"HIDDEN"},
+        description="How the mesh's Armature modifier placed the handle's vertices (in the mesh object's "
+        "space) when the controller was assigned: Follow Rig holds them there until the controller moves",
+    )
 
 
 class ModalDeformBakeStatus(bpy.types.PropertyGroup):
@@ -211,11 +220,64 @@ class ModalDeformDynamics(bpy.types.PropertyGroup):
         description="Frame the simulation starts on, at rest in the pose of the controllers there; before it "
         "the mesh holds that pose",
     )
+    # On a rig: playback/rig.py.
+    follow_rig: BoolProperty(
+        name="Follow Rig",
+        default=False,
+        update=_dynamics_changed,
+        description="The mesh's Armature modifier drives the dynamics: parts not attached to the bones lag, "
+        "overshoot and settle as the rig moves, shown before the Armature modifier so that its skinning "
+        "and your corrective shape keys still apply; with the rig still the mesh is exactly the "
+        "Armature modifier's",
+    )
+    attach_group: StringProperty(
+        name="Attach",
+        update=_dynamics_changed,
+        description="Vertex group of the vertices held where the rig puts them (weight above 0.5), as Cloth's "
+        "Pin Group: Fill Attach from Armature makes it from the vertices near the bones, then paint it",
+    )
     cache: PointerProperty(
         type=bpy.types.Palette,
         name="Cache",
         description="Datablock holding the cached frames (hidden: its name starts with a dot)",
     )
+
+
+# Shape keys blended as shapes: shapes/.
+def _shapes_changed(shapes, context):
+    from .shapes import blending
+
+    blending.refresh(shapes.id_data)
+
+
+class ModalDeformShapes(bpy.types.PropertyGroup):
+    """Blend as Shapes: the mesh shows the rotation-aware blend of its shape keys (shapes/), from
+    the shape space baked of them (kept in ``space``, storage.write_arrays) and the keys' values."""
+
+    enabled: BoolProperty(
+        name="Blend as Shapes",
+        default=False,
+        update=_shapes_changed,
+        description="Show the shape keys blended as shapes: where a part turns between the basis and a key "
+        "(a jaw opening, a finger curling) the in-between turns too and keeps its size, where "
+        "Blender's linear mix cuts through and shrinks it. The keys' values (keyframed, driven or "
+        "moved) are the weights",
+    )
+    space: PointerProperty(
+        type=bpy.types.Palette,
+        name="Shape Space",
+        description="Datablock holding the baked shape space (hidden: its name starts with a dot)",
+    )
+    key_names: StringProperty(
+        name="Keys", description="The shape keys of the space, one per line, in the mesh's order"
+    )
+    keys_digest: StringProperty(
+        name="Keys Digest",
+        description="Faces, basis and keys (coordinates and Relative To) at the bake",
+    )
+    dimension: IntProperty(name="Dimension", description="Reduced coordinates of the space")
+    baked_at: StringProperty(name="Baked At", description="Local date and time of the bake")
+    seconds: FloatProperty(name="Seconds", description="Wall time of the bake")
 
 
 class ModalDeformSettings(bpy.types.PropertyGroup):
@@ -343,6 +405,11 @@ class ModalDeformSettings(bpy.types.PropertyGroup):
         name="Dynamics",
         description="Secondary motion and the per-frame cache of the pose",
     )
+    shapes: PointerProperty(
+        type=ModalDeformShapes,
+        name="Blend as Shapes",
+        description="The shape keys blended as shapes",
+    )
     preview_amplitude: FloatProperty(
         name="Amplitude",
         default=0.1,
@@ -353,7 +420,13 @@ class ModalDeformSettings(bpy.types.PropertyGroup):
     )
 
 
-CLASSES = (ModalDeformHandle, ModalDeformBakeStatus, ModalDeformDynamics, ModalDeformSettings)
+CLASSES = (
+    ModalDeformHandle,
+    ModalDeformBakeStatus,
+    ModalDeformDynamics,
+    ModalDeformShapes,
+    ModalDeformSettings,
+)
 
 
 _register_classes, _unregister_classes = bpy.utils.register_classes_factory(CLASSES)

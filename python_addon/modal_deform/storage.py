@@ -69,18 +69,19 @@ def groups(obj):
                 f"'{obj.name}': the {purpose} vertex group '{name}' does not exist (deleted or "
                 f"renamed?): choose another one or clear it"
             )
-        hashes[setting] = _digest(weights[setting])
+        hashes[setting] = digest(weights[setting])
     return Groups(names, weights, hashes)
 
 
 def _group_hash(obj, group, cached):
     key = (obj.data.as_pointer(), group)
     if not cached or key not in _group_hashes:
-        _group_hashes[key] = _digest(mesh_io.group_weights(obj, group))
+        _group_hashes[key] = digest(mesh_io.group_weights(obj, group))
     return _group_hashes[key]
 
 
-def _digest(*arrays):
+def digest(*arrays):
+    """A hash (32 hex digits) of the arrays' bytes, one after another."""
     h = hashlib.blake2b(digest_size=16)
     for a in arrays:
         h.update(memoryview(np.ascontiguousarray(a)).cast("B"))
@@ -92,7 +93,7 @@ def fingerprint(mesh):
     totals, corners = mesh_io.face_corners(mesh)
     co = np.empty(3 * len(mesh.vertices), np.float32)
     mesh.vertices.foreach_get("co", co)
-    return len(mesh.vertices), _digest(totals, corners), _digest(co)
+    return len(mesh.vertices), digest(totals, corners), digest(co)
 
 
 def _cached_fingerprint(mesh):
@@ -126,24 +127,46 @@ def stale_reason(obj, cached=False):
     return ""
 
 
-def store(obj, basis, mesh_fingerprint, vertex_groups, seconds, energy):
-    """Keep `basis` (baked from obj's mesh with `mesh_fingerprint` and the Groups `vertex_groups`)
-    in the .blend as obj's basis."""
-    arrays = basis.to_arrays()
-    block = bpy.data.palettes.new(PREFIX + obj.name)
+def write_arrays(name, arrays):
+    """A new datablock `name` holding `arrays` (dict of numpy arrays, as ``to_arrays`` gives) and a
+    new bake id (BAKE_ID)."""
+    block = bpy.data.palettes.new(name)
     block.use_fake_user = (
         False  # palettes get one by default; this one lives as long as its objects
     )
     shapes = {}
-    for name, a in arrays.items():
+    for key, a in arrays.items():
         if a.ndim == 0:
-            block[name] = a.item()
+            block[key] = a.item()
         else:
-            block[name] = a.ravel()
-            shapes[name] = list(a.shape)
+            block[key] = a.ravel()
+            shapes[key] = list(a.shape)
     block[_SHAPES] = shapes
-    bake_id = uuid.uuid4().hex
-    block[BAKE_ID] = bake_id
+    block[BAKE_ID] = uuid.uuid4().hex
+    return block
+
+
+def read_arrays(block):
+    """The arrays write_arrays kept in `block`, each flat one a zero-copy view of its ID property
+    (for ``from_arrays`` to check). Raises KeyError, TypeError or AttributeError on a damaged one."""
+    shapes = block[_SHAPES].to_dict()
+    arrays = {}
+    for name in block.keys():
+        if name in (_SHAPES, BAKE_ID):
+            continue
+        value = block[name]
+        if name in shapes:
+            arrays[name] = np.frombuffer(value, dtype=value.typecode).reshape(shapes[name])
+        else:
+            arrays[name] = np.array(value, dtype=np.int32 if isinstance(value, int) else np.float64)
+    return arrays
+
+
+def store(obj, basis, mesh_fingerprint, vertex_groups, seconds, energy):
+    """Keep `basis` (baked from obj's mesh with `mesh_fingerprint` and the Groups `vertex_groups`)
+    in the .blend as obj's basis."""
+    block = write_arrays(PREFIX + obj.name, basis.to_arrays())
+    bake_id = block[BAKE_ID]
 
     settings = obj.modal_deform
     _release(settings)
@@ -197,19 +220,7 @@ def load(obj):
         _bases.move_to_end(bake_id)
         return _bases[bake_id]
     try:
-        shapes = block[_SHAPES].to_dict()
-        arrays = {}
-        for name in block.keys():
-            if name in (_SHAPES, BAKE_ID):
-                continue
-            value = block[name]
-            if name in shapes:
-                arrays[name] = np.frombuffer(value, dtype=value.typecode).reshape(shapes[name])
-            else:
-                arrays[name] = np.array(
-                    value, dtype=np.int32 if isinstance(value, int) else np.float64
-                )
-        basis = mdc.Basis.from_arrays(arrays)
+        basis = mdc.Basis.from_arrays(read_arrays(block))
     except (KeyError, TypeError, ValueError, AttributeError) as error:
         raise NotReady(f"the basis stored for '{obj.name}' is damaged ({error}): re-bake") from None
     _remember(bake_id, basis)

@@ -259,6 +259,7 @@ class VIEW3D_PT_modal_deform_dynamics(_Panel, bpy.types.Panel):
         column.prop(dynamics, "damping")
         column.prop(dynamics, "substeps")
         column.prop(dynamics, "frame_start")
+        _draw_rig(layout, context, obj)
         box = layout.box()
         try:
             cache = frame_cache.get(obj)
@@ -284,6 +285,28 @@ class VIEW3D_PT_modal_deform_dynamics(_Panel, bpy.types.Panel):
             "modal_deform.export_shape_keys", text="Export Shape Keys", icon="SHAPEKEY_DATA"
         )
         column.operator("modal_deform.export_mesh_cache", text="Export Mesh Cache", icon="EXPORT")
+
+
+def _draw_rig(layout, context, obj):
+    """Follow Rig's settings in the Dynamics panel: the switch, the Attach group and its fill, and
+    what the rig's Player warns of (playback/rig.py)."""
+    dynamics = obj.modal_deform.dynamics
+    column = layout.column()
+    column.use_property_split = True
+    column.use_property_decorate = False
+    column.active = dynamics.enabled
+    column.prop(dynamics, "follow_rig")
+    if not dynamics.follow_rig:
+        return
+    row = column.row(align=True)
+    row.prop_search(dynamics, "attach_group", obj, "vertex_groups", text="Attach")
+    row.operator("modal_deform.fill_attach", text="", icon="BONE_DATA")
+    for text in timeline.rig_warnings(obj):
+        wrapped_label(layout, context, text, icon="INFO")
+    row = layout.row(align=True)  # the buttons below the box export in rest space
+    row.label(text="Export Skinned:")
+    row.operator("modal_deform.export_shape_keys", text="", icon="SHAPEKEY_DATA").space = "SKINNED"
+    row.operator("modal_deform.export_mesh_cache", text="", icon="EXPORT").space = "SKINNED"
 
 
 CLASSES = (

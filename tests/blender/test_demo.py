@@ -1,5 +1,6 @@
 """`make demo`'s script (blender_scripts/demo.py), small: it runs to its end in the Blender app that
-`make demo` runs, writes its .blend and pictures, and Suzanne's ears overshoot and settle."""
+`make demo` runs, writes its .blend and pictures, Suzanne's ears overshoot and settle, and her
+ears blended as shapes at 0.5 keep more of their length than Blender's mix."""
 
 import re
 
@@ -8,7 +9,7 @@ from conftest import BLENDER_PYTHON, ROOT
 
 
 @pytest.mark.skipif(BLENDER_PYTHON is not None, reason="make demo runs the Blender app")
-def test_demo_runs_and_the_ears_overshoot_and_settle(run_blender, tmp_path):
+def test_demo_runs_the_ears_overshoot_and_settle_and_blend_as_shapes(run_blender, tmp_path):
     output = tmp_path / "out"
     result = run_blender(
         ROOT / "blender_scripts" / "demo.py",
@@ -22,8 +23,10 @@ def test_demo_runs_and_the_ears_overshoot_and_settle(run_blender, tmp_path):
         120,
         "--dynamics-subdivisions",
         1,
+        "--shapes-subdivisions",
+        1,
     )
-    for name in ("demo.blend", "demo.png", "demo_dynamics.png"):
+    for name in ("demo.blend", "demo.png", "demo_dynamics.png", "demo_shapes.png"):
         assert (output / name).stat().st_size > 0, name
     found = re.search(
         r"the ears' way from rest \(0\) to where they settle \(1\), frames 1 to \d+: ([\d. ]+)",
@@ -33,3 +36,12 @@ def test_demo_runs_and_the_ears_overshoot_and_settle(run_blender, tmp_path):
     way = [float(value) for value in found.group(1).split()]
     assert max(way) > 1.03, f"the ears do not overshoot: {way}"
     assert abs(way[-1] - 1) < 0.01, f"the ears do not settle: {way}"
+    found = re.search(
+        r"the left ear from its hinge to its tip: rest ([\d.]+), key ([\d.]+), Blender's mix at "
+        r"0.5 ([\d.]+), Blend as Shapes at 0.5 ([\d.]+)",
+        result.stdout,
+    )
+    assert found, result.stdout[-2000:]
+    rest, key, mix, blend = (float(value) for value in found.groups())
+    assert abs(key - rest) < 1e-3 * rest, (rest, key)
+    assert mix < 0.5 * rest and blend > 0.7 * rest, (rest, mix, blend)

@@ -1,4 +1,5 @@
-"""Blender with a window under Xvfb: posing driven by simulated events (scripts/pose_with_mouse.py),
+"""Blender with a window under Xvfb: posing driven by simulated events (scripts/pose_with_mouse.py,
+and with a bone as the controller, scripts/pose_bone_with_mouse.py),
 every panel drawn and screenshotted (scripts/draw_panels.py), and the viewport's frame time while
 posing (bench/viewport_frames.py). Each runs in every window (the `window` fixture); its screenshots
 and figures stay in build/test-artefacts/gui-<Blender X.Y>/ (build/ is the build's own, ignored by git)."""
@@ -112,6 +113,13 @@ def test_pose_with_simulated_mouse_and_keys(window):
     artefacts = window[2]
     run_script(window, SCRIPTS / "pose_with_mouse.py")
     assert (artefacts / "pose.png").stat().st_size > 0
+
+
+def test_pose_a_bone_with_simulated_mouse_and_keys(window):
+    """A handle's controller is a bone, turned in Pose Mode with R while Pose runs."""
+    artefacts = window[2]
+    print("\n".join(run_script(window, SCRIPTS / "pose_bone_with_mouse.py")["log"]))
+    assert (artefacts / "bone-pose.png").stat().st_size > 0
 
 
 def test_every_panel_draws_at_the_default_sidebar_width(window):

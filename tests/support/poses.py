@@ -1,4 +1,5 @@
-"""Rigid transforms and poses of handles, as the benchmarks and tests move them (NumPy only).
+"""Rigid transforms and poses of handles, as the benchmarks and tests move them, and smooth shape
+keys of a mesh (NumPy only).
 
 handles, poses = poses.end_pull(V)
 for frame in range(1, poses[0].frames + 1):
@@ -69,3 +70,33 @@ def end_pull(V):
     return handles, (
         Pose("pull", "far 10% turned by 0.6 rad and moved by a quarter of the length", at, 6),
     )
+
+
+def smooth_keys(V, count, seed=1):
+    """`count` smooth deformations of V (n, 3), float64, as shape keys for the shape blending
+    benchmarks: each swings the part beyond a plane across the longest axis about an axis through
+    the centre, by an angle that rises smoothly across the plane (a random plane, axis and angle
+    of 0.6 to 1.2 radians per key, from `seed`)."""
+    rng = np.random.default_rng(seed)
+    centre = V.mean(0)
+    extent = V.max(0) - V.min(0)
+    long = int(np.argmax(extent))
+    t = (V[:, long] - V[:, long].min()) / extent[long]
+    keys = []
+    for j in range(count):
+        cut = 0.3 + 0.4 * rng.random()
+        side = 1 if j % 2 else -1
+        s = np.clip((side * (t - cut)) / 0.2 + 0.5, 0, 1)
+        s = s * s * (3 - 2 * s)
+        axis = rng.normal(size=3)
+        angle = (0.6 + 0.6 * rng.random()) * (1 if rng.random() < 0.5 else -1)
+        pivot = centre.copy()
+        pivot[long] = V[:, long].min() + cut * extent[long]
+        # each vertex turned by its own fraction s of the angle about the pivot (Rodrigues)
+        angles = angle * s
+        a = axis / np.linalg.norm(axis)
+        P = V - pivot
+        cos, sin = np.cos(angles)[:, None], np.sin(angles)[:, None]
+        X = P * cos + np.cross(a, P) * sin + a * (P @ a)[:, None] * (1 - cos) + pivot
+        keys.append(X)
+    return keys

@@ -15,6 +15,7 @@ from .bake import bake_fraction as bake_fraction
 from .dynamics import SIMULATION_OPTIONS, Simulation
 from .energy import MATERIAL_OPTIONS, Arap, DiscreteShells
 from .frame_budget import FrameBudget as FrameBudget
+from .inbetween import INBETWEEN_OPTIONS, Inbetween
 from .mesh import check, mass, read_mesh
 from .modes import rigid_motions, solve_in_range, vibration_modes
 from .reduction import ghost_mesh, restrict_to_ghost
@@ -40,6 +41,8 @@ __all__ = [
     "Cancelled",
     "DiscreteShells",
     "FULL_SOLVE_OPTIONS",
+    "INBETWEEN_OPTIONS",
+    "Inbetween",
     "MATERIAL_OPTIONS",
     "OutOfMemoryError",
     "ReducedSolver",

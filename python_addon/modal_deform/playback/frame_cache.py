@@ -26,17 +26,27 @@ import json
 
 import bpy
 import numpy as np
+from mathutils import Matrix
 
 from .. import handles, mesh_io, storage
+from . import rig
 
 PREFIX = ".Modal Deform Cache "
-_ARRAYS = ("q", "v", "transforms", "curves")
-#: What a cache datablock holds (create() writes them all).
+_IDENTITY = Matrix.Identity(4)
+#: "rig", on a rig only (playback/rig.py): each frame's rig (Rig.frame), the bones whose motion the
+#: next frame's step needs (Simulation.rig_state: the frame's and the one before's).
+_ARRAYS = ("q", "v", "transforms", "curves", "rig")
+_OPTIONAL = ("rig",)
+#: What a cache datablock holds (create() writes them all; an optional array only on a rig).
 _FIELDS = (
-    ("kind", "start", "signature", "basis_id", "curve_paths", "keys_digest", "frames")
-    + _ARRAYS
-    + tuple(name + "_width" for name in _ARRAYS)
-)
+    "kind",
+    "start",
+    "signature",
+    "basis_id",
+    "curve_paths",
+    "keys_digest",
+    "frames",
+) + tuple(f for name in _ARRAYS if name not in _OPTIONAL for f in (name, name + "_width"))
 
 
 def kind(obj):
@@ -59,6 +69,11 @@ def _pose_fields(obj):
                     tuple(value for row in h.bind_matrix for value in row),
                 )
                 + ((h.bone,) if h.bone else ())  # an object controller's as before bones came
+                + (  # a handle bound in the rig's rest pose as before bind_skinning came
+                    ()
+                    if h.bind_skinning == _IDENTITY
+                    else (tuple(value for row in h.bind_skinning for value in row),)
+                )
                 for h in settings.handles
             ),
         ),
@@ -85,6 +100,8 @@ def signature(obj, scene):
             ("start", dynamics.frame_start),
             ("fps", scene.render.fps / scene.render.fps_base),
         )
+        if dynamics.follow_rig:
+            fields += (("rig", rig.signature(obj)),)
     return repr(fields)
 
 
@@ -114,8 +131,9 @@ class Cache:
     curve_paths = property(lambda self: json.loads(self.block["curve_paths"]))
 
     def array(self, name):
-        """(frames, width) float64 view of the array `name` ("q", "v", "transforms", "curves")."""
-        width = self.block[name + "_width"]
+        """(frames, width) float64 view of the array `name` ("q", "v", "transforms", "curves",
+        "rig")."""
+        width = self.block.get(name + "_width", 0)
         if not width:
             return np.empty((len(self), 0))
         return _values(self.block, name)[: len(self) * width].reshape(-1, width)
@@ -140,7 +158,7 @@ class Cache:
         v = self.array("v")
         return self.array("q")[index].copy(), (v[index].copy() if v.shape[1] else None)
 
-    def append(self, q, v, transforms, curves):
+    def append(self, q, v, transforms, curves, rig=None):
         """Add the frame after the last (end + 1): each row written in place into the room its array
         keeps after the last frame, the array grown to twice the frames when full (so that caching a
         frame costs the same at any length of cache, where copying every array grew with it)."""
@@ -150,16 +168,19 @@ class Cache:
             "v": np.empty(0) if v is None else v,
             "transforms": transforms,
             "curves": curves,
+            "rig": np.empty(0) if rig is None else rig,
         }
         for name, row in rows.items():
             row = np.asarray(row, np.float64).ravel()
-            width = self.block[name + "_width"]
+            width = self.block.get(name + "_width", 0)
+            if not row.size and not width:
+                continue
             if frames and row.size != width:
                 raise ValueError(
                     f"cache: frame {self.end + 1}'s {name} has {row.size} values, earlier frames "
                     f"{width}"
                 )
-            if not frames or len(self.block[name]) < (frames + 1) * width:
+            if not frames or name not in self.block or len(self.block[name]) < (frames + 1) * width:
                 room = np.zeros(max(_FIRST_ROOM, 2 * (frames + 1)) * row.size)
                 room[: frames * width] = self.array(name).ravel()
                 _set_array(self.block, name, room)
@@ -173,7 +194,9 @@ class Cache:
         if keep == len(self):
             return
         for name in _ARRAYS:
-            width = self.block[name + "_width"]
+            width = self.block.get(name + "_width", 0)
+            if name not in self.block:
+                continue
             _set_array(
                 self.block, name, self.array(name)[:keep].ravel().copy() if width else np.empty(0)
             )
@@ -222,8 +245,9 @@ def create(obj, scene, start):
     block["keys_digest"] = keys_digest(curves)
     block["frames"] = 0
     for name in _ARRAYS:
-        _set_array(block, name, np.empty(0))
-        block[name + "_width"] = 0
+        if name not in _OPTIONAL:
+            _set_array(block, name, np.empty(0))
+            block[name + "_width"] = 0
     obj.modal_deform.dynamics.cache = block
     return Cache(block)
 
@@ -257,7 +281,8 @@ def settings_changed(obj):
 
 
 def controller_curves(obj):
-    """The animation curves of obj's controllers, as (path, F-curve): path "controller:data_path[index]".
+    """The animation curves of obj's controllers, as (path, F-curve): path "controller:data_path[index]";
+    on a rig, then those that move the rig (rig.action_curves).
     A bone's are those of its armature's action that move it: the armature object's own (paths not
     under pose.bones) and those of the bone and its parents (paths under pose.bones["name"])."""
     from .frame_keys import action_fcurves
@@ -272,7 +297,7 @@ def controller_curves(obj):
             if moves(curve.data_path):
                 found.append((f"{controller.name}:{curve.data_path}[{curve.array_index}]", curve))
     found.sort(key=lambda item: item[0])
-    return found
+    return found + (rig.action_curves(obj) if rig.follows(obj) else [])
 
 
 def _moves_bone(bone):

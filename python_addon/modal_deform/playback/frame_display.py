@@ -4,6 +4,10 @@ timeline plays (Blender 4+), a stand-in mesh without shape keys whose positions 
 the modifier reads instead (frame_mesh(stand_in=True)) because Blender evaluates it faster
 (bench/results/playback.json, "evaluate_ms" of "dynamic_step" against "dynamic_step_still").
 
+On a rig (Follow Rig, rig.py) the display is an offset instead (offset_mesh): Set Position adds
+a rest-space displacement to the positions as the shape keys leave them, first in the stack and so
+before the Armature modifier, which skins it; no stand-in there.
+
 The artist's positions and shape keys are never written. Where the attribute is missing the modifier
 leaves the positions alone (the Named Attribute node's "Exists" is Set Position's selection; Blender
 3.4 has no such output: there a BOOLEAN point attribute, SHOWN, written True with the attribute, is
@@ -29,6 +33,10 @@ MARK = "modal_deform_playback"
 ATTRIBUTE = "modal_deform_playback"
 #: Blender 3.4's selection (see the module's comment): True on every point where ATTRIBUTE holds a frame.
 SHOWN = "modal_deform_playback_shown"
+#: On a rig (playback/rig.py): the FLOAT_VECTOR point attribute holding the frame's rest-space
+#: offset, and the ID property marking the node group that adds it (offset_node_group).
+OFFSET_ATTRIBUTE = "modal_deform_offset"
+OFFSET = "modal_deform_offset"
 #: ID property of a stand-in's object, mesh and node group (one each per object that plays): the name
 #: of the object it stands in for.
 STAND_IN = "modal_deform_stand_in"
@@ -62,7 +70,7 @@ def node_group():
         (
             g
             for g in bpy.data.node_groups
-            if g.library is None and g.get(MARK) and not g.get(STAND_IN)
+            if g.library is None and g.get(MARK) and not g.get(STAND_IN) and not g.get(OFFSET)
         ),
         None,
     )
@@ -83,11 +91,11 @@ def node_group():
     return tree
 
 
-def _add_modifier(obj):
+def _add_modifier(obj, tree=None):
     """The modifier, new, first in obj's stack (before the artist's modifiers: they act on the frame),
-    hidden in Edit Mode (which shows the mesh being edited)."""
+    hidden in Edit Mode (which shows the mesh being edited); `tree`: its node group (node_group())."""
     modifier = obj.modifiers.new(MODIFIER, "NODES")
-    modifier.node_group = node_group()
+    modifier.node_group = tree or node_group()
     modifier.show_in_editmode = modifier.show_on_cage = False
     if len(obj.modifiers) > 1:
         if hasattr(obj.modifiers, "move"):  # Blender 4.0+
@@ -141,6 +149,57 @@ def frame_mesh(obj, stand_in=False):
             shown = attributes.get(SHOWN) or attributes.new(SHOWN, "BOOLEAN", "POINT")
             shown.data.foreach_set("value", np.ones(len(mesh.vertices), bool))
     return mesh
+
+
+def offset_node_group():
+    """The file's node group of the display on a rig (made on first use): Geometry → Set Position
+    (Offset: OFFSET_ATTRIBUTE, zero where it is missing; Position as the geometry has it) →
+    Geometry. An offset of zero leaves every position's bits as they are."""
+    tree = next(
+        (g for g in bpy.data.node_groups if g.library is None and g.get(MARK) and g.get(OFFSET)),
+        None,
+    )
+    if tree is not None:
+        return tree
+    tree = _geometry_group(NODE_GROUP + " Offset")
+    tree[OFFSET] = True
+    group_in, group_out = tree.nodes.new("NodeGroupInput"), tree.nodes.new("NodeGroupOutput")
+    set_position = tree.nodes.new("GeometryNodeSetPosition")
+    tree.links.new(group_in.outputs[0], set_position.inputs["Geometry"])
+    tree.links.new(
+        _named_attribute(tree, "FLOAT_VECTOR", OFFSET_ATTRIBUTE)[1], set_position.inputs["Offset"]
+    )
+    tree.links.new(set_position.outputs[0], group_out.inputs[0])
+    return tree
+
+
+def shows_offset(obj):
+    """Whether obj's display is the offset on a rig (offset_mesh)."""
+    modifier = modifier_of(obj)
+    return modifier is not None and bool(modifier.node_group.get(OFFSET))
+
+
+def offset_mesh(obj):
+    """The mesh whose OFFSET_ATTRIBUTE (made if needed, zero) the display on a rig adds to the
+    positions, first in obj's stack (before its Armature modifier: the skinning carries the
+    offset); the display of positions (frame_mesh) goes first. No stand-in: the offset adds to the
+    mesh as its shape keys leave it."""
+    modifier = modifier_of(obj)
+    if modifier is not None and not modifier.node_group.get(OFFSET):
+        remove(obj)
+        modifier = None
+    if modifier is None:
+        _add_modifier(obj, offset_node_group())
+    mesh = obj.data
+    if mesh.attributes.get(OFFSET_ATTRIBUTE) is None:
+        mesh.attributes.new(OFFSET_ATTRIBUTE, "FLOAT_VECTOR", "POINT")
+    return mesh
+
+
+def offset_values(mesh):
+    """The #V by 3 float32 view of OFFSET_ATTRIBUTE's values in `mesh` (offset_mesh). Use at once,
+    then update the mesh."""
+    return mesh_io.attribute_co(mesh, mesh.attributes[OFFSET_ATTRIBUTE])
 
 
 def frame_positions(mesh):
@@ -268,7 +327,7 @@ def remove(obj):
         mesh.library is not None
     ):  # a linked mesh's attribute is the library's: the modifier alone goes
         return
-    for name in (ATTRIBUTE, SHOWN):
+    for name in (ATTRIBUTE, SHOWN, OFFSET_ATTRIBUTE):
         attribute = mesh.attributes.get(name)
         if attribute is not None:
             mesh.attributes.remove(attribute)

@@ -10,7 +10,7 @@ import numpy as np
 from .. import handles
 from ..jobs import FrameJob
 from ..ops_common import FAILURES, JobOperator, mesh_poll
-from . import frame_cache, point_cache, timeline
+from . import frame_cache, point_cache, rig, timeline
 from .frame_keys import AnimationJob
 
 
@@ -85,14 +85,21 @@ def cached_frames(obj):
     return range(cache.start, cache.end + 1)
 
 
-def cached_positions(obj, scene):
-    """frame -> #V by 3 float32 positions of obj's cached frame (the mesh must still fit its basis)."""
+def cached_positions(obj, scene, space="REST"):
+    """frame -> #V by 3 float32 positions of obj's cached frame (the mesh must still fit its basis).
+    On a rig, `space`: "REST", the mesh before its Armature modifier (the base mesh plus the
+    offset), or "SKINNED", after it (linear blend skinning at the frame's cached rig, in the mesh
+    object's space, without the shape keys)."""
     cache = frame_cache.get(obj)
     player = timeline.player(obj, scene)
     out = np.empty((len(obj.data.vertices), 3), np.float32)
+    skinned = space == "SKINNED" and player.rig is not None
 
     def positions(frame):
         player.positions(cache.state(frame)[0], out)
+        if skinned:
+            rig_frame = cache.array("rig")[cache.row(frame)].reshape(-1, 4, 4)
+            out[...] = player.rig.skinned(out, rig_frame)
         return out
 
     return positions
@@ -112,6 +119,57 @@ class MODAL_DEFORM_OT_free_cache(bpy.types.Operator):
         return {"FINISHED"}
 
 
+#: Where a rig's frames are exported (cached_positions).
+SPACES = (
+    (
+        "REST",
+        "Rest Space",
+        "The mesh before its Armature modifier: the rig skins the export as it skins the mesh",
+    ),
+    (
+        "SKINNED",
+        "Skinned",
+        "The mesh after its Armature modifier (linear blend skinning, shape keys left out): turn the "
+        "Armature modifier off to play it",
+    ),
+)
+
+
+class MODAL_DEFORM_OT_fill_attach(bpy.types.Operator):
+    """Fill the Attach group (made when there is none) with the vertices near the deforming bones of the mesh's Armature modifier, at rest: the vertices the rig holds, which you can then paint"""
+
+    bl_idname = "modal_deform.fill_attach"
+    bl_label = "Fill Attach from Armature"
+    bl_options = {"REGISTER", "UNDO"}
+
+    reach: bpy.props.FloatProperty(
+        name="Reach",
+        default=rig.ATTACH_REACH,
+        min=0.0,
+        soft_max=2.0,
+        description="How far from a bone a vertex is attached, as a fraction of the bone's length",
+    )
+
+    poll = classmethod(mesh_poll)
+
+    def execute(self, context):
+        obj = handles.owner(context.object)
+        try:
+            count = rig.fill_attach(obj, self.reach)
+        except rig.RigError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        group = obj.modal_deform.dynamics.attach_group
+        if not count:
+            self.report(
+                {"WARNING"},
+                f"No vertex within {self.reach:g} bone lengths of a bone: '{group}' is empty",
+            )
+        else:
+            self.report({"INFO"}, f"Attached {count} vertices near the bones in '{group}'")
+        return {"FINISHED"}
+
+
 class MODAL_DEFORM_OT_export_shape_keys(JobOperator, bpy.types.Operator):
     """Write the cached frames into shape keys, one per frame keyed to show on its frame only, that play \
 back and render without the add-on; the cache is then freed, as the keys take its place. Esc cancels"""
@@ -120,13 +178,14 @@ back and render without the add-on; the cache is then freed, as the keys take it
     bl_label = "Export Shape Keys"
     bl_options = {"REGISTER", "UNDO"}
 
+    space: bpy.props.EnumProperty(name="Space", items=SPACES, options={"SKIP_SAVE"})
+
     poll = classmethod(cache_poll)
 
     def _job(self, context):
         obj = handles.owner(context.object)
-        return AnimationJob(
-            context, obj, cached_frames(obj), positions=cached_positions(obj, context.scene)
-        )
+        positions = cached_positions(obj, context.scene, self.space)
+        return AnimationJob(context, obj, cached_frames(obj), positions=positions)
 
     def _status(self):
         return f"Modal Deform: exporting shape keys, frame {self.job.frames_done}/{len(self.job.frames)}"
@@ -135,14 +194,17 @@ back and render without the add-on; the cache is then freed, as the keys take it
         result = super()._finish()
         if self.job.written:
             timeline.free(self.job.obj)
+            if rig.follows(self.job.obj):  # the keys carry the offset the rig's playback added
+                self.job.obj.modal_deform.dynamics.enabled = False
         return result
 
 
-class MODAL_DEFORM_OT_export_mesh_cache(bpy.types.Operator):
-    """Write the cached frames into a point-cache file (PC2 or MDD) that Blender's Mesh Cache modifier \
-and other packages read, for machines without the add-on"""
+class ExportMeshCache:
+    """An export to a point-cache file: the file's path and format, the file browser, the writing.
+    What is exported comes from _frames(obj, scene) and _positions(obj, scene) (frame -> positions,
+    called once per frame in order): the cached frames (MODAL_DEFORM_OT_export_mesh_cache), or
+    others (shapes.operators)."""
 
-    bl_idname = "modal_deform.export_mesh_cache"
     bl_label = "Export Mesh Cache"
     bl_options = {"REGISTER"}
 
@@ -164,8 +226,6 @@ and other packages read, for machines without the add-on"""
         ),
     )
 
-    poll = classmethod(cache_poll)
-
     def invoke(self, context, event):
         obj = handles.owner(context.object)
         if not self.filepath:
@@ -185,14 +245,14 @@ and other packages read, for machines without the add-on"""
             self.report({"ERROR"}, "No file to write: choose a file path")
             return {"CANCELLED"}
         try:
-            frames = cached_frames(obj)
+            frames = self._frames(obj, scene)
             point_cache.write(
                 path,
                 self.file_format,
                 len(obj.data.vertices),
                 frames,
                 scene.render.fps / scene.render.fps_base,
-                cached_positions(obj, scene),
+                self._positions(obj, scene),
             )
         except (OSError, *FAILURES) as error:
             self.report({"ERROR"}, f"Export failed: {error}")
@@ -205,7 +265,25 @@ and other packages read, for machines without the add-on"""
         return {"FINISHED"}
 
 
+class MODAL_DEFORM_OT_export_mesh_cache(ExportMeshCache, bpy.types.Operator):
+    """Write the cached frames into a point-cache file (PC2 or MDD) that Blender's Mesh Cache modifier \
+and other packages read, for machines without the add-on"""
+
+    bl_idname = "modal_deform.export_mesh_cache"
+
+    space: bpy.props.EnumProperty(name="Space", items=SPACES, options={"SKIP_SAVE"})
+
+    poll = classmethod(cache_poll)
+
+    def _frames(self, obj, scene):
+        return cached_frames(obj)
+
+    def _positions(self, obj, scene):
+        return cached_positions(obj, scene, self.space)
+
+
 CLASSES = (
+    MODAL_DEFORM_OT_fill_attach,
     MODAL_DEFORM_OT_free_cache,
     MODAL_DEFORM_OT_export_shape_keys,
     MODAL_DEFORM_OT_export_mesh_cache,

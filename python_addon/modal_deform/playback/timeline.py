@@ -10,6 +10,9 @@ only the frame it shows). Before the cache's first frame the mesh holds that fra
 The result is shown by frame_display.py: mapped straight into a point attribute that a Geometry
 Nodes modifier sets the positions from, or while the timeline plays into a stand-in mesh the modifier
 reads (the artist's positions and shape keys are not written).
+On a rig (rig.py) the simulation steps with each frame's bones, which the cache keeps beside the
+state, and the frame shows as a rest-space offset before the Armature modifier
+(frame_display.offset_mesh).
 Frames computed here are checked against what they were computed from each time they are shown
 (frame_cache: settings, basis, keyframes, the controllers' transforms at that frame) and computed
 again from there when that changed.
@@ -24,7 +27,7 @@ from .. import app_handlers, handles, mesh_io, storage
 from .. import core as mdc
 from ..ops_common import FAILURES, is_posing
 from ..pose import posing
-from . import frame_cache, frame_display
+from . import frame_cache, frame_display, rig
 
 # Runtime state, by object name: the Player (solver or simulation kept between frames), and the
 # last problem met (shown in the panel). Forgotten when a file is loaded.
@@ -48,24 +51,66 @@ class Player:
         self.pose_signature = frame_cache.pose_signature(obj)
         self.basis_id = frame_cache.basis_id(obj)
         self.kind = frame_cache.kind(obj)
-        self.pose = pose or posing.Pose(types.SimpleNamespace(scene=scene), obj)
-        self.basis, self.handles = self.pose.basis, self.pose.handles
+        self.rig = None
+        if rig.follows(obj):
+            self._on_rig(obj, scene)
+        else:
+            self.pose = pose or posing.Pose(types.SimpleNamespace(scene=scene), obj)
+            self.basis, self.handles = self.pose.basis, self.pose.handles
         dynamics = settings.dynamics
+        indices = [h.indices for h in self.handles]
+        weights = [h.weight for h in self.handles]
+        if self.rig is not None:  # the Attach group: a handle held at the identity
+            indices.append(self.rig.attach)
+            weights.append(1.0)
+        # A rig's first frame solves its static pose with the simulation's handles (first()).
+        self._solver_arguments = dict(
+            handles=indices,
+            weights=weights,
+            pull=settings.stiffness,
+            energy=settings.status.energy.lower(),
+        )
         self.simulation = mdc.Simulation(
             self.basis,
-            [h.indices for h in self.handles],
+            indices,
             pull=settings.stiffness,
             period=dynamics.period,
             damping=dynamics.damping,
             fps=scene.render.fps / scene.render.fps_base,
             substeps=dynamics.substeps,
-            weights=[h.weight for h in self.handles],
+            weights=weights,
             energy=settings.status.energy.lower(),
+            rig=None if self.rig is None else self.rig.weights,
         )
         self.rest = self.basis.rest.astype(np.float32)
+        # On a rig, True when its mesh was edited since its weights were read (_edits_reported).
+        self.rig_edited = False
         # The mesh (address, vertex count) last found equal to rest; None again when Blender reports
         # a geometry update of it (_edits_reported). An undo makes every Player again (_undone).
         self.compared = None
+
+    def _on_rig(self, obj, scene):
+        """Follow Rig (rig.py): the basis, the artist's handles (none needed), the rig read once
+        (its weights, the Attach group) and each handle's mean weights, for mapping its
+        controller's motion into rest space. No Pose: the first frame's static pose, when a
+        controller is not at its rest, is solved with the Attach group held (first())."""
+        self.pose = None
+        self.basis = storage.ready_basis(obj)
+        self.handles, self.warnings = [], []
+        if obj.modal_deform.handles:
+            self.handles, self.warnings = handles.resolve(
+                obj, scene, self.basis.rest, self.basis.region
+            )
+        self.rig = rig.Rig(obj, self.basis.num_vertices)
+        self.warnings += self.rig.warnings
+        self.handle_weights = [
+            None if h.controller is None else self.rig.handle_weights(h.indices)
+            for h in self.handles
+        ]
+
+    def rig_frame(self, obj):
+        """The rig now (rig.Rig.frame), None off a rig."""
+        return None if self.rig is None else self.rig.frame(obj)
 
     def check_mesh(self, obj, edits_reported=False):
         """Raise storage.NotReady when obj's vertices are no longer those of the bake (moved or
@@ -86,16 +131,36 @@ class Player:
         self.compared = compared
 
     def fits(self, obj, signature):
-        """Whether this Player is for obj's basis and settings (`signature`: frame_cache.signature)."""
-        return self.signature == signature and self.basis_id == frame_cache.basis_id(obj)
+        """Whether this Player is for obj's basis and settings (`signature`: frame_cache.signature)
+        and, on a rig, its weights as read."""
+        return (
+            self.signature == signature
+            and self.basis_id == frame_cache.basis_id(obj)
+            and not self.rig_edited
+        )
 
-    def transforms(self, obj):
-        """The handles' transforms now, (handles, 4, 4) float64."""
-        return np.array(handles.transforms(obj, self.handles)).reshape(-1, 4, 4)
+    def transforms(self, obj, rig_frame=None):
+        """The handles' transforms now, (handles, 4, 4) float64; on a rig in rest space at
+        `rig_frame` (rig_frame()), the Attach group's identity last."""
+        found = handles.transforms(obj, self.handles)
+        if self.rig is not None:
+            found = self.rig.to_rest(found, rig_frame, self.handle_weights, self.handles)
+            found.append(np.eye(4))
+        return np.array(found).reshape(-1, 4, 4)
 
     def first(self, transforms):
         """The state at the cache's first frame: the static pose for `transforms` (solved from rest,
-        so that the same bake gives the same bits), at rest."""
+        so that the same bake gives the same bits), at rest. On a rig with every handle at the
+        identity: exactly zero displacement (the Armature modifier's result, to the bit)."""
+        if self.rig is not None:
+            if all(np.array_equal(T, np.eye(4)) for T in transforms):
+                q = np.zeros(self.simulation.dimension)
+                return q, q.copy()
+            solver = mdc.ReducedSolver(self.basis, **self._solver_arguments)
+            solver.set_transforms(list(transforms))
+            solver.solve(max_iterations=posing.CONVERGE_MAX_ITERATIONS)
+            q = solver.q
+            return q, np.zeros_like(q)
         solver = self.pose.solver
         solver.reset()
         solver.set_transforms(list(transforms))
@@ -103,11 +168,12 @@ class Player:
         q = solver.q
         return q, (np.zeros_like(q) if self.kind == "DYNAMIC" else None)
 
-    def next(self, cache, frame, transforms, out=None):
+    def next(self, cache, frame, transforms, out=None, rig_frame=None):
         """The state at `frame` (the one after cache.end), from the cached frame before it, and
         whether its positions x̄ + U q are in `out` now: a simulation step maps them into `out` (a
         function giving a #V by 3 float32 C-contiguous array, called at once) when given; a frame
-        not shown (a jump forward's frames in between, a bake's) is not mapped."""
+        not shown (a jump forward's frames in between, a bake's) is not mapped. On a rig,
+        `rig_frame`: the rig at `frame` (rig_frame()); the cache holds every earlier frame's."""
         if self.kind == "STATIC":  # from the pose of the frame before, which the solver holds
             self.pose.solver.set_transforms(list(transforms))
             self.pose.converge()
@@ -122,8 +188,16 @@ class Player:
         def cached_transforms(f):
             return list(cache.array("transforms")[cache.row(f)].reshape(-1, 4, 4))
 
+        def cached_bones(f):  # the simulation's bones at a cached frame, None off a rig
+            if self.rig is None:
+                return None
+            return self.rig.bones_of(cache.array("rig")[cache.row(f)].reshape(-1, 4, 4))
+
         def set_cached_state(f):  # BFGS's memory kept when it is the simulation's own state
-            simulation.set_state(*cache.state(f), cached_transforms(f))
+            rig_state = None
+            if self.rig is not None:  # the rig at f and the frame before (still before the start)
+                rig_state = np.array([cached_bones(max(f - 1, cache.start)), cached_bones(f)])
+            simulation.set_state(*cache.state(f), cached_transforms(f), bones=rig_state)
 
         block_start = frame - (frame - cache.start - 1) % simulation.memory_frames - 1
         set_cached_state(frame - 1)
@@ -131,12 +205,13 @@ class Player:
             set_cached_state(block_start)
             simulation.forget()
             for f in range(block_start + 1, frame):
-                simulation.advance(cached_transforms(f))
+                simulation.advance(cached_transforms(f), bones=cached_bones(f))
             set_cached_state(frame - 1)
+        bones = None if self.rig is None else self.rig.bones_of(rig_frame)
         if out is None:
-            simulation.advance(list(transforms))
+            simulation.advance(list(transforms), bones=bones)
         else:
-            simulation.step(list(transforms), out=out())
+            simulation.step(list(transforms), out=out(), bones=bones)
         q, v = simulation.state
         return q, v, out is not None
 
@@ -158,6 +233,13 @@ def player(obj, scene, signature=None):
         )
         found = _players[obj.name] = Player(obj, scene, pose=found.pose if same_pose else None)
     return found
+
+
+def rig_warnings(obj):
+    """What the Player of obj on a rig found worth saying (vertices weighted to no bone, handles
+    sharing vertices); [] without one."""
+    found = _players.get(obj.name)
+    return found.warnings if found is not None and found.rig is not None else []
 
 
 def wants_playback(obj):
@@ -198,12 +280,16 @@ def fill(obj, scene, cache, frame, player_, out=None, curves=None):
         for f in range(cache.end + 1, frame + 1):
             if scene.frame_current != f:
                 set_frame(scene, f)
-            transforms = player_.transforms(obj)
+            rig_frame = player_.rig_frame(obj)
+            transforms = player_.transforms(obj, rig_frame)
             if not len(cache):
                 q, v = player_.first(transforms)
+                if player_.rig is not None:  # the weights its frames are made with
+                    cache.block[rig.WEIGHTS] = player_.rig.digest
             else:
-                q, v, mapped = player_.next(cache, f, transforms, out if f == frame else None)
-            cache.append(q, v, transforms, frame_cache.curve_values(curves, f))
+                shown = out if f == frame else None
+                q, v, mapped = player_.next(cache, f, transforms, shown, rig_frame)
+            cache.append(q, v, transforms, frame_cache.curve_values(curves, f), rig_frame)
     finally:
         if scene.frame_current != here:
             set_frame(scene, here)
@@ -214,6 +300,9 @@ def show(obj, scene, edits_reported=False):
     """Show obj's state at the scene's frame, computing what the cache lacks up to it.
     `edits_reported`: as Player.check_mesh takes it."""
     frame = scene.frame_current
+    on_rig = rig.follows(obj)
+    if on_rig:  # the Armature modifier as the offset needs it, checked every frame
+        rig.check_order(obj, frame_display.modifier_of(obj))
     cache = frame_cache.get(obj)
     signature = frame_cache.signature(obj, scene)
     start = obj.modal_deform.dynamics.frame_start
@@ -225,21 +314,35 @@ def show(obj, scene, edits_reported=False):
         cache = frame_cache.create(obj, scene, start)
     player_ = player(obj, scene, signature)
     player_.check_mesh(obj, edits_reported)
+    if on_rig and len(cache) and cache.block.get(rig.WEIGHTS) != player_.rig.digest:
+        cache.cut(cache.start)  # weights painted since its frames were made
     curves = frame_cache.controller_curves(obj)
     frame_cache.keyframes_changed(cache, curves)
     shown = max(frame, cache.start)
     index = cache.row(frame)
-    if index is not None and not np.array_equal(
-        player_.transforms(obj).ravel(), cache.array("transforms")[index]
-    ):
-        cache.cut(frame)
-    mesh = frame_display.frame_mesh(obj, stand_in=_playing)
+    if index is not None:
+        rig_frame = player_.rig_frame(obj)
+        if not np.array_equal(
+            player_.transforms(obj, rig_frame).ravel(), cache.array("transforms")[index]
+        ) or (on_rig and not np.array_equal(rig_frame.ravel(), cache.array("rig")[index])):
+            cache.cut(frame)
+    if on_rig:
+        mesh = frame_display.offset_mesh(obj)
 
-    def display():  # a frame simulated here is mapped by its step straight into it (no copy between)
-        return frame_display.frame_positions(mesh)
+        def display():
+            return frame_display.offset_values(mesh)
+    else:
+        if frame_display.shows_offset(obj):  # Follow Rig turned off
+            frame_display.remove(obj)
+        mesh = frame_display.frame_mesh(obj, stand_in=_playing)
+
+        def display():  # a frame simulated here is mapped by its step straight into it
+            return frame_display.frame_positions(mesh)
 
     if not fill(obj, scene, cache, shown, player_, out=display, curves=curves):
         player_.positions(cache.array("q")[cache.row(shown)], display())
+    if on_rig:  # the rest-space offset x̄ + U q - x̄: exactly zero at q = 0
+        np.subtract(display(), player_.rest, out=display())
     mesh.update()
 
 
@@ -266,6 +369,7 @@ def _edits_reported(depsgraph):
         if obj is not None and obj.type == "MESH" and obj.data.as_pointer() in edited:
             found.compared = None
             frame_display.end_stand_in(obj)
+            found.rig_edited = found.rig is not None  # weights painted: read again (fits())
 
 
 def _frame_changed(scene, depsgraph=None):
@@ -278,7 +382,8 @@ def _frame_changed(scene, depsgraph=None):
         if not wants_playback(obj):
             if displayed and obj.type == "MESH" and obj.library is None:
                 if not plays(obj):  # freed, dynamics off
-                    frame_display.remove(obj)
+                    if not obj.modal_deform.shapes.enabled:  # a blend of shapes shows (shapes/)
+                        frame_display.remove(obj)
                 elif _playing:  # Edit, Sculpt or Paint Mode: the mesh itself shows there
                     frame_display.end_stand_in(obj)
             continue

@@ -15,45 +15,26 @@ Writes OUTPUT/result.json ({"ok": bool, "log": [...]}) and screenshots, then qui
 import importlib
 import os
 import threading
-import time
 
 import addon_utils
 import bpy
 import numpy as np
 from mathutils import Vector
-from support.blender import evaluated_positions
+from support.blender import evaluated_positions, key_positions, positions
 from window import (
     enable_addon,
     output,
     override,
+    press,
     run,
     say,
     screenshot,
     show_sidebar_tab,
     subdivided_suzanne,
+    transform_with_mouse,
     view3d,
+    wait_until,
 )
-
-
-def key_positions(obj, name):
-    block = obj.data.shape_keys.key_blocks[name]
-    co = np.empty(3 * len(block.data), np.float32)
-    block.data.foreach_get("co", co)
-    return co.reshape(-1, 3)
-
-
-def base_positions(obj):
-    co = np.empty(3 * len(obj.data.vertices), np.float32)
-    obj.data.vertices.foreach_get("co", co)
-    return co.reshape(-1, 3)
-
-
-def wait_until(condition, seconds):
-    """Yield to Blender until condition() holds; fail after `seconds`."""
-    start = time.time()
-    while not condition():
-        assert time.time() - start < seconds, f"timed out after {seconds} s"
-        yield 0.1
 
 
 def steps():
@@ -75,8 +56,7 @@ def steps():
         assert bpy.ops.modal_deform.bake("INVOKE_DEFAULT") == {"RUNNING_MODAL"}
     yield 0.3
     assert baking(), "the bake is not running on its thread"
-    window.event_simulate(type="ESC", value="PRESS", x=region.x + 10, y=region.y + 10)
-    window.event_simulate(type="ESC", value="RELEASE", x=region.x + 10, y=region.y + 10)
+    press("ESC", region.x + 10, region.y + 10)
     yield from wait_until(lambda: not baking(), 60)
     yield 0.5  # the operator's next timer event ends it
     assert obj.modal_deform.basis is None and not any(
@@ -102,7 +82,7 @@ def steps():
     say("bake, undo, redo: ok")
 
     # A handle on the top of the head (Edit Mode selection -> vertex group + Empty), the chin pinned.
-    V = base_positions(obj)
+    V = positions(obj)
     rest = V.copy()
     for mask, pinned in ((V[:, 2] > 0.55, False), (V[:, 2] < -0.55, True)):
         obj.data.polygons.foreach_set("select", np.zeros(len(obj.data.polygons), bool))
@@ -136,17 +116,7 @@ def steps():
     yield 0.3
     assert ops_common.running is not None
     x, y = region.x + region.width // 2, region.y + region.height // 2
-    window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x, y=y)
-    yield 0.1
-    window.event_simulate(type="G", value="PRESS", x=x, y=y)
-    window.event_simulate(type="G", value="RELEASE", x=x, y=y)
-    yield 0.2
-    for i in range(1, 11):
-        window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x + 12 * i, y=y + 6 * i)
-        yield 0.05
-    window.event_simulate(type="LEFTMOUSE", value="PRESS", x=x + 120, y=y + 60)
-    window.event_simulate(type="LEFTMOUSE", value="RELEASE", x=x + 120, y=y + 60)
-    yield 0.2
+    yield from transform_with_mouse("G", (x, y), (x + 120, y + 60))
     moved = np.array(controller.matrix_world.translation) - np.array(
         obj.matrix_world @ Vector(rest[group].mean(axis=0))
     )
@@ -158,7 +128,7 @@ def steps():
     yield from wait_until(lambda: ops_common.running.pose.stats["converged"], 30)
     assert type(ops_common.running.shown) is displays.PositionsDisplay
     assert obj.data.shape_keys is None and obj.data.get(displays.POSING_FLAG)
-    pose = base_positions(obj)
+    pose = positions(obj)
     followed = pose[group].mean(axis=0) - rest[group].mean(axis=0)
     assert np.linalg.norm(followed - moved) < 0.05 * np.linalg.norm(moved), (followed, moved)
     say(
@@ -172,12 +142,11 @@ def steps():
     screenshot("pose.png")
 
     # Esc: the mesh is as it was (Suzanne had no shape keys).
-    window.event_simulate(type="ESC", value="PRESS", x=x, y=y)
-    window.event_simulate(type="ESC", value="RELEASE", x=x, y=y)
+    press("ESC", x, y)
     yield 0.3
     assert ops_common.running is None, "Esc did not end the pose"
     assert obj.data.shape_keys is None, "Esc left shape keys behind"
-    assert base_positions(obj).tobytes() == rest.tobytes()
+    assert positions(obj).tobytes() == rest.tobytes()
     assert obj.data.get(displays.POSING_FLAG) is None
     say("Esc restored the mesh")
 
@@ -188,17 +157,15 @@ def steps():
         assert bpy.ops.modal_deform.pose("INVOKE_DEFAULT") == {"RUNNING_MODAL"}
     controller.location.x += 0.2
     yield 0.5
-    posed = base_positions(obj)
+    posed = positions(obj)
     assert np.abs(posed - rest).max() > 0.05, "the pose did not follow the controller"
     saved = os.path.join(output, "saved_while_posing_positions.blend")
     bpy.ops.wm.save_as_mainfile(filepath=saved, copy=True)
-    assert base_positions(obj).tobytes() == rest.tobytes(), "saving left the pose in the base mesh"
+    assert positions(obj).tobytes() == rest.tobytes(), "saving left the pose in the base mesh"
     with bpy.data.libraries.load(saved) as (data_from, data_to):
         data_to.objects = [obj.name]
     copy = data_to.objects[0]
-    assert base_positions(copy).tobytes() == rest.tobytes(), (
-        "the saved base mesh is not the rest mesh"
-    )
+    assert positions(copy).tobytes() == rest.tobytes(), "the saved base mesh is not the rest mesh"
     assert copy.data.get(displays.POSING_FLAG) is None
     assert np.abs(key_positions(copy, posing.POSE_KEY) - posed).max() < 1e-5, (
         "the saved pose is not the pose"
@@ -209,11 +176,10 @@ def steps():
     assert np.abs(key_positions(obj, posing.POSE_KEY) - posed).max() > 0.01, (
         "the pose stopped after saving"
     )
-    window.event_simulate(type="ESC", value="PRESS", x=x, y=y)
-    window.event_simulate(type="ESC", value="RELEASE", x=x, y=y)
+    press("ESC", x, y)
     yield 0.3
     assert ops_common.running is None and obj.data.shape_keys is None
-    assert base_positions(obj).tobytes() == rest.tobytes()
+    assert positions(obj).tobytes() == rest.tobytes()
     say("saving mid-pose wrote the rest mesh and the pose's key; Esc restored the mesh")
 
     # Tab into Edit Mode while the pose is in the vertex positions: the pose goes into the shape key
@@ -222,21 +188,18 @@ def steps():
         assert bpy.ops.modal_deform.pose("INVOKE_DEFAULT") == {"RUNNING_MODAL"}
     controller.location.x += 0.1
     yield 0.5
-    posed = base_positions(obj)
+    posed = positions(obj)
     with override():
         controller.select_set(False)
         obj.select_set(True)
         bpy.context.view_layer.objects.active = obj
-    window.event_simulate(type="TAB", value="PRESS", x=x, y=y)
-    window.event_simulate(type="TAB", value="RELEASE", x=x, y=y)
+    press("TAB", x, y)
     yield 0.5
     assert ops_common.running is None, "Edit Mode did not end the pose"
     assert obj.mode == "EDIT"
     with override():
         bpy.ops.object.mode_set(mode="OBJECT")
-    assert base_positions(obj).tobytes() == rest.tobytes(), (
-        "Edit Mode took the pose for the rest mesh"
-    )
+    assert positions(obj).tobytes() == rest.tobytes(), "Edit Mode took the pose for the rest mesh"
     assert key_positions(obj, "Basis").tobytes() == rest.tobytes()
     assert np.abs(key_positions(obj, posing.POSE_KEY) - posed).max() < 0.05, "the pose was not kept"
     assert obj.data.get(displays.POSING_FLAG) is None
@@ -272,9 +235,7 @@ def steps():
     with bpy.data.libraries.load(saved) as (data_from, data_to):
         data_to.objects = [obj.name]
     copy = data_to.objects[0]
-    assert base_positions(copy).tobytes() == rest.tobytes(), (
-        "the saved base mesh is not the rest mesh"
-    )
+    assert positions(copy).tobytes() == rest.tobytes(), "the saved base mesh is not the rest mesh"
     assert np.abs(key_positions(copy, posing.POSE_KEY) - posed).max() < 0.05, (
         "the saved pose is not the pose"
     )
@@ -286,17 +247,15 @@ def steps():
 
     # Enter applies; Ctrl+Z takes the applied pose back.
     before = key_positions(obj, posing.POSE_KEY).tobytes()
-    window.event_simulate(type="RET", value="PRESS", x=x, y=y)
-    window.event_simulate(type="RET", value="RELEASE", x=x, y=y)
+    press("RET", x, y)
     yield 0.3
     assert ops_common.running is None, "Enter did not end the pose"
     assert key_positions(obj, posing.POSE_KEY).tobytes() != key_positions(obj, "Basis").tobytes()
-    window.event_simulate(type="Z", value="PRESS", x=x, y=y, ctrl=True)
-    window.event_simulate(type="Z", value="RELEASE", x=x, y=y, ctrl=True)
+    press("Z", x, y, ctrl=True)
     yield 0.5
     obj = bpy.data.objects["Suzanne"]  # undo re-reads the data
     controller = obj.modal_deform.handles[0].controller
-    assert base_positions(obj).tobytes() == rest.tobytes()
+    assert positions(obj).tobytes() == rest.tobytes()
     undone = key_positions(obj, posing.POSE_KEY).tobytes()
     assert undone == solved.tobytes(), "Ctrl+Z did not take the applied pose back to the solved one"
     say("saving while posing wrote a consistent file; Enter applied and Ctrl+Z took it back")
@@ -311,14 +270,13 @@ def steps():
     yield 0.5
     cache = obj.modal_deform.dynamics.cache
     assert cache is not None and cache["frames"] > 0, "the animation bake cached no frame"
-    window.event_simulate(type="ESC", value="PRESS", x=x, y=y)
-    window.event_simulate(type="ESC", value="RELEASE", x=x, y=y)
+    press("ESC", x, y)
     yield 0.3
     assert obj.modal_deform.dynamics.cache is None, "Esc left the cache behind"
     assert [(b.name, b.mute) for b in obj.data.shape_keys.key_blocks] == keys, (
         "Esc changed the shape keys"
     )
-    assert base_positions(obj).tobytes() == rest.tobytes()
+    assert positions(obj).tobytes() == rest.tobytes()
     say("animation bake cancelled with Esc: its cached frames went")
 
     # Secondary motion played in the window: Dynamics on, the controller keyed to slide and stop, the
@@ -364,7 +322,7 @@ def steps():
     assert evaluated_positions(obj).tobytes() == expected.tobytes(), (
         "scrubbing did not read the cache"
     )
-    assert base_positions(obj).tobytes() == rest.tobytes()
+    assert positions(obj).tobytes() == rest.tobytes()
     played = cache.end
     with override():
         assert bpy.ops.modal_deform.free_cache() == {"FINISHED"}
@@ -386,14 +344,14 @@ def steps():
     controller.location.z += 0.3
     yield 0.5
     assert type(ops_common.running.shown) is displays.StandInDisplay and obj.data != mesh
-    assert base_positions(obj).tobytes() != rest.tobytes(), "the pose did not follow the controller"
+    assert positions(obj).tobytes() != rest.tobytes(), "the pose did not follow the controller"
     addon_utils.disable("modal_deform", default_set=True)
     assert ops_common.running is None, "disabling the add-on left the pose running"
     assert obj.data == mesh, "disabling did not put the artist's mesh back"
     assert key_positions(obj, posing.POSE_KEY).tobytes() == before, (
         "disabling changed the shape key"
     )
-    assert base_positions(obj).tobytes() == rest.tobytes()
+    assert positions(obj).tobytes() == rest.tobytes()
     # Blender frees the ended pose's modal handler at the next event it handles (the artist's next
     # click in Preferences); Blender 4.3 crashes when a modal operator starts before that.
     window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x, y=y)
@@ -410,10 +368,10 @@ def steps():
     controller.location.z -= 0.3
     yield 0.5
     assert type(ops_common.running.shown) is displays.PositionsDisplay
-    assert np.abs(base_positions(obj) - rest).max() > 0.05, "the pose did not follow the controller"
+    assert np.abs(positions(obj) - rest).max() > 0.05, "the pose did not follow the controller"
     addon_utils.disable("modal_deform", default_set=True)
     assert ops_common.running is None, "disabling the add-on left the pose running"
-    assert base_positions(obj).tobytes() == rest.tobytes(), (
+    assert positions(obj).tobytes() == rest.tobytes(), (
         "disabling did not restore the vertex positions"
     )
     assert obj.data.shape_keys is None and obj.data.get(displays.POSING_FLAG) is None

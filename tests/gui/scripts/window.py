@@ -10,6 +10,7 @@ import json
 import os
 import subprocess
 import sys
+import time
 import traceback
 
 import bpy
@@ -81,18 +82,51 @@ def click(x, y):
     window.event_simulate(type="LEFTMOUSE", value="RELEASE", x=x, y=y)
 
 
-def show_sidebar_tab():
+def press(key, x, y, **modifiers):
+    """A key pressed and released with the mouse at (x, y) in the window (modifiers: ctrl=True...)."""
+    window, _, _ = view3d()
+    window.event_simulate(type=key, value="PRESS", x=x, y=y, **modifiers)
+    window.event_simulate(type=key, value="RELEASE", x=x, y=y, **modifiers)
+
+
+def transform_with_mouse(key, start, end, steps=10):
+    """Move or turn what is selected as an artist does (a generator: yield from it): the mouse at
+    start, the key (G, R), the mouse moved to end in steps, a click that confirms."""
+    window, _, _ = view3d()
+    (x0, y0), (x1, y1) = start, end
+    window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x0, y=y0)
+    yield 0.1
+    press(key, x0, y0)
+    yield 0.2
+    for i in range(1, steps + 1):
+        x, y = x0 + (x1 - x0) * i // steps, y0 + (y1 - y0) * i // steps
+        window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x, y=y)
+        yield 0.05
+    click(x1, y1)
+    yield 0.2
+
+
+def wait_until(condition, seconds):
+    """Yield to Blender until condition() holds (a generator: yield from it); fail after `seconds`."""
+    start = time.time()
+    while not condition():
+        assert time.time() - start < seconds, f"timed out after {seconds} s"
+        yield 0.1
+
+
+def show_sidebar_tab(below=182):
     """Open the sidebar on its Modal Deform tab (a generator: yield from it) with clicks on its tabs
     (at the sidebar's right edge), as an artist does. Blender 4.x tells the active tab: the clicks
-    walk down the tabs until it is Modal Deform. Blender 3.4 does not: a click on the fourth tab of a
-    factory-startup sidebar (Item, Tool, View, Modal Deform)."""
+    walk down the tabs until it is Modal Deform. Blender 3.4 does not: a click `below` pixels under
+    the sidebar's top, on the last tab of a factory-startup sidebar: 182 in Object Mode (Item, Tool,
+    View, Modal Deform), 262 in Pose Mode (Animation before Modal Deform)."""
     _, area, _ = view3d()
     area.spaces.active.show_region_ui = True
     yield 0.3
     region = sidebar()
     x, top = region.x + region.width - 10, region.y + region.height
     if not hasattr(region, "active_panel_category"):
-        click(x, top - 182)
+        click(x, top - below)
         yield 0.3
         return
     for y in range(top - 10, top - 400, -15):
