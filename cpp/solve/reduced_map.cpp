@@ -9,6 +9,16 @@
 
 namespace modal_deform {
 
+void add_columns(const Eigen::VectorXd& rest, const Eigen::MatrixXd& U, const Eigen::VectorXd& q,
+                 Eigen::VectorXd& x) {
+  const Eigen::Index r = U.cols(), panels = r - r % 4;
+  x = rest;
+  for (Eigen::Index j = 0; j < panels; j += 4)
+    x += U.col(j) * q[j] + U.col(j + 1) * q[j + 1] + U.col(j + 2) * q[j + 2] +
+         U.col(j + 3) * q[j + 3];
+  for (Eigen::Index j = panels; j < r; ++j) x += U.col(j) * q[j];
+}
+
 GhostEnergy::GhostEnergy(const Basis& basis, EnergyKind energy)
     : energy_(make_energy(energy, basis.scale * basis.ghost_vertices, basis.ghost_faces,
                           ghost_material(basis))),
@@ -25,14 +35,7 @@ double GhostEnergy::value_and_gradient(const Eigen::VectorXd& q, Eigen::VectorXd
 }
 
 bool GhostEnergy::in_range(const Eigen::VectorXd& q) {
-  // x = x̄ + U q four columns at a time: one pass over x per four columns, where Eigen's
-  // column-major matrix-vector product (SSE, the wheel's baseline) makes one per column.
-  const Eigen::Index r = vectors_.cols(), panels = r - r % 4;
-  x_ = rest_;
-  for (Eigen::Index j = 0; j < panels; j += 4)
-    x_ += vectors_.col(j) * q[j] + vectors_.col(j + 1) * q[j + 1] + vectors_.col(j + 2) * q[j + 2] +
-          vectors_.col(j + 3) * q[j + 3];
-  for (Eigen::Index j = panels; j < r; ++j) x_ += vectors_.col(j) * q[j];
+  add_columns(rest_, vectors_, q, x_);
   return positions_in_range(x_);
 }
 

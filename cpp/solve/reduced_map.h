@@ -12,6 +12,12 @@
 
 namespace modal_deform {
 
+// x = rest + U q (x sized like rest) four columns at a time: one pass over x per four columns,
+// where Eigen's column-major matrix-vector product (SSE, the wheel's baseline) makes one per
+// column.
+void add_columns(const Eigen::VectorXd& rest, const Eigen::MatrixXd& U, const Eigen::VectorXd& q,
+                 Eigen::VectorXd& x);
+
 // E(q) on the ghost: the basis's energy (with its weights, the ghost's painted stiffness the means
 // of the fine weights), or ARAP, of the ghost mesh scaled by s = basis.scale. An evaluation costs
 // O(#ghost vertices · r), whatever the size of the fine mesh. Not thread-safe (work space).

@@ -20,10 +20,15 @@
 //   rest): a fixed start, so a blend is a function of the weights alone. The rigid coordinates (the
 //   basis's num_rigid first columns) are held at the linear blend's: the blend is placed like the
 //   linear blend (the same centre of mass and no linearised rotation from it), without drift.
+//   Not Newton: the exact reduced Hessian U_sᵀ ∇²E U_s costs O(nnz(∇²E) r + #ghost vertices · r²),
+//   some 50 energy evaluations on the dragon's ghost, and Newton from the linear blend still takes
+//   about 20 steps there where BFGS takes 45 to 55.
 //
-// Cost of a blend: O(k · #ghost terms) to blend the rests, O(k r²) + r³/3 for the initial inverse
-// Hessian, then per BFGS iteration O(#ghost vertices · r + r²); the map O(#V · r) (16-bit vectors,
-// FinePositions), plus O(#V) per key with a non-zero weight on a proxy. r = basis dimension + k.
+// Cost of a blend, k keys, r = basis dimension + k: O(k · #ghost terms) to blend the rests,
+// O(k r²) + r³ for the initial inverse Hessian, then per BFGS iteration (their count grows with r)
+// an energy evaluation on the ghost, O(#ghost terms + #ghost vertices · r), and O(r²); the map
+// O(#V · r) (16-bit vectors, FinePositions), plus O(#V) per key with a non-zero weight on a
+// proxy. k enters through r and the rests' blend.
 //
 // Not thread-safe: one space per thread.
 #pragma once
@@ -55,6 +60,7 @@ struct BlendStats {
   double energy = 0;         // the blended energy at the blend (up to a constant)
   double gradient_norm = 0;  // ‖∇f‖ over the non-rigid coordinates
   double solve_ms = 0;       // the minimisation, milliseconds
+  double map_ms = 0;         // the map to the fine mesh (and the keys' residuals), milliseconds
   double ms = 0;             // the whole blend, the map included, milliseconds
 };
 
@@ -64,6 +70,7 @@ void for_each_blend_stat(Visit&& visit) {
   visit("converged", [](auto& s) -> auto& { return s.converged; });
   visit("ms", [](auto& s) -> auto& { return s.ms; });
   visit("solve_ms", [](auto& s) -> auto& { return s.solve_ms; });
+  visit("map_ms", [](auto& s) -> auto& { return s.map_ms; });
   visit("evaluations", [](auto& s) -> auto& { return s.evaluations; });
   visit("energy", [](auto& s) -> auto& { return s.energy; });
   visit("gradient_norm", [](auto& s) -> auto& { return s.gradient_norm; });

@@ -147,8 +147,8 @@ def test_out_and_stats(bar, bent):
     out = np.zeros((len(V), 3), np.float32)
     assert bent.blend([0.25], out=out) is out
     stats = bent.stats
-    assert set(stats) >= {"iterations", "converged", "ms"}
-    assert stats["ms"] > 0
+    assert set(stats) >= {"iterations", "converged", "ms", "solve_ms", "map_ms"}
+    assert stats["ms"] > 0 and 0 < stats["map_ms"] <= stats["ms"]
 
 
 def test_weights_outside_zero_one(bar, bent):
@@ -265,6 +265,25 @@ def test_weights_with_no_minimum_give_the_linear_blend_and_say_so(bar, basis):
             assert not space.stats["converged"]
             assert np.abs(X - linear).max() < 1e-4 * np.ptp(V)
     assert space.blend([0.5, 0.0]) is not None and not space.stats["diverged"]
+
+
+def test_on_a_proxy_keys_keep_their_detail(bar):
+    """On a proxy each key is P U q_i plus its residual, the detail the proxy cannot hold: weight 1
+    gives the key to the map's precision, the weighted residuals being summed over the keys."""
+    V, F = bar
+    basis = mdc.bake(V, F, proxy=100, proxy_above=200)
+    assert basis.num_basis_vertices < len(V)
+    rng = np.random.default_rng(5)
+    keys = [bend(V, np.pi / 2) + 0.01 * rng.normal(size=V.shape), twist(V, np.pi)]
+    space = mdc.ShapeSpace(V, F, keys, basis=basis)
+    assert np.abs(space.to_arrays()["key_residuals"]).max() > 0.01  # the noise, beyond the proxy
+    for i, key in enumerate(keys):
+        w = np.zeros(2)
+        w[i] = 1
+        assert np.abs(space.blend(w) - key).max() < 1e-4 * LENGTH
+    both = space.blend([0.3, 0.4]).copy()
+    assert np.isfinite(both).all()
+    assert np.array_equal(space.blend([0.3, 0.4]), both)
 
 
 def test_a_space_with_only_rigid_coordinates_blends_linearly(bar):

@@ -28,12 +28,14 @@ first columns) are held at the linear blend's: the blend has the linear blend's 
 no linearised rotation from it, so it does not drift.
 
 Cost of a blend, with k keys and r = basis dimension + k: O(k · ghost terms) to blend the rests,
-O(k r²) + r³/3 for the initial inverse Hessian, O(ghost vertices · r + r²) per BFGS iteration
-(tens of them: the count, not an iteration's cost, keeps a blend above its target), and the map to
-the fine mesh O(n r) (16-bit vectors, as ``ReducedSolver``), plus O(n) per key with a non-zero
-weight on a proxy. bench/shape_space.py times blends and bakes. Weights outside [0, 1] (a negative weight
-makes the energy unbounded below) give the stationary point BFGS reaches from the linear blend;
-``stats["converged"]`` says when none was reached.
+O(k r²) + r³ for the initial inverse Hessian, then per BFGS iteration one energy evaluation on the
+ghost, O(ghost terms + ghost vertices · r), and O(r²) (45 to 55 iterations at r = 80 on the
+dragon: their count, not an iteration's cost, keeps a blend above its 4 ms target; Newton with the
+exact reduced Hessian takes fewer steps, about 20, each costing some 50 evaluations), and the map
+to the fine mesh O(n r) (16-bit vectors, as ``ReducedSolver``), plus O(n) per key with a non-zero
+weight on a proxy. bench/shape_space.py times blends, where they go, and bakes. Weights outside
+[0, 1] (a negative weight makes the energy unbounded below) give the stationary point BFGS reaches
+from the linear blend; ``stats["converged"]`` says when none was reached.
 """
 
 import numpy as np
@@ -130,7 +132,7 @@ class ShapeSpace:
     @property
     def stats(self):
         """The last blend's {"iterations", "converged", "ms" (the whole blend, the map included),
-        "solve_ms" (the minimisation), "evaluations", "energy" (the blended energy, up to a
+        "solve_ms" (the minimisation), "map_ms" (the map to the fine mesh), "evaluations", "energy" (the blended energy, up to a
         constant), "gradient_norm", "stalled", "diverged"}; empty before the first blend.
         "diverged": the minimisation ran off farther than the model's size from the linear blend
         (weights whose rest weight 1 - sum(w) is negative can leave the energy without a minimum,
