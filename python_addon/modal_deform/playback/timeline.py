@@ -61,8 +61,14 @@ class Player:
         indices = [h.indices for h in self.handles]
         weights = [h.weight for h in self.handles]
         if self.rig is not None:  # the Attach group: a handle held at the identity
-            indices.append(self.rig.attach)
-            weights.append(1.0)
+            attach = self.rig.attach
+            region = self.basis.region
+            if region is not None and region.size:  # outside its region the mesh moves not at all
+                attach = attach[np.isin(attach, region, assume_unique=True)]
+            self.attached = attach.size > 0
+            if self.attached:
+                indices.append(attach)
+                weights.append(1.0)
         # A rig's first frame solves its static pose with the simulation's handles (first()).
         self._solver_arguments = dict(
             handles=indices,
@@ -141,11 +147,13 @@ class Player:
 
     def transforms(self, obj, rig_frame=None):
         """The handles' transforms now, (handles, 4, 4) float64; on a rig in rest space at
-        `rig_frame` (rig_frame()), the Attach group's identity last."""
+        `rig_frame` (rig_frame()), the Attach group's identity last (when it holds a vertex the
+        basis moves)."""
         found = handles.transforms(obj, self.handles)
         if self.rig is not None:
             found = self.rig.to_rest(found, rig_frame, self.handle_weights, self.handles)
-            found.append(np.eye(4))
+            if self.attached:
+                found.append(np.eye(4))
         return np.array(found).reshape(-1, 4, 4)
 
     def first(self, transforms):
