@@ -1,6 +1,6 @@
 """Dynamics on a rig keeps the bake's material (issue 50, item 2): three tubes skinned to one chain of
 bones, attached at their base, jump with the armature object: one of uniform material, one whose top
-half is painted stiff (a Stiffness group), one baked with its top half as its Region. The stiff top
+half is painted stiff (a Stiffness group), one baked with its upper two thirds as its Region. The stiff top
 lags less than the uniform one; outside the Region the mesh is the Armature modifier's result to
 the bit, while inside it lags as on the whole mesh."""
 
