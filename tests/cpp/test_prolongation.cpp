@@ -57,10 +57,9 @@ TEST(Prolongation, PositionsAreRestPlusTheInterpolatedDisplacement) {
   EXPECT_LT((out.cast<double>() - flatten(expected)).cwiseAbs().maxCoeff(), 1e-6);
   // Without the rest, the interpolated displacement alone.
   prolongate_positions(P, nullptr, d.data(), out.data());
-  EXPECT_LT((out.cast<double>() - flatten(RowMatrixX3d(g.fine.V * A.transpose())))
-                .cwiseAbs()
-                .maxCoeff(),
-            1e-6);
+  EXPECT_LT(
+      (out.cast<double>() - flatten(RowMatrixX3d(g.fine.V * A.transpose()))).cwiseAbs().maxCoeff(),
+      1e-6);
 }
 
 TEST(Prolongation, DetailOffTheProxyStaysInTheRestFrame) {
