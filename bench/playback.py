@@ -225,13 +225,11 @@ def without_display(obj, timeline, frame_cache, frames):
 RIG_BONES = (3, 30, 100)
 #: The rig case's parts of a frame's handler, each the time spent in the add-on's calls named:
 #: the rig's bones read (playback.rig.Rig.frame), the simulation's step (Simulation.advance) and
-#: the map of its q into the display's attribute (the simulation's displacement U q, or in an add-on
-#: from before it the positions x̄ + U q, from which the display's offset was then subtracted in
-#: "other").
+#: the map of its q into the display's offset attribute (the simulation's displacement U q).
 RIG_PARTS = {
     "bones": ("rig", ("frame",)),
     "step": ("simulation", ("advance",)),
-    "map": ("simulation", ("positions", "positions_of", "displacement_of")),
+    "map": ("simulation", ("displacement_of",)),
 }
 
 
@@ -313,9 +311,8 @@ class Parts:
         for part, (owner_name, methods) in RIG_PARTS.items():
             owner = getattr(player, owner_name)
             for name in methods:
-                if hasattr(owner, name):
-                    setattr(owner, name, self._timed(part, getattr(owner, name)))
-                    self._wrapped.append((owner, name))
+                setattr(owner, name, self._timed(part, getattr(owner, name)))
+                self._wrapped.append((owner, name))
 
     def _timed(self, part, method):
         def timed(*args, **kwargs):

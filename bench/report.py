@@ -1694,9 +1694,16 @@ def rig_playback(runs):
                 f"{p['before_ms']:.2f} + {p['evaluate_ms']:.2f}",
                 f"{case['armature_alone']['evaluate_ms']:.2f}",
                 "" if target is None else f"≤ {target:.0f}: {met}",
-                "{:.1f} / {:.1f}".format(*loads) if (loads := load_range(run)) else "",
+                "{:.1f} / {:.1f}".format(*loads) if (loads := load_range(rig_run(run))) else "",
             ]
         )
+    apart = sorted(
+        {
+            (m["date"], m["commit"][:12])
+            for run, _ in rigged
+            if (m := run.get("rig_measured")) is not None
+        }
+    )
     return [
         "",
         "### Secondary motion on a rig (issue 50)",
@@ -1731,7 +1738,22 @@ def rig_playback(runs):
             ],
             rows,
         ),
-    ]
+    ] + (
+        [
+            "",
+            "The rig case measured apart from the runs above and merged into their record: "
+            + "; ".join(f"{date}, commit `{commit}`" for date, commit in apart)
+            + " (the load beside each row).",
+        ]
+        if apart
+        else []
+    )
+
+
+def rig_run(run):
+    """The run's rig case's own provenance (rig_measured: its date, commit and load average) when it
+    was measured apart from the run's other figures, else the run."""
+    return run.get("rig_measured", run)
 
 
 def load_range(run):
