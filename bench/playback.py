@@ -23,6 +23,13 @@ simulates every frame in between: its handler's time per frame simulated. For re
 evaluation of the same mesh without the display, its vertex positions written (a copy of the mesh
 on another object): the floor of what the display costs. The load average (1, 5, 15 min) before and
 after the run.
+
+The rig case (issue 50, "rig"; --rig-only runs it alone): the dragon, its handles taken off, skinned by
+an Armature modifier to a chain of RIG_BONES bones along its long axis (chain_rig), keyed to jump,
+turn, bend and stop (animate_rig), Follow Rig on; per frame played and simulated live, the add-on's
+frame handler split (RIG_PARTS: the bones read, the step, the map into the offset attribute; the
+rest) beside Blender's evaluation before and after it, then the same frames with the add-on off the
+mesh (its Armature modifier alone: the floor).
 """
 
 import argparse
@@ -70,6 +77,14 @@ def arguments():
     parser.add_argument(
         "--quick", action="store_true", help="dragon_vrip_res4 and a small basis (smoke test)"
     )
+    parser.add_argument(
+        "--rig-bones",
+        type=int,
+        nargs="+",
+        default=RIG_BONES,
+        help="the rig case's bone counts (quick: the first)",
+    )
+    parser.add_argument("--rig-only", action="store_true", help="the rig case alone")
     return parser.parse_args(argv)
 
 
@@ -206,6 +221,229 @@ def without_display(obj, timeline, frame_cache, frames):
     return {"evaluate_ms": float(np.median(evaluate)), "frames": len(evaluate)}
 
 
+#: The rig case's armatures: chains of these many bones along the dragon's long axis.
+RIG_BONES = (3, 30, 100)
+#: The rig case's parts of a frame's handler, each the time spent in the add-on's calls named:
+#: the rig's bones read (playback.rig.Rig.frame), the simulation's step (Simulation.advance) and
+#: the map of its q into the display's offset attribute (the simulation's displacement U q).
+RIG_PARTS = {
+    "bones": ("rig", ("frame",)),
+    "step": ("simulation", ("advance",)),
+    "map": ("simulation", ("displacement_of",)),
+}
+
+
+def chain_rig(obj, bones):
+    """An armature of `bones` bones in a chain along obj's long axis, through the centre of its
+    bounding box, placed as obj; obj's vertex groups named like them, weights by formula (linear
+    between the bones' centres, two bones a vertex at most, in steps of 1/255: a call of
+    VertexGroup.add a weight); an Armature modifier after the display's; the Attach group filled by
+    the add-on's operator within a tenth of the dragon's length of the chain. Returns the armature."""
+    V = blender_pose.addon("mesh_io").positions(obj.data)
+    axis = int(np.argmax(np.ptp(V, axis=0)))
+    low, high = V[:, axis].min(), V[:, axis].max()
+    centre = (V.min(axis=0) + V.max(axis=0)) / 2
+    armature = bpy.data.objects.new(f"Rig {bones}", bpy.data.armatures.new(f"Rig {bones}"))
+    bpy.context.scene.collection.objects.link(armature)
+    armature.matrix_world = obj.matrix_world
+    view_layer = bpy.context.view_layer
+    view_layer.objects.active = armature
+    bpy.ops.object.mode_set(mode="EDIT")
+    parent = None
+    for b in range(bones):
+        bone = armature.data.edit_bones.new(f"Bone{b}")
+        head, tail = centre.copy(), centre.copy()
+        head[axis] = low + (high - low) * b / bones
+        tail[axis] = low + (high - low) * (b + 1) / bones
+        bone.head, bone.tail = head, tail
+        bone.parent, bone.use_connect = parent, parent is not None
+        parent = bone
+    bpy.ops.object.mode_set(mode="OBJECT")
+    view_layer.objects.active = obj
+
+    t = (V[:, axis] - low) / (high - low)
+    centres = (np.arange(bones) + 0.5) / bones
+    k = np.clip(np.searchsorted(centres, t) - 1, 0, bones - 2)
+    s = np.clip((t - centres[k]) / (centres[k + 1] - centres[k]), 0.0, 1.0)
+    vertex = np.repeat(np.arange(len(V)), 2)
+    bone = np.column_stack([k, k + 1]).ravel()
+    level = np.rint(255 * np.column_stack([1 - s, s]).ravel()).astype(np.int64)
+    keep = level > 0
+    vertex, bone, level = vertex[keep], bone[keep], level[keep]
+    keys, inverse = np.unique(bone * 256 + level, return_inverse=True)
+    order = np.argsort(inverse, kind="stable")
+    groups = [obj.vertex_groups.new(name=f"Bone{b}") for b in range(bones)]
+    for key, members in zip(keys, np.split(vertex[order], np.cumsum(np.bincount(inverse))[:-1])):
+        groups[key // 256].add(members.tolist(), (key % 256) / 255, "REPLACE")
+    modifier = obj.modifiers.new("Armature", "ARMATURE")
+    modifier.object = armature
+    reach = 0.1 * bones  # a tenth of the length, in bone lengths
+    assert bpy.ops.modal_deform.fill_attach(reach=reach) == {"FINISHED"}
+    return armature
+
+
+def animate_rig(armature, bones, length):
+    """The rig moves fast and stops: the armature object jumps by a fifth of `length` (frames 1 to
+    5 up, 5 to 9 down) turning by 30 degrees about the vertical, then every bone bends by 60/bones
+    degrees (frames 9 to 13) and back (13 to 17); still from frame 17 on."""
+    armature.keyframe_insert("location", frame=1)
+    armature.keyframe_insert("rotation_euler", frame=1)
+    armature.location.z += 0.2 * length
+    armature.keyframe_insert("location", frame=5)
+    armature.location.z -= 0.2 * length
+    armature.rotation_euler.z = math.radians(30)
+    armature.keyframe_insert("location", frame=9)
+    armature.keyframe_insert("rotation_euler", frame=9)
+    for pose_bone in armature.pose.bones:
+        pose_bone.rotation_mode = "XYZ"
+        for frame, angle in ((9, 0.0), (13, 60.0 / bones), (17, 0.0)):
+            pose_bone.rotation_euler = (0.0, 0.0, math.radians(angle))
+            pose_bone.keyframe_insert("rotation_euler", frame=frame)
+
+
+class Parts:
+    """Milliseconds spent in the add-on's calls of RIG_PARTS during a frame, per part (each call
+    of a method of the object's Player wrapped while it is in place)."""
+
+    def __init__(self, player):
+        self.ms = dict.fromkeys(RIG_PARTS, 0.0)
+        self._wrapped = []
+        for part, (owner_name, methods) in RIG_PARTS.items():
+            owner = getattr(player, owner_name)
+            for name in methods:
+                setattr(owner, name, self._timed(part, getattr(owner, name)))
+                self._wrapped.append((owner, name))
+
+    def _timed(self, part, method):
+        def timed(*args, **kwargs):
+            start = time.perf_counter()
+            try:
+                return method(*args, **kwargs)
+            finally:
+                self.ms[part] += 1e3 * (time.perf_counter() - start)
+
+        return timed
+
+    def take(self):
+        """The milliseconds since the last take, per part."""
+        found, self.ms = self.ms, dict.fromkeys(RIG_PARTS, 0.0)
+        return found
+
+    def remove(self):
+        for owner, name in self._wrapped:
+            delattr(owner, name)
+
+
+def timed_rig_frames(obj, scene, timeline, frame_cache, frames, rounds=ROUNDS):
+    """Per frame of `frames`, played (the add-on's playback handlers called around them) and
+    simulated live (the cache cut at the first frame each round): "before" Blender's evaluation from
+    frame_set's call to the add-on's frame handler (the animation, the rig, the mesh with the offset
+    it had), "handler" the handler's work (playback.timeline.show), split into RIG_PARTS and "other"
+    (the checks, the cache, the attribute's update), "evaluate" Blender's evaluation after it (the
+    mesh with its new offset: the display's Geometry Nodes modifier, then the Armature modifier),
+    and the step's own milliseconds (Simulation.stats). Each: the median over the frames of its
+    least over `rounds` rounds."""
+    handlers = bpy.app.handlers.frame_change_post
+    clock = {}
+
+    def before(*args):
+        clock["before"] = time.perf_counter()
+
+    def after(*args):
+        clock["after"] = time.perf_counter()
+
+    add_on_handler = playback_handler("frame_change_post")
+    handlers.insert(list(handlers).index(add_on_handler), before)
+    handlers.insert(list(handlers).index(add_on_handler) + 1, after)
+    names = ("before", "handler", *RIG_PARTS, "other", "evaluate", "step_native")
+    figures = {name: np.full((rounds, len(frames)), np.inf) for name in names}
+    player = timeline.player(obj, scene)
+    parts = Parts(player)
+    playback_handler("animation_playback_pre")(scene, None)
+    try:
+        for round_ in range(rounds):
+            frame_cache.get(obj).cut(frames[0])
+            for index, frame in enumerate(frames):
+                parts.take()
+                called = time.perf_counter()
+                scene.frame_set(frame)
+                returned = time.perf_counter()
+                assert obj.name not in timeline.problems, timeline.problems
+                assert timeline.player(obj, scene) is player, "the Player was made again"
+                handler = 1e3 * (clock["after"] - clock["before"])
+                split = parts.take()
+                row = {
+                    "before": 1e3 * (clock["before"] - called),
+                    "handler": handler,
+                    "other": handler - sum(split.values()),
+                    "evaluate": 1e3 * (returned - clock["after"]),
+                    "step_native": player.simulation.stats["ms"],
+                    **split,
+                }
+                for name, value in row.items():
+                    figures[name][round_, index] = value
+    finally:
+        handlers.remove(before)
+        handlers.remove(after)
+        parts.remove()
+        playback_handler("animation_playback_post")(scene, None)
+    result = {
+        name + "_ms": float(np.median(values.min(axis=0))) for name, values in figures.items()
+    }
+    result.update(frames=len(frames), rounds=rounds)
+    return result
+
+
+def armature_alone(scene, frames, rounds=ROUNDS):
+    """The floor: frame_set's time with the add-on's display and dynamics off the rigged mesh (the
+    animation, the rig, the mesh's Armature modifier alone): the median over the frames of the
+    least over `rounds` rounds."""
+    times = np.full((rounds, len(frames)), np.inf)
+    for round_ in range(rounds):
+        for index, frame in enumerate(frames):
+            start = time.perf_counter()
+            scene.frame_set(frame)
+            times[round_, index] = 1e3 * (time.perf_counter() - start)
+    return {"evaluate_ms": float(np.median(times.min(axis=0))), "frames": len(frames)}
+
+
+def rig_case(obj, scene, timeline, frame_cache, bones, timed):
+    """Follow Rig on obj (its handles taken off) skinned by a chain of `bones` bones (chain_rig,
+    animate_rig): the frames `timed` played (timed_rig_frames), then the same frames with the
+    add-on's display and dynamics off (armature_alone); the rig, its vertex groups and Attach group
+    taken off after."""
+    settings = obj.modal_deform
+    settings.handles.clear()
+    timeline.free(obj)
+    start = time.perf_counter()
+    armature = chain_rig(obj, bones)
+    setup_seconds = time.perf_counter() - start
+    animate_rig(armature, bones, max(obj.dimensions))
+    settings.dynamics.enabled = settings.dynamics.follow_rig = True
+    start = time.perf_counter()
+    scene.frame_set(1)  # the Player made: the rig's weights read once
+    first_seconds = time.perf_counter() - start
+    assert obj.name not in timeline.problems, timeline.problems
+    attached = len(timeline.player(obj, scene).rig.attach)
+    result = {
+        "bones": bones,
+        "attached": attached,
+        "setup_seconds": setup_seconds,
+        "first_frame_seconds": first_seconds,
+        "played": timed_rig_frames(obj, scene, timeline, frame_cache, timed),
+    }
+    timeline.free(obj)
+    settings.dynamics.follow_rig = settings.dynamics.enabled = False
+    result["armature_alone"] = armature_alone(scene, timed)
+    obj.modifiers.remove(obj.modifiers["Armature"])
+    for group in list(obj.vertex_groups):
+        if group.name.startswith("Bone") or group.name == settings.dynamics.attach_group:
+            obj.vertex_groups.remove(group)
+    settings.dynamics.attach_group = ""
+    bpy.data.objects.remove(armature)
+    return result
+
+
 def saved_size(folder, name):
     path = os.path.join(folder, name)
     bpy.ops.wm.save_as_mainfile(filepath=path, copy=True)
@@ -244,48 +482,56 @@ def main():
         "frames": frames,
     }
 
-    # The static animation: baked into the cache, then read back frame by frame.
-    start = time.perf_counter()
-    assert bpy.ops.modal_deform.bake_animation(frame_start=1, frame_end=frames) == {"FINISHED"}
-    results["static_bake_seconds"] = time.perf_counter() - start
-    results["static_cache_bytes"] = frame_cache.get(obj).nbytes()
-    results["static_read"] = timed_frames(obj, scene, timeline, frame_cache, timed)
-    with tempfile.TemporaryDirectory() as folder:
-        if not args.no_sizes:
-            results["blend_with_cache_bytes"] = saved_size(folder, "cache.blend")
-            pc2 = os.path.join(folder, "dragon.pc2")
-            assert bpy.ops.modal_deform.export_mesh_cache(filepath=pc2, file_format="PC2") == {
-                "FINISHED"
-            }
-            results["pc2_bytes"] = os.path.getsize(pc2)
+    if not args.rig_only:
+        # The static animation: baked into the cache, then read back frame by frame.
+        start = time.perf_counter()
+        assert bpy.ops.modal_deform.bake_animation(frame_start=1, frame_end=frames) == {"FINISHED"}
+        results["static_bake_seconds"] = time.perf_counter() - start
+        results["static_cache_bytes"] = frame_cache.get(obj).nbytes()
+        results["static_read"] = timed_frames(obj, scene, timeline, frame_cache, timed)
+        with tempfile.TemporaryDirectory() as folder:
+            if not args.no_sizes:
+                results["blend_with_cache_bytes"] = saved_size(folder, "cache.blend")
+                pc2 = os.path.join(folder, "dragon.pc2")
+                assert bpy.ops.modal_deform.export_mesh_cache(filepath=pc2, file_format="PC2") == {
+                    "FINISHED"
+                }
+                results["pc2_bytes"] = os.path.getsize(pc2)
 
-        # Secondary motion: each frame simulated live from the one before, then read back.
-        settings.dynamics.enabled = True
-        timeline.set_frame(scene, 1)
-        timeline.show(obj, scene)
-        results["dynamic_step"] = timed_frames(
-            obj, scene, timeline, frame_cache, timed, stepping=True
-        )
-        results["dynamic_step_still"] = timed_frames(
-            obj, scene, timeline, frame_cache, timed, stepping=True, playing=False
-        )
-        results["dynamic_read"] = timed_frames(obj, scene, timeline, frame_cache, timed)
-        results["dynamic_cache_bytes_per_frame"] = frame_cache.get(obj).nbytes() / len(
-            frame_cache.get(obj)
-        )
-        results["dynamic_jump"] = jump_forward(obj, scene, timeline, frame_cache, len(timed))
-        results["without_display"] = without_display(obj, timeline, frame_cache, timed)
+            # Secondary motion: each frame simulated live from the one before, then read back.
+            settings.dynamics.enabled = True
+            timeline.set_frame(scene, 1)
+            timeline.show(obj, scene)
+            results["dynamic_step"] = timed_frames(
+                obj, scene, timeline, frame_cache, timed, stepping=True
+            )
+            results["dynamic_step_still"] = timed_frames(
+                obj, scene, timeline, frame_cache, timed, stepping=True, playing=False
+            )
+            results["dynamic_read"] = timed_frames(obj, scene, timeline, frame_cache, timed)
+            results["dynamic_cache_bytes_per_frame"] = frame_cache.get(obj).nbytes() / len(
+                frame_cache.get(obj)
+            )
+            results["dynamic_jump"] = jump_forward(obj, scene, timeline, frame_cache, len(timed))
+            results["without_display"] = without_display(obj, timeline, frame_cache, timed)
 
-        if not args.no_sizes:
-            # The static animation as a shape key per frame, as Bake Animation wrote it before the cache.
-            settings.dynamics.enabled = False
-            assert bpy.ops.modal_deform.bake_animation(frame_start=1, frame_end=frames) == {
-                "FINISHED"
-            }
-            start = time.perf_counter()
-            assert bpy.ops.modal_deform.export_shape_keys() == {"FINISHED"}
-            results["shape_keys_export_seconds"] = time.perf_counter() - start
-            results["blend_with_shape_keys_bytes"] = saved_size(folder, "keys.blend")
+            if not args.no_sizes:
+                # The static animation as a shape key per frame, as Bake Animation wrote it before the cache.
+                settings.dynamics.enabled = False
+                assert bpy.ops.modal_deform.bake_animation(frame_start=1, frame_end=frames) == {
+                    "FINISHED"
+                }
+                start = time.perf_counter()
+                assert bpy.ops.modal_deform.export_shape_keys() == {"FINISHED"}
+                results["shape_keys_export_seconds"] = time.perf_counter() - start
+                results["blend_with_shape_keys_bytes"] = saved_size(folder, "keys.blend")
+    # Follow Rig (issue 50): the dragon skinned by chains of bones, the frames played live.
+    if obj.data.shape_keys is not None:  # the export's, which the rig's mesh has not
+        obj.shape_key_clear()
+    results["rig"] = [
+        rig_case(obj, scene, timeline, frame_cache, bones, timed)
+        for bones in (args.rig_bones[:1] if args.quick else args.rig_bones)
+    ]
     results["load_average"] = {"before": load_before, "after": os.getloadavg()}
     pathlib.Path(args.output).write_text(json.dumps(results, indent=1))
     print(json.dumps(results, indent=1))

@@ -1633,6 +1633,7 @@ def section_playback(result):
             "",
             "Target (issue 40, a live step with Blender's evaluation): " + "; ".join(checks) + ".",
         ]
+    out += rig_playback(runs)
     out += measured_apart(runs)
     sized = [run for run in runs if "blend_with_shape_keys_bytes" in run]
     if sized:
@@ -1664,6 +1665,96 @@ def section_playback(result):
         ]
     out += ["", provenance(result)]
     return "\n".join(out)
+
+
+#: The add-on's share of a played frame on a rig (Follow Rig, issue 50) in at most this many ms, by
+#: the vertex count of the dragon (100k, and subdivided twice, 1.6M, on a proxy).
+RIG_TARGETS_MS = {100250: 4.0, 1606964: 8.0}
+
+
+def rig_playback(runs):
+    """The rig case of the playback runs (issue 50's Speed): per Blender, mesh and bone count, the
+    add-on's share split, Blender's evaluation beside it and the Armature modifier alone."""
+    rigged = [(run, case) for run in runs for case in run.get("rig", [])]
+    if not rigged:
+        return []
+    played = rigged[0][1]["played"]
+    rows = []
+    for run, case in rigged:
+        p = case["played"]
+        target = RIG_TARGETS_MS.get(run["vertices"])
+        met = "" if target is None else ("met" if p["handler_ms"] <= target else "**NOT met**")
+        rows.append(
+            [
+                run["blender"],
+                f"{run['vertices']:,}",
+                case["bones"],
+                f"{case['attached']:,}",
+                f"**{p['handler_ms']:.2f}**",
+                f"{p['bones_ms']:.2f} / {p['step_ms']:.2f} / {p['map_ms']:.2f} / {p['other_ms']:.2f}",
+                f"{p['before_ms']:.2f} + {p['evaluate_ms']:.2f}",
+                f"{case['armature_alone']['evaluate_ms']:.2f}",
+                "" if target is None else f"≤ {target:.0f}: {met}",
+                "{:.1f} / {:.1f}".format(*loads) if (loads := load_range(rig_run(run))) else "",
+            ]
+        )
+    apart = sorted(
+        {
+            (m["date"], m["commit"][:12])
+            for run, _ in rigged
+            if (m := run.get("rig_measured")) is not None
+        }
+    )
+    return [
+        "",
+        "### Secondary motion on a rig (issue 50)",
+        "",
+        "The same dragon skinned by an Armature modifier to a chain of 3, 30 or 100 bones along its long "
+        "axis (weights by formula, linear between the bones' centres, two bones a vertex at most; the "
+        "Attach group filled by Fill Attach from Armature within a tenth of the dragon's length of the "
+        "chain); the armature object keyed to jump and turn (frames 1 to 9), every bone to bend and back "
+        "(9 to 17), still after; Follow Rig on, the frames played (the add-on's playback handlers called "
+        f"around them) and each simulated live, the median over {played['frames']} frames of a frame's "
+        f'least over {played["rounds"]} rounds. "add-on" is the frame handler\'s work '
+        "(playback.timeline.show), split into the rig's bones read (rig.Rig.frame), the simulation's step, "
+        "the map of its q into the display's offset attribute (U q, natively), and the rest (the checks, "
+        "the keyframes' digest and values, the cache, the attribute's update). Blender evaluates the frame "
+        "twice: before the handler (the animation, the rig, the mesh with the offset it had) and after it "
+        "(the mesh again with its new offset: the display's Geometry Nodes Set Position, then the Armature "
+        "modifier); \"Armature alone\" is frame_set's time with the add-on's display and dynamics off the "
+        "same mesh: its Armature modifier alone, the floor.",
+        "",
+        table(
+            [
+                "Blender",
+                "vertices",
+                "bones",
+                "attached",
+                "add-on ms",
+                "bones / step / map / other ms",
+                "Blender before + after ms",
+                "Armature alone ms",
+                "target (add-on)",
+                "load before / after",
+            ],
+            rows,
+        ),
+    ] + (
+        [
+            "",
+            "The rig case measured apart from the runs above and merged into their record: "
+            + "; ".join(f"{date}, commit `{commit}`" for date, commit in apart)
+            + " (the load beside each row).",
+        ]
+        if apart
+        else []
+    )
+
+
+def rig_run(run):
+    """The run's rig case's own provenance (rig_measured: its date, commit and load average) when it
+    was measured apart from the run's other figures, else the run."""
+    return run.get("rig_measured", run)
 
 
 def load_range(run):

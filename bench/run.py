@@ -48,7 +48,9 @@ Experiments (each writes bench/results/<name>.json: machine, commit, command, pa
   playback     the per-frame cache and secondary motion (issue 40) in bpy 4.5 and 5.3 on the extension zips:
                per frame, a cached frame read back and a live simulation step with Blender's evaluation,
                at 100k vertices (and 1.6M on a proxy unless --quick); the cache's and the .blend's sizes
-               for 250 frames of the 100k dragon against a shape key per frame and a PC2 file
+               for 250 frames of the 100k dragon against a shape key per frame and a PC2 file; the same
+               dragons skinned by chains of 3, 30 and 100 bones with Follow Rig on (issue 50), the add-on's
+               share of a played frame beside Blender's evaluation and the Armature modifier alone
                (bench/playback.py)
   shape_keys_blender  Blend as Shapes in bpy 4.5 and 5.3 on the extension zips: the 100k dragon with 8 keys
                made by formula, driven by changing key values; per update the add-on's handler, the core's

@@ -82,6 +82,8 @@ void bind_dynamics(py::module_& m) {
            py::call_guard<py::gil_scoped_release>())
       .def("positions_of", &ReducedDynamics::positions_of, py::arg("q"), py::arg("out").noconvert(),
            py::call_guard<py::gil_scoped_release>())
+      .def("displacement_of", &ReducedDynamics::displacement_of, py::arg("q"),
+           py::arg("out").noconvert(), py::call_guard<py::gil_scoped_release>())
       .def_property_readonly("q", [](const ReducedDynamics& s) { return Eigen::VectorXd(s.q()); })
       .def_property_readonly("v", [](const ReducedDynamics& s) { return Eigen::VectorXd(s.v()); })
       .def("energy", &ReducedDynamics::energy)

@@ -69,8 +69,10 @@ void prolongate_positions(const Prolongation& prolongation, const float* rest,
       const float* d1 = proxy_displacement + 3 * vertices[3 * i + 1];
       const float* d2 = proxy_displacement + 3 * vertices[3 * i + 2];
       const float w0 = weights[3 * i], w1 = weights[3 * i + 1], w2 = weights[3 * i + 2];
-      for (int a = 0; a < 3; ++a)
-        out[3 * i + a] = rest[3 * i + a] + (w0 * d0[a] + w1 * d1[a] + w2 * d2[a]);
+      for (int a = 0; a < 3; ++a) {
+        const float d = w0 * d0[a] + w1 * d1[a] + w2 * d2[a];
+        out[3 * i + a] = rest ? rest[3 * i + a] + d : d;
+      }
     }
   });
 }

@@ -40,9 +40,9 @@ Prolongation prolongation_to_proxy(const VerticesRef& V, const VerticesRef& prox
 // #V rows that hold every fine vertex at rest (zero weights on proxy vertex 0).
 Prolongation held_at_rest(Eigen::Index num_vertices);
 
-// out_i = x̄_i + Σ_k w_ik d_{v_ik} for every fine vertex: `rest` (3#V, x̄), `proxy_displacement`
-// (3#P, d) and `out` (3#V), interleaved, in single precision. In parallel over blocks of fine
-// vertices.
+// out_i = x̄_i + Σ_k w_ik d_{v_ik} for every fine vertex: `rest` (3#V, x̄; null: the displacement
+// Σ_k w_ik d_{v_ik} alone), `proxy_displacement` (3#P, d) and `out` (3#V), interleaved, in single
+// precision. In parallel over blocks of fine vertices.
 void prolongate_positions(const Prolongation& prolongation, const float* rest,
                           const float* proxy_displacement, float* out);
 

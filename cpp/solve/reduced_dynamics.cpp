@@ -146,9 +146,19 @@ Eigen::MatrixXd ReducedDynamics::inverse_rest_hessian(const Eigen::MatrixXd& K,
 
 void ReducedDynamics::positions_of(const Eigen::VectorXd& q,
                                    Eigen::Ref<Eigen::VectorXf> out) const {
+  check_coordinates(q);
+  fine_positions_.write(q.cast<float>(), out);
+}
+
+void ReducedDynamics::displacement_of(const Eigen::VectorXd& q,
+                                      Eigen::Ref<Eigen::VectorXf> out) const {
+  check_coordinates(q);
+  fine_positions_.write_displacement(q.cast<float>(), out);
+}
+
+void ReducedDynamics::check_coordinates(const Eigen::VectorXd& q) const {
   if (q.size() != dimension())
     throw InputError(message("q: expected ", dimension(), " reduced coordinates, got ", q.size()));
-  fine_positions_.write(q.cast<float>(), out);
 }
 
 void ReducedDynamics::set_state(const Eigen::VectorXd& q, const Eigen::VectorXd& v,

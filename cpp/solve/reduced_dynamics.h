@@ -215,6 +215,9 @@ class ReducedDynamics {
   // x̄ + U q for another q (a cached frame's), the state left alone. Throws InputError for a q of
   // the wrong size.
   void positions_of(const Eigen::VectorXd& q, Eigen::Ref<Eigen::VectorXf> out) const;
+  // U q alone for a q (FinePositions::write_displacement): on a rig, the offset shown before the
+  // Armature modifier, written without reading x̄. Throws InputError as positions_of.
+  void displacement_of(const Eigen::VectorXd& q, Eigen::Ref<Eigen::VectorXf> out) const;
 
   int dimension() const { return ghost_energy_.dimension(); }
   int num_handles() const { return static_cast<int>(centres_.size()); }
@@ -225,6 +228,8 @@ class ReducedDynamics {
   const Eigen::VectorXd& rig_acceleration() const { return rig_acceleration_; }
 
  private:
+  // Throws InputError for a q of the wrong size.
+  void check_coordinates(const Eigen::VectorXd& q) const;
   // Φ (above) for the current substep and scheme: ½‖x − prediction‖² + potential_weight
   // (damping_weight V(x) − damping_pullᵀx), V = E + E_C.
   double incremental_potential(const Eigen::VectorXd& x, Eigen::VectorXd& gradient);

@@ -54,19 +54,20 @@ FinePositions::FinePositions(const Basis& basis)
   if (basis.on_proxy()) proxy_displacement_.resize(basis.vectors.rows());
 }
 
-void FinePositions::write(const Eigen::VectorXf& q, Eigen::Ref<Eigen::VectorXf> out) const {
+void FinePositions::write(const Eigen::VectorXf& q, const float* rest,
+                          Eigen::Ref<Eigen::VectorXf> out) const {
   const Eigen::Index fine_rows = 3 * static_cast<Eigen::Index>(basis_.num_vertices());
   if (out.size() != fine_rows)
     throw InputError(
         message("out: expected ", fine_rows, " values (3 per vertex), got ", out.size()));
   if (!basis_.on_proxy()) {
-    quantized_vectors_.map(basis_.vectors, q, rest_.data(), tolerance_, out.data());
+    quantized_vectors_.map(basis_.vectors, q, rest, tolerance_, out.data());
     return;
   }
-  // On a proxy: its displacement U q, then x̄ + P (U q) on the fine vertices (convex weights: the
+  // On a proxy: its displacement U q, then (x̄ +) P (U q) on the fine vertices (convex weights: the
   // displacement's error bound holds there too).
   quantized_vectors_.map(basis_.vectors, q, nullptr, tolerance_, proxy_displacement_.data());
-  prolongate_positions(basis_.prolongation, rest_.data(), proxy_displacement_.data(), out.data());
+  prolongate_positions(basis_.prolongation, rest, proxy_displacement_.data(), out.data());
 }
 
 }  // namespace modal_deform

@@ -62,9 +62,19 @@ class FinePositions {
   // InputError for a wrong size.
   void write(Eigen::Ref<Eigen::VectorXf> out) const { write(q_, out); }
   // The same for another q (r entries), leaving the one set alone.
-  void write(const Eigen::VectorXf& q, Eigen::Ref<Eigen::VectorXf> out) const;
+  void write(const Eigen::VectorXf& q, Eigen::Ref<Eigen::VectorXf> out) const {
+    write(q, rest_.data(), out);
+  }
+  // The displacement U q (P U q on a proxy) alone, within the same tolerance: exactly zero at
+  // q = 0.
+  void write_displacement(const Eigen::VectorXf& q, Eigen::Ref<Eigen::VectorXf> out) const {
+    write(q, nullptr, out);
+  }
 
  private:
+  // rest + U q (rest null: U q alone) into `out`.
+  void write(const Eigen::VectorXf& q, const float* rest, Eigen::Ref<Eigen::VectorXf> out) const;
+
   const Basis& basis_;
   // x̄ in single precision (3#V, interleaved), what Blender stores: the map reads half the bytes
   // of the double rest for it, a third of all it reads on a proxy.

@@ -55,6 +55,11 @@ TEST(Prolongation, PositionsAreRestPlusTheInterpolatedDisplacement) {
   prolongate_positions(P, flatten(g.fine.V).cast<float>().eval().data(), d.data(), out.data());
   const RowMatrixX3d expected = g.fine.V + g.fine.V * A.transpose();
   EXPECT_LT((out.cast<double>() - flatten(expected)).cwiseAbs().maxCoeff(), 1e-6);
+  // Without the rest, the interpolated displacement alone.
+  prolongate_positions(P, nullptr, d.data(), out.data());
+  EXPECT_LT(
+      (out.cast<double>() - flatten(RowMatrixX3d(g.fine.V * A.transpose()))).cwiseAbs().maxCoeff(),
+      1e-6);
 }
 
 TEST(Prolongation, DetailOffTheProxyStaysInTheRestFrame) {

@@ -194,6 +194,14 @@ def test_a_run_is_deterministic_and_its_state_reloads_bit_identical(tube):
     )
     with pytest.raises(ValueError, match="q"):
         reloaded.positions_of(q[:-1])
+    # Its displacement alone (a rig's display shows it): U q, the positions less the rest up to
+    # float rounding, exactly zero at q = 0.
+    rest = basis.rest.astype(np.float32)
+    size = np.ptp(basis.rest, axis=0).max()
+    assert np.abs(reloaded.displacement_of(q) - (cached.positions() - rest)).max() < 1e-6 * size
+    assert not reloaded.displacement_of(np.zeros_like(q)).any()
+    with pytest.raises(ValueError, match="q"):
+        reloaded.displacement_of(q[:-1])
     # Its own state set again, as playback does before each step, continues the same.
     energy = cached.energy()
     cached.set_state(q, v, moves[7])

@@ -170,6 +170,13 @@ class Simulation(_inputs.InBasis):
         self._native.positions_of(_arrays.values(q, "q", self.dimension), out.reshape(-1))
         return out
 
+    def displacement_of(self, q, out=None):
+        """U q alone, (n, 3) float32 as ``positions_of`` (exactly zero at q = 0): on a rig, the
+        rest-space offset shown before the Armature modifier, written without reading x̄."""
+        out = _arrays.positions_out(out, self.num_vertices)
+        self._native.displacement_of(_arrays.values(q, "q", self.dimension), out.reshape(-1))
+        return out
+
     def set_state(self, q, v, transforms=None, *, bones=None):
         """Puts the simulation at (q, v), e.g. a cached frame's, or a pose's ``ReducedSolver.q``
         with zero velocity. ``transforms``: the controllers' at that state (one 4x4 per handle), the

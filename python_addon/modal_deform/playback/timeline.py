@@ -178,10 +178,10 @@ class Player:
 
     def next(self, cache, frame, transforms, out=None, rig_frame=None):
         """The state at `frame` (the one after cache.end), from the cached frame before it, and
-        whether its positions x̄ + U q are in `out` now: a simulation step maps them into `out` (a
-        function giving a #V by 3 float32 C-contiguous array, called at once) when given; a frame
-        not shown (a jump forward's frames in between, a bake's) is not mapped. On a rig,
-        `rig_frame`: the rig at `frame` (rig_frame()); the cache holds every earlier frame's."""
+        whether what the display shows of it (shown()) is in `out` now: a simulation step maps it
+        into `out` (a function giving a #V by 3 float32 C-contiguous array, called at once) when
+        given; a frame not shown (a jump forward's frames in between, a bake's) is not mapped. On a
+        rig, `rig_frame`: the rig at `frame` (rig_frame()); the cache holds every earlier frame's."""
         if self.kind == "STATIC":  # from the pose of the frame before, which the solver holds
             self.pose.solver.set_transforms(list(transforms))
             self.pose.converge()
@@ -216,16 +216,26 @@ class Player:
                 simulation.advance(cached_transforms(f), bones=cached_bones(f))
             set_cached_state(frame - 1)
         bones = None if self.rig is None else self.rig.bones_of(rig_frame)
-        if out is None:
+        if out is None or self.rig is not None:
             simulation.advance(list(transforms), bones=bones)
         else:
             simulation.step(list(transforms), out=out(), bones=bones)
         q, v = simulation.state
+        if out is not None and self.rig is not None:
+            self.shown(q, out())
         return q, v, out is not None
 
     def positions(self, q, out):
         """x̄ + U q into `out` (#V by 3 float32, C-contiguous)."""
         self.simulation.positions_of(q, out)
+
+    def shown(self, q, out):
+        """What the display shows of q, into `out` (#V by 3 float32, C-contiguous): x̄ + U q; on a
+        rig the rest-space offset U q (exactly zero at q = 0), written without reading x̄."""
+        if self.rig is None:
+            self.positions(q, out)
+        else:
+            self.simulation.displacement_of(q, out)
 
 
 def player(obj, scene, signature=None):
@@ -352,9 +362,7 @@ def show(obj, scene, edits_reported=False):
             return frame_display.frame_positions(mesh)
 
     if not fill(obj, scene, cache, shown, player_, out=display, curves=curves):
-        player_.positions(cache.array("q")[cache.row(shown)], display())
-    if on_rig:  # the rest-space offset x̄ + U q - x̄: exactly zero at q = 0
-        np.subtract(display(), player_.rest, out=display())
+        player_.shown(cache.array("q")[cache.row(shown)], display())
     mesh.update()
 
 
