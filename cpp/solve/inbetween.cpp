@@ -12,6 +12,7 @@
 
 #include "solve/reduced_solver.h"
 #include "util/errors.h"
+#include "util/parallel_for.h"
 
 namespace modal_deform {
 namespace {
@@ -38,6 +39,10 @@ constexpr double kFloor = 1e-6;
 constexpr double kProximity = 1e-2;
 // L-BFGS pairs kept.
 constexpr int kCorrections = 8;
+// The nodes are evaluated in this many runs of consecutive nodes, each on its own copy of the
+// ghost energy (whose work space is its own), spread over the threads: nodes are independent
+// given the states, so the results are the same bits for any thread count.
+constexpr int kRuns = 4;
 // A key's penalty curvature below this fraction of its largest is a direction the keyed handles
 // do not see.
 constexpr double kZeroCurvature = 1e-10;
@@ -166,8 +171,7 @@ class Inbetween::Problem {
   Problem(const Basis& basis, const Handles& handles, const Eigen::VectorXd& weights,
           const std::vector<InbetweenKey>& keys, const InbetweenOptions& options, EnergyKind energy,
           const DynamicsParameters& parameters)
-      : ghost_energy_(basis, energy),
-        never_keyed_(dynamics_handle_term(basis, handles, never_keyed_weights(weights, keys),
+      : never_keyed_(dynamics_handle_term(basis, handles, never_keyed_weights(weights, keys),
                                           options.simulation.pull)),
         r_(basis.dimension()),
         h_(parameters.substep),
@@ -199,26 +203,38 @@ class Inbetween::Problem {
                    (inverse.asDiagonal() * (eigen.eigenvectors().transpose() * term.gradient)));
       key_terms_.push_back(std::move(term));
     }
-    hessian_ = ghost_energy_.rest_hessian() + never_keyed_.hessian();
+    for (int run = 0; run < kRuns; ++run) evaluators_.emplace_back(basis, energy, never_keyed_);
+    hessian_ = evaluators_.front().ghost_energy.rest_hessian() + never_keyed_.hessian();
     hessian_ = 0.5 * (hessian_ + hessian_.transpose()).eval();
     for (const InbetweenKey& key : keys)
       key_nodes_.push_back((key.frame - keys.front().frame) * substeps);
-    work_.resize(r_);
     gx_.assign(N_, Eigen::VectorXd(r_));
     gq_.assign(N_, Eigen::VectorXd(r_));
+    px_.assign(N_, Eigen::VectorXd(r_));
+    pq_.assign(N_, Eigen::VectorXd(r_));
     R_.assign(N_, Eigen::VectorXd(r_));
   }
 
   int nodes() const { return N_; }
-  int evaluations() const { return evaluations_; }
+  int evaluations() const {
+    int sum = 0;
+    for (const Evaluator& evaluator : evaluators_) sum += evaluator.evaluations;
+    return sum;
+  }
 
   // ½ Σ ‖R_n‖² + the keys' penalty at the nodes q (N + 1 states), keeping ∇V and R for
   // gradient(); +inf where the ghost leaves the coordinates the energies take.
   double objective(const std::vector<Eigen::VectorXd>& q) {
-    for (int n = 0; n < N_; ++n) {
-      if (!potential_gradient(0.5 * (q[n] + q[n + 1]), gx_[n])) return kInfinity;
-      if (b_ != 0 && !potential_gradient(q[n], gq_[n])) return kInfinity;
-    }
+    std::array<bool, kRuns> finite;
+    over_nodes(
+        [&](Evaluator& evaluator, int begin, int end, bool& ok) {
+          for (int n = begin; n < end && ok; ++n)
+            ok = evaluator.potential_gradient(0.5 * (q[n] + q[n + 1]), gx_[n]) &&
+                 (b_ == 0 || evaluator.potential_gradient(q[n], gq_[n]));
+        },
+        finite);
+    for (bool ok : finite)
+      if (!ok) return kInfinity;
     control_ = 0;
     for (int n = 0; n < N_; ++n) {
       Eigen::VectorXd& R = R_[n];
@@ -239,26 +255,32 @@ class Inbetween::Problem {
 
   // ∇ of the last objective() with respect to q_1 … q_N (N blocks).
   void gradient(const std::vector<Eigen::VectorXd>& q, std::vector<Eigen::VectorXd>& g) {
+    // F_n enters R_n and R_{n+1}, each times s: its ∂/∂q_n and ∂/∂q_{n+1} applied to
+    // u_n = s (R_n + R_{n+1}), ∇²V(x_n) u_n and ∇²V(q_n) u_n, node by node in parallel.
+    std::array<bool, kRuns> unused;
+    over_nodes(
+        [&](Evaluator& evaluator, int begin, int end, bool&) {
+          Eigen::VectorXd u(r_);
+          for (int n = begin; n < end; ++n) {
+            u = R_[n];
+            if (n + 1 < N_) u += R_[n + 1];
+            u *= s_;
+            const Eigen::VectorXd x = 0.5 * (q[n] + q[n + 1]);
+            hessian_product(evaluator, x, gx_[n], u, px_[n]);
+            if (n >= 1 && b_ != 0) hessian_product(evaluator, q[n], gq_[n], u, pq_[n]);
+          }
+        },
+        unused);
     g.assign(N_, Eigen::VectorXd::Zero(r_));
-    Eigen::VectorXd u(r_), product(r_);
     for (int n = 0; n < N_; ++n) {
       // R_n's second difference on q_{n+1}, q_n (n ≥ 1), q_{n−1} (n ≥ 2); g[m − 1] is q_m's.
       g[n] += R_[n];
       if (n >= 1) g[n - 1] -= 2 * R_[n];
       if (n >= 2) g[n - 2] += R_[n];
-      // F_n enters R_n and R_{n+1}, each times s: its ∂/∂q_n and ∂/∂q_{n+1} applied to u.
-      u = R_[n];
-      if (n + 1 < N_) u += R_[n + 1];
-      u *= s_;
-      const Eigen::VectorXd x = 0.5 * (q[n] + q[n + 1]);
-      hessian_product(x, gx_[n], u, product);
-      g[n] += (a_ / 2) * product;
+      g[n] += (a_ / 2) * px_[n];
       if (n >= 1) {
-        g[n - 1] += (a_ / 2) * product;
-        if (b_ != 0) {
-          hessian_product(q[n], gq_[n], u, product);
-          g[n - 1] -= b_ * product;
-        }
+        g[n - 1] += (a_ / 2) * px_[n];
+        if (b_ != 0) g[n - 1] -= b_ * pq_[n];
       }
     }
     for (const KeyTerm& key : key_terms_)
@@ -350,25 +372,47 @@ class Inbetween::Problem {
     return F;
   }
 
-  // ∇V(x) into `gradient`; false where the ghost leaves the energies' range.
-  bool potential_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& gradient) {
-    ++evaluations_;
-    if (!std::isfinite(ghost_energy_.value_and_gradient(x, gradient))) return false;
-    never_keyed_.value_and_gradient(x, work_);
-    gradient += work_;
-    return true;
+  // V's gradient on a ghost energy of its own.
+  struct Evaluator {
+    Evaluator(const Basis& basis, EnergyKind energy, const ReducedHandleTerm& never_keyed)
+        : ghost_energy(basis, energy), never_keyed(never_keyed), work(basis.dimension()) {}
+
+    // ∇V(x) into `gradient`; false where the ghost leaves the energies' range.
+    bool potential_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& gradient) {
+      ++evaluations;
+      if (!std::isfinite(ghost_energy.value_and_gradient(x, gradient))) return false;
+      never_keyed.value_and_gradient(x, work);
+      gradient += work;
+      return true;
+    }
+
+    GhostEnergy ghost_energy;
+    const ReducedHandleTerm& never_keyed;
+    Eigen::VectorXd work;
+    int evaluations = 0;
+  };
+
+  // work(evaluator, begin, end, ok) for the kRuns runs of nodes [begin, end) that split 0 … N − 1,
+  // each on its own evaluator, in parallel; ok starts true.
+  template <typename Work>
+  void over_nodes(Work&& work, std::array<bool, kRuns>& ok) {
+    ok.fill(true);
+    parallel_for(kRuns, [&](int run) {
+      work(evaluators_[run], N_ * run / kRuns, N_ * (run + 1) / kRuns, ok[run]);
+    });
   }
 
   // ∇²V(x) u from ∇V(x) (`gradient`) and one more gradient.
-  void hessian_product(const Eigen::VectorXd& x, const Eigen::VectorXd& gradient,
-                       const Eigen::VectorXd& u, Eigen::VectorXd& product) {
+  void hessian_product(Evaluator& evaluator, const Eigen::VectorXd& x,
+                       const Eigen::VectorXd& gradient, const Eigen::VectorXd& u,
+                       Eigen::VectorXd& product) const {
     const double size = u.cwiseAbs().maxCoeff();
     if (!(size > 0)) {
       product.setZero();
       return;
     }
     const double step = kDifferenceStep * std::max(1.0, x.cwiseAbs().maxCoeff()) / size;
-    if (!potential_gradient(x + step * u, product)) {
+    if (!evaluator.potential_gradient(x + step * u, product)) {
       // Beyond the energies' range: the model's curvature instead.
       product = hessian_ * u;
       return;
@@ -378,14 +422,15 @@ class Inbetween::Problem {
 
   // ∇²V at q by differences of ghost gradients, symmetrised (r + 1 gradients).
   Eigen::MatrixXd hessian_at(const Eigen::VectorXd& q) {
+    Evaluator& evaluator = evaluators_.front();
     Eigen::VectorXd base(r_), moved(r_);
-    if (!potential_gradient(q, base)) return hessian_;
+    if (!evaluator.potential_gradient(q, base)) return hessian_;
     const double step = kDifferenceStep * std::max(1.0, q.cwiseAbs().maxCoeff());
     Eigen::MatrixXd H(r_, r_);
     Eigen::VectorXd x = q;
     for (Eigen::Index j = 0; j < r_; ++j) {
       x[j] += step;
-      if (!potential_gradient(x, moved)) return hessian_;
+      if (!evaluator.potential_gradient(x, moved)) return hessian_;
       H.col(j) = (moved - base) / step;
       x[j] = q[j];
     }
@@ -443,8 +488,8 @@ class Inbetween::Problem {
   }
 
  private:
-  GhostEnergy ghost_energy_;
   ReducedHandleTerm never_keyed_;
+  std::deque<Evaluator> evaluators_;  // kRuns, one a run of nodes
   Eigen::Index r_;
   double h_, rho_, a_, b_, s_;
   int N_ = 0;
@@ -455,9 +500,9 @@ class Inbetween::Problem {
   BandedCholesky cholesky_;
   // At the last objective(): ∇V(x_n), ∇V(q_n), R_n, ½ Σ ‖R_n‖².
   std::vector<Eigen::VectorXd> gx_, gq_, R_;
+  // At the last gradient(): ∇²V(x_n) u_n and ∇²V(q_n) u_n.
+  std::vector<Eigen::VectorXd> px_, pq_;
   double control_ = 0;
-  int evaluations_ = 0;
-  Eigen::VectorXd work_;
 };
 
 Inbetween::Inbetween(const Basis& basis, const Handles& handles, const VectorRef& weights,

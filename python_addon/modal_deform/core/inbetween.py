@@ -16,7 +16,8 @@ inverse Hessian the inverse of a Gauss-Newton matrix of the dynamics linearised 
 r-by-r blocks either side of the diagonal) and factored once; the gradient is exact and a line
 search keeps every step a descent. Cost, with N = frames × substeps between the first key and the
 last and r = basis.dimension: O(N r³) once for the model, then per iteration O(N) ghost gradient
-evaluations (each O(ghost vertices × r)) and O(N r²) for the banded solve; tens of iterations.
+evaluations (each O(ghost vertices × r), the nodes' in parallel on the threads, the same bits
+for any thread count) and O(N r²) for the banded solve; tens of iterations.
 
 Simulation's energy correction (a rescaling of each substep's end velocity) is not smooth: the
 in-betweens measure the control on the midpoint equation alone, so a free motion of Simulation is
