@@ -19,6 +19,7 @@ namespace modal_deform {
 void bind_inbetween(py::module_& m) {
   const auto inbetween_options = [](auto visit) { for_each_inbetween_option(visit); };
   m.attr("INBETWEEN_OPTIONS") = option_table<InbetweenOptions>(inbetween_options);
+  m.attr("MAX_INBETWEEN_KEYS") = kMaxInbetweenKeys;
   py::class_<Inbetween>(m, "Inbetween")
       .def(py::init([inbetween_options](
                         const Basis& basis, const std::vector<Eigen::VectorXi>& handles,

@@ -17,7 +17,7 @@ namespace modal_deform {
 void bind_shapes(py::module_& m) {
   const auto blend_options = [](auto visit) { for_each_blend_option(visit); };
   m.attr("BLEND_OPTIONS") = option_table<BlendOptions>(blend_options);
-  m.attr("MAX_KEYS") = kMaxKeys;
+  m.attr("MAX_SHAPE_KEYS") = kMaxShapeKeys;
   py::class_<ShapeSpace>(m, "ShapeSpace")
       .def(py::init([](const Basis& basis, const std::vector<RowMatrixX3d>& keys) {
              py::gil_scoped_release release;

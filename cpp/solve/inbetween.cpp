@@ -120,8 +120,8 @@ std::string key_name(const InbetweenKey& key, int index) {
 // The keys by frame, each checked (the constructor's comment says what is refused).
 std::vector<InbetweenKey> checked_keys(std::vector<InbetweenKey> keys, int num_handles) {
   if (keys.empty()) throw InputError("keys: none given; in-betweens need at least one key");
-  if (static_cast<int>(keys.size()) > kMaxKeys)
-    throw InputError(message("keys: ", keys.size(), " given, at most ", kMaxKeys));
+  if (static_cast<int>(keys.size()) > kMaxInbetweenKeys)
+    throw InputError(message("keys: ", keys.size(), " given, at most ", kMaxInbetweenKeys));
   for (size_t i = 0; i < keys.size(); ++i) {
     const InbetweenKey& key = keys[i];
     const std::string name = key_name(key, static_cast<int>(i));

@@ -72,7 +72,7 @@ struct InbetweenKey {
 
 // The most keys, and the longest span from the first key to the last, in frames: the unknowns
 // are (span × substeps) states of r coordinates.
-constexpr int kMaxKeys = 100;
+constexpr int kMaxInbetweenKeys = 100;
 constexpr int kMaxInbetweenFrames = 10000;
 // The latest frame that positions() and state() take (Simulation steps there from the last key).
 constexpr int kMaxInbetweenFrame = 1000000;
@@ -129,8 +129,8 @@ void for_each_inbetween_stat(Visit&& visit) {
 class Inbetween {
  public:
   // basis: validated, must outlive this. handles: fine vertex indices, weights one per handle
-  // (empty: 1), as Simulation's. keys: at least one, at most kMaxKeys, at distinct frames in
-  // [0, kMaxInbetweenFrame] spanning at most kMaxInbetweenFrames, in any order; each with one
+  // (empty: 1), as Simulation's. keys: at least one, at most kMaxInbetweenKeys, at distinct frames
+  // in [0, kMaxInbetweenFrame] spanning at most kMaxInbetweenFrames, in any order; each with one
   // entry per handle, rigid where given (check_transforms), keying at least one handle. Throws
   // InputError naming what is wrong.
   Inbetween(const Basis& basis, const Handles& handles, const VectorRef& weights,

@@ -91,8 +91,9 @@ ShapeSpace::ShapeSpace(const Basis& basis, const std::vector<RowMatrixX3d>& keys
         "mesh");
   const Eigen::Index k = static_cast<Eigen::Index>(keys.size());
   if (k == 0) throw InputError("shapes: expected at least one key, got none");
-  if (k > kMaxKeys)
-    throw InputError(message("shapes: a shape space takes up to ", kMaxKeys, " keys, got ", k));
+  if (k > kMaxShapeKeys)
+    throw InputError(
+        message("shapes: a shape space takes up to ", kMaxShapeKeys, " keys, got ", k));
   const Eigen::Index n = basis.num_vertices();
   for (Eigen::Index i = 0; i < k; ++i) {
     if (keys[i].rows() != n)
@@ -180,8 +181,8 @@ ShapeSpace::ShapeSpace(ShapeSpaceData data) : data_(std::move(data)) {
   if (data_.base_dimension <= basis.num_rigid || data_.base_dimension > r)
     throw InputError(message("base_dimension: expected a value in (", basis.num_rigid, ", ", r,
                              "], got ", data_.base_dimension));
-  if (data_.coordinates.rows() != r || k < 1 || k > kMaxKeys)
-    throw InputError(message("coordinates: expected ", r, " rows and 1 to ", kMaxKeys,
+  if (data_.coordinates.rows() != r || k < 1 || k > kMaxShapeKeys)
+    throw InputError(message("coordinates: expected ", r, " rows and 1 to ", kMaxShapeKeys,
                              " columns, got ", data_.coordinates.rows(), " by ", k));
   if (!data_.coordinates.allFinite() || (data_.coordinates.array().abs() > kMaxCoordinate).any())
     throw InputError("coordinates: an entry is not finite or too large");

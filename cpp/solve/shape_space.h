@@ -45,7 +45,7 @@
 namespace modal_deform {
 
 // Keys a space takes at most.
-constexpr int kMaxKeys = 1000;
+constexpr int kMaxShapeKeys = 1000;
 
 // The farthest a blend may move a ghost vertex from the linear blend, in the normalised frame
 // (the model's longest side is 10): beyond, the blend has run off (BlendStats::diverged).
@@ -107,8 +107,8 @@ class ShapeSpace {
  public:
   // basis: of the rest mesh, validated here; keys: k ≥ 1 arrays #V by 3 (mesh units), finite, in
   // range. Throws InputError naming the key that is wrong: another vertex count, a non-finite
-  // coordinate, more than kMaxKeys keys, a region basis. A key's element of zero size (its rest
-  // has no term there) leaves the key out of that element's blend.
+  // coordinate, more than kMaxShapeKeys keys, a region basis. A key's element of zero size (its
+  // rest has no term there) leaves the key out of that element's blend.
   ShapeSpace(const Basis& basis, const std::vector<RowMatrixX3d>& keys);
   // A space stored as `data` (validated: InputError naming what is wrong).
   explicit ShapeSpace(ShapeSpaceData data);

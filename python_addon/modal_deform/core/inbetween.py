@@ -42,6 +42,8 @@ from .solve import SOLVER_OPTIONS
 
 #: Inbetween's options, the native core's (cpp/solve/inbetween.h): Simulation's and the solve's.
 INBETWEEN_OPTIONS = _options.table(_native.INBETWEEN_OPTIONS)
+#: The most keyed frames an Inbetween takes.
+MAX_KEYS = _native.MAX_INBETWEEN_KEYS
 
 
 class Inbetween(_inputs.InBasis):

@@ -47,7 +47,7 @@ from .bake import BAKE_OPTIONS, Basis, bake
 #: A blend's options (cpp/solve/shape_space.h, for_each_blend_option): {name: Option}.
 BLEND_OPTIONS = _options.table(_native.BLEND_OPTIONS)
 #: The most keys a space takes.
-MAX_KEYS = _native.MAX_KEYS
+MAX_KEYS = _native.MAX_SHAPE_KEYS
 # 1: the augmented basis (Basis's fields), base_dimension, key_coordinates, key_residuals.
 FORMAT_VERSION = 1
 

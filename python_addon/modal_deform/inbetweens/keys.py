@@ -14,12 +14,13 @@ refused with a message; so is having none.
 import numpy as np
 
 from .. import handles as handles_
+from ..core.inbetween import MAX_KEYS as MAX_INBETWEEN_KEYS
 from ..playback import frame_cache, timeline
 from ..playback.frame_keys import action_fcurves
 
-#: Keyframes a motion takes at most: a controller keyed on most frames is an animation already,
-#: for Dynamics to follow; and the solve's cost grows with the frames between the first key and the last.
-MAX_KEYS = 200
+#: Keyframes a motion takes at most (the core's limit): a controller keyed on most frames is an
+#: animation already, for Dynamics to follow.
+MAX_KEYS = MAX_INBETWEEN_KEYS
 #: Frames from the first key to the last at most: the solve's time and memory grow with them (every
 #: substep between is an unknown).
 MAX_SPAN = 2000
