@@ -59,7 +59,9 @@ scene.render.resolution_x = scene.render.resolution_y = 64
 scene.render.resolution_percentage = 100
 scene.world.use_nodes = True
 scene.world.node_tree.nodes["Background"].inputs[1].default_value = 0.0
-scene.render.image_settings.file_format = "PNG"
+# BMP, read here: Blender under Wine cannot load an image file back (it maps the file).
+scene.render.image_settings.file_format = "BMP"
+scene.render.image_settings.color_mode = "RGB"
 seen = []
 
 
@@ -71,14 +73,27 @@ def record(scene_, depsgraph=None):  # after the add-on's handler: what the rend
 bpy.app.handlers.frame_change_post.append(record)
 
 
+def read_bmp(path):
+    """A 24-bit BMP's pixels (rows bottom first, columns, RGB) in [0, 1]."""
+    data = np.fromfile(path, np.uint8)
+
+    def field(start, size):
+        return int.from_bytes(data[start : start + size].tobytes(), "little", signed=True)
+
+    offset, width, height, bits = field(10, 4), field(18, 4), field(22, 4), field(28, 2)
+    assert bits == 24 and height > 0, (bits, height)
+    stride = (3 * width + 3) // 4 * 4
+    rows = data[offset : offset + stride * height].reshape(height, stride)[:, : 3 * width]
+    return rows.reshape(height, width, 3)[..., ::-1] / 255.0
+
+
 def render(name):
-    """Frame 6 rendered as an animation of one frame, its pixels (rows, columns, RGBA)."""
+    """Frame 6 rendered as an animation of one frame, its pixels (rows, columns, RGB)."""
     scene.frame_start = scene.frame_end = 6
     scene.render.filepath = support.tmp(name + "_")
     assert bpy.ops.render.render(animation=True) == {"FINISHED"}
-    image = bpy.data.images.load(support.tmp(name + "_0006.png"))
-    pixels = np.array(image.pixels[:]).reshape(64, 64, 4)
-    bpy.data.images.remove(image)
+    pixels = read_bmp(support.tmp(name + "_0006.bmp"))
+    assert pixels.shape == (64, 64, 3), pixels.shape
     return pixels
 
 
