@@ -32,9 +32,34 @@ PREFIX = ".Modal Deform "
 _SHAPES = "shapes"
 BAKE_ID = "bake_id"
 
-# Loaded bases by bake id, most recent last: a pose, a solve and the preview share one load.
-_bases = collections.OrderedDict()
-_CACHED_BASES = 2
+
+class RecentLoads:
+    """What was loaded from stored arrays, by bake id, the `size` most recently used kept: a pose,
+    a solve and the preview share one load."""
+
+    def __init__(self, size):
+        self._loads = collections.OrderedDict()
+        self._size = size
+
+    def get(self, bake_id):
+        """The load kept for `bake_id`, or None."""
+        if bake_id not in self._loads:
+            return None
+        self._loads.move_to_end(bake_id)
+        return self._loads[bake_id]
+
+    def keep(self, bake_id, load):
+        self._loads[bake_id] = load
+        self._loads.move_to_end(bake_id)
+        while len(self._loads) > self._size:
+            self._loads.popitem(last=False)
+
+    def clear(self):
+        self._loads.clear()
+
+
+# Loaded bases.
+_bases = RecentLoads(2)
 # Mesh fingerprints for the panel by mesh pointer, and vertex group hashes by (mesh pointer, group
 # name), dropped when the depsgraph reports new geometry (weight painting is a geometry update).
 _fingerprints = {}
@@ -169,7 +194,7 @@ def store(obj, basis, mesh_fingerprint, vertex_groups, seconds, energy):
     bake_id = block[BAKE_ID]
 
     settings = obj.modal_deform
-    _release(settings)
+    release(settings, "basis")
     settings.basis = block
     status = settings.status
     status.dimension = basis.dimension
@@ -186,28 +211,23 @@ def store(obj, basis, mesh_fingerprint, vertex_groups, seconds, energy):
     for setting in GROUPS:
         setattr(status, setting, vertex_groups.names[setting])
         setattr(status, setting + "_hash", vertex_groups.hashes[setting])
-    _remember(bake_id, basis)
+    _bases.keep(bake_id, basis)
 
 
 def clear(obj):
     """Forget obj's basis (the datablock goes when no other object uses it)."""
     settings = obj.modal_deform
-    _release(settings)
+    release(settings, "basis")
     settings.property_unset("status")
 
 
-def _release(settings):
-    block = settings.basis
-    settings.basis = None
+def release(owner, name):
+    """Point owner's datablock property `name` at nothing; the datablock goes when nothing else
+    uses it (and it is not linked from a library)."""
+    block = getattr(owner, name)
+    setattr(owner, name, None)
     if block is not None and block.users == 0 and block.library is None:
         bpy.data.palettes.remove(block)
-
-
-def _remember(bake_id, basis):
-    _bases[bake_id] = basis
-    _bases.move_to_end(bake_id)
-    while len(_bases) > _CACHED_BASES:
-        _bases.popitem(last=False)
 
 
 def load(obj):
@@ -216,14 +236,14 @@ def load(obj):
     if block is None:
         raise NotReady(f"'{obj.name}' has no baked basis: bake it first")
     bake_id = block.get(BAKE_ID)
-    if bake_id in _bases:
-        _bases.move_to_end(bake_id)
-        return _bases[bake_id]
+    loaded = _bases.get(bake_id)
+    if loaded is not None:
+        return loaded
     try:
         basis = mdc.Basis.from_arrays(read_arrays(block))
     except (KeyError, TypeError, ValueError, AttributeError) as error:
         raise NotReady(f"the basis stored for '{obj.name}' is damaged ({error}): re-bake") from None
-    _remember(bake_id, basis)
+    _bases.keep(bake_id, basis)
     return basis
 
 

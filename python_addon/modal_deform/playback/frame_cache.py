@@ -262,11 +262,7 @@ def create(obj, scene, start):
 
 def free(obj):
     """Forget obj's cache (the datablock goes when no other object uses it)."""
-    dynamics = obj.modal_deform.dynamics
-    block = dynamics.cache
-    dynamics.cache = None
-    if block is not None and block.users == 0 and block.library is None:
-        bpy.data.palettes.remove(block)
+    storage.release(obj.modal_deform.dynamics, "cache")
 
 
 def outdated(cache, obj, signature_now):

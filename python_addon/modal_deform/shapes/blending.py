@@ -21,7 +21,6 @@ so the mesh shows Blender's own mix, and the panel says why (problems). Dynamics
 wins: while it plays (enabled, or a cache) its frames show and the blend waits.
 """
 
-import collections
 import time
 
 import bpy
@@ -40,9 +39,8 @@ DYNAMICS_WINS = (
     "and Free its cache to see the blend"
 )
 
-# Loaded spaces by bake id, most recent last.
-_spaces = collections.OrderedDict()
-_CACHED_SPACES = 2
+# Loaded spaces by bake id.
+_spaces = storage.RecentLoads(2)
 # By object name: (bake id, weights bytes) of the blend shown; the keys last compared with the
 # digest (bake id, vertex and corner counts, copies of the arrays, Relative To names) and the stale
 # reason found then; the problem that keeps the blend from showing, and a note on the blend shown
@@ -59,14 +57,14 @@ def store(obj, space, digest, names, seconds):
     """Keep `space` (baked of obj's keys `names`, whose keys.digest was `digest`) as obj's space."""
     block = storage.write_arrays(PREFIX + obj.name, space.to_arrays())
     settings = obj.modal_deform.shapes
-    _release(settings)
+    storage.release(settings, "space")
     settings.space = block
     settings.key_names = "\n".join(names)
     settings.keys_digest = digest
     settings.dimension = space.dimension
     settings.baked_at = time.strftime("%Y-%m-%d %H:%M")
     settings.seconds = seconds
-    _remember(block[storage.BAKE_ID], space)
+    _spaces.keep(block[storage.BAKE_ID], space)
     _shown.pop(obj.name, None)
 
 
@@ -74,23 +72,9 @@ def clear(obj):
     """Forget obj's space and turn Blend as Shapes off (the mesh shows Blender's mix)."""
     settings = obj.modal_deform.shapes
     settings.enabled = False
-    _release(settings)
+    storage.release(settings, "space")
     for name in ("key_names", "keys_digest", "dimension", "baked_at", "seconds"):
         settings.property_unset(name)
-
-
-def _release(settings):
-    block = settings.space
-    settings.space = None
-    if block is not None and block.users == 0 and block.library is None:
-        bpy.data.palettes.remove(block)
-
-
-def _remember(bake_id, space):
-    _spaces[bake_id] = space
-    _spaces.move_to_end(bake_id)
-    while len(_spaces) > _CACHED_SPACES:
-        _spaces.popitem(last=False)
 
 
 def space_names(obj):
@@ -104,16 +88,16 @@ def load(obj):
     if block is None:
         raise storage.NotReady(f"'{obj.name}': its shape keys are not baked as shapes: Bake")
     bake_id = block.get(storage.BAKE_ID)
-    if bake_id in _spaces:
-        _spaces.move_to_end(bake_id)
-        return _spaces[bake_id]
+    loaded = _spaces.get(bake_id)
+    if loaded is not None:
+        return loaded
     try:
         space = mdc.ShapeSpace.from_arrays(storage.read_arrays(block))
     except (KeyError, TypeError, ValueError, AttributeError) as error:
         raise storage.NotReady(
             f"the shape space stored for '{obj.name}' is damaged ({error}): re-bake"
         ) from None
-    _remember(bake_id, space)
+    _spaces.keep(bake_id, space)
     return space
 
 
