@@ -9,6 +9,7 @@ import bpy
 import numpy as np
 from mathutils import Quaternion
 from support import blender as support
+from support import rig as rig_support
 
 timeline, frame_display, handles, mdc = support.enable_addon(
     "playback.timeline", "playback.frame_display", "handles", "core"
@@ -23,33 +24,16 @@ assert bpy.ops.modal_deform.bake() == {"FINISHED"}
 size = np.ptp(V, axis=0).max()
 
 # The armature: the chain along z, and a root bone of another chain beside it, deforming nothing.
-rig = bpy.data.objects.new("Rig", bpy.data.armatures.new("Rig"))
-scene.collection.objects.link(rig)
-rig.matrix_world = obj.matrix_world
+rig = rig_support.chain_armature("Rig", BONES, LENGTH, obj.matrix_world)
 view_layer.objects.active = rig
 bpy.ops.object.mode_set(mode="EDIT")
-parent = None
-for b in range(BONES):
-    bone = rig.data.edit_bones.new(f"Bone{b}")
-    bone.head, bone.tail = (0, 0, b * LENGTH / BONES), (0, 0, (b + 1) * LENGTH / BONES)
-    bone.parent, bone.use_connect = parent, parent is not None
-    parent = bone
 other = rig.data.edit_bones.new("Other")
 other.head, other.tail, other.use_deform = (1, 0, 0), (1, 0, 1), False
 bpy.ops.object.mode_set(mode="OBJECT")
 view_layer.objects.active = obj
 
 # Weights along z, linear between the bones' centres; an Armature modifier.
-centres = (np.arange(BONES) + 0.5) * LENGTH / BONES
-k = np.clip(np.searchsorted(centres, V[:, 2]) - 1, 0, BONES - 2)
-t = np.clip((V[:, 2] - centres[k]) / (centres[k + 1] - centres[k]), 0.0, 1.0)
-for b in range(BONES):
-    group = obj.vertex_groups.new(name=f"Bone{b}")
-    for i in range(len(V)):
-        w = (1 - t[i]) * (k[i] == b) + t[i] * (k[i] + 1 == b)
-        if w > 0:
-            group.add([i], float(w), "REPLACE")
-obj.modifiers.new("Armature", "ARMATURE").object = rig
+rig_support.skin(obj, rig, rig_support.chain_weights(V[:, 2], BONES, LENGTH))
 obj.parent = rig
 obj.matrix_parent_inverse = rig.matrix_world.inverted()
 dynamics = obj.modal_deform.dynamics

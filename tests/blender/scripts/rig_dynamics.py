@@ -15,6 +15,7 @@ import bpy
 import numpy as np
 from mathutils import Quaternion
 from support import blender as support
+from support import rig as rig_support
 
 timeline, frame_cache, frame_display, frame_keys, rig_module, ui, mdc = support.enable_addon(
     "playback.timeline",
@@ -35,44 +36,18 @@ assert bpy.ops.modal_deform.bake() == {"FINISHED"}
 size = np.ptp(V, axis=0).max()
 
 
-def chain_weights(z, bones=BONES, length=LENGTH):
-    """(n, bones): a partition of unity along z, linear between the bones' centres."""
-    centres = (np.arange(bones) + 0.5) * length / bones
-    W = np.zeros((len(z), bones))
-    k = np.clip(np.searchsorted(centres, z) - 1, 0, bones - 2)
-    t = np.clip((z - centres[k]) / (centres[k + 1] - centres[k]), 0.0, 1.0)
-    W[np.arange(len(z)), k], W[np.arange(len(z)), k + 1] = 1 - t, t
-    return W
-
-
-def make_armature(name, bones=BONES, length=LENGTH):
+def make_armature(name, bones=BONES):
     """An armature object placed as the mesh object, a chain of `bones` bones along z."""
-    armature = bpy.data.objects.new(name, bpy.data.armatures.new(name))
-    scene.collection.objects.link(armature)
-    armature.matrix_world = obj.matrix_world
-    view_layer.objects.active = armature
-    bpy.ops.object.mode_set(mode="EDIT")
-    parent = None
-    for b in range(bones):
-        bone = armature.data.edit_bones.new(f"Bone{b}")
-        bone.head, bone.tail = (0, 0, b * length / bones), (0, 0, (b + 1) * length / bones)
-        bone.parent, bone.use_connect = parent, parent is not None
-        parent = bone
-    bpy.ops.object.mode_set(mode="OBJECT")
-    view_layer.objects.active = obj
-    return armature
+    return rig_support.chain_armature(name, bones, LENGTH, obj.matrix_world)
 
 
 def weight(target, armature, bones=BONES):
     """Vertex groups named like the bones, weights by chain_weights, and an Armature modifier."""
-    W = chain_weights(V[:, 2], bones)
-    for b in range(bones):
-        group = target.vertex_groups.get(f"Bone{b}") or target.vertex_groups.new(name=f"Bone{b}")
-        for i in np.flatnonzero(W[:, b] > 0):
-            group.add([int(i)], float(W[i, b]), "REPLACE")
-    modifier = target.modifiers.new("Armature", "ARMATURE")
-    modifier.object = armature
-    return modifier
+    return rig_support.skin(target, armature, chain_weights(V[:, 2], bones))
+
+
+def chain_weights(z, bones=BONES):
+    return rig_support.chain_weights(z, bones, LENGTH)
 
 
 rig = make_armature("Rig")
@@ -438,11 +413,7 @@ for group in list(big.vertex_groups):
         big.vertex_groups.remove(group)
 big.modifiers.remove(big.modifiers["Armature"])
 W = chain_weights(V[:, 2], 200)
-for b in range(200):
-    group = big.vertex_groups.new(name=f"Bone{b}")
-    for i in np.flatnonzero(W[:, b] > 0):
-        group.add([int(i)], float(W[i, b]), "REPLACE")
-big.modifiers.new("Armature", "ARMATURE").object = many
+rig_support.skin(big, many, W)
 big.parent, big.matrix_parent_inverse = many, many.matrix_world.inverted()
 many.keyframe_insert("rotation_euler", frame=1)
 many.rotation_euler.x = 0.5

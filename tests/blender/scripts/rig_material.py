@@ -7,6 +7,7 @@ the bit, while inside it lags as on the whole mesh."""
 import bpy
 import numpy as np
 from support import blender as support
+from support import rig as rig_support
 
 timeline, frame_display, mdc = support.enable_addon(
     "playback.timeline", "playback.frame_display", "core"
@@ -24,17 +25,7 @@ for name in ("Stiff top", "Top region"):
     scene.collection.objects.link(tube)
     tubes.append(tube)
 
-armature = bpy.data.objects.new("Rig", bpy.data.armatures.new("Rig"))
-scene.collection.objects.link(armature)
-view_layer.objects.active = armature
-bpy.ops.object.mode_set(mode="EDIT")
-parent = None
-for b in range(BONES):
-    bone = armature.data.edit_bones.new(f"Bone{b}")
-    bone.head, bone.tail = (0, 0, b * LENGTH / BONES), (0, 0, (b + 1) * LENGTH / BONES)
-    bone.parent, bone.use_connect = parent, parent is not None
-    parent = bone
-bpy.ops.object.mode_set(mode="OBJECT")
+armature = rig_support.chain_armature("Rig", BONES, LENGTH)
 
 # Weights: each vertex to the bone along it (rigid segments), so that skinning alone moves nothing
 # relative to the bones and the lag is the simulation's.
@@ -48,9 +39,7 @@ def group(tube, name, indices, weight=1.0):
 
 
 for tube in tubes:
-    for b in range(BONES):
-        group(tube, f"Bone{b}", np.flatnonzero(bone_of == b))
-    tube.modifiers.new("Armature", "ARMATURE").object = armature
+    rig_support.skin(tube, armature, np.eye(BONES)[bone_of])
     tube.parent = armature
     settings = tube.modal_deform
     settings.modes, settings.derivatives, settings.ghost = 12, 20, 300
