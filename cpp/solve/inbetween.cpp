@@ -19,8 +19,7 @@ namespace {
 
 // The key penalty's weight against the motion's own terms at a key node (traces of the normal
 // matrix's blocks): the keys' fits are met within about its inverse of what the motion would
-// rather do; higher slows the quasi-Newton iteration on large motions (1e6 stalled where 1e4
-// converges in 20 iterations: the bar, its end moved by 5% of its length in 6 frames).
+// rather do; higher stiffens the problem and slows the quasi-Newton iteration on large motions.
 constexpr double kKeyDominance = 1e4;
 // The static poses (posing's minima): BFGS iterations at most.
 constexpr int kPoseIterations = 1000;
