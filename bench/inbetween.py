@@ -24,7 +24,7 @@ import numpy as np
 from dynamics import tail_and_head
 from shapes import rigid_transform as rigid
 from support import SHARED_MESHES as MESHES
-from support.inbetween import free_motion_keys, rigid_fit
+from support.inbetween import free_motion_keys
 
 import modal_deform.core as mdc
 
@@ -74,7 +74,7 @@ def solve_cost(basis, V, handles, frames):
 
 
 def key_error(V, handle, X, T):
-    fit = rigid_fit(V[handle], X[handle])
+    fit = mdc.rigid_fit(V[handle], X[handle])
     return float(np.linalg.norm(V[handle] @ (fit - T)[:3, :3].T + (fit - T)[:3, 3], axis=1).max())
 
 

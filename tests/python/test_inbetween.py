@@ -4,7 +4,7 @@ import warnings
 
 import numpy as np
 import pytest
-from support.inbetween import free_motion_keys, rigid_fit
+from support.inbetween import free_motion_keys
 from support.poses import translation
 
 import modal_deform.core as mdc
@@ -51,7 +51,7 @@ def test_free_motion_is_reproduced(bar):
 
 def key_error(V, handle, X, T):
     """How far the rigid fit of the handle's vertices at X takes them from where T puts them."""
-    fit = rigid_fit(V[handle], X[handle])
+    fit = mdc.rigid_fit(V[handle], X[handle])
     return np.linalg.norm(V[handle] @ (fit - T)[:3, :3].T + (fit - T)[:3, 3], axis=1).max()
 
 
@@ -183,5 +183,5 @@ def test_rigid_fit_recovers_a_rigid_motion():
         np.linalg.det(np.linalg.qr(rng.normal(size=(3, 3)))[0])
     )
     moved = points @ T[:3, :3].T + T[:3, 3]
-    fitted = rigid_fit(points, moved)
+    fitted = mdc.rigid_fit(points, moved)
     np.testing.assert_allclose(points @ fitted[:3, :3].T + fitted[:3, 3], moved, atol=1e-12)

@@ -7,20 +7,6 @@ import numpy as np
 import modal_deform.core as mdc
 
 
-def rigid_fit(rest, moved):
-    """The rigid 4x4 transform T minimising Σ ‖T rest_i − moved_i‖² (Kabsch: the rotation from the
-    SVD of the centred points' covariance, a reflection turned into a rotation)."""
-    rest = np.asarray(rest, dtype=np.float64)
-    moved = np.asarray(moved, dtype=np.float64)
-    a, b = rest.mean(axis=0), moved.mean(axis=0)
-    U, _, Vt = np.linalg.svd((moved - b).T @ (rest - a))
-    D = np.diag([1.0, 1.0, np.sign(np.linalg.det(U @ Vt))])
-    T = np.eye(4)
-    T[:3, :3] = U @ D @ Vt
-    T[:3, 3] = b - T[:3, :3] @ a
-    return T
-
-
 def free_motion_keys(basis, handles, start, frames, key_frames, **parameters):
     """A free body released at rest from posing's minimum with `handles` at `start` (one 4x4 each),
     stepped `frames` frames by Simulation: its positions at frames 0 … frames, and the keys at
@@ -34,5 +20,5 @@ def free_motion_keys(basis, handles, start, frames, key_frames, **parameters):
     for _ in range(frames):
         positions.append(sim.step([]).copy())
     rest = basis.rest
-    keys = [(f, [rigid_fit(rest[h], positions[f][h]) for h in handles]) for f in key_frames]
+    keys = [(f, [mdc.rigid_fit(rest[h], positions[f][h]) for h in handles]) for f in key_frames]
     return np.array(positions), keys

@@ -29,8 +29,9 @@ from .solve import (
     solve_full,
 )
 from .solve import nearest_rigid as nearest_rigid
+from .solve import rigid_fit as rigid_fit
 
-# FrameBudget, bake_fraction and nearest_rigid serve the add-on, testing the tests: mdc.<name>
+# FrameBudget, bake_fraction, nearest_rigid and rigid_fit serve the add-on, testing the tests: mdc.<name>
 # works (imported `as` themselves, re-exported), __all__ leaves them out.
 __all__ = [
     "Arap",

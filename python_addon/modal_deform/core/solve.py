@@ -41,6 +41,21 @@ def nearest_rigid(matrix, centre):
     return _native.nearest_rigid(M, _arrays.values(centre, "centre", 3))
 
 
+def rigid_fit(rest, moved):
+    """The rigid 4x4 transform T minimising Σ ‖T rest_i − moved_i‖² over the points ``rest`` and
+    ``moved`` ((n, 3) each), float64: a handle's rigid part in a motion (Kabsch: the rotation from
+    the SVD of the centred points' covariance, a reflection turned into a rotation)."""
+    rest = np.asarray(rest, dtype=np.float64)
+    moved = np.asarray(moved, dtype=np.float64)
+    a, b = rest.mean(axis=0), moved.mean(axis=0)
+    U, _, Vt = np.linalg.svd((moved - b).T @ (rest - a))
+    D = np.diag([1.0, 1.0, np.sign(np.linalg.det(U @ Vt))])
+    T = np.eye(4)
+    T[:3, :3] = U @ D @ Vt
+    T[:3, 3] = b - T[:3, :3] @ a
+    return T
+
+
 class ReducedSolver(_inputs.InBasis):
     """BFGS in a baked basis: x = x̄ + U q, energy on the ghost, handles exact on the fine mesh.
 

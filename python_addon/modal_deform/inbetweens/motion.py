@@ -52,17 +52,6 @@ def is_fresh(cache, wanted):
     return cache.kind == "INBETWEEN" and (cache.signature, cache.block["keys_digest"]) == wanted
 
 
-def rigid_fit(rest, moved):
-    """The rigid 4x4 T minimising Σ ‖T rest_i − moved_i‖² (Kabsch)."""
-    a, b = rest.mean(axis=0), moved.mean(axis=0)
-    U, _, Vt = np.linalg.svd((moved - b).T @ (rest - a))
-    D = np.diag([1.0, 1.0, np.sign(np.linalg.det(U @ Vt))])
-    T = np.eye(4)
-    T[:3, :3] = U @ D @ Vt
-    T[:3, 3] = b - T[:3, :3] @ a
-    return T
-
-
 def key_errors(inbetween, rest, keyed_handles, keys):
     """[(frame, handle name, error)]: how far each keyed handle's rigid fit at its key lies from the
     keyed transform (the largest distance over its vertices), as a fraction of the mesh's diagonal."""
@@ -74,7 +63,7 @@ def key_errors(inbetween, rest, keyed_handles, keys):
             if T is None:
                 continue
             points = np.c_[rest[handle.indices], np.ones(len(handle.indices))]
-            fit = rigid_fit(rest[handle.indices], X[handle.indices])
+            fit = mdc.rigid_fit(rest[handle.indices], X[handle.indices])
             miss = np.linalg.norm(points @ (fit - T)[:3].T, axis=1).max()
             errors.append((frame, handle.name, float(miss / diagonal)))
     return errors

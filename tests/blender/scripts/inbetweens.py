@@ -9,12 +9,13 @@ import numpy as np
 from mathutils import Euler
 from support import blender as support
 
-frame_cache, timeline, handles, motion, keys_ = support.enable_addon(
+frame_cache, timeline, handles, motion, keys_, mdc = support.enable_addon(
     "playback.frame_cache",
     "playback.timeline",
     "handles",
     "inbetweens.motion",
     "inbetweens.keys",
+    "core",
 )
 obj, V = support.baked_suzanne(1, 12, 20, 400)
 diagonal = np.linalg.norm(np.ptp(V, axis=0))
@@ -45,7 +46,7 @@ def keyed_transform(frame):
 def head_error(X, T):
     """How far the head handle's rigid fit in X lies from T, over the mesh's diagonal."""
     rest = V[head_indices].astype(np.float64)
-    fit = motion.rigid_fit(rest, X[head_indices].astype(np.float64))
+    fit = mdc.rigid_fit(rest, X[head_indices].astype(np.float64))
     points = np.c_[rest, np.ones(len(rest))]
     return np.linalg.norm(points @ (fit - T)[:3].T, axis=1).max() / diagonal
 

@@ -9,13 +9,14 @@ import numpy as np
 from mathutils import Euler
 from support import blender as support
 
-frame_cache, timeline, handles, motion, keys_, point_cache = support.enable_addon(
+frame_cache, timeline, handles, motion, keys_, point_cache, mdc = support.enable_addon(
     "playback.frame_cache",
     "playback.timeline",
     "handles",
     "inbetweens.motion",
     "inbetweens.keys",
     "playback.point_cache",
+    "core",
 )
 scene, view_layer = bpy.context.scene, bpy.context.view_layer
 obj, V = support.baked_suzanne(1, 12, 20, 400)
@@ -81,7 +82,7 @@ for frame, transforms in keys:
         if T is None:
             continue
         rest = V[handle.indices].astype(np.float64)
-        fit = motion.rigid_fit(rest, shown[frame][handle.indices].astype(np.float64))
+        fit = mdc.rigid_fit(rest, shown[frame][handle.indices].astype(np.float64))
         error = np.linalg.norm(np.c_[rest, np.ones(len(rest))] @ (fit - T)[:3].T, axis=1).max()
         print(f"key at frame {frame}, {handle.name}: within {error / diagonal:.2e} of the diagonal")
         assert error < 0.01 * diagonal, (frame, handle.name, error / diagonal)
@@ -89,7 +90,7 @@ for frame, transforms in keys:
 scene.frame_set(10)
 interpolated = handles.transforms(obj, player.handles)[1]
 rest = V[player.handles[1].indices].astype(np.float64)
-fit = motion.rigid_fit(rest, shown[10][player.handles[1].indices].astype(np.float64))
+fit = mdc.rigid_fit(rest, shown[10][player.handles[1].indices].astype(np.float64))
 assert np.abs(fit - interpolated).max() > 1e-3, "the ear follows its curve between its keys"
 
 # Export Mesh Cache: the frames the timeline shows.
