@@ -109,6 +109,28 @@ def playback_handler(name):
     )
 
 
+class HandlerClock:
+    """Clocks read just before and just after the add-on's frame handler (``before``, ``after``,
+    perf_counter seconds), by handlers put around it in frame_change_post until ``remove()``."""
+
+    def __init__(self):
+        self.before = self.after = None
+        handlers = bpy.app.handlers.frame_change_post
+        add_on_handler = playback_handler("frame_change_post")
+        handlers.insert(list(handlers).index(add_on_handler), self._before)
+        handlers.insert(list(handlers).index(add_on_handler) + 1, self._after)
+
+    def _before(self, *args):
+        self.before = time.perf_counter()
+
+    def _after(self, *args):
+        self.after = time.perf_counter()
+
+    def remove(self):
+        bpy.app.handlers.frame_change_post.remove(self._before)
+        bpy.app.handlers.frame_change_post.remove(self._after)
+
+
 def timed_frames(
     obj, scene, timeline, frame_cache, frames, stepping=False, rounds=ROUNDS, playing=True
 ):
@@ -124,18 +146,7 @@ def timed_frames(
     leaves out the time a neighbour on this shared machine takes from a frame (a frame is the same
     work in every round)."""
     scratch = np.empty((len(obj.data.vertices), 3), np.float32)
-    handlers = bpy.app.handlers.frame_change_post
-    clock = {}
-
-    def before(*args):
-        clock["before"] = time.perf_counter()
-
-    def after(*args):
-        clock["after"] = time.perf_counter()
-
-    add_on_handler = playback_handler("frame_change_post")
-    handlers.insert(list(handlers).index(add_on_handler), before)
-    handlers.insert(list(handlers).index(add_on_handler) + 1, after)
+    clock = HandlerClock()
     figures = {
         name: np.full((rounds, len(frames)), np.inf)
         for name in ("handler", "map", "evaluate", "step")
@@ -151,8 +162,8 @@ def timed_frames(
                 scene.frame_set(frame)
                 returned = time.perf_counter()
                 assert obj.name not in timeline.problems, timeline.problems
-                figures["handler"][round_, index] = 1e3 * (clock["after"] - clock["before"])
-                figures["evaluate"][round_, index] = 1e3 * (returned - clock["after"])
+                figures["handler"][round_, index] = 1e3 * (clock.after - clock.before)
+                figures["evaluate"][round_, index] = 1e3 * (returned - clock.after)
                 if stepping:
                     stats = timeline.player(obj, scene).simulation.stats
                     figures["step"][round_, index] = stats["ms"]
@@ -162,8 +173,7 @@ def timed_frames(
                 timeline.player(obj, scene).positions(q, scratch)
                 figures["map"][round_, index] = 1e3 * (time.perf_counter() - start)
     finally:
-        handlers.remove(before)
-        handlers.remove(after)
+        clock.remove()
         if playing:
             playback_handler("animation_playback_post")(scene, None)
     least = {name: float(np.median(values.min(axis=0))) for name, values in figures.items()}
@@ -343,18 +353,7 @@ def timed_rig_frames(obj, scene, timeline, frame_cache, frames, rounds=ROUNDS):
     mesh with its new offset: the display's Geometry Nodes modifier, then the Armature modifier),
     and the step's own milliseconds (Simulation.stats). Each: the median over the frames of its
     least over `rounds` rounds."""
-    handlers = bpy.app.handlers.frame_change_post
-    clock = {}
-
-    def before(*args):
-        clock["before"] = time.perf_counter()
-
-    def after(*args):
-        clock["after"] = time.perf_counter()
-
-    add_on_handler = playback_handler("frame_change_post")
-    handlers.insert(list(handlers).index(add_on_handler), before)
-    handlers.insert(list(handlers).index(add_on_handler) + 1, after)
+    clock = HandlerClock()
     names = ("before", "handler", *RIG_PARTS, "other", "evaluate", "step_native")
     figures = {name: np.full((rounds, len(frames)), np.inf) for name in names}
     player = timeline.player(obj, scene)
@@ -370,21 +369,20 @@ def timed_rig_frames(obj, scene, timeline, frame_cache, frames, rounds=ROUNDS):
                 returned = time.perf_counter()
                 assert obj.name not in timeline.problems, timeline.problems
                 assert timeline.player(obj, scene) is player, "the Player was made again"
-                handler = 1e3 * (clock["after"] - clock["before"])
+                handler = 1e3 * (clock.after - clock.before)
                 split = parts.take()
                 row = {
-                    "before": 1e3 * (clock["before"] - called),
+                    "before": 1e3 * (clock.before - called),
                     "handler": handler,
                     "other": handler - sum(split.values()),
-                    "evaluate": 1e3 * (returned - clock["after"]),
+                    "evaluate": 1e3 * (returned - clock.after),
                     "step_native": player.simulation.stats["ms"],
                     **split,
                 }
                 for name, value in row.items():
                     figures[name][round_, index] = value
     finally:
-        handlers.remove(before)
-        handlers.remove(after)
+        clock.remove()
         parts.remove()
         playback_handler("animation_playback_post")(scene, None)
     result = {
