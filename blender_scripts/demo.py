@@ -20,6 +20,10 @@ Last, shape keys blended as shapes (issue 52, demo_shapes.py): a Suzanne with a 
 ears-fold key, both at 0.5, as Blender mixes them and as Blend as Shapes blends them, with the keys at
 1, OUTPUT/demo_shapes.png.
 
+And in-betweens (issue 51, demo_inbetweens.py): Suzanne's head keyed at three poses only, moved
+through them by Dynamics > In-betweens above the same frames as Blender interpolates the keys,
+with a plot of her ear tip's height over the frames, OUTPUT/demo_inbetweens.png.
+
 Writes OUTPUT/demo.png (Cycles on the CPU: rest, Modal Deform, Laplacian Deform side by side; below
 them the uniform and the painted finger and the ear) and OUTPUT/demo.blend (Suzanne alone), ready to
 pose: select the mesh, Sidebar > Modal Deform > Pose, then move the
@@ -40,6 +44,7 @@ from mathutils import Matrix, Vector
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import demo_dynamics  # noqa: E402
+import demo_inbetweens  # noqa: E402
 import demo_rig  # noqa: E402
 import demo_shapes  # noqa: E402
 from headless import add_handle, bind_laplacian_deform, enable_addon, evaluated_positions  # noqa: E402
@@ -82,6 +87,12 @@ def arguments():
         type=int,
         default=2,
         help="Catmull-Clark levels of the shape keys' Suzanne (2: ~8k vertices)",
+    )
+    parser.add_argument(
+        "--inbetweens-subdivisions",
+        type=int,
+        default=2,
+        help="Catmull-Clark levels of the in-betweens' Suzanne (2: ~8k vertices)",
     )
     return parser.parse_args(argv)
 
@@ -353,6 +364,16 @@ def main():
         tuple(modules), output, args.shapes_subdivisions, args.width // 2
     )
     print(f"rendered {strip} (shape keys blended as shapes) in {time.perf_counter() - start:.1f} s")
+
+    start = time.perf_counter()
+    modules = (
+        importlib.import_module(f"{addon}.{name}")
+        for name in ("playback.frame_cache", "inbetweens.motion")
+    )
+    strip = demo_inbetweens.inbetweens(
+        tuple(modules), output, args.inbetweens_subdivisions, args.width // 2
+    )
+    print(f"rendered {strip} (in-betweens) in {time.perf_counter() - start:.1f} s")
 
 
 main()

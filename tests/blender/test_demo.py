@@ -1,6 +1,8 @@
 """`make demo`'s script (blender_scripts/demo.py), small: it runs to its end in the Blender app that
-`make demo` runs, writes its .blend and pictures, Suzanne's ears overshoot and settle, and her
-ears blended as shapes at 0.5 keep more of their length than Blender's mix."""
+`make demo` runs, writes its .blend and pictures, Suzanne's ears overshoot and settle, her
+ears blended as shapes at 0.5 keep more of their length than Blender's mix, and her ear tip with
+In-betweens is flung past the last key's pose, where Blender's interpolation stops, and settles
+there."""
 
 import re
 
@@ -9,7 +11,9 @@ from conftest import BLENDER_PYTHON, ROOT
 
 
 @pytest.mark.skipif(BLENDER_PYTHON is not None, reason="make demo runs the Blender app")
-def test_demo_runs_the_ears_overshoot_and_settle_and_blend_as_shapes(run_blender, tmp_path):
+def test_demo_runs_the_ears_overshoot_and_settle_and_blend_as_shapes_and_in_between(
+    run_blender, tmp_path
+):
     output = tmp_path / "out"
     result = run_blender(
         ROOT / "blender_scripts" / "demo.py",
@@ -25,8 +29,17 @@ def test_demo_runs_the_ears_overshoot_and_settle_and_blend_as_shapes(run_blender
         1,
         "--shapes-subdivisions",
         1,
+        "--inbetweens-subdivisions",
+        1,
     )
-    for name in ("demo.blend", "demo.png", "demo_dynamics.png", "demo_shapes.png"):
+    for name in (
+        "demo.blend",
+        "demo.png",
+        "demo_dynamics.png",
+        "demo_rig.png",
+        "demo_shapes.png",
+        "demo_inbetweens.png",
+    ):
         assert (output / name).stat().st_size > 0, name
     found = re.search(
         r"the ears' way from rest \(0\) to where they settle \(1\), frames 1 to \d+: ([\d. ]+)",
@@ -45,3 +58,11 @@ def test_demo_runs_the_ears_overshoot_and_settle_and_blend_as_shapes(run_blender
     rest, key, mix, blend = (float(value) for value in found.groups())
     assert abs(key - rest) < 1e-3 * rest, (rest, key)
     assert mix < 0.5 * rest and blend > 0.7 * rest, (rest, mix, blend)
+    found = re.search(
+        r"the ear tip rises ([\d.]+) above where Blender's interpolation holds it and settles "
+        r"within ([\d.]+) of it",
+        result.stdout,
+    )
+    assert found, result.stdout[-2000:]
+    rises, settled = (float(value) for value in found.groups())
+    assert rises > 0.05 and settled < 0.02, (rises, settled)
