@@ -59,8 +59,8 @@ def test_demo_runs_the_ears_overshoot_and_settle_and_blend_as_shapes_and_in_betw
     assert abs(key - rest) < 1e-3 * rest, (rest, key)
     assert mix < 0.5 * rest and blend > 0.7 * rest, (rest, mix, blend)
     found = re.search(
-        r"the ear tip rises ([\d.]+) above where Blender's interpolation holds it and settles "
-        r"within ([\d.]+) of it",
+        r"the ear tip rises ([\d.]+) \([\d.]+% of her width\) above where Blender's interpolation "
+        r"holds it and settles within ([\d.]+) of it",
         result.stdout,
     )
     assert found, result.stdout[-2000:]
