@@ -41,10 +41,18 @@
 // minima) interpolated linearly per coordinate. Cost, N = frames × substeps: O(N r³) once for the
 // model (and r + 1 ghost gradients a key); an iteration O(N) ghost gradients (4 a substep with
 // damping, 2 without, each O(#ghost vertices · r)) and O(N r²) for the banded solve and the
-// pairs; tens of iterations (bench/results/inbetween.json). The nodes' ghost gradients are
-// independent given the states: each objective and gradient evaluates them in parallel, in
-// fixed runs of consecutive nodes on ghost energies of their own, and sums in node order (the
-// same bits for any thread count).
+// pairs. Small motions converge in tens of iterations; large ones (the bench's dragon, its head
+// swung through 50°) converge linearly and slowly, not within 100 (bench/results/inbetween.json),
+// and the alternatives measured cost more ghost gradients for the same control: the model rebuilt
+// from ∇²V at every node along the motion saves iterations, but its steps still backtrack (the
+// objective departs from any Gauss-Newton model within a step); a truncated Newton method
+// (conjugate gradients on the exact Hessian, its products differences of gradients, the model as
+// preconditioner) needs many products a step. Nor is the start what limits them: the linearised
+// problem through the keys solved exactly (a wiggly spline) needs orders of magnitude more
+// control than the linear interpolation. The nodes' ghost gradients are independent given the
+// states: each objective and gradient evaluates them in parallel, in fixed runs of consecutive
+// nodes on ghost energies of their own, and sums in node order (the same bits for any thread
+// count).
 //
 // Before the first key the motion holds the static pose of that key (ReducedSolver's minimum with
 // the handles keyed there at their transforms, the never-keyed at the identity, the others free)
