@@ -79,8 +79,6 @@ def measure(name, quick):
 
     result.update(
         dimension=space.dimension,
-        cubature_terms=len(space.cubature_terms),
-        cubature_vertices=space.cubature_vertices,
         blend_ms_median=float(np.median(ms)),
         blend_ms_min=float(np.min(ms)),
         solve_ms_median=median("solve_ms"),

@@ -26,15 +26,13 @@ void bind_shapes(py::module_& m) {
            py::arg("basis"), py::arg("keys"))
       // A stored space: its basis (validated when made) and its own arrays.
       .def(py::init([](const Basis& basis, int base_dimension, const Eigen::MatrixXd& coordinates,
-                       const RowMatrixXf& residuals, const std::vector<int>& cubature_terms,
-                       const std::vector<double>& cubature_weights) {
+                       const RowMatrixXf& residuals) {
              py::gil_scoped_release release;
              return std::make_unique<ShapeSpace>(
-                 ShapeSpaceData{basis, base_dimension, coordinates, residuals,
-                                Cubature{cubature_terms, cubature_weights}});
+                 ShapeSpaceData{basis, base_dimension, coordinates, residuals});
            }),
            py::arg("basis"), py::arg("base_dimension"), py::arg("coordinates"),
-           py::arg("residuals"), py::arg("cubature_terms"), py::arg("cubature_weights"))
+           py::arg("residuals"))
       .def(
           "blend",
           [blend_options](ShapeSpace& space, const VectorRef& weights,
@@ -57,19 +55,6 @@ void bind_shapes(py::module_& m) {
       .def_property_readonly("coordinates",
                              [](const ShapeSpace& s) { return s.data().coordinates; })
       .def_property_readonly("residuals", [](const ShapeSpace& s) { return s.data().residuals; })
-      .def_property_readonly("cubature_terms",
-                             [](const ShapeSpace& s) {
-                               const std::vector<int>& terms = s.data().cubature.terms;
-                               return Eigen::VectorXi(Eigen::Map<const Eigen::VectorXi>(
-                                   terms.data(), static_cast<Eigen::Index>(terms.size())));
-                             })
-      .def_property_readonly("cubature_weights",
-                             [](const ShapeSpace& s) {
-                               const std::vector<double>& weights = s.data().cubature.weights;
-                               return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(
-                                   weights.data(), static_cast<Eigen::Index>(weights.size())));
-                             })
-      .def_property_readonly("cubature_vertices", &ShapeSpace::cubature_vertices)
       .def_property_readonly("num_keys", &ShapeSpace::num_keys)
       .def_property_readonly("dimension", &ShapeSpace::dimension)
       .def_property_readonly("num_vertices", &ShapeSpace::num_vertices);

@@ -246,30 +246,22 @@ void add_owned(const Term& term, const double* full, Owned owned, double* out) {
   }
 }
 
-// w f(s) of `term` at x into `value` and, when it has one (s differentiable, f'(s) ≠ 0), its
-// gradient w f'(s) ∇s over its K vertices into `full` (3K): whether it has.
-template <typename Term>
-bool term_gradient(const Term& term, const double* x, double& value, double* full) {
+// Adds w f'(s) ∇s of `term` at x to `out` for its vertices in `owned`; returns w f(s).
+template <typename Term, typename Owned>
+double add_gradient(const Term& term, const double* x, Owned owned, double* out) {
   constexpr int K = kVerticesOf<Term>, N = kDofsOf<Term>;
   double r[N];
   relative(term, x, r);
   const auto frame = Term::Quantity::frame(r);
   const Response q = respond(term, frame);
-  value = q.f;
-  if (!q.differentiable || q.df == 0) return false;
-  double g[N];
-  gradient_of(term, q.faded, frame, g);
-  for (double& gi : g) gi *= q.df;
-  to_vertices<K>(g, full);
-  return true;
-}
-
-// Adds w f'(s) ∇s of `term` at x to `out` for its vertices in `owned`; returns w f(s).
-template <typename Term, typename Owned>
-double add_gradient(const Term& term, const double* x, Owned owned, double* out) {
-  double value, full[3 * kVerticesOf<Term>];
-  if (term_gradient(term, x, value, full)) add_owned(term, full, owned, out);
-  return value;
+  if (q.differentiable && q.df != 0) {
+    double g[N], full[3 * K];
+    gradient_of(term, q.faded, frame, g);
+    for (double& gi : g) gi *= q.df;
+    to_vertices<K>(g, full);
+    add_owned(term, full, owned, out);
+  }
+  return q.f;
 }
 
 // Terms that add_gradients_in_lanes evaluates at once: one SSE2 packet of doubles, the wheel's
@@ -557,6 +549,7 @@ DiscreteShells::DiscreteShells(const VerticesRef& V, const FacesRef& F, double b
   require_stiffness_paint(paint, V.rows());
   rest_ = flatten(V);
   const double* x = rest_.data();
+  const int n = static_cast<int>(V.rows());
   const MeshTopology topology = build_topology(V, F);
   // Elements below kCollapse of the mesh's extent have no terms: their derivatives would grow
   // as inverse powers of their size, out of double range.
@@ -612,11 +605,6 @@ DiscreteShells::DiscreteShells(const VerticesRef& V, const FacesRef& F, double b
     hinges_.terms.push_back(term);
   }
 
-  finish_sets();
-}
-
-void DiscreteShells::finish_sets() {
-  const int n = num_vertices();
   std::vector<std::array<int, 2>> pairs;
   std::vector<int> work(n, 0);
   for_each_set([&](const auto& set) {
@@ -697,84 +685,6 @@ void DiscreteShells::blend_rests(const std::vector<const DiscreteShells*>& rests
       term.sin_rest = im / norm;
     }
   }
-}
-
-std::vector<std::array<int, 4>> DiscreteShells::term_vertices() const {
-  std::vector<std::array<int, 4>> vertices;
-  for_each_set([&](const auto& set) {
-    for (const auto& term : set.terms) {
-      std::array<int, 4> v{-1, -1, -1, -1};
-      std::copy(term.vertices.begin(), term.vertices.end(), v.begin());
-      vertices.push_back(v);
-    }
-  });
-  return vertices;
-}
-
-RowMatrixXd DiscreteShells::term_gradients(const VectorRef& x) const {
-  require_positions(x, rest_.size(), "X");
-  const TermCounts counts = term_counts();
-  RowMatrixXd gradients = RowMatrixXd::Zero(counts.edges + counts.triangles + counts.hinges, 12);
-  int row = 0;
-  for_each_set([&](const auto& set) {
-    for (const auto& term : set.terms) {
-      double value;
-      term_gradient(term, x.data(), value, gradients.row(row).data());
-      ++row;
-    }
-  });
-  return gradients;
-}
-
-DiscreteShells DiscreteShells::select_terms(const std::vector<int>& terms,
-                                            const std::vector<double>& factors,
-                                            const std::vector<int>& vertices) const {
-  const TermCounts counts = term_counts();
-  const int total = counts.edges + counts.triangles + counts.hinges, n = num_vertices();
-  if (factors.size() != terms.size())
-    throw InputError(message("select_terms: ", terms.size(), " terms but ", factors.size(),
-                             " factors"));
-  std::vector<int> local(static_cast<size_t>(n), -1);
-  for (size_t i = 0; i < vertices.size(); ++i) {
-    const int v = vertices[i];
-    if (v < 0 || v >= n || local[static_cast<size_t>(v)] >= 0)
-      throw InputError(message("select_terms: vertices[", i, "] = ", v,
-                               " is not a vertex or is listed twice"));
-    local[static_cast<size_t>(v)] = static_cast<int>(i);
-  }
-  std::vector<char> taken(static_cast<size_t>(total), 0);
-  DiscreteShells selected;
-  selected.rest_.resize(3 * static_cast<Eigen::Index>(vertices.size()));
-  for (size_t i = 0; i < vertices.size(); ++i)
-    selected.rest_.segment<3>(3 * static_cast<Eigen::Index>(i)) = rest_.segment<3>(3 * vertices[i]);
-  // Term t of its kind's set: copied with its weight times the factor and its vertices renumbered.
-  const auto take = [&](const auto& from, auto& into, int t, double factor) {
-    auto term = from.terms[static_cast<size_t>(t)];
-    term.weight *= factor;
-    for (int& v : term.vertices) {
-      v = local[static_cast<size_t>(v)];
-      if (v < 0) throw InputError("select_terms: a selected term has a vertex not among vertices");
-    }
-    into.terms.push_back(term);
-  };
-  for (size_t i = 0; i < terms.size(); ++i) {
-    const int t = terms[i];
-    if (t < 0 || t >= total || taken[static_cast<size_t>(t)])
-      throw InputError(message("select_terms: terms[", i, "] = ", t, " is not a term in [0, ",
-                               total, ") or is listed twice"));
-    taken[static_cast<size_t>(t)] = 1;
-    if (!(std::isfinite(factors[i]) && factors[i] >= 0))
-      throw InputError(message("select_terms: factors[", i, "] = ", factors[i],
-                               " is not a finite number ≥ 0"));
-    if (t < counts.edges)
-      take(edges_, selected.edges_, t, factors[i]);
-    else if (t < counts.edges + counts.triangles)
-      take(triangles_, selected.triangles_, t - counts.edges, factors[i]);
-    else
-      take(hinges_, selected.hinges_, t - counts.edges - counts.triangles, factors[i]);
-  }
-  selected.finish_sets();
-  return selected;
 }
 
 DiscreteShells::TermCounts DiscreteShells::term_counts() const {

@@ -132,25 +132,7 @@ class DiscreteShells final : public Energy {
   // How many length, area and bending terms the mesh has (degenerate rest elements have none).
   TermCounts term_counts() const;
 
-  // The terms by one index: the edges, then the triangles, then the hinges, each set in this
-  // energy's order. Each term's vertices (2, 3 or 4; −1 after them).
-  std::vector<std::array<int, 4>> term_vertices() const;
-  // Each term's gradient at x (3n): #terms by 12, row t the gradient of term t over its vertices
-  // in term_vertices' order (3 per vertex, zero after them). Throws InputError for a bad x.
-  RowMatrixXd term_gradients(const VectorRef& x) const;
-  // The energy Σ_t factor_t E_t of `terms` alone (the numbering above; distinct, each factor
-  // finite and ≥ 0) on `vertices` (distinct vertices of this energy, among them every vertex of
-  // those terms): its vertex i is vertices[i], at its rest here; each term keeps its rest, collapse
-  // threshold and fade, its weight times its factor. A cubature's energy (reduction/cubature.h).
-  // Throws InputError for a bad index, vertex or factor.
-  DiscreteShells select_terms(const std::vector<int>& terms, const std::vector<double>& factors,
-                              const std::vector<int>& vertices) const;
-
  private:
-  DiscreteShells() = default;
-  // The sparsity, the partition and each set's order and offsets, from the terms and rest_.
-  void finish_sets();
-
   template <typename Visit>
   void for_each_set(Visit&& visit) const {
     visit(edges_);

@@ -5,13 +5,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <random>
-#include <cstdio>
-#include <cstdlib>
 #include <string>
 
 #include "mesh/normalization.h"
 #include "reduction/ghost.h"
+#include "solve/bfgs.h"
 #include "util/errors.h"
 #include "util/require_positions.h"
 
@@ -172,7 +170,7 @@ ShapeSpace::ShapeSpace(const Basis& basis, const std::vector<RowMatrixX3d>& keys
               .transpose();
   }
   validate_basis(space);
-  prepare(true);
+  prepare();
 }
 
 ShapeSpace::ShapeSpace(ShapeSpaceData data) : data_(std::move(data)) {
@@ -197,222 +195,86 @@ ShapeSpace::ShapeSpace(ShapeSpaceData data) : data_(std::move(data)) {
   if (!data_.residuals.allFinite() ||
       (data_.residuals.array().abs() > static_cast<float>(kMaxCoordinate)).any())
     throw InputError("residuals: an entry is not finite or too large");
-  const Cubature& cubature = data_.cubature;
-  if (cubature.weights.size() != cubature.terms.size())
-    throw InputError(message("cubature: ", cubature.terms.size(), " terms but ",
-                             cubature.weights.size(), " weights"));
-  for (size_t i = 0; i < cubature.terms.size(); ++i) {
-    if (cubature.terms[i] < 0 || (i > 0 && cubature.terms[i] <= cubature.terms[i - 1]))
-      throw InputError(message("cubature: terms[", i, "] = ", cubature.terms[i],
-                               " is negative or not above the term before it"));
-    if (!(std::isfinite(cubature.weights[i]) && cubature.weights[i] > 0))
-      throw InputError(message("cubature: weights[", i, "] = ", cubature.weights[i],
-                               " is not a finite number > 0"));
-  }
-  prepare(false);  // checks the terms against the ghost's
+  prepare();
 }
 
-namespace {
-
-// The ghost's energy at `rest` (3g, normalised frame) with the basis's material.
-std::unique_ptr<DiscreteShells> ghost_energy(const Basis& basis, const Eigen::VectorXd& rest) {
-  const Material material = ghost_material(basis);
-  const Eigen::Index g = basis.ghost_vertices.rows();
-  return std::make_unique<DiscreteShells>(Eigen::Map<const RowMatrixX3d>(rest.data(), g, 3),
-                                          basis.ghost_faces, material.bending, material.membrane,
-                                          material.paint);
-}
-
-// Term t of `from`'s numbering (term_vertices) in `to`'s, by match = from.match_terms(to), and
-// `counts` of each; −1 where `to` has no such term.
-int matched_term(int t, const DiscreteShells::TermMatch& match,
-                 const DiscreteShells::TermCounts& from, const DiscreteShells::TermCounts& to) {
-  if (t < from.edges) return match.edges[t];
-  t -= from.edges;
-  if (t < from.triangles) {
-    const int m = match.triangles[t];
-    return m < 0 ? -1 : to.edges + m;
-  }
-  const int m = match.hinges[t - from.triangles];
-  return m < 0 ? -1 : to.edges + to.triangles + m;
-}
-
-// Training blends of the cubature: each key alone at ½ (the first kTrainingKeys), then
-// kTrainingMixes random mixes (each weight in [0, 1], kept with probability ½), a fixed sequence.
-constexpr int kTrainingKeys = 16;
-const int kTrainingMixes = std::getenv("MD_MIX") ? std::atoi(std::getenv("MD_MIX")) : 24;
-// Points of each training blend's minimisation the fit takes: evenly along its evaluations, from
-// the linear blend to the minimum.
-const int kTrainingPoints = std::getenv("MD_PTS") ? std::atoi(std::getenv("MD_PTS")) : 4;
-// The cubature's fit: the relative residual of the reduced gradients it stops at, and its terms
-// at most.
-constexpr CubatureOptions kCubatureFit{600, 0.02};
-
-std::vector<Eigen::VectorXd> training_weights(Eigen::Index k) {
-  std::vector<Eigen::VectorXd> weights;
-  for (Eigen::Index i = 0; i < std::min<Eigen::Index>(k, kTrainingKeys); ++i)
-    weights.push_back(0.5 * Eigen::VectorXd::Unit(k, i));
-  std::mt19937 random(52);
-  std::uniform_real_distribution<double> uniform(0.0, 1.0);
-  for (int b = 0; b < kTrainingMixes; ++b) {
-    Eigen::VectorXd w(k);
-    for (Eigen::Index i = 0; i < k; ++i) {
-      const double value = uniform(random);
-      w[i] = uniform(random) < 0.5 ? value : 0.0;
-    }
-    weights.push_back(w);
-  }
-  return weights;
-}
-
-}  // namespace
-
-void ShapeSpace::prepare(bool fit) {
+void ShapeSpace::prepare() {
   const Basis& basis = data_.basis;
   const Eigen::Index r = basis.dimension(), k = data_.coordinates.cols();
   num_rigid_ = basis.num_rigid;
   const double s = basis.scale;
+  ghost_rest_ = s * flatten(basis.ghost_vertices);
   ghost_vectors_ = s * basis.ghost_vectors;
-  // Every term of the ghost at each rest.
-  BlendedEnergy full;
-  full.rest = s * flatten(basis.ghost_vertices);
-  full.vectors = ghost_vectors_;
+  const Material material = ghost_material(basis);
+  const Eigen::Index g = basis.ghost_vertices.rows();
+  energies_.clear();
   for (Eigen::Index j = 0; j <= k; ++j) {
-    Eigen::VectorXd rest = full.rest;
+    Eigen::VectorXd rest = ghost_rest_;
     if (j > 0) rest += ghost_vectors_ * data_.coordinates.col(j - 1);
     if (!positions_in_range(rest))
       throw InputError(message(key_name(j - 1), ": its shape is out of range"));
-    full.rests.push_back(ghost_energy(basis, rest));
+    const RowMatrixX3d V = Eigen::Map<const RowMatrixX3d>(rest.data(), g, 3);
+    energies_.push_back(std::make_unique<DiscreteShells>(V, basis.ghost_faces, material.bending,
+                                                         material.membrane, material.paint));
   }
+  blended_ = std::make_unique<DiscreteShells>(
+      Eigen::Map<const RowMatrixX3d>(ghost_rest_.data(), g, 3), basis.ghost_faces, material.bending,
+      material.membrane, material.paint);
+  matches_.clear();
+  for (const auto& energy : energies_) matches_.push_back(blended_->match_terms(*energy));
   const Eigen::MatrixXd free = ghost_vectors_.rightCols(r - num_rigid_);
   rest_hessians_.clear();
   for (Eigen::Index j = 0; j <= k; ++j) {
-    const SparseMatrix H = full.rests[j]->hessian(full.rests[j]->rest());
+    const SparseMatrix H = energies_[j]->hessian(energies_[j]->rest());
     const Eigen::MatrixXd HU = H * free;
     rest_hessians_.push_back(free.transpose() * HU);
   }
   map_ = std::make_unique<FinePositions>(basis);
   q_ = Eigen::VectorXd::Zero(r);
-  full.blended = ghost_energy(basis, full.rest);
-  for (const auto& energy : full.rests) full.matches.push_back(full.blended->match_terms(*energy));
-  full.x.resize(full.rest.size());
-  full.gradient.resize(full.rest.size());
-  if (fit) fit_cubature(full);
-  // The cubature's energies: its terms at each rest, on its terms' vertices (ascending).
-  const Cubature& cubature = data_.cubature;
-  const DiscreteShells& basis_energy = *full.rests[0];
-  const DiscreteShells::TermCounts counts = basis_energy.term_counts();
-  const int total = counts.edges + counts.triangles + counts.hinges;
-  if (!cubature.terms.empty() && cubature.terms.back() >= total)
-    throw InputError(message("cubature: term ", cubature.terms.back(), " is not among the ghost's ",
-                             total, " terms"));
-  const std::vector<std::array<int, 4>> term_vertices = basis_energy.term_vertices();
-  std::vector<int> vertices;
-  for (int t : cubature.terms)
-    for (int v : term_vertices[t])
-      if (v >= 0) vertices.push_back(v);
-  std::sort(vertices.begin(), vertices.end());
-  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
-  BlendedEnergy& energy = cubature_energy_;
-  const Eigen::Index m = static_cast<Eigen::Index>(vertices.size());
-  energy.rest.resize(3 * m);
-  energy.vectors.resize(3 * m, r);
-  for (Eigen::Index i = 0; i < m; ++i) {
-    energy.rest.segment<3>(3 * i) = full.rest.segment<3>(3 * vertices[i]);
-    energy.vectors.middleRows<3>(3 * i) = ghost_vectors_.middleRows<3>(3 * vertices[i]);
-  }
-  energy.rests.clear();
-  energy.matches.clear();
-  for (Eigen::Index j = 0; j <= k; ++j) {
-    const DiscreteShells& rest = *full.rests[j];
-    const DiscreteShells::TermMatch match = basis_energy.match_terms(rest);
-    std::vector<int> terms;
-    std::vector<double> factors;
-    for (size_t i = 0; i < cubature.terms.size(); ++i) {
-      const int t = matched_term(cubature.terms[i], match, counts, rest.term_counts());
-      if (t < 0) continue;
-      terms.push_back(t);
-      factors.push_back(cubature.weights[i]);
-    }
-    energy.rests.push_back(
-        std::make_unique<DiscreteShells>(rest.select_terms(terms, factors, vertices)));
-  }
-  energy.blended = std::make_unique<DiscreteShells>(
-      basis_energy.select_terms(cubature.terms, cubature.weights, vertices));
-  for (const auto& rest : energy.rests) energy.matches.push_back(energy.blended->match_terms(*rest));
-  energy.x.resize(3 * m);
-  energy.gradient.resize(3 * m);
-  ghost_energy_ = std::move(full);
+  x_.resize(ghost_rest_.size());
+  energy_gradient_.resize(ghost_rest_.size());
 }
 
-void ShapeSpace::fit_cubature(BlendedEnergy& full) {
-  const Eigen::Index free = dimension() - num_rigid_;
-  data_.cubature = {};
-  if (free == 0) return;
-  std::vector<CubatureSample> samples;
-  std::vector<Eigen::VectorXd> visited;
-  Eigen::VectorXd gradient;
-  for (const Eigen::VectorXd& weights : training_weights(num_keys())) {
-    visited.clear();
-    minimize(weights, {&full}, {}, &visited);
-    if (visited.empty()) continue;
-    // Each point's equations weigh one over the reduced gradient's norm at the linear blend.
-    objective(full, visited.front(), gradient);
-    const double start_norm = gradient.norm();
-    if (!(start_norm > 0)) continue;
-    const size_t count = visited.size();
-    for (int i = 0; i < kTrainingPoints; ++i) {
-      const size_t at = count == 1 ? 0 : i * (count - 1) / (kTrainingPoints - 1);
-      if (i > 0 && at == (i - 1) * (count - 1) / (kTrainingPoints - 1)) continue;
-      objective(full, visited[at], gradient);
-      samples.push_back({full.blended->term_gradients(full.x), 1.0 / start_norm});
-    }
-  }
-  CubatureOptions fit_options = kCubatureFit;
-  if (std::getenv("MD_CUB_TERMS")) fit_options.max_terms = std::atoi(std::getenv("MD_CUB_TERMS"));
-  if (std::getenv("MD_CUB_TOL")) fit_options.tolerance = std::atof(std::getenv("MD_CUB_TOL"));
-  const auto t0 = std::chrono::steady_clock::now();
-  // Coordinates in which the rest's reduced Hessian is the identity: a gradient error e moves the
-  // minimum by about H⁻¹ e, so the fit weighs errors along soft directions more.
-  Eigen::MatrixXd H0 = rest_hessians_[0];
-  H0.diagonal().array() += 1e-8 * H0.diagonal().maxCoeff();
-  const Eigen::LLT<Eigen::MatrixXd> llt(H0);
-  Eigen::MatrixXd whitened = full.vectors.rightCols(free);
-  if (std::getenv("MD_CUB_WHITE") && llt.info() == Eigen::Success)
-    whitened = llt.matrixL().solve(Eigen::MatrixXd(whitened.transpose())).transpose();
-  data_.cubature = modal_deform::fit_cubature(whitened,
-                                              full.blended->term_vertices(), samples, fit_options)
-                       .cubature;
-  if (std::getenv("MD_CUB_LOG")) std::fprintf(stderr, "samples %zu fit %g ms\n", samples.size(), milliseconds_since(t0));
-}
-
-double ShapeSpace::objective(BlendedEnergy& energy, const Eigen::VectorXd& z,
-                             Eigen::VectorXd& gradient) {
+double ShapeSpace::objective(const Eigen::VectorXd& z, Eigen::VectorXd& gradient) {
   q_.tail(z.size()) = z;
-  add_columns(energy.rest, energy.vectors, q_, energy.x);
-  if (!positions_in_range(energy.x)) return std::numeric_limits<double>::infinity();
-  const double value = energy.blended->value_and_gradient(energy.x, energy.gradient);
-  gradient.noalias() = energy.vectors.rightCols(z.size()).transpose() * energy.gradient;
+  add_columns(ghost_rest_, ghost_vectors_, q_, x_);
+  if (!positions_in_range(x_)) return std::numeric_limits<double>::infinity();
+  const double value = blended_->value_and_gradient(x_, energy_gradient_);
+  gradient.noalias() = ghost_vectors_.rightCols(z.size()).transpose() * energy_gradient_;
   return value;
 }
 
-BfgsResult ShapeSpace::minimize(const VectorRef& weights,
-                                const std::vector<BlendedEnergy*>& energies,
-                                const BlendOptions& options, std::vector<Eigen::VectorXd>* visited) {
-  const Eigen::Index k = num_keys(), free = dimension() - num_rigid_;
+void ShapeSpace::blend(const VectorRef& weights, Eigen::Ref<Eigen::VectorXf> out,
+                       const BlendOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  check_options(options, [](auto visit) { for_each_blend_option(visit); });
+  const Eigen::Index k = num_keys(), r = dimension(), free = r - num_rigid_;
+  if (weights.size() != k)
+    throw InputError(message("weights: expected ", k, " (one per key), got ", weights.size()));
+  for (Eigen::Index i = 0; i < k; ++i)
+    if (!(std::abs(weights[i]) <= kMaxWeight))
+      throw InputError(message("weights[", i, "]: expected a number in [", -kMaxWeight, ", ",
+                               kMaxWeight, "], got ", weights[i]));
+  const Eigen::Index fine_rows = 3 * static_cast<Eigen::Index>(num_vertices());
+  if (out.size() != fine_rows)
+    throw InputError(
+        message("out: expected ", fine_rows, " values (3 per vertex), got ", out.size()));
   // The blended energy: the rest weighted 1 − Σ w_i.
   std::vector<double> c(static_cast<size_t>(k) + 1);
   std::vector<const DiscreteShells*> rests(c.size());
   c[0] = 1.0 - weights.sum();
   for (Eigen::Index i = 0; i < k; ++i) c[static_cast<size_t>(i) + 1] = weights[i];
-  for (BlendedEnergy* energy : energies) {
-    for (size_t j = 0; j < c.size(); ++j) rests[j] = energy->rests[j].get();
-    energy->blended->blend_rests(rests, energy->matches, c);
-  }
+  for (size_t j = 0; j < c.size(); ++j) rests[j] = energies_[j].get();
+  blended_->blend_rests(rests, matches_, c);
   // From the linear blend, rigid coordinates held, with (Σ |c_j| H_j)⁻¹.
   const Eigen::VectorXd linear = data_.coordinates * weights;
   q_ = linear;
   stats_ = {};
+  if (free == 0) {  // nothing but rigid coordinates: the linear blend is the blend
+    stats_.converged = true;
+    write_positions(weights, out, start);
+    return;
+  }
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(free, free);
   for (size_t j = 0; j < c.size(); ++j)
     if (c[j] != 0) H += std::abs(c[j]) * rest_hessians_[j];
@@ -426,23 +288,10 @@ BfgsResult ShapeSpace::minimize(const VectorRef& weights,
   Bfgs bfgs;
   bfgs.start(linear.tail(free), inverse);
   const auto solve_start = std::chrono::steady_clock::now();
-  BfgsResult result;
-  const double loose = std::getenv("MD_LOOSE") ? std::atof(std::getenv("MD_LOOSE")) : 1e-6;
-  for (size_t e = 0; e < energies.size(); ++e) {
-    BlendedEnergy& energy = *energies[e];
-    bfgs.objective_changed();
-    const BfgsResult stage = bfgs.minimize(
-        [&](const Eigen::VectorXd& z, Eigen::VectorXd& gradient) {
-          if (visited) visited->push_back(z);
-          return objective(energy, z, gradient);
-        },
-        options.max_iterations, e + 1 < energies.size() ? std::max(loose, options.tolerance) : options.tolerance);
-    if (std::getenv("MD_CUB_LOG")) std::fprintf(stderr, "stage %zu its %d\n", e, stage.iterations);
-    result.iterations += stage.iterations;
-    result.evaluations += stage.evaluations;
-    result.converged = stage.converged;
-    result.stalled = stage.stalled;
-  }
+  const BfgsResult result =
+      bfgs.minimize([this](const Eigen::VectorXd& z,
+                           Eigen::VectorXd& gradient) { return objective(z, gradient); },
+                    options.max_iterations, options.tolerance);
   q_.head(num_rigid_) = linear.head(num_rigid_);
   q_.tail(free) = bfgs.x();
   stats_.iterations = result.iterations;
@@ -452,38 +301,6 @@ BfgsResult ShapeSpace::minimize(const VectorRef& weights,
   stats_.energy = bfgs.value();
   stats_.gradient_norm = bfgs.gradient().norm();
   stats_.solve_ms = milliseconds_since(solve_start);
-  return result;
-}
-
-void ShapeSpace::blend(const VectorRef& weights, Eigen::Ref<Eigen::VectorXf> out,
-                       const BlendOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  check_options(options, [](auto visit) { for_each_blend_option(visit); });
-  const Eigen::Index k = num_keys(), free = dimension() - num_rigid_;
-  if (weights.size() != k)
-    throw InputError(message("weights: expected ", k, " (one per key), got ", weights.size()));
-  for (Eigen::Index i = 0; i < k; ++i)
-    if (!(std::abs(weights[i]) <= kMaxWeight))
-      throw InputError(message("weights[", i, "]: expected a number in [", -kMaxWeight, ", ",
-                               kMaxWeight, "], got ", weights[i]));
-  const Eigen::Index fine_rows = 3 * static_cast<Eigen::Index>(num_vertices());
-  if (out.size() != fine_rows)
-    throw InputError(
-        message("out: expected ", fine_rows, " values (3 per vertex), got ", out.size()));
-  const Eigen::VectorXd linear = data_.coordinates * weights;
-  // Nothing but rigid coordinates, or no term with a gradient at any training blend (keys that
-  // are rigid motions of the basis): the linear blend is the blend.
-  if (free == 0 || data_.cubature.terms.empty()) {
-    q_ = linear;
-    stats_ = {};
-    stats_.converged = true;
-    write_positions(weights, out, start);
-    return;
-  }
-  if (std::getenv("MD_TWO"))
-    minimize(weights, {&cubature_energy_, &ghost_energy_}, options);
-  else
-    minimize(weights, {&cubature_energy_}, options);
   // Weights whose rest weight 1 − Σ w_i is negative can leave the energy without a minimum (two
   // keys at 1 that stretch the same elements): a blend that ran off farther than the model's size
   // from the linear blend is none, and the linear blend is returned instead.

@@ -39,8 +39,6 @@
 
 #include "basis/basis.h"
 #include "energy/discrete_shells.h"
-#include "reduction/cubature.h"
-#include "solve/bfgs.h"
 #include "solve/reduced_map.h"
 #include "util/option.h"
 
@@ -103,9 +101,6 @@ struct ShapeSpaceData {
   int base_dimension = 0;       // columns of the rest's basis; the keys' follow
   Eigen::MatrixXd coordinates;  // r by k: q_i, key i = x̄ + U q_i (+ residual i on a proxy)
   RowMatrixXf residuals;  // on a proxy, k by 3#V: what of each key P U cannot hold; else 0 by 0
-  // The blended energy's terms on the ghost a blend evaluates, and their weights: indices of the
-  // ghost's Discrete Shells terms at the basis (DiscreteShells::term_vertices' numbering).
-  Cubature cubature;
 };
 
 class ShapeSpace {
@@ -137,47 +132,28 @@ class ShapeSpace {
   int num_keys() const { return static_cast<int>(data_.coordinates.cols()); }
   int dimension() const { return data_.basis.dimension(); }
   int num_vertices() const { return data_.basis.num_vertices(); }
-  // The ghost vertices a blend's energy evaluation touches (those of the cubature's terms).
-  int cubature_vertices() const { return static_cast<int>(cubature_energy_.rest.size() / 3); }
 
  private:
-  // The blended energy on some of the ghost's vertices, normalised frame: all of the ghost with
-  // every term (the bake's training), or a cubature's vertices and terms (what blends evaluate).
-  struct BlendedEnergy {
-    Eigen::VectorXd rest;     // 3m: the vertices' ghost rest s x̄_s
-    Eigen::MatrixXd vectors;  // 3m by r: their rows of s U_s
-    // The energy with the basis (0) and each key (1 … k) as the rest, their blend, and the
-    // blend's terms in each.
-    std::vector<std::unique_ptr<DiscreteShells>> rests;
-    std::unique_ptr<DiscreteShells> blended;
-    std::vector<DiscreteShells::TermMatch> matches;
-    Eigen::VectorXd x, gradient;  // work space (3m)
-  };
-
   // x̄ + U q_ (+ the weighted residuals on a proxy) into `out`; the time since `start` in stats_.
   void write_positions(const VectorRef& weights, Eigen::Ref<Eigen::VectorXf> out,
                        std::chrono::steady_clock::time_point start);
-  // The ghost's energies and reduced Hessians, the map; the cubature fitted first when `fit`.
-  void prepare(bool fit);
-  // Fits data_.cubature to blends of `full` (every term of the ghost) solved with it.
-  void fit_cubature(BlendedEnergy& full);
-  // BFGS on `energy` blended for `weights` from the linear blend: q_ and stats_ (but the map's);
-  // the points it evaluates (the non-rigid coordinates) appended to `visited` when given.
-  BfgsResult minimize(const VectorRef& weights, const std::vector<BlendedEnergy*>& energies,
-                      const BlendOptions& options,
-                      std::vector<Eigen::VectorXd>* visited = nullptr);
-  double objective(BlendedEnergy& energy, const Eigen::VectorXd& z, Eigen::VectorXd& gradient);
+  void prepare();
+  double objective(const Eigen::VectorXd& z, Eigen::VectorXd& gradient);
 
   ShapeSpaceData data_;
   int num_rigid_ = 0;
-  // The ghost's vectors s U_s (3g by r), normalised frame.
+  // Ghost, normalised frame: rest s x̄_s (3g), vectors s U_s (3g by r).
+  Eigen::VectorXd ghost_rest_;
   Eigen::MatrixXd ghost_vectors_;
-  BlendedEnergy cubature_energy_, ghost_energy_;
+  // Energies of the ghost with the rest (0) and each key (1 … k) as the rest, and the blend.
+  std::vector<std::unique_ptr<DiscreteShells>> energies_;
+  std::unique_ptr<DiscreteShells> blended_;
+  std::vector<DiscreteShells::TermMatch> matches_;  // the blend's terms in each energy
   // Reduced Hessians at each rest over the non-rigid coordinates ((r − num_rigid)², k + 1).
   std::vector<Eigen::MatrixXd> rest_hessians_;
   std::unique_ptr<FinePositions> map_;
-  // The last blend.
-  Eigen::VectorXd q_;
+  // Work space and the last blend.
+  Eigen::VectorXd q_, x_, energy_gradient_;
   BlendStats stats_;
 };
 

@@ -49,8 +49,7 @@ BLEND_OPTIONS = _options.table(_native.BLEND_OPTIONS)
 #: The most keys a space takes.
 MAX_KEYS = _native.MAX_SHAPE_KEYS
 # 1: the augmented basis (Basis's fields), base_dimension, key_coordinates, key_residuals.
-# 2: and cubature_terms, cubature_weights.
-FORMAT_VERSION = 2
+FORMAT_VERSION = 1
 
 
 def _keys(shapes, n):
@@ -126,17 +125,6 @@ class ShapeSpace:
         return self._native.coordinates
 
     @property
-    def cubature_terms(self):
-        """(m,) int32: the terms of the ghost's energy a blend evaluates, the cubature fitted at the
-        bake (their weights: ``to_arrays()["cubature_weights"]``)."""
-        return np.array(self._native.cubature_terms, dtype=np.int32)
-
-    cubature_vertices = property(
-        lambda self: self._native.cubature_vertices,
-        doc="the ghost vertices a blend's energy evaluation touches (the cubature terms')",
-    )
-
-    @property
     def q(self):
         """The reduced coordinates of the last blend (r,) float64."""
         return self._native.q
@@ -182,8 +170,6 @@ class ShapeSpace:
         arrays["base_dimension"] = np.array(self.base_dimension, dtype=np.int32)
         arrays["key_coordinates"] = np.array(self._native.coordinates, dtype=np.float64)
         arrays["key_residuals"] = np.array(self._native.residuals, dtype=np.float32)
-        arrays["cubature_terms"] = np.array(self._native.cubature_terms, dtype=np.int32)
-        arrays["cubature_weights"] = np.array(self._native.cubature_weights, dtype=np.float64)
         return arrays
 
     @classmethod
@@ -206,8 +192,6 @@ class ShapeSpace:
             "base_dimension": (np.int32, 0),
             "key_coordinates": (np.float64, 2),
             "key_residuals": (np.float32, 2),
-            "cubature_terms": (np.int32, 1),
-            "cubature_weights": (np.float64, 1),
         }
         for name, (dtype, ndim) in own.items():
             if name not in keys:
@@ -232,8 +216,6 @@ class ShapeSpace:
                 int(arrays["base_dimension"]),
                 np.asfortranarray(arrays["key_coordinates"]),
                 np.ascontiguousarray(arrays["key_residuals"]),
-                arrays["cubature_terms"],
-                arrays["cubature_weights"],
             )
         )
         return space
