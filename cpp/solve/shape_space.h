@@ -24,12 +24,10 @@
 //   some 50 energy evaluations on the dragon's ghost, and Newton from the linear blend still takes
 //   about 20 steps there where BFGS takes 45 to 55.
 //   Not an optimized cubature (An, Kim, James 2008; the 2015 paper evaluates its energy so): on
-//   the dragon's ghost (1000 vertices, 8060 terms, r = 80) a cubature fitted by greedy NNLS to the
-//   reduced gradients of training blends leaves the blend where the ghost's energy has it only
-//   when it touches nearly every ghost vertex, so the projections, a third of an evaluation, do not
-//   shrink: 400 terms on 723 vertices misplace blends by about half the nonlinear correction
-//   (linear blend to blend), 1500 terms on 979 vertices by 7.5% (median; 48% at worst). The ghost
-//   is already the energy's reduction. The experiment and its figures: commit 0e3b170.
+//   the dragon's ghost a cubature fitted by greedy NNLS to the reduced gradients of training
+//   blends keeps the blend where the ghost's energy puts it only when it touches nearly every
+//   ghost vertex, so the projections, a third of an evaluation, do not shrink: the ghost is
+//   already the energy's reduction (docs/design.md, "Not a cubature"; the experiment: 0e3b170).
 //
 // Cost of a blend, k keys, r = basis dimension + k: O(k · #ghost terms) to blend the rests,
 // O(k r²) + r³ for the initial inverse Hessian, then per BFGS iteration (their count grows with r)
