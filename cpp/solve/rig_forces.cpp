@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "util/errors.h"
+#include "util/require_positions.h"
 
 namespace modal_deform {
 
@@ -74,6 +75,11 @@ void check_bone_matrices(const Transforms& bones, int num_bones) {
     if (!B.allFinite()) throw InputError(message("bones[", b, "]: has non-finite entries"));
     if (!(B.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).isZero(1e-9))
       throw InputError(message("bones[", b, "]: not affine (last row should be 0 0 0 1)"));
+    // Beyond the coordinates the core takes, the rig's acceleration (a second difference times
+    // fps²) and the determinant below would overflow.
+    if (!(B.topRows<3>().cwiseAbs().maxCoeff() <= kMaxCoordinate))
+      throw InputError(message("bones[", b, "]: an entry is beyond ", kMaxCoordinate,
+                               " in magnitude (the core takes coordinates up to it)"));
     const Eigen::Matrix3d L = B.topLeftCorner<3, 3>();
     const double norm = L.norm();
     if (!(std::abs(L.determinant()) > kSingularBone * norm * norm * norm))

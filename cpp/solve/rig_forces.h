@@ -59,8 +59,8 @@ SkinningWeights skinning_weights_from_rows(int num_vertices, int num_bones,
                                            const Eigen::VectorXi& columns,
                                            const Eigen::VectorXd& values);
 
-// Throws InputError unless there is one bone matrix per bone, finite, affine (last row 0 0 0 1)
-// and invertible.
+// Throws InputError unless there is one bone matrix per bone, finite, affine (last row 0 0 0 1),
+// with entries at most kMaxCoordinate in magnitude and invertible; the message names the bone.
 void check_bone_matrices(const Transforms& bones, int num_bones);
 
 class RigForces {

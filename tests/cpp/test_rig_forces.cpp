@@ -99,6 +99,12 @@ TEST(RigForces, RefusesBadWeightsAndBones) {
   Transforms infinite = bones;
   infinite[0](0, 3) = std::numeric_limits<double>::infinity();
   expect_input_error([&] { check_bone_matrices(infinite, 4); }, "non-finite");
+  Transforms enormous = bones;
+  enormous[3](1, 3) = 2e15;  // beyond kMaxCoordinate: its second difference times fps² overflows
+  expect_input_error([&] { check_bone_matrices(enormous, 4); }, "bones[3]: an entry is beyond");
+  enormous[3](1, 3) = 1;
+  enormous[3](2, 2) = -1e300;
+  expect_input_error([&] { check_bone_matrices(enormous, 4); }, "bones[3]: an entry is beyond");
 }
 
 }  // namespace

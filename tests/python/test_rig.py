@@ -308,6 +308,37 @@ def test_bad_rigs_are_refused_with_a_message(tube):
         mdc.Simulation(basis, [attach]).step([np.eye(4)], bones=bad)
 
 
+def test_a_refused_frame_leaves_the_simulation_as_it_was(tube):
+    """Bones non-finite, not affine or beyond the coordinates the core takes (kMaxCoordinate, 1e15:
+    their second difference times fps² would overflow the rig's acceleration) are refused naming
+    the bone, before the state changes: the next frame is the same bits as without the refused
+    one."""
+    V, basis, W, attach, top = tube
+    frames = [chain(translation([0.1 * f * f, 0, 0]), (0.05 * f, 0)) for f in range(6)]
+    sims = [mdc.Simulation(basis, [attach], rig=W) for _ in range(2)]
+    for sim in sims:
+        for B in frames[:4]:
+            sim.step([np.eye(4)], bones=B)
+    for entry, value, match in [
+        ((1, 0, 3), np.nan, "non-finite"),
+        ((1, 3, 2), 0.5, "affine"),
+        ((1, 0, 3), 2e15, "beyond"),
+        ((1, 2, 1), -1e300, "beyond"),
+        ((1, 0, 0), 1e200, "beyond"),
+    ]:
+        bad = frames[4].copy()
+        bad[entry] = value
+        with pytest.raises(ValueError, match=rf"bones\[1\].*{match}"):
+            sims[1].step([np.eye(4)], bones=bad)
+    for B in frames[4:]:
+        np.testing.assert_array_equal(
+            sims[1].step([np.eye(4)], bones=B), sims[0].step([np.eye(4)], bones=B)
+        )
+    for a, b in zip(sims[0].state, sims[1].state):
+        np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(sims[0].rig_acceleration, sims[1].rig_acceleration)
+
+
 def test_sparse_weights_naming_no_column_are_refused(tube):
     V, basis, W, attach, top = tube
     n = len(V)
