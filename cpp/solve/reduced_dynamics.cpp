@@ -179,9 +179,9 @@ void ReducedDynamics::set_state(const Eigen::VectorXd& q, const Eigen::VectorXd&
     throw InputError("bones: the previous frame's bones given without the current ones");
   if (!rig_current.empty()) check_bone_matrices(rig_current, num_bones());
   if (!rig_previous.empty()) check_bone_matrices(rig_previous, num_bones());
+  // No bones: no rig history (rig_current_ empty), as before the first frame.
   const Transforms& previous = rig_previous.empty() ? rig_current : rig_previous;
-  const bool own_rig =
-      rig_current.empty() || (rig_current == rig_current_ && previous == rig_previous_);
+  const bool own_rig = rig_current == rig_current_ && previous == rig_previous_;
   // The simulation's own state (playback sets each frame's cached state before stepping from it)
   // is kept: its energy and gradient were evaluated there, at these transforms, by the last step,
   // and BFGS's memory is the one that step left.
@@ -197,10 +197,8 @@ void ReducedDynamics::set_state(const Eigen::VectorXd& q, const Eigen::VectorXd&
     transforms_ = transforms;
     handle_term_.set_transforms(transforms_);
   }
-  if (!rig_current.empty()) {
-    rig_previous_ = previous;
-    rig_current_ = rig_current;
-  }
+  rig_previous_ = previous;
+  rig_current_ = rig_current;
   forget();
   q_ = q;
   v_ = v;

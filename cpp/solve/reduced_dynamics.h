@@ -23,11 +23,12 @@
 // ρ g, g from the second difference of the bones over the previous two frames and this one,
 // constant over the frame (every substep sees the same g, so substeps change nothing in how the
 // rig's motion is read); the handles stay in rest space (identity: held where the rig puts them).
-// Before the first frame the rig counts as having been still in the pose of the first frame it is
-// given (set_state's or step's); the state carries the two frames' bones the next one needs
-// (rig_previous, rig_current), so a frame is the same bits however reached. ρ and β are set by
-// the lowest mode of the mesh as attached (K plus the handles' term) instead of K's: the wobble
-// the artist sees on the rig. A frame on the rig costs O(bones · r) more than one without.
+// Before the first frame (and after a set_state without bones) the rig counts as having been still
+// in the pose of the first frame it is given (set_state's or step's); the state carries the two
+// frames' bones the next one needs (rig_previous, rig_current), so a frame is the same bits however
+// reached. ρ and β are set by the lowest mode of the mesh as attached (K plus the handles' term)
+// instead of K's: the wobble the artist sees on the rig. A frame on the rig costs O(bones · r) more
+// than one without.
 //
 // Not thread-safe: one simulation per thread.
 #pragma once
@@ -191,15 +192,17 @@ class ReducedDynamics {
   //
   // On a rig, rig_previous and rig_current: the bones at the frame before the state and at the
   // state; rig_current alone (rig_previous empty): the rig still in that pose until the state;
-  // both empty keep the current ones. The rig's history is part of what makes the state the
-  // simulation's own.
+  // both empty: no history, the next step takes the rig as still in the pose it is given (as a
+  // fresh simulation's first), so the frames from (q, v, transforms) are the same bits whatever
+  // was stepped before. The rig's history is part of what makes the state the simulation's own.
   void set_state(const Eigen::VectorXd& q, const Eigen::VectorXd& v,
                  const Transforms& transforms = {}, const Transforms& rig_previous = {},
                  const Transforms& rig_current = {});
   const Eigen::VectorXd& q() const { return q_; }
   const Eigen::VectorXd& v() const { return v_; }
   // On a rig: the bones at the frame before the state and at the state (empty until the rig is
-  // first given: the next step takes it as still in the pose it is given).
+  // first given and after a set_state without bones: the next step takes it as still in the pose
+  // it is given).
   const Transforms& rig_previous() const { return rig_previous_; }
   const Transforms& rig_current() const { return rig_current_; }
   bool on_rig() const { return rig_ != nullptr; }

@@ -194,6 +194,35 @@ def test_frames_are_the_same_bits_however_reached(tube):
     assert not first.state[0].any()
 
 
+def test_a_state_set_without_bones_has_no_rig_history(tube):
+    """set_state(q, v) without bones on a rig: the next step takes the rig as still in the pose it
+    is given (as a fresh simulation's first), whatever the simulation stepped before, so the
+    frames from there are the same bits however the simulation got there; with the cached
+    rig_state, the original run's."""
+    V, basis, W, attach, top = tube
+    frames = [chain(translation([0.05 * f * f, 0, 0]), (0.04 * f, 0)) for f in range(16)]
+    run = mdc.Simulation(basis, [attach], rig=W, memory_frames=1)
+    results, cached = [], {}
+    for f, B in enumerate(frames):
+        results.append(run.step([np.eye(4)], bones=B).copy())
+        cached[f] = (*run.state, run.rig_state)
+    q, v, rig_state = cached[8]
+    fresh = mdc.Simulation(basis, [attach], rig=W, memory_frames=1)
+    histories = []
+    for sim in (run, fresh):
+        sim.set_state(q, v, [np.eye(4)])
+        histories.append(sim.rig_state)
+    for B in frames[9:]:
+        np.testing.assert_array_equal(
+            run.step([np.eye(4)], bones=B), fresh.step([np.eye(4)], bones=B)
+        )
+    assert histories == [None, None]
+    assert not np.array_equal(fresh.state[0], cached[15][0])  # the rig's motion was dropped
+    run.set_state(q, v, [np.eye(4)], bones=rig_state)
+    for f in range(9, 16):
+        np.testing.assert_array_equal(run.step([np.eye(4)], bones=frames[f]), results[f])
+
+
 def test_the_period_is_the_lowest_mode_as_attached(tube):
     V, basis, W, attach, top = tube
     period = 12.0

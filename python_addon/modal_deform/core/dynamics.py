@@ -157,7 +157,7 @@ class Simulation(_inputs.InBasis):
         """On a rig, (2, b, 4, 4): the bones at the frame before the state and at the state, what
         the next frame's acceleration needs (``set_state(..., bones=...)`` takes it back). None
         without a rig, or before the rig is first given (the next step then takes it as still in
-        the pose it is given)."""
+        the pose it is given), or after ``set_state`` without bones."""
         current = self._native.rig_current
         if not current:
             return None
@@ -182,8 +182,9 @@ class Simulation(_inputs.InBasis):
         with zero velocity. ``transforms``: the controllers' at that state (one 4x4 per handle), the
         start of the next step; None keeps the current ones. On a rig, ``bones``: a cached
         ``rig_state`` (2, b, 4, 4), or (b, 4, 4), the rig at the state and still in that pose
-        before it; None keeps the current ones. BFGS's memory (step()) is forgotten unless this is
-        the simulation's own state, bit for bit (rig's included)."""
+        before it; None: no history, the next step takes the rig as still in the pose it is given
+        (as a fresh simulation's first frame), whatever was stepped before. BFGS's memory (step())
+        is forgotten unless this is the simulation's own state, bit for bit (rig's included)."""
         r = self.dimension
         q = _arrays.values(q, "q", r)
         v = _arrays.values(v, "v", r)
