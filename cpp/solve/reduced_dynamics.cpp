@@ -75,6 +75,20 @@ DynamicsParameters dynamics_parameters(const Eigen::MatrixXd& hessian,
   parameters.substep = h;
   parameters.mass_scale = lowest_eigenvalue / product.real();
   parameters.rayleigh = -sum.real() / product.real();
+  // Options each within its range may together leave double precision (ρ and the frame's length
+  // squared grow as fps⁻²): refused, naming them, rather than a simulation of infinities. The
+  // midpoint rule and implicit Euler weigh the potential by h²/(4ρ) and h²/ρ, the damping by
+  // 2β/h, and the rig's second difference divides by the frame's length squared.
+  const double frame = 1 / options.fps;
+  const double weight = h * h / parameters.mass_scale;
+  if (!(std::isfinite(frame * frame) && std::isfinite(parameters.mass_scale) &&
+        parameters.mass_scale > 0 && std::isfinite(parameters.rayleigh) &&
+        std::isfinite(weight) && weight / 4 > 0 && std::isfinite(2 * parameters.rayleigh / h)))
+    throw InputError(message("fps = ", options.fps, ", period = ", options.period,
+                             ", damping = ", options.damping, ", substeps = ", options.substeps,
+                             ": the mass scale (", parameters.mass_scale, "), the damping (",
+                             parameters.rayleigh, " s) or the substep (", h,
+                             " s) they give is beyond double precision (raise fps)"));
   return parameters;
 }
 

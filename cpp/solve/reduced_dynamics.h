@@ -113,7 +113,8 @@ struct DynamicsParameters {
 };
 
 // From `hessian` (r by r, symmetric: K, or on a rig K plus the handles' term) and the options
-// (checked). Throws InputError when it has no flexible mode to set the period by.
+// (checked). Throws InputError when it has no flexible mode to set the period by, or when the
+// options together give a mass scale, damping or substep beyond double precision (a tiny fps).
 DynamicsParameters dynamics_parameters(const Eigen::MatrixXd& hessian,
                                        const SimulationOptions& options);
 

@@ -258,6 +258,28 @@ def test_bfgs_memory_spans_blocks_of_frames_and_a_frame_inside_one_is_reached_ag
         mdc.Simulation(basis, handles, memory_frames=0)
 
 
+@pytest.mark.parametrize(
+    "options",
+    [
+        {"fps": 1e-300},
+        {"fps": 1e-157, "substeps": 64},
+        {"fps": 1e-150, "period": 1e6, "damping": 1.0, "substeps": 64},
+    ],
+)
+def test_options_beyond_double_precision_together_are_refused(bar, options):
+    """Each option within its range, together they make the mass scale, the damping or the
+    substep overflow (ρ grows as fps⁻², h² as fps⁻²): refused naming them, for Simulation and
+    Inbetween alike, not a simulation of infinities."""
+    V, F, basis = bar
+    with pytest.raises(ValueError, match=r"fps = .*period = .*substeps = .*beyond double"):
+        mdc.Simulation(basis, [], **options)
+    handles = [np.flatnonzero(V[:, 2] < 0.3)]
+    with pytest.raises(ValueError, match=r"fps = .*period = .*substeps = .*beyond double"):
+        mdc.Inbetween(basis, handles, [(0, [np.eye(4)]), (3, [np.eye(4)])], **options)
+    fine = mdc.Simulation(basis, [], **{**options, "fps": 1e-100})
+    assert np.isfinite(fine.mass_scale) and fine.mass_scale > 0
+
+
 def test_parameters_are_defined_once_and_checked(bar):
     V, F, basis = bar
     assert (
