@@ -330,38 +330,31 @@ def curve_values(curves, frame):
 #: handles, float[3][3].
 _KEYFRAME_POINTS_BYTES = 36
 #: The distance between two keyframes in that array (the size of a BezTriple, one for a build of
-#: Blender), found from the first curve of two keyframes or more (_keyframe_memory).
+#: Blender), read from the first curve of two keyframes or more that keys_digest meets.
 _keyframe_stride = None
-
-
-def _keyframe_memory(points, count):
-    """Blender's array of the `count` keyframes `points` (count > 0) in place, from the first to the
-    point and handles of the last, as mesh_io.item_memory gives it: the stride read once, a
-    curve's array then found from its first keyframe alone (every frame shown reads it)."""
-    global _keyframe_stride
-    if count == 1:
-        return mesh_io.item_memory(points, _KEYFRAME_POINTS_BYTES)[0]
-    if _keyframe_stride is None:
-        _keyframe_stride = mesh_io.item_memory(points, _KEYFRAME_POINTS_BYTES)[1]
-    size = _keyframe_stride * (count - 1) + _KEYFRAME_POINTS_BYTES
-    return (ctypes.c_char * size).from_address(points[0].as_pointer())
 
 
 def keys_digest(curves):
     """A hash of the curves' keyframes and extrapolation: cheap enough for every frame shown, it
     tells when keyframes_changed must compare values. Each curve's keyframes are hashed as the bytes
-    of Blender's array of them (BezTriple, one after another, read in place): every keyframe whole
-    (point, handles, interpolation, easing and its parameters) but the last, of which only the point
-    and handles shape the curve. A change that moves no value (a selection) leads to a comparison
-    that finds nothing. One hash of every curve's bytes joined (a call of the hash per curve cost
-    as much again on a rig of 100 bones, 306 curves)."""
+    of Blender's array of them (BezTriple, one after another, read in place, as
+    mesh_io.item_memory reads it, from the first keyframe alone once the stride is known): every
+    keyframe whole (point, handles, interpolation, easing and its parameters) but the last, of which
+    only the point and handles shape the curve. A change that moves no value (a selection) leads to
+    a comparison that finds nothing. One hash of every curve's bytes joined (a call of the hash per
+    curve cost as much again on a rig of 100 bones, 306 curves)."""
+    global _keyframe_stride
     parts = []
     for path, curve in curves:
         points = curve.keyframe_points
         count = len(points)
         parts.append(f"{path}:{curve.extrapolation}:{count}".encode())
-        if count:
-            parts.append(_keyframe_memory(points, count))
+        if not count:
+            continue
+        if _keyframe_stride is None and count > 1:
+            _keyframe_stride = mesh_io.item_memory(points, _KEYFRAME_POINTS_BYTES)[1]
+        size = _KEYFRAME_POINTS_BYTES + (count - 1) * (_keyframe_stride or 0)
+        parts.append((ctypes.c_char * size).from_address(points[0].as_pointer()))
     return hashlib.blake2b(b"".join(parts), digest_size=16).hexdigest()
 
 

