@@ -118,7 +118,12 @@ def check_order(obj, display):
 
 
 def deform_bones(armature):
-    return [bone.name for bone in armature.data.bones if bone.use_deform]
+    """The names of the armature's deforming bones, in its order, read in two calls (their names,
+    then use_deform in bulk) rather than two per bone: every frame shown reads them (signature())."""
+    bones = armature.data.bones
+    deform = np.empty(len(bones), bool)
+    bones.foreach_get("use_deform", deform)
+    return [name for name, used in zip(bones.keys(), deform) if used]
 
 
 def signature(obj):
@@ -154,13 +159,28 @@ def world_skinning(armature, pose, rest_inverse, mesh_world):
     """Bones' world skinning matrices (b, 4, 4): armature world x pose x rest⁻¹ x armature world⁻¹
     x mesh world, from their pose matrices `pose` and inverse rest matrices (armature space)."""
     armature_world = np.array(armature.matrix_world)
-    try:
-        to_armature = np.linalg.solve(armature_world, mesh_world)  # armature⁻¹ x mesh world
-    except np.linalg.LinAlgError:
+    inverse = affine_inverse(armature_world)
+    if inverse is None:
         raise RigError(
             f"Follow Rig: armature '{armature.name}' is scaled to nothing (its matrix is singular)"
-        ) from None
-    return armature_world @ (pose @ rest_inverse) @ to_armature
+        )
+    return armature_world @ (pose @ rest_inverse) @ (inverse @ mesh_world)
+
+
+def affine_inverse(M):
+    """The inverse of an affine 4x4 matrix M (last row 0, 0, 0, 1, as an object's matrix), None when
+    it is singular: the 3x3 part's adjugate over its determinant (its rows' cross products), with no
+    LAPACK call, which waits milliseconds for OpenBLAS's threads on a busy machine where the frame's
+    own work of this is microseconds."""
+    R, t = M[:3, :3], M[:3, 3]
+    cofactors = np.cross(R[[1, 2, 0]], R[[2, 0, 1]])  # rows r1 x r2, r2 x r0, r0 x r1
+    determinant = float((R[0] * cofactors[0]).sum())
+    if determinant == 0.0 or not np.isfinite(determinant):
+        return None
+    inverse = np.eye(4)
+    inverse[:3, :3] = cofactors.T / determinant
+    inverse[:3, 3] = -(inverse[:3, :3] * t).sum(axis=1)
+    return inverse
 
 
 class CompressedRows:
