@@ -47,7 +47,13 @@ import demo_dynamics  # noqa: E402
 import demo_inbetweens  # noqa: E402
 import demo_rig  # noqa: E402
 import demo_shapes  # noqa: E402
-from headless import add_handle, bind_laplacian_deform, enable_addon, evaluated_positions  # noqa: E402
+from headless import (  # noqa: E402
+    add_handle,
+    bind_laplacian_deform,
+    enable_addon,
+    evaluated_positions,
+    smooth_suzanne,
+)
 from rendering import render, side_by_side, stage  # noqa: E402
 
 #: The pose: the top of the head turned about the vertical and then bent sideways (degrees).
@@ -100,13 +106,7 @@ def arguments():
 def subdivided_suzanne(levels):
     for obj in list(bpy.data.objects):
         bpy.data.objects.remove(obj)
-    bpy.ops.mesh.primitive_monkey_add()
-    suzanne = bpy.context.object
-    modifier = suzanne.modifiers.new("Subdivision", "SUBSURF")
-    modifier.levels = levels
-    bpy.ops.object.modifier_apply(modifier=modifier.name)
-    bpy.ops.object.shade_smooth()
-    return suzanne
+    return smooth_suzanne("Suzanne", levels)
 
 
 def interactive_updates(posing, displays, obj, count):
@@ -341,39 +341,42 @@ def main():
     bpy.ops.wm.save_as_mainfile(filepath=str(output / "demo.blend"))
     print(f"wrote {output / 'demo.blend'}")
 
-    start = time.perf_counter()
-    modules = (
-        importlib.import_module(f"{addon}.{name}")
-        for name in ("playback.frame_cache", "pose.posing")
-    )
-    strip = demo_dynamics.secondary_motion(
-        tuple(modules), output, args.dynamics_subdivisions, args.width // 2
-    )
-    print(f"rendered {strip} (secondary motion) in {time.perf_counter() - start:.1f} s")
+    def modules(*names):
+        return tuple(importlib.import_module(f"{addon}.{name}") for name in names)
 
-    start = time.perf_counter()
-    frame_cache = importlib.import_module(f"{addon}.playback.frame_cache")
-    strip = demo_rig.rig_dynamics(frame_cache, output, args.width * 3 // 10, args.samples)
-    print(f"rendered {strip} (secondary motion on a rig) in {time.perf_counter() - start:.1f} s")
+    def rendered(what, strip_of):
+        start = time.perf_counter()
+        strip = strip_of()
+        print(f"rendered {strip} ({what}) in {time.perf_counter() - start:.1f} s")
 
-    start = time.perf_counter()
-    modules = (
-        importlib.import_module(f"{addon}.{name}") for name in ("mesh_io", "shapes.blending")
+    half = args.width // 2
+    rendered(
+        "secondary motion",
+        lambda: demo_dynamics.secondary_motion(
+            modules("playback.frame_cache", "pose.posing"), output, args.dynamics_subdivisions, half
+        ),
     )
-    strip = demo_shapes.shapes_blended(
-        tuple(modules), output, args.shapes_subdivisions, args.width // 2
+    rendered(
+        "secondary motion on a rig",
+        lambda: demo_rig.rig_dynamics(
+            *modules("playback.frame_cache"), output, args.width * 3 // 10, args.samples
+        ),
     )
-    print(f"rendered {strip} (shape keys blended as shapes) in {time.perf_counter() - start:.1f} s")
-
-    start = time.perf_counter()
-    modules = (
-        importlib.import_module(f"{addon}.{name}")
-        for name in ("playback.frame_cache", "inbetweens.motion")
+    rendered(
+        "shape keys blended as shapes",
+        lambda: demo_shapes.shapes_blended(
+            modules("mesh_io", "shapes.blending"), output, args.shapes_subdivisions, half
+        ),
     )
-    strip = demo_inbetweens.inbetweens(
-        tuple(modules), output, args.inbetweens_subdivisions, args.width // 2
+    rendered(
+        "in-betweens",
+        lambda: demo_inbetweens.inbetweens(
+            modules("playback.frame_cache", "inbetweens.motion"),
+            output,
+            args.inbetweens_subdivisions,
+            half,
+        ),
     )
-    print(f"rendered {strip} (in-betweens) in {time.perf_counter() - start:.1f} s")
 
 
 main()

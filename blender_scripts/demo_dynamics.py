@@ -10,7 +10,7 @@ import math
 
 import bpy
 import numpy as np
-from headless import add_handle, evaluated_positions
+from headless import add_handle, evaluated_positions, smooth_suzanne
 from rendering import render, side_by_side
 
 #: The head's tilt about the camera's axis (degrees) and the frames it starts and stops on.
@@ -22,6 +22,17 @@ STRIP = (1, 4, 6, 8, 10, 13, 17, 24, 40)
 CORE_RADIUS, CHIN = 0.55, -0.35
 
 
+def head_handle(suzanne):
+    """Bake `suzanne` and hold her head (CORE_RADIUS, CHIN) by a handle, her ears and chin free.
+    Returns her rest positions (#V by 3) and the handle's controller."""
+    V = np.empty(3 * len(suzanne.data.vertices), np.float32)
+    suzanne.data.vertices.foreach_get("co", V)
+    V = V.reshape(-1, 3)
+    assert bpy.ops.modal_deform.bake() == {"FINISHED"}
+    core = (np.hypot(V[:, 0], V[:, 1]) < CORE_RADIUS) & (V[:, 2] > CHIN)
+    return V, add_handle(suzanne, core).controller
+
+
 def secondary_motion(addon, output, levels, width):
     """Bake a Suzanne subdivided `levels` times, tilt her head and let the ears follow; render the
     STRIP frames (`width` pixels wide each) into OUTPUT/demo_dynamics.png. Returns the strip's path."""
@@ -31,19 +42,8 @@ def secondary_motion(addon, output, levels, width):
     shown = [o for o in bpy.context.scene.objects if o.type == "MESH" and not o.hide_render]
     for obj in shown:
         obj.hide_render = True
-    bpy.ops.mesh.primitive_monkey_add()
-    suzanne = bpy.context.object
-    suzanne.name = "Suzanne dynamics"
-    modifier = suzanne.modifiers.new("Subdivision", "SUBSURF")
-    modifier.levels = levels
-    bpy.ops.object.modifier_apply(modifier=modifier.name)
-    bpy.ops.object.shade_smooth()
-    V = np.empty(3 * len(suzanne.data.vertices), np.float32)
-    suzanne.data.vertices.foreach_get("co", V)
-    V = V.reshape(-1, 3)
-    assert bpy.ops.modal_deform.bake() == {"FINISHED"}
-    core = (np.hypot(V[:, 0], V[:, 1]) < CORE_RADIUS) & (V[:, 2] > CHIN)
-    controller = add_handle(suzanne, core).controller
+    suzanne = smooth_suzanne("Suzanne dynamics", levels)
+    V, controller = head_handle(suzanne)
     bpy.context.view_layer.objects.active = suzanne
     scene.frame_set(TURN_START)
     controller.keyframe_insert("rotation_euler", frame=TURN_START)

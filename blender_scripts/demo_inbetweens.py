@@ -21,7 +21,8 @@ import time
 
 import bpy
 import numpy as np
-from headless import add_handle, evaluated_positions
+from demo_dynamics import head_handle
+from headless import evaluated_positions, smooth_suzanne
 from rendering import look_at, render, side_by_side
 
 #: The keys: (frame, the head's Empty turned about the camera's axis, degrees).
@@ -34,9 +35,6 @@ LAST = 48
 SOLVE_ITERATIONS = 400
 #: The camera for this strip: in front of Suzanne, a little to her left (+x) and above.
 EYE, TARGET, LENS = (0.8, -7.0, 0.6), (0.0, 0.0, 0.05), 75
-#: The head: Suzanne's vertices within this distance of the vertical axis and above her chin; the
-#: ears (|x| > 1) and the chin swing free.
-CORE_RADIUS, CHIN = 0.55, -0.35
 #: The plot's colours (RGB): the in-betweens, Blender's interpolation, the axes and key lines, the
 #: background.
 INBETWEEN_COLOUR, INTERPOLATION_COLOUR = (0.3, 0.6, 1.0), (0.9, 0.55, 0.2)
@@ -128,19 +126,8 @@ def inbetweens(addon, output, levels, width):
     camera.data.lens = LENS
     scene.render.resolution_x, scene.render.resolution_y = width, width * 3 // 4
 
-    bpy.ops.mesh.primitive_monkey_add()
-    suzanne = bpy.context.object
-    suzanne.name = "Suzanne in-betweens"
-    modifier = suzanne.modifiers.new("Subdivision", "SUBSURF")
-    modifier.levels = levels
-    bpy.ops.object.modifier_apply(modifier=modifier.name)
-    bpy.ops.object.shade_smooth()
-    V = np.empty(3 * len(suzanne.data.vertices), np.float32)
-    suzanne.data.vertices.foreach_get("co", V)
-    V = V.reshape(-1, 3)
-    assert bpy.ops.modal_deform.bake() == {"FINISHED"}
-    core = (np.hypot(V[:, 0], V[:, 1]) < CORE_RADIUS) & (V[:, 2] > CHIN)
-    controller = add_handle(suzanne, core).controller
+    suzanne = smooth_suzanne("Suzanne in-betweens", levels)
+    V, controller = head_handle(suzanne)
     bpy.context.view_layer.objects.active = suzanne
     _keyed(controller)
     scene.frame_start, scene.frame_end = 1, LAST

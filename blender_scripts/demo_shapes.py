@@ -11,6 +11,7 @@ import time
 
 import bpy
 import numpy as np
+from headless import smooth_suzanne
 from mathutils import Vector
 from mathutils.bvhtree import BVHTree
 from rendering import look_at, render, side_by_side
@@ -111,13 +112,7 @@ def shapes_blended(addon, output, levels, width):
         .to_euler()
     )
 
-    bpy.ops.mesh.primitive_monkey_add()
-    suzanne = bpy.context.object
-    suzanne.name = "Suzanne shapes"
-    modifier = suzanne.modifiers.new("Subdivision", "SUBSURF")
-    modifier.levels = levels
-    bpy.ops.object.modifier_apply(modifier=modifier.name)
-    bpy.ops.object.shade_smooth()
+    suzanne = smooth_suzanne("Suzanne shapes", levels)
     mesh = suzanne.data
     V = mesh_io.vertex_positions(mesh).astype(np.float64)
     F = mesh_io.triangles(mesh)

@@ -74,6 +74,19 @@ def save(output):
     bpy.ops.wm.save_as_mainfile(filepath=str(pathlib.Path(path).resolve()))
 
 
+def smooth_suzanne(name, levels):
+    """Blender's Suzanne as an object named `name`, subdivided `levels` times (the modifier
+    applied) and shaded smooth: the demos' mesh."""
+    bpy.ops.mesh.primitive_monkey_add()
+    suzanne = bpy.context.object
+    suzanne.name = name
+    modifier = suzanne.modifiers.new("Subdivision", "SUBSURF")
+    modifier.levels = levels
+    bpy.ops.object.modifier_apply(modifier=modifier.name)
+    bpy.ops.object.shade_smooth()
+    return suzanne
+
+
 def add_handle(obj, mask):
     """A handle of obj's vertices in the boolean `mask`, made as an artist does: select them in Edit
     Mode, Add Handle (a vertex group and an Empty at their centre). Returns the handle."""
