@@ -125,14 +125,16 @@ def _float3_view(items):
     return np.ndarray((count, 3), np.float32, buffer=memory, strides=(stride, 4))
 
 
-def item_memory(items, item_bytes):
+def item_memory(items, item_bytes, stride=None):
     """Blender's array behind the RNA collection `items` (not empty; its items one after another in
     one array: a mesh's vertices, a key's points, an F-curve's keyframes), in place: a ctypes buffer
     from the first item to the first `item_bytes` of the last, and the stride between items (the
-    distance between the first two). Read anew each time: use at once, never keep it."""
+    distance between the first two, unless the caller knows it: `stride`). Read anew each time: use
+    at once, never keep it."""
     count = len(items)
     address = items[0].as_pointer()
-    stride = items[1].as_pointer() - address if count > 1 else item_bytes
+    if stride is None:
+        stride = items[1].as_pointer() - address if count > 1 else item_bytes
     return (ctypes.c_char * (stride * (count - 1) + item_bytes)).from_address(address), stride
 
 

@@ -22,7 +22,6 @@ checked at every frame shown); and a frame whose controllers stand elsewhere tha
 constraint, a driver, a moved parent) cuts the cache there when it is shown.
 """
 
-import ctypes
 import hashlib
 import json
 
@@ -351,10 +350,10 @@ def keys_digest(curves):
         parts.append(f"{path}:{curve.extrapolation}:{count}".encode())
         if not count:
             continue
-        if _keyframe_stride is None and count > 1:
-            _keyframe_stride = mesh_io.item_memory(points, _KEYFRAME_POINTS_BYTES)[1]
-        size = _KEYFRAME_POINTS_BYTES + (count - 1) * (_keyframe_stride or 0)
-        parts.append((ctypes.c_char * size).from_address(points[0].as_pointer()))
+        memory, stride = mesh_io.item_memory(points, _KEYFRAME_POINTS_BYTES, _keyframe_stride)
+        if count > 1:
+            _keyframe_stride = stride
+        parts.append(memory)
     return hashlib.blake2b(b"".join(parts), digest_size=16).hexdigest()
 
 
