@@ -333,17 +333,24 @@ class Rig:
             if weights is None:
                 result.append(np.eye(4))
                 continue
-            A = np.einsum("b,bij->ij", weights, bones)
+            inverse = affine_inverse(np.einsum("b,bij->ij", weights, bones))
+            if inverse is None:
+                raise RigError(
+                    f"Follow Rig: the bones under handle '{handle.name}' "
+                    f"blend to a singular matrix this frame: a bone is "
+                    f"scaled to nothing"
+                )
             target = mesh_world @ T @ handle.bind_skinning
-            result.append(mdc.nearest_rigid(np.linalg.solve(A, target), handle.centre))
+            result.append(mdc.nearest_rigid(inverse @ target, handle.centre))
         return result
 
     def skinned(self, X, frame):
         """X (n, 3) rest-space positions skinned at a frame of the rig, in the mesh object's space
         (what the Armature modifier shows)."""
-        mesh_world = frame[-1]
-        bones = np.linalg.solve(mesh_world, self.bones_of(frame))
-        return mdc.skin(X, self.weights, bones)
+        inverse = affine_inverse(frame[-1])
+        if inverse is None:
+            raise RigError("Follow Rig: the mesh object is scaled to nothing (its matrix is singular)")
+        return mdc.skin(X, self.weights, inverse @ self.bones_of(frame))
 
 
 def bind_skinning(obj, indices):

@@ -315,6 +315,12 @@ timeline.free(obj)
 plays(1)
 assert np.abs(offset()).max() < 1e-6 * size, np.abs(offset()).max()
 plays(32)
+# The bone under the handle scaled to nothing: refused, naming the handle (a clear message where
+# the rest-space transform's inverse does not exist).
+rig.pose.bones["Bone2"].scale = (0.0, 0.0, 0.0)
+refused("bones under handle 'Tip' blend to a singular matrix", 32)
+rig.pose.bones["Bone2"].scale = (1.0, 1.0, 1.0)
+plays(32)
 obj.modal_deform.handles.remove(0)
 obj.vertex_groups.remove(handle_group)
 # A bone renamed: Blender renames its vertex group, the rig plays on.
