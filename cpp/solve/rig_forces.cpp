@@ -123,6 +123,13 @@ void RigForces::acceleration(const Transforms& previous, const Transforms& curre
         ((next[bone] - 2 * current[bone] + previous[bone]).topRows<3>() * frequency2).eval();
     const Eigen::Matrix<double, 3, 4> felt =
         current[bone].topLeftCorner<3, 3>().partialPivLu().solve(second_difference);
+    // A bone scaled to almost nothing (1e-100, which the relative singularity check lets pass)
+    // pulls its motion back enormously: refused where a frame's worth of it leaves the coordinates
+    // the core takes, before it overflows the force.
+    if (!(felt.cwiseAbs().maxCoeff() * dt * dt <= kMaxCoordinate))
+      throw InputError(message("bones[", bone,
+                               "]: its motion pulled back into its frame is beyond ", kMaxCoordinate,
+                               " a frame (a bone scaled to almost nothing)"));
     for (int j = 0; j < 3; ++j)
       for (int l = 0; l < 4; ++l) work_[12 * bone + 4 * j + l] = felt(j, l);
   }

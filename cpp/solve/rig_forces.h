@@ -73,7 +73,8 @@ class RigForces {
   // g (r) for bones moving from `previous` through `current` to `next` in steps of `dt` seconds
   // (each checked by check_bone_matrices): the acceleration the second difference
   // (next − 2 current + previous)/dt² gives, pulled back by the current bones' linear parts.
-  // Exactly zero when the three are equal.
+  // Exactly zero when the three are equal. Throws InputError naming a bone whose acceleration
+  // pulled back, times dt², is beyond kMaxCoordinate (a bone scaled to almost nothing).
   void acceleration(const Transforms& previous, const Transforms& current, const Transforms& next,
                     double dt, Eigen::VectorXd& g) const;
 

@@ -72,6 +72,29 @@ TEST(RigForces, IsTheProjectionOfEachBonesAccelerationPulledBackByItsFrame) {
   EXPECT_TRUE((g.array() == 0).all());
 }
 
+TEST(RigForces, RefusesABoneScaledToAlmostNothingThatMoves) {
+  const Basis basis = random_basis();
+  const RigForces forces(basis, weights(basis.num_vertices()));
+  const double dt = 1.0 / 24;
+  Transforms tiny = random_bones(2);
+  tiny[1].topLeftCorner<3, 3>() *= 1e-100;  // well conditioned, so not singular
+  Eigen::VectorXd g;
+  forces.acceleration(tiny, tiny, tiny, dt, g);  // still: nothing to pull back
+  EXPECT_TRUE((g.array() == 0).all());
+  Transforms moved = tiny;
+  moved[1](0, 3) += 0.1;
+  expect_input_error([&] { forces.acceleration(tiny, tiny, moved, dt, g); },
+                     "bones[1]: its motion pulled back into its frame is beyond");
+  // Scaled by 1e-6, the same motion is taken: a large but representable pull-back.
+  Transforms small = random_bones(2);
+  small[1].topLeftCorner<3, 3>() *= 1e-6;
+  Transforms small_moved = small;
+  small_moved[1](0, 3) += 0.1;
+  forces.acceleration(small, small, small_moved, dt, g);
+  EXPECT_TRUE(g.allFinite());
+  EXPECT_GT(g.norm(), 0);
+}
+
 TEST(RigForces, RefusesBadWeightsAndBones) {
   const Basis basis = random_basis();
   const int n = basis.num_vertices();
