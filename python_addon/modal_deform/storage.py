@@ -41,12 +41,19 @@ class RecentLoads:
         self._loads = collections.OrderedDict()
         self._size = size
 
-    def get(self, bake_id):
-        """The load kept for `bake_id`, or None."""
-        if bake_id not in self._loads:
-            return None
-        self._loads.move_to_end(bake_id)
-        return self._loads[bake_id]
+    def load(self, block, from_arrays, what):
+        """What the stored `block` (write_arrays) holds, from_arrays(read_arrays(block)), kept by its
+        bake id: read once. Raises NotReady naming `what` when its arrays are damaged."""
+        bake_id = block.get(BAKE_ID)
+        if bake_id in self._loads:
+            self._loads.move_to_end(bake_id)
+            return self._loads[bake_id]
+        try:
+            loaded = from_arrays(read_arrays(block))
+        except (KeyError, TypeError, ValueError, AttributeError) as error:
+            raise NotReady(f"{what} is damaged ({error}): re-bake") from None
+        self.keep(bake_id, loaded)
+        return loaded
 
     def keep(self, bake_id, load):
         self._loads[bake_id] = load
@@ -235,16 +242,7 @@ def load(obj):
     block = obj.modal_deform.basis
     if block is None:
         raise NotReady(f"'{obj.name}' has no baked basis: bake it first")
-    bake_id = block.get(BAKE_ID)
-    loaded = _bases.get(bake_id)
-    if loaded is not None:
-        return loaded
-    try:
-        basis = mdc.Basis.from_arrays(read_arrays(block))
-    except (KeyError, TypeError, ValueError, AttributeError) as error:
-        raise NotReady(f"the basis stored for '{obj.name}' is damaged ({error}): re-bake") from None
-    _bases.keep(bake_id, basis)
-    return basis
+    return _bases.load(block, mdc.Basis.from_arrays, f"the basis stored for '{obj.name}'")
 
 
 def ready_basis(obj):

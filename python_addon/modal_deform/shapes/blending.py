@@ -87,18 +87,9 @@ def load(obj):
     block = obj.modal_deform.shapes.space
     if block is None:
         raise storage.NotReady(f"'{obj.name}': its shape keys are not baked as shapes: Bake")
-    bake_id = block.get(storage.BAKE_ID)
-    loaded = _spaces.get(bake_id)
-    if loaded is not None:
-        return loaded
-    try:
-        space = mdc.ShapeSpace.from_arrays(storage.read_arrays(block))
-    except (KeyError, TypeError, ValueError, AttributeError) as error:
-        raise storage.NotReady(
-            f"the shape space stored for '{obj.name}' is damaged ({error}): re-bake"
-        ) from None
-    _spaces.keep(bake_id, space)
-    return space
+    return _spaces.load(
+        block, mdc.ShapeSpace.from_arrays, f"the shape space stored for '{obj.name}'"
+    )
 
 
 def stale_reason(obj):
