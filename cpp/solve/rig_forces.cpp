@@ -128,8 +128,8 @@ void RigForces::acceleration(const Transforms& previous, const Transforms& curre
     // the core takes, before it overflows the force.
     if (!(felt.cwiseAbs().maxCoeff() * dt * dt <= kMaxCoordinate))
       throw InputError(message("bones[", bone,
-                               "]: its motion pulled back into its frame is beyond ", kMaxCoordinate,
-                               " a frame (a bone scaled to almost nothing)"));
+                               "]: its motion pulled back into its frame is beyond ",
+                               kMaxCoordinate, " a frame (a bone scaled to almost nothing)"));
     for (int j = 0; j < 3; ++j)
       for (int l = 0; l < 4; ++l) work_[12 * bone + 4 * j + l] = felt(j, l);
   }
