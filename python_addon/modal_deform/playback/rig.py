@@ -159,24 +159,23 @@ def world_skinning(armature, pose, rest_inverse, mesh_world):
     """Bones' world skinning matrices (b, 4, 4): armature world x pose x rest⁻¹ x armature world⁻¹
     x mesh world, from their pose matrices `pose` and inverse rest matrices (armature space)."""
     armature_world = np.array(armature.matrix_world)
-    inverse = affine_inverse(armature_world)
-    if inverse is None:
-        raise RigError(
-            f"Follow Rig: armature '{armature.name}' is scaled to nothing (its matrix is singular)"
-        )
+    inverse = affine_inverse(
+        armature_world,
+        f"Follow Rig: armature '{armature.name}' is scaled to nothing (its matrix is singular)",
+    )
     return armature_world @ (pose @ rest_inverse) @ (inverse @ mesh_world)
 
 
-def affine_inverse(M):
-    """The inverse of an affine 4x4 matrix M (last row 0, 0, 0, 1, as an object's matrix), None when
-    it is singular: the 3x3 part's adjugate over its determinant (its rows' cross products), with no
-    LAPACK call, which waits milliseconds for OpenBLAS's threads on a busy machine where the frame's
-    own work of this is microseconds."""
+def affine_inverse(M, refusal):
+    """The inverse of an affine 4x4 matrix M (last row 0, 0, 0, 1, as an object's matrix); RigError
+    `refusal` when it is singular. The 3x3 part's adjugate over its determinant (its rows' cross
+    products), with no LAPACK call, which waits milliseconds for OpenBLAS's threads on a busy
+    machine where the frame's own work of this is microseconds."""
     R, t = M[:3, :3], M[:3, 3]
     cofactors = np.cross(R[[1, 2, 0]], R[[2, 0, 1]])  # rows r1 x r2, r2 x r0, r0 x r1
     determinant = float((R[0] * cofactors[0]).sum())
     if determinant == 0.0 or not np.isfinite(determinant):
-        return None
+        raise RigError(refusal)
     inverse = np.eye(4)
     inverse[:3, :3] = cofactors.T / determinant
     inverse[:3, 3] = -(inverse[:3, :3] * t).sum(axis=1)
@@ -333,13 +332,11 @@ class Rig:
             if weights is None:
                 result.append(np.eye(4))
                 continue
-            inverse = affine_inverse(np.einsum("b,bij->ij", weights, bones))
-            if inverse is None:
-                raise RigError(
-                    f"Follow Rig: the bones under handle '{handle.name}' "
-                    f"blend to a singular matrix this frame: a bone is "
-                    f"scaled to nothing"
-                )
+            inverse = affine_inverse(
+                np.einsum("b,bij->ij", weights, bones),
+                f"Follow Rig: the bones under handle '{handle.name}' blend to a singular matrix "
+                f"this frame: a bone is scaled to nothing",
+            )
             target = mesh_world @ T @ handle.bind_skinning
             result.append(mdc.nearest_rigid(inverse @ target, handle.centre))
         return result
@@ -347,9 +344,9 @@ class Rig:
     def skinned(self, X, frame):
         """X (n, 3) rest-space positions skinned at a frame of the rig, in the mesh object's space
         (what the Armature modifier shows)."""
-        inverse = affine_inverse(frame[-1])
-        if inverse is None:
-            raise RigError("Follow Rig: the mesh object is scaled to nothing (its matrix is singular)")
+        inverse = affine_inverse(
+            frame[-1], "Follow Rig: the mesh object is scaled to nothing (its matrix is singular)"
+        )
         return mdc.skin(X, self.weights, inverse @ self.bones_of(frame))
 
 
